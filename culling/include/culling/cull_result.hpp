@@ -1,0 +1,61 @@
+#pragma once
+// The output of a culling pass, from either backend.
+
+#include "culling/params.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace lc {
+
+// Per-phase wall or device times in milliseconds; negative = not run.
+struct Timings {
+    double depthMs = -1, cullMs = -1, groundTruthMs = -1, shadeMs = -1;
+};
+
+// Lists stored compactly: list l covers lightIndices[listOffset[l] ..
+// listOffset[l] + listCount[l]), indices ascending. Memory grows with the
+// entries the scene produces: 4 bytes per entry + 8 per list + per-tile depth
+// bounds, never tiles x lights.
+//
+// List numbering: `all` has exactly one list. Every other algorithm has
+// listsPerTile lists per tile, list = tileIndex * listsPerTile + sub, where sub
+// is 0 (naive, minmax, 2.5d), 0 near / 1 far (halfz), or the depth slice
+// (clustered).
+struct CullResult {
+    Algorithm algorithm = Algorithm::All;
+    CullSettings settings;
+    TileGrid grid;
+    std::uint32_t listsPerTile = 1;
+
+    // Per tile, view depth bounds of the pixels holding geometry. An empty tile
+    // has depthMin = +inf, depthMax = -inf (and, for all but `all`, an empty list).
+    // For `halfz`, halfzSplit[t] is the split: depth <= split -> near list.
+    std::vector<double> tileDepthMin, tileDepthMax, halfzSplit;
+    // Per tile: 2.5d occupancy mask of the cells over [depthMin, depthMax];
+    // clustered: occupied slices. Empty otherwise.
+    std::vector<std::uint32_t> cellMask;
+    // Clustered depth range: slices are `settings.slicing` over [clusterNear, clusterFar].
+    double clusterNear = 0, clusterFar = 0;
+
+    std::vector<std::uint32_t> listOffset, listCount, lightIndices;
+
+    std::string backend;      // "cpu" or "vulkan"
+    std::string device;       // physical device name, or the CPU's
+    std::string timingMethod; // how cullMs/depthMs were taken
+    Timings timings;
+
+    std::uint32_t listCountTotal() const { return std::uint32_t(listCount.size()); }
+    std::uint64_t entries() const { return lightIndices.size(); }
+    // Bytes of the result a renderer would upload: indices, offsets, counts,
+    // per-tile depth bounds (as float) and masks.
+    std::uint64_t bytes() const;
+    // The list a shading pass loops over at pixel (px, py) whose geometry lies
+    // at view depth viewDepth. Follows exactly the rule the passes use.
+    std::uint32_t listOfPixel(std::uint32_t px, std::uint32_t py, double viewDepth) const;
+    // Empty when internally consistent (sizes, offsets in range, sorted, unique).
+    std::string validate(std::size_t lightCount) const;
+};
+
+} // namespace lc

@@ -1,0 +1,38 @@
+#pragma once
+// Depth buffers and the CPU reference rasteriser.
+
+#include "culling/projection.hpp"
+#include "culling/scene.hpp"
+
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+namespace lc {
+
+// A D32 depth image, row-major, row 0 at the top. Window depth in [0,1]; a
+// pixel equal to clearDepth holds no geometry.
+struct DepthImage {
+    std::uint32_t width = 0, height = 0;
+    float clearDepth = 1.0f;
+    std::vector<float> depth;
+
+    float at(std::uint32_t x, std::uint32_t y) const { return depth[std::size_t(y) * width + x]; }
+    bool hasGeometry(std::uint32_t x, std::uint32_t y) const { return at(x, y) != clearDepth; }
+    std::size_t geometryPixelCount() const;
+};
+
+// Cooperative cancellation for long operations; checked between chunks.
+struct CancelToken {
+    std::atomic<bool> cancelled{false};
+    void throwIfCancelled() const;
+};
+
+// Rasterises every mesh triangle into a depth image: pixel-centre sampling,
+// top-left fill rule, clipping against the near plane (and the far plane where
+// finite), depth interpolated linearly in screen space (as hardware does) and
+// stored as float, LESS (GREATER for reversed-Z) depth test, both faces drawn.
+DepthImage rasterizeDepthCpu(const Scene& scene, const Projection& proj,
+                             const CancelToken* cancel = nullptr);
+
+} // namespace lc

@@ -1,0 +1,30 @@
+#pragma once
+// Diagnostics export, shared by the CLI (`run --out`) and the studio.
+
+#include "culling/pipeline.hpp"
+
+#include <string>
+
+namespace lc {
+
+// summary.json text (see docs/FORMATS.md for every key).
+std::string summaryJson(const Scene& scene, const CullSettings& settings, const RunOutput& run);
+// tiles.csv text: tile_x,tile_y,cell,view_depth_min,view_depth_max,cell_mask,count,lights
+std::string tilesCsv(const RunOutput& run);
+// heatmap.png: the depth image tinted per tile by list length, with a legend.
+// Returns RGB8 pixels (width x height, plus the legend band) and its size.
+struct RgbImage {
+    std::uint32_t width = 0, height = 0;
+    std::vector<std::uint8_t> rgb;
+};
+RgbImage heatmapImage(const RunOutput& run);
+void writePng(const RgbImage& img, const std::string& path);
+
+// Writes summary.json, tiles.csv and heatmap.png into `dir` atomically: all
+// files go to a temporary sibling folder that is renamed onto `dir` at the end;
+// on any failure nothing is left behind and an existing `dir` is untouched
+// until the rename. Throws Error naming the path.
+void exportDiagnostics(const Scene& scene, const CullSettings& settings, const RunOutput& run,
+                       const std::string& dir);
+
+} // namespace lc

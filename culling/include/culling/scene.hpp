@@ -1,0 +1,98 @@
+#pragma once
+// The scene model: triangle meshes with a transform, point lights and the
+// culling camera. Plain structs of flat arrays; conversions from OpenMesh (and,
+// in the studio, to VTK) live in adapters at the edges.
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace lc {
+
+// A triangle mesh in its own model space. `positions` are xyz triples,
+// `indices` index triples; `transform` maps model to world space.
+struct Mesh {
+    std::string name;
+    std::string sourcePath;          // as written in the scene file (relative); empty if built in
+    std::vector<float> positions;    // 3 per vertex
+    std::vector<std::uint32_t> indices; // 3 per triangle
+    glm::dmat4 transform{1.0};
+
+    std::size_t vertexCount() const { return positions.size() / 3; }
+    std::size_t triangleCount() const { return indices.size() / 3; }
+    glm::vec3 vertex(std::size_t i) const {
+        return {positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]};
+    }
+    // Empty string when valid, else what is wrong (non-finite coordinate,
+    // index out of range, index count not a multiple of 3).
+    std::string validate() const;
+};
+
+// A point light. Its bounding sphere radius follows the inverse-square law,
+// r = sqrt(max(I*c.r, I*c.g, I*c.b) / I_min), unless `explicitRadius` > 0.
+struct PointLight {
+    std::string name;
+    glm::dvec3 position{0.0};        // world space
+    glm::dvec3 color{1.0};           // linear RGB, each >= 0
+    double intensity = 1.0;          // >= 0
+    double minIntensity = 0.01;      // I_min > 0: the cut-off that defines the radius
+    double explicitRadius = 0.0;     // > 0 overrides the inverse-square radius
+
+    // Bounding-sphere radius in world units. Precondition: validate() is empty.
+    double radius() const;
+    // Empty when valid; otherwise names the bad field.
+    std::string validate() const;
+};
+
+enum class ProjectionKind {
+    Perspective,       // [0,1] window depth, near -> 0, far -> 1
+    PerspectiveGL,     // OpenGL-style [-1,1] NDC depth, stored as (ndc+1)/2
+    ReversedZ,         // near -> 1, far -> 0; far may be +infinity
+    Orthographic,      // [0,1] depth
+    OrthographicGL,    // [-1,1] NDC depth, stored as (ndc+1)/2
+};
+
+const char* toString(ProjectionKind k);
+// Throws SettingsError("projection", ...) for unknown names.
+ProjectionKind projectionKindFromString(const std::string& s);
+bool isOrthographic(ProjectionKind k);
+bool isReversed(ProjectionKind k);
+
+// The culling camera: where the depth pre-pass and the tile grid come from.
+struct Camera {
+    glm::dvec3 position{0.0, 0.0, 5.0};
+    glm::dvec3 target{0.0, 0.0, 0.0};
+    glm::dvec3 up{0.0, 1.0, 0.0};
+    ProjectionKind projection = ProjectionKind::Perspective;
+    double fovYDeg = 60.0;           // perspective: vertical field of view, (0, 180)
+    double orthoHeight = 10.0;       // orthographic: vertical extent in world units
+    double nearPlane = 0.1;          // > 0
+    double farPlane = 1000.0;        // > near; +infinity only with ReversedZ
+    std::uint32_t width = 1280;      // pixels, >= 1
+    std::uint32_t height = 720;
+    std::uint32_t tileSize = 16;     // pixels, >= 1
+
+    glm::dmat4 viewFromWorld() const;
+    double aspect() const { return double(width) / double(height); }
+    // Empty when valid; otherwise names the bad field ("camera.near: ...").
+    std::string validate() const;
+};
+
+struct Scene {
+    std::string name;
+    std::vector<Mesh> meshes;
+    std::vector<PointLight> lights;
+    Camera camera;
+
+    std::size_t triangleCount() const;
+    // Throws LightError for the first bad light, SettingsError for a bad
+    // camera, InputError for a bad mesh.
+    void validate() const;
+    // World-space bounds of all meshes (min, max); (0,0) when there are none.
+    std::pair<glm::dvec3, glm::dvec3> bounds() const;
+};
+
+} // namespace lc
