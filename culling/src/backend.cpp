@@ -1,0 +1,40 @@
+// View-space lights and the backend registry.
+#include "culling/backend.hpp"
+
+#include "culling/errors.hpp"
+#include "vk/vulkan_backend.hpp"
+
+namespace lc {
+
+ViewLights makeViewLights(const Scene& scene) {
+    ViewLights out;
+    const glm::dmat4 viewFromWorld = scene.camera.viewFromWorld();
+    out.centers.reserve(scene.lights.size());
+    out.radii.reserve(scene.lights.size());
+    out.power.reserve(scene.lights.size());
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        const PointLight& l = scene.lights[i];
+        if (std::string e = l.validate(); !e.empty()) throw LightError(i, l.name, e);
+        // viewFromWorld is rigid (rotation + translation), so radii carry over unchanged.
+        out.centers.push_back(glm::dvec3(viewFromWorld * glm::dvec4(l.position, 1.0)));
+        out.radii.push_back(l.radius());
+        out.power.push_back(l.color * l.intensity);
+    }
+    return out;
+}
+
+std::vector<std::string> availableBackends() {
+    std::vector<std::string> names{"cpu"};
+    if (!vulkanDeviceNames().empty()) names.push_back("vulkan");
+    return names;
+}
+
+std::unique_ptr<CullBackend> makeBackend(const std::string& name, const std::string& device) {
+    if (name == "cpu") return makeCpuBackend();
+    if (name == "vulkan") return makeVulkanBackend(device);
+    std::string known;
+    for (const auto& b : availableBackends()) known += (known.empty() ? "" : ", ") + b;
+    throw Error("unknown backend '" + name + "' (available: " + known + ")");
+}
+
+} // namespace lc
