@@ -1,0 +1,83 @@
+// The deterministic light generator. It uses its own PRNG (splitmix64) and its
+// own uniform mapping, never <random>'s distributions: those are allowed to
+// differ between standard libraries, and a seed must give the same lights on
+// every machine.
+
+#include "culling/errors.hpp"
+#include "culling/scene_io.hpp"
+
+#include <cmath>
+
+namespace lc {
+
+namespace {
+
+// splitmix64 (Steele, Lea, Flood 2014): a full-period 64-bit generator with
+// good statistical quality for this purpose and a one-line state.
+struct SplitMix64 {
+    std::uint64_t state;
+    std::uint64_t next() {
+        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    // Uniform in [0, 1): the top 53 bits as a double's mantissa (exact).
+    double unit() { return double(next() >> 11) * 0x1.0p-53; }
+    double range(double lo, double hi) { return lo + (hi - lo) * unit(); }
+};
+
+void checkRange(const char* field, double lo, double hi) {
+    if (!std::isfinite(lo) || !std::isfinite(hi) || lo > hi)
+        throw SettingsError(field, "range must be finite with min <= max");
+}
+
+} // namespace
+
+std::vector<PointLight> generateLights(const LightGenSettings& s) {
+    for (int k = 0; k < 3; ++k) {
+        checkRange("lights.box", s.boxMin[k], s.boxMax[k]);
+        checkRange("lights.color", s.colorMin[k], s.colorMax[k]);
+    }
+    checkRange("lights.intensity", s.intensityMin, s.intensityMax);
+    if (s.intensityMin < 0) throw SettingsError("lights.intensity", "must be >= 0");
+    if (s.colorMin.r < 0 || s.colorMin.g < 0 || s.colorMin.b < 0)
+        throw SettingsError("lights.color", "must be >= 0");
+    if (!(s.minIntensity > 0) || !std::isfinite(s.minIntensity))
+        throw SettingsError("lights.min_intensity", "must be finite and > 0");
+
+    SplitMix64 rng{s.seed};
+    std::vector<PointLight> out;
+    out.reserve(s.count);
+    for (std::uint32_t i = 0; i < s.count; ++i) {
+        PointLight l;
+        l.name = "light_" + std::to_string(i);
+        // Fixed draw order (x, y, z, r, g, b, intensity) keeps lights stable
+        // when only one range changes.
+        for (int k = 0; k < 3; ++k) l.position[k] = rng.range(s.boxMin[k], s.boxMax[k]);
+        for (int k = 0; k < 3; ++k) l.color[k] = rng.range(s.colorMin[k], s.colorMax[k]);
+        l.intensity = rng.range(s.intensityMin, s.intensityMax);
+        l.minIntensity = s.minIntensity;
+        out.push_back(std::move(l));
+    }
+    return out;
+}
+
+LightGenSettings defaultLightGen(const Scene& scene, std::uint32_t count, std::uint64_t seed) {
+    LightGenSettings s;
+    s.count = count;
+    s.seed = seed;
+    auto [lo, hi] = scene.bounds();
+    if (lo == hi && scene.triangleCount() == 0) {
+        lo = glm::dvec3(-10, 0, -10);  // no geometry: the settings' default box
+        hi = glm::dvec3(10, 5, 10);
+    }
+    // Grow by 5% of the diagonal (at least 0.1 units) so lights also sit just
+    // outside the geometry's surfaces, not only inside its bounding box.
+    const double grow = std::max(0.1, 0.05 * glm::length(hi - lo));
+    s.boxMin = lo - glm::dvec3(grow);
+    s.boxMax = hi + glm::dvec3(grow);
+    return s;
+}
+
+} // namespace lc
