@@ -22,10 +22,6 @@
 
 namespace lc {
 
-void CancelToken::throwIfCancelled() const {
-    if (cancelled.load(std::memory_order_relaxed)) throw Cancelled();
-}
-
 std::size_t DepthImage::geometryPixelCount() const {
     std::size_t n = 0;
     for (float d : depth) n += d != clearDepth;
