@@ -125,8 +125,9 @@ public:
     bool binary(json::binary_t& v) { return value() && dom_.binary(v); }
 
     bool start_object(std::size_t n) {
+        std::string path = currentPath();  // before value() advances an array index
         value();
-        frames_.push_back({currentPath(), true, {}, 0, {}});
+        frames_.push_back({std::move(path), true, {}, 0, {}});
         return dom_.start_object(n);
     }
     bool key(std::string& k) {
@@ -143,8 +144,9 @@ public:
         return dom_.end_object();
     }
     bool start_array(std::size_t n) {
+        std::string path = currentPath();
         value();
-        frames_.push_back({currentPath(), false, {}, 0, {}});
+        frames_.push_back({std::move(path), false, {}, 0, {}});
         return dom_.start_array(n);
     }
     bool end_array() {
