@@ -23,6 +23,10 @@
 #include <mutex>
 #include <thread>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 namespace lc {
 
 namespace {
@@ -136,6 +140,10 @@ struct PixelGroup {
 // accumulated in the order given, with the same float operations. The inner
 // loop runs over pixels and vectorises; light data are loop invariants.
 //   contribution = power * max(0, n.l) / max(d^2, 1e-4),  l = (c - P) / |c - P|
+// x86-64 always has SSE2: the pixel loop runs 4 pixels per instruction with
+// explicit intrinsics (GCC will not vectorise std::sqrt without
+// -fno-math-errno). SSE's add/mul/div/sqrt are IEEE-exact like the scalar
+// tail's, so every pixel gets bitwise the value the scalar loop would give.
 void shadeGroup(PixelGroup& g, std::size_t begin, std::size_t end, const LightSoA& L,
                 const std::uint32_t* lightIndex, std::size_t lightCount) {
     float* __restrict ar = g.ar.data();
@@ -151,12 +159,33 @@ void shadeGroup(PixelGroup& g, std::size_t begin, std::size_t end, const LightSo
         const std::size_t i = lightIndex ? lightIndex[k] : k;
         const float lx = L.x[i], ly = L.y[i], lz = L.z[i];
         const float cr = L.r[i], cg = L.g[i], cb = L.b[i];
-        for (std::size_t p = begin; p < end; ++p) {
+        std::size_t p = begin;
+#if defined(__SSE2__)
+        const __m128 vlx = _mm_set1_ps(lx), vly = _mm_set1_ps(ly), vlz = _mm_set1_ps(lz);
+        const __m128 vcr = _mm_set1_ps(cr), vcg = _mm_set1_ps(cg), vcb = _mm_set1_ps(cb);
+        const __m128 tiny = _mm_set1_ps(1e-30f), floor2 = _mm_set1_ps(1e-4f), zero = _mm_setzero_ps();
+        for (; p + 4 <= end; p += 4) {
+            const __m128 dx = _mm_sub_ps(vlx, _mm_loadu_ps(px + p));
+            const __m128 dy = _mm_sub_ps(vly, _mm_loadu_ps(py + p));
+            const __m128 dz = _mm_sub_ps(vlz, _mm_loadu_ps(pz + p));
+            const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+            const __m128 len = _mm_sqrt_ps(_mm_max_ps(d2, tiny));
+            const __m128 dot = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(nx + p), dx),
+                                                     _mm_mul_ps(_mm_loadu_ps(ny + p), dy)),
+                                          _mm_mul_ps(_mm_loadu_ps(nz + p), dz));
+            const __m128 ndl = _mm_div_ps(dot, len);
+            const __m128 f = _mm_div_ps(_mm_max_ps(ndl, zero), _mm_max_ps(d2, floor2));
+            _mm_storeu_ps(ar + p, _mm_add_ps(_mm_loadu_ps(ar + p), _mm_mul_ps(vcr, f)));
+            _mm_storeu_ps(ag + p, _mm_add_ps(_mm_loadu_ps(ag + p), _mm_mul_ps(vcg, f)));
+            _mm_storeu_ps(ab + p, _mm_add_ps(_mm_loadu_ps(ab + p), _mm_mul_ps(vcb, f)));
+        }
+#endif
+        for (; p < end; ++p) {
             const float dx = lx - px[p], dy = ly - py[p], dz = lz - pz[p];
-            const float d2 = dx * dx + dy * dy + dz * dz;
-            // A light exactly at the pixel has no direction: its n.l is 0.
+            const float d2 = (dx * dx + dy * dy) + dz * dz;
+            // A light exactly at the pixel has no direction: clamp the length.
             const float len = std::sqrt(d2 > 1e-30f ? d2 : 1e-30f);
-            const float ndl = (nx[p] * dx + ny[p] * dy + nz[p] * dz) / len;
+            const float ndl = ((nx[p] * dx + ny[p] * dy) + nz[p] * dz) / len;
             const float f = (ndl > 0.0f ? ndl : 0.0f) / (d2 > 1e-4f ? d2 : 1e-4f);
             ar[p] += cr * f;
             ag[p] += cg * f;
