@@ -232,13 +232,12 @@ Scene atrium() {
                 const double zc = -(i + 0.5) * spacing;
                 Builder a("arch");
                 a.arch({0, 0, 0}, spacing / 2 - 0.5, 0.4, 0.8, 12);
-                // The arch lies in XY; rotate it into the ZY plane of the colonnade.
-                for (std::size_t k = 0; k < a.mesh.positions.size(); k += 3) {
-                    const double ax = a.mesh.positions[k], ay = a.mesh.positions[k + 1], az = a.mesh.positions[k + 2];
-                    const auto base = b.vertex({x + az, y + floorH - 1.3 + ay, zc + ax});
-                    (void)base;
-                }
-                const std::uint32_t off = std::uint32_t(b.mesh.positions.size() / 3 - a.mesh.positions.size() / 3);
+                // The arch is built in XY; swap x and z to stand it in the
+                // colonnade's ZY plane, springing from the capitals' tops.
+                const auto off = std::uint32_t(b.mesh.positions.size() / 3);
+                for (std::size_t k = 0; k < a.mesh.positions.size(); k += 3)
+                    b.vertex({x + a.mesh.positions[k + 2], y + floorH - 1.3 + a.mesh.positions[k + 1],
+                              zc + a.mesh.positions[k]});
                 for (std::uint32_t idx : a.mesh.indices) b.mesh.indices.push_back(off + idx);
             }
         }

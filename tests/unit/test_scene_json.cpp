@@ -264,3 +264,17 @@ TEST(SceneJson, FileLevelErrors) {
     EXPECT_THROW(saveSceneFile(makeBuiltinScene("sky"), dir + "/no/such/dir/s.json"), InputError);
     fs::remove_all(dir);
 }
+
+TEST(SceneJson, ExampleScenesInResourcesLoadAndValidate) {
+    int n = 0;
+    for (const auto& e : fs::directory_iterator(std::string(LC_SOURCE_DIR) + "/resources/scenes")) {
+        if (e.path().extension() != ".json") continue;
+        SCOPED_TRACE(e.path().string());
+        const Scene s = loadSceneFile(e.path().string());
+        EXPECT_NO_THROW(s.validate());
+        EXPECT_GT(s.triangleCount(), 0u);
+        EXPECT_FALSE(s.lights.empty());
+        ++n;
+    }
+    EXPECT_GE(n, 2);
+}
