@@ -1,0 +1,127 @@
+// lightcull-studio: the Qt + VTK scene editor.
+//
+//   lightcull-studio [--scene FILE | --builtin NAME] [--run] [--screenshot FILE.png] [--quit]
+//
+// With no arguments it opens the built-in default scene and runs culling once.
+// --screenshot grabs the whole main window once the run's result has arrived
+// and both views have rendered; --quit exits afterwards (exit code 0 only when
+// every requested step worked).
+
+#include "cull_worker.hpp"
+#include "document.hpp"
+#include "main_window.hpp"
+
+#include "culling/scene_io.hpp"
+
+#include <QApplication>
+#include <QCommandLineParser>
+#include <QSurfaceFormat>
+#include <QTimer>
+#include <QVTKOpenGLNativeWidget.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+
+namespace {
+
+// VTK renders through GLX only: without an X display, say how to get one
+// instead of letting the xcb plugin abort.
+bool haveDisplay(int argc, char** argv) {
+    const char* platform = std::getenv("QT_QPA_PLATFORM");
+    const bool xcb = !platform || std::string(platform).rfind("xcb", 0) == 0;
+    if (!xcb) return true; // the user picked another platform on purpose
+    const char* display = std::getenv("DISPLAY");
+    if (display && *display) return true;
+    std::fprintf(stderr,
+                 "lightcull-studio: no X display (DISPLAY is not set).\n"
+                 "The studio renders with OpenGL through X11. Without a desktop, run it under Xvfb:\n"
+                 "  xvfb-run -a -s \"-screen 0 1920x1080x24\" %s",
+                 argc > 0 ? argv[0] : "lightcull-studio");
+    for (int i = 1; i < argc; ++i) std::fprintf(stderr, " %s", argv[i]);
+    std::fprintf(stderr, "\n");
+    return false;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    if (!haveDisplay(argc, argv)) return 2;
+    // Must precede QApplication: VTK's widget needs its own GL surface format.
+    QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+    QApplication::setAttribute(Qt::AA_ShareOpenGLContexts);
+    QApplication app(argc, argv);
+    QApplication::setOrganizationName("LightCull");
+    QApplication::setApplicationName("LightCull Studio");
+
+    QCommandLineParser parser;
+    parser.setApplicationDescription("LightCull Studio: place lights, run tiled/clustered light culling, "
+                                     "see the result.");
+    parser.addHelpOption();
+    QCommandLineOption sceneOpt("scene", "Open a scene JSON file.", "FILE");
+    QCommandLineOption builtinOpt("builtin", QString("Open a built-in scene (default %1).").arg(lc::kDefaultBuiltin),
+                                  "NAME");
+    QCommandLineOption runOpt("run", "Run culling once the scene is open.");
+    QCommandLineOption shotOpt("screenshot", "Save a PNG of the window after the run and render.", "FILE.png");
+    QCommandLineOption quitOpt("quit", "Quit after the run / screenshot.");
+    parser.addOptions({sceneOpt, builtinOpt, runOpt, shotOpt, quitOpt});
+    parser.process(app);
+    if (parser.isSet(sceneOpt) && parser.isSet(builtinOpt)) {
+        std::fprintf(stderr, "lightcull-studio: --scene and --builtin are exclusive\n");
+        return 2;
+    }
+
+    lcui::MainWindow window;
+    // A script has nobody to answer dialogs: errors go to stderr instead.
+    const bool scripted = parser.isSet(quitOpt);
+    if (scripted)
+        window.prompts.showError = [](QWidget*, const QString& title, const QString& text) {
+            std::fprintf(stderr, "lightcull-studio: %s: %s\n", qPrintable(title), qPrintable(text));
+        };
+    window.show();
+
+    // Opening a scene runs culling once (so does the default start).
+    bool ok = true;
+    if (parser.isSet(sceneOpt)) ok = window.openSceneFile(parser.value(sceneOpt));
+    else ok = window.openBuiltin(parser.isSet(builtinOpt) ? parser.value(builtinOpt)
+                                                          : QString(lc::kDefaultBuiltin));
+    if (!ok && scripted) return 1;
+    const quint64 generation = window.cullService()->lastGeneration();
+    const bool wantRun = generation > 0 || parser.isSet(runOpt);
+    if (wantRun && generation == 0) window.runCulling();
+
+    const QString shot = parser.value(shotOpt);
+    auto finish = [&window, &app, shot, scripted](bool runOk) {
+        // Let both views render the result before grabbing.
+        QTimer::singleShot(300, &window, [&window, &app, shot, scripted, runOk] {
+            int code = runOk ? 0 : 1;
+            if (!shot.isEmpty()) {
+                const QImage img = window.grabWindow();
+                if (img.isNull() || !img.save(shot)) {
+                    std::fprintf(stderr, "lightcull-studio: cannot write screenshot %s\n", qPrintable(shot));
+                    code = 1;
+                } else {
+                    std::fprintf(stdout, "screenshot written to %s\n", qPrintable(shot));
+                }
+            }
+            if (scripted) {
+                window.document()->undoStack()->setClean(); // nothing to ask about
+                app.exit(code);
+            }
+        });
+    };
+    if (!shot.isEmpty() || scripted) {
+        if (wantRun) {
+            const quint64 target = window.cullService()->lastGeneration();
+            QObject::connect(&window, &lcui::MainWindow::runFinished, &window,
+                             [finish, target](quint64 g) { if (g >= target) finish(true); });
+            QObject::connect(&window, &lcui::MainWindow::runFailed, &window, [finish, target](quint64 g, const QString& m) {
+                std::fprintf(stderr, "lightcull-studio: culling failed: %s\n", qPrintable(m));
+                if (g >= target) finish(false);
+            });
+        } else {
+            finish(true);
+        }
+    }
+    return app.exec();
+}

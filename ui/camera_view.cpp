@@ -1,0 +1,336 @@
+#include "camera_view.hpp"
+
+#include "document.hpp"
+#include "vtk_adapters.hpp"
+
+#include <vtkActor.h>
+#include <vtkActor2D.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkCoordinate.h>
+#include <vtkDoubleArray.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkInteractorStyleUser.h>
+#include <vtkLookupTable.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkPolyDataMapper2D.h>
+#include <vtkProperty.h>
+#include <vtkProperty2D.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+#include <QVTKInteractor.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace lcui {
+
+namespace {
+constexpr int kLegendWidthPx = 110; // band to the right of the image for the legend
+
+// 2D mapper whose points are in the renderer's normalised viewport
+// coordinates: (0,0) bottom-left, (1,1) top-right of the letterboxed image.
+vtkSmartPointer<vtkPolyDataMapper2D> normalizedMapper(vtkPolyData* pd) {
+    auto coord = vtkSmartPointer<vtkCoordinate>::New();
+    coord->SetCoordinateSystemToNormalizedViewport();
+    auto m = vtkSmartPointer<vtkPolyDataMapper2D>::New();
+    m->SetInputData(pd);
+    m->SetTransformCoordinate(coord);
+    return m;
+}
+} // namespace
+
+CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(parent), doc_(doc) {
+    vtkNew<vtkGenericOpenGLRenderWindow> rw;
+    setRenderWindow(rw);
+    background_->SetBackground(0.12, 0.12, 0.14);
+    scene_->SetBackground(0.02, 0.02, 0.03);
+    rw->AddRenderer(background_);
+    rw->AddRenderer(scene_);
+
+    // Heat map: per-tile quads, coloured through the LUT (blue = short list,
+    // red = the longest list of this run), translucent over the shaded scene.
+    lut_->SetHueRange(0.667, 0.0);
+    lut_->SetSaturationRange(0.9, 0.9);
+    lut_->SetValueRange(1.0, 1.0);
+    lut_->SetAlphaRange(0.55, 0.55);
+    lut_->SetNumberOfTableValues(256);
+    lut_->Build();
+    auto heatMapper = normalizedMapper(heatData_);
+    heatMapper->SetScalarModeToUseCellData();
+    heatMapper->SetLookupTable(lut_);
+    heatMapper->UseLookupTableScalarRangeOn();
+    heatActor_->SetMapper(heatMapper);
+    gridActor_->SetMapper(normalizedMapper(gridData_));
+    gridActor_->GetProperty()->SetColor(1, 1, 1);
+    gridActor_->GetProperty()->SetOpacity(0.3);
+    selActor_->SetMapper(normalizedMapper(selData_));
+    selActor_->GetProperty()->SetColor(1, 1, 0);
+    selActor_->GetProperty()->SetLineWidth(3);
+    scene_->AddActor2D(heatActor_);
+    scene_->AddActor2D(gridActor_);
+    scene_->AddActor2D(selActor_);
+
+    legend_->SetLookupTable(lut_);
+    legend_->SetTitle("lights\nper tile");
+    legend_->SetNumberOfLabels(5);
+    legend_->SetLabelFormat("%.0f");
+    legend_->SetMaximumWidthInPixels(kLegendWidthPx - 10);
+    legend_->GetTitleTextProperty()->SetFontSize(14);
+    legend_->GetTitleTextProperty()->SetColor(1, 1, 1);
+    legend_->GetTitleTextProperty()->ShadowOff();
+    legend_->GetTitleTextProperty()->ItalicOff();
+    legend_->GetLabelTextProperty()->SetColor(1, 1, 1);
+    legend_->GetLabelTextProperty()->ShadowOff();
+    legend_->GetLabelTextProperty()->ItalicOff();
+    legend_->UnconstrainedFontSizeOn();
+    legend_->GetLabelTextProperty()->SetFontSize(13);
+    legend_->SetVisibility(false);
+    background_->AddActor2D(legend_);
+
+    caption_->GetTextProperty()->SetFontSize(13);
+    caption_->GetTextProperty()->SetColor(0.9, 0.9, 0.9);
+    caption_->SetDisplayPosition(6, 6);
+    background_->AddActor2D(caption_);
+
+    // The camera view is the culling camera: no orbiting here, a click selects a tile.
+    vtkNew<vtkInteractorStyleUser> style;
+    interactor()->SetInteractorStyle(style);
+    interactor()->AddObserver(vtkCommand::LeftButtonPressEvent, this, &CameraView::onLeftPress);
+
+    connect(doc_, &Document::sceneReset, this, [this] {
+        rebuildMeshes();
+        updateCamera();
+        updateOverlay();
+    });
+    connect(doc_, &Document::meshesChanged, this, [this] {
+        rebuildMeshes();
+        renderNow();
+    });
+    connect(doc_, &Document::cameraChanged, this, [this] {
+        updateCamera();
+        updateOverlay();
+    });
+    connect(doc_, &Document::runOutputChanged, this, &CameraView::updateOverlay);
+    connect(doc_, &Document::tileSelectionChanged, this, [this] {
+        updateSelectedTile();
+        renderNow();
+    });
+    rebuildMeshes();
+    updateCamera();
+    updateOverlay();
+}
+
+CameraView::~CameraView() = default;
+
+vtkRenderer* CameraView::sceneRenderer() const { return scene_.Get(); }
+vtkScalarBarActor* CameraView::legend() const { return legend_.Get(); }
+
+void CameraView::renderNow() {
+    if (renderWindow()) renderWindow()->Render();
+    update();
+}
+
+void CameraView::resizeEvent(QResizeEvent* e) {
+    QVTKOpenGLNativeWidget::resizeEvent(e);
+    updateViewport();
+}
+
+void CameraView::updateViewport() {
+    const lc::Camera& cam = doc_->scene().camera;
+    const double w = std::max(1, width()), h = std::max(1, height());
+    const double availW = std::max(1.0, w - kLegendWidthPx);
+    const double aspect = cam.aspect();
+    double vw = availW, vh = availW / aspect;
+    if (vh > h) {
+        vh = h;
+        vw = h * aspect;
+    }
+    const double x0 = (availW - vw) / 2, y0 = (h - vh) / 2;
+    scene_->SetViewport(x0 / w, y0 / h, (x0 + vw) / w, (y0 + vh) / h);
+    legend_->SetPosition((availW + 6) / w, 0.08);
+    legend_->SetWidth((kLegendWidthPx - 10) / w);
+    legend_->SetHeight(0.84);
+}
+
+void CameraView::rebuildMeshes() {
+    for (auto& a : meshActors_) scene_->RemoveActor(a);
+    meshActors_.clear();
+    for (const auto& m : doc_->scene().meshes) {
+        auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+        mapper->SetInputData(meshToPolyData(m));
+        auto actor = vtkSmartPointer<vtkActor>::New();
+        actor->SetMapper(mapper);
+        actor->GetProperty()->SetColor(0.78, 0.78, 0.74);
+        actor->GetProperty()->SetAmbient(0.15);
+        actor->GetProperty()->SetDiffuse(0.85);
+        scene_->AddActor(actor);
+        meshActors_.push_back(actor);
+    }
+}
+
+void CameraView::updateCamera() {
+    const lc::Camera& c = doc_->scene().camera;
+    vtkCamera* vc = scene_->GetActiveCamera();
+    vc->SetPosition(c.position.x, c.position.y, c.position.z);
+    vc->SetFocalPoint(c.target.x, c.target.y, c.target.z);
+    vc->SetViewUp(c.up.x, c.up.y, c.up.z);
+    vc->OrthogonalizeViewUp();
+    const bool ortho = lc::isOrthographic(c.projection);
+    vc->SetParallelProjection(ortho);
+    vc->SetParallelScale(c.orthoHeight / 2); // VTK: half the viewport height
+    vc->SetViewAngle(c.fovYDeg);             // VTK's view angle is vertical
+    // Near plane = the culling camera's; far = its far plane, pulled in to the
+    // scene's extent (an infinite or very far plane would waste depth precision).
+    const auto [lo, hi] = doc_->scene().bounds();
+    double farthest = 0;
+    for (int i = 0; i < 8; ++i) {
+        const glm::dvec3 corner((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
+        farthest = std::max(farthest, glm::length(corner - c.position));
+    }
+    double farPlane = std::min(c.farPlane, farthest * 1.05 + 1.0);
+    farPlane = std::max(farPlane, c.nearPlane * 2);
+    vc->SetClippingRange(c.nearPlane, farPlane);
+    updateViewport();
+}
+
+std::vector<int> CameraView::tileHeatValues(const lc::RunOutput& run) {
+    const lc::CullResult& r = run.result;
+    const std::uint32_t tiles = r.grid.tileCount();
+    std::vector<int> heat(tiles, -1);
+    for (std::uint32_t t = 0; t < tiles; ++t) {
+        const bool geometry = t < r.tileDepthMin.size() && r.tileDepthMin[t] <= r.tileDepthMax[t];
+        if (!geometry) continue;
+        if (r.algorithm == lc::Algorithm::All) {
+            heat[t] = r.listCount.empty() ? 0 : int(r.listCount[0]);
+            continue;
+        }
+        int m = 0;
+        for (std::uint32_t s = 0; s < r.listsPerTile; ++s) {
+            const std::size_t l = std::size_t(t) * r.listsPerTile + s;
+            if (l < r.listCount.size()) m = std::max(m, int(r.listCount[l]));
+        }
+        heat[t] = m;
+    }
+    return heat;
+}
+
+void CameraView::updateOverlay() {
+    const auto run = doc_->runOutput();
+    const lc::Camera& cam = doc_->scene().camera;
+    heatData_->Initialize();
+    gridData_->Initialize();
+    if (!run) {
+        legend_->SetVisibility(false);
+        caption_->SetInput("no culling run yet (F5)");
+        updateSelectedTile();
+        renderNow();
+        return;
+    }
+    const lc::TileGrid& g = run->result.grid;
+    const double W = g.width, H = g.height;
+    auto nx = [&](double px) { return px / W; };
+    auto ny = [&](double py) { return 1.0 - py / H; }; // pixel rows go down, viewport y up
+
+    // Tile corner lattice, clipped to the image (edge tiles are partial).
+    vtkNew<vtkPoints> pts;
+    auto cornerX = [&](std::uint32_t i) { return std::min<double>(double(i) * g.tileSize, W); };
+    auto cornerY = [&](std::uint32_t j) { return std::min<double>(double(j) * g.tileSize, H); };
+    for (std::uint32_t j = 0; j <= g.tilesY; ++j)
+        for (std::uint32_t i = 0; i <= g.tilesX; ++i) pts->InsertNextPoint(nx(cornerX(i)), ny(cornerY(j)), 0);
+    auto pid = [&](std::uint32_t i, std::uint32_t j) { return vtkIdType(j * (g.tilesX + 1) + i); };
+
+    const std::vector<int> heat = tileHeatValues(*run);
+    vtkNew<vtkCellArray> quads;
+    vtkNew<vtkDoubleArray> values;
+    values->SetName("list_length");
+    int maxHeat = 0;
+    for (std::uint32_t ty = 0; ty < g.tilesY; ++ty)
+        for (std::uint32_t tx = 0; tx < g.tilesX; ++tx) {
+            const int v = heat[g.tileIndex(tx, ty)];
+            if (v < 0) continue; // no geometry: nothing drawn over the background
+            const vtkIdType q[4] = {pid(tx, ty), pid(tx + 1, ty), pid(tx + 1, ty + 1), pid(tx, ty + 1)};
+            quads->InsertNextCell(4, q);
+            values->InsertNextValue(v);
+            maxHeat = std::max(maxHeat, v);
+        }
+    heatData_->SetPoints(pts);
+    heatData_->SetPolys(quads);
+    heatData_->GetCellData()->SetScalars(values);
+    lut_->SetTableRange(0, std::max(1, maxHeat));
+
+    vtkNew<vtkCellArray> lines;
+    for (std::uint32_t i = 0; i <= g.tilesX; ++i) {
+        const vtkIdType l[2] = {pid(i, 0), pid(i, g.tilesY)};
+        lines->InsertNextCell(2, l);
+    }
+    for (std::uint32_t j = 0; j <= g.tilesY; ++j) {
+        const vtkIdType l[2] = {pid(0, j), pid(g.tilesX, j)};
+        lines->InsertNextCell(2, l);
+    }
+    gridData_->SetPoints(pts);
+    gridData_->SetLines(lines);
+    // A grid finer than ~4 screen pixels per tile is noise: hide it then.
+    const double* vp = scene_->GetViewport();
+    const double tilePx = g.tileSize * (vp[2] - vp[0]) * width() / std::max(1u, cam.width);
+    gridActor_->SetVisibility(tilePx >= 6.0);
+
+    legend_->SetVisibility(true);
+    const std::string caption = std::string(lc::toString(run->result.algorithm)) + "  " +
+                                std::to_string(g.tilesX) + "x" + std::to_string(g.tilesY) +
+                                " tiles of " + std::to_string(g.tileSize) + " px";
+    caption_->SetInput(caption.c_str());
+    updateSelectedTile();
+    renderNow();
+}
+
+void CameraView::updateSelectedTile() {
+    selData_->Initialize();
+    const auto run = doc_->runOutput();
+    const int tile = doc_->selectedTile();
+    if (!run || tile < 0 || std::uint32_t(tile) >= run->result.grid.tileCount()) return;
+    const lc::TileGrid& g = run->result.grid;
+    const auto rect = g.tileRect(std::uint32_t(tile) % g.tilesX, std::uint32_t(tile) / g.tilesX);
+    vtkNew<vtkPoints> pts;
+    pts->InsertNextPoint(rect.x0 / double(g.width), 1 - rect.y0 / double(g.height), 0);
+    pts->InsertNextPoint(rect.x1 / double(g.width), 1 - rect.y0 / double(g.height), 0);
+    pts->InsertNextPoint(rect.x1 / double(g.width), 1 - rect.y1 / double(g.height), 0);
+    pts->InsertNextPoint(rect.x0 / double(g.width), 1 - rect.y1 / double(g.height), 0);
+    vtkNew<vtkCellArray> loop;
+    const vtkIdType ids[5] = {0, 1, 2, 3, 0};
+    loop->InsertNextCell(5, ids);
+    selData_->SetPoints(pts);
+    selData_->SetLines(loop);
+}
+
+int CameraView::tileAtWidgetPos(const QPoint& pos) const {
+    const lc::Camera& cam = doc_->scene().camera;
+    const double nxw = (pos.x() + 0.5) / std::max(1, width());
+    const double nyw = 1.0 - (pos.y() + 0.5) / std::max(1, height());
+    const double* vp = scene_->GetViewport();
+    const double u = (nxw - vp[0]) / (vp[2] - vp[0]);
+    const double v = (nyw - vp[1]) / (vp[3] - vp[1]);
+    if (u < 0 || u >= 1 || v <= 0 || v > 1) return -1;
+    const auto px = std::uint32_t(u * cam.width), py = std::uint32_t((1 - v) * cam.height);
+    const lc::TileGrid g = lc::TileGrid::make(cam.width, cam.height, cam.tileSize);
+    if (px >= cam.width || py >= cam.height) return -1;
+    return int(g.tileOfPixel(px, py));
+}
+
+void CameraView::onLeftPress() {
+    int x = 0, y = 0;
+    interactor()->GetEventPosition(x, y); // device pixels, y up
+    const double dpr = devicePixelRatioF();
+    const QPoint pos(int(x / dpr), int(height() - 1 - y / dpr));
+    const int tile = tileAtWidgetPos(pos);
+    doc_->setSelectedTile(tile);
+    emit tileClicked(tile);
+}
+
+} // namespace lcui

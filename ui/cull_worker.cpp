@@ -1,0 +1,108 @@
+#include "cull_worker.hpp"
+
+#include "culling/errors.hpp"
+
+#include <QMetaObject>
+
+namespace lcui {
+
+void CullWorker::post(CullRequest request) {
+    bool schedule = false;
+    {
+        std::lock_guard lock(mutex_);
+        if (pending_) ++dropped_;
+        pending_ = std::move(request);
+        if (!scheduled_) scheduled_ = schedule = true;
+    }
+    if (schedule) QMetaObject::invokeMethod(this, "drain", Qt::QueuedConnection);
+}
+
+void CullWorker::cancelCurrent() {
+    std::lock_guard lock(mutex_);
+    pending_.reset();
+    if (cancel_) cancel_->cancelled = true;
+}
+
+quint64 CullWorker::droppedRequests() const {
+    std::lock_guard lock(mutex_);
+    return dropped_;
+}
+
+void CullWorker::drain() {
+    for (;;) {
+        CullRequest req;
+        std::shared_ptr<lc::CancelToken> cancel = std::make_shared<lc::CancelToken>();
+        {
+            std::lock_guard lock(mutex_);
+            if (!pending_) {
+                scheduled_ = false;
+                return;
+            }
+            req = std::move(*pending_);
+            pending_.reset();
+            cancel_ = cancel;
+        }
+        emit started(req.generation);
+        try {
+            if (!backend_ || req.backend != backendName_ || req.device != deviceSelector_) {
+                backend_.reset(); // release the old device before opening a new one
+                backendName_.clear();
+                backend_ = lc::makeBackend(req.backend, req.device);
+                backendName_ = req.backend;
+                deviceSelector_ = req.device;
+                emit backendReady(QString::fromStdString(backend_->name()),
+                                  QString::fromStdString(backend_->deviceName()));
+            }
+            lc::RunOptions options;
+            // The studio shows false negatives and efficiency; the Lambert image
+            // error (pixels x lights) is left to the CLI and exports.
+            options.truthOptions.imageError = false;
+            auto out = std::make_shared<lc::RunOutput>(
+                lc::runPipeline(*req.scene, req.settings, *backend_, options, cancel.get()));
+            emit finished(req.generation, std::shared_ptr<const lc::RunOutput>(std::move(out)));
+        } catch (const lc::Cancelled&) {
+            emit failed(req.generation, tr("culling cancelled"));
+        } catch (const std::exception& e) {
+            emit failed(req.generation, QString::fromStdString(e.what()));
+        }
+    }
+}
+
+CullService::CullService(QObject* parent) : QObject(parent), worker_(new CullWorker) {
+    qRegisterMetaType<std::shared_ptr<const lc::RunOutput>>();
+    thread_.setObjectName("CullWorker");
+    worker_->moveToThread(&thread_);
+    connect(&thread_, &QThread::finished, worker_, &QObject::deleteLater);
+    connect(worker_, &CullWorker::started, this, &CullService::started, Qt::QueuedConnection);
+    connect(worker_, &CullWorker::finished, this, &CullService::finished, Qt::QueuedConnection);
+    connect(worker_, &CullWorker::failed, this, &CullService::failed, Qt::QueuedConnection);
+    connect(worker_, &CullWorker::backendReady, this, &CullService::backendReady,
+            Qt::QueuedConnection);
+    thread_.start();
+}
+
+CullService::~CullService() {
+    worker_->cancelCurrent();
+    thread_.quit();
+    thread_.wait();
+}
+
+quint64 CullService::request(const lc::Scene& scene, const lc::CullSettings& settings,
+                             const QString& backend, const QString& device) {
+    CullRequest r;
+    r.generation = ++generation_;
+    r.scene = std::make_shared<const lc::Scene>(scene);
+    r.settings = settings;
+    r.backend = backend.toStdString();
+    r.device = device.toStdString();
+    worker_->post(std::move(r));
+    return generation_;
+}
+
+QString CullService::defaultBackend() {
+    for (const auto& b : lc::availableBackends())
+        if (b == "vulkan") return "vulkan";
+    return "cpu";
+}
+
+} // namespace lcui

@@ -1,0 +1,92 @@
+#pragma once
+// Culling off the UI thread. A CullWorker lives on its own QThread and owns the
+// backend (and with it the Vulkan device); the UI posts requests through
+// CullService and gets results back through queued signals.
+//
+// "Latest request wins": the worker has one pending slot, not a queue. A request
+// posted while another is still waiting replaces it (dragging a light in Live
+// mode must not pile up runs); the run already in progress finishes, and the
+// document keeps the result with the highest generation number.
+
+#include "culling/backend.hpp"
+#include "culling/pipeline.hpp"
+
+#include <QObject>
+#include <QString>
+#include <QThread>
+
+#include <memory>
+#include <mutex>
+#include <optional>
+
+namespace lcui {
+
+struct CullRequest {
+    quint64 generation = 0;
+    std::shared_ptr<const lc::Scene> scene;
+    lc::CullSettings settings;
+    std::string backend; // "cpu", "vulkan"
+    std::string device;  // selector for makeBackend (empty: default)
+};
+
+class CullWorker : public QObject {
+    Q_OBJECT
+public:
+    // Thread-safe: replaces the pending request and wakes the worker.
+    void post(CullRequest request);
+    // Thread-safe: drops the pending request and cancels the run in progress
+    // (used on shutdown).
+    void cancelCurrent();
+    // Requests that were replaced before they ran (for diagnostics and tests).
+    quint64 droppedRequests() const;
+
+signals:
+    void started(quint64 generation);
+    void finished(quint64 generation, std::shared_ptr<const lc::RunOutput> output);
+    void failed(quint64 generation, QString message);
+    void backendReady(QString name, QString device);
+
+private slots:
+    void drain();
+
+private:
+    mutable std::mutex mutex_;
+    std::optional<CullRequest> pending_;
+    bool scheduled_ = false;
+    quint64 dropped_ = 0;
+    std::shared_ptr<lc::CancelToken> cancel_;
+    // Touched only on the worker thread:
+    std::unique_ptr<lc::CullBackend> backend_;
+    std::string backendName_, deviceSelector_;
+};
+
+// The UI-side handle: starts the thread, numbers the requests.
+class CullService : public QObject {
+    Q_OBJECT
+public:
+    explicit CullService(QObject* parent = nullptr);
+    ~CullService() override;
+
+    // Copies the scene and posts it; returns the request's generation.
+    quint64 request(const lc::Scene& scene, const lc::CullSettings& settings,
+                    const QString& backend, const QString& device);
+    quint64 lastGeneration() const { return generation_; }
+    CullWorker* worker() { return worker_; }
+    // "vulkan" when this build and machine have it, else "cpu".
+    static QString defaultBackend();
+
+signals:
+    void started(quint64 generation);
+    void finished(quint64 generation, std::shared_ptr<const lc::RunOutput> output);
+    void failed(quint64 generation, QString message);
+    void backendReady(QString name, QString device);
+
+private:
+    QThread thread_;
+    CullWorker* worker_;
+    quint64 generation_ = 0;
+};
+
+} // namespace lcui
+
+Q_DECLARE_METATYPE(std::shared_ptr<const lc::RunOutput>)

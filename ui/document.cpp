@@ -1,0 +1,181 @@
+#include "document.hpp"
+
+#include "commands.hpp"
+
+#include <algorithm>
+
+namespace lcui {
+
+Document::Document(QObject* parent) : QObject(parent) {
+    connect(&undo_, &QUndoStack::cleanChanged, this, [this](bool clean) { emit dirtyChanged(!clean); });
+}
+
+void Document::resetScene(lc::Scene scene, const QString& path) {
+    scene_ = std::move(scene);
+    undo_.clear();
+    undo_.setClean();
+    filePath_ = path;
+    selectedLights_.clear();
+    cameraSelected_ = false;
+    selectedTile_ = -1;
+    run_.reset();
+    emit sceneReset();
+    emit selectionChanged();
+    emit tileSelectionChanged(-1);
+    emit runOutputChanged();
+    emit filePathChanged(path);
+    emit dirtyChanged(false);
+    emit sceneEdited();
+}
+
+void Document::markSaved(const QString& path) {
+    filePath_ = path;
+    undo_.setClean();
+    emit filePathChanged(path);
+    emit dirtyChanged(false);
+}
+
+void Document::setSettings(const lc::CullSettings& s) {
+    settings_ = s;
+    emit settingsChanged();
+}
+
+void Document::setSelectedLights(std::vector<int> lights) {
+    const int n = int(scene_.lights.size());
+    lights.erase(std::remove_if(lights.begin(), lights.end(), [n](int i) { return i < 0 || i >= n; }),
+                 lights.end());
+    // Deduplicate keeping the order: the last one is the current light.
+    std::vector<int> unique;
+    for (int i : lights)
+        if (std::find(unique.begin(), unique.end(), i) == unique.end()) unique.push_back(i);
+    lights = std::move(unique);
+    if (lights == selectedLights_ && !cameraSelected_) return;
+    selectedLights_ = std::move(lights);
+    cameraSelected_ = false;
+    emit selectionChanged();
+}
+
+void Document::selectCamera() {
+    selectedLights_.clear();
+    cameraSelected_ = true;
+    emit selectionChanged();
+}
+
+void Document::setSelectedTile(int tile) {
+    if (tile == selectedTile_) return;
+    selectedTile_ = tile;
+    emit tileSelectionChanged(tile);
+}
+
+void Document::moveLight(int index, const glm::dvec3& position, int dragId) {
+    if (index < 0 || index >= int(scene_.lights.size())) return;
+    const glm::dvec3 from = scene_.lights[std::size_t(index)].position;
+    if (from == position) return;
+    undo_.push(new MoveLightCommand(this, index, from, position, dragId));
+}
+
+void Document::setLight(int index, const lc::PointLight& light) {
+    if (index < 0 || index >= int(scene_.lights.size())) return;
+    undo_.push(new SetLightCommand(this, index, scene_.lights[std::size_t(index)], light));
+}
+
+void Document::addLights(const std::vector<lc::PointLight>& lights, const QString& text) {
+    if (lights.empty()) return;
+    std::vector<int> idx(lights.size());
+    for (std::size_t i = 0; i < lights.size(); ++i) idx[i] = int(scene_.lights.size() + i);
+    undo_.push(new InsertLightsCommand(this, std::move(idx), lights, text));
+}
+
+void Document::duplicateLights(const std::vector<int>& indices) {
+    std::vector<lc::PointLight> copies;
+    for (int i : indices) {
+        if (i < 0 || i >= int(scene_.lights.size())) continue;
+        lc::PointLight l = scene_.lights[std::size_t(i)];
+        l.name += " copy";
+        copies.push_back(std::move(l));
+    }
+    addLights(copies, tr("Duplicate %n light(s)", nullptr, int(copies.size())));
+}
+
+void Document::deleteLights(std::vector<int> indices) {
+    const int n = int(scene_.lights.size());
+    indices.erase(std::remove_if(indices.begin(), indices.end(), [n](int i) { return i < 0 || i >= n; }),
+                  indices.end());
+    std::sort(indices.begin(), indices.end());
+    indices.erase(std::unique(indices.begin(), indices.end()), indices.end());
+    if (indices.empty()) return;
+    std::vector<lc::PointLight> removed;
+    for (int i : indices) removed.push_back(scene_.lights[std::size_t(i)]);
+    undo_.push(new RemoveLightsCommand(this, std::move(indices), std::move(removed)));
+}
+
+void Document::setCamera(const lc::Camera& camera, const QString& text) {
+    undo_.push(new SetCameraCommand(this, scene_.camera, camera, text));
+}
+
+void Document::importMesh(lc::Mesh mesh) { undo_.push(new AddMeshCommand(this, std::move(mesh))); }
+
+bool Document::setRunOutput(std::shared_ptr<const lc::RunOutput> run, quint64 generation) {
+    if (generation < runGeneration_) return false;
+    run_ = std::move(run);
+    runGeneration_ = generation;
+    emit runOutputChanged();
+    return true;
+}
+
+// --- applied by the commands --------------------------------------------------
+
+void Document::applyLightPosition(int index, const glm::dvec3& p) {
+    scene_.lights[std::size_t(index)].position = p;
+    emit lightChanged(index);
+    emit sceneEdited();
+}
+
+void Document::applyLight(int index, const lc::PointLight& l) {
+    scene_.lights[std::size_t(index)] = l;
+    emit lightChanged(index);
+    emit sceneEdited();
+}
+
+void Document::applyInsertLights(const std::vector<int>& indices,
+                                 const std::vector<lc::PointLight>& lights) {
+    // Ascending final indices: inserting in order puts each light exactly there.
+    for (std::size_t k = 0; k < indices.size(); ++k)
+        scene_.lights.insert(scene_.lights.begin() + indices[k], lights[k]);
+    selectedLights_ = indices;
+    cameraSelected_ = false;
+    emit lightsChanged();
+    emit selectionChanged();
+    emit sceneEdited();
+}
+
+void Document::applyRemoveLights(const std::vector<int>& indices) {
+    for (auto it = indices.rbegin(); it != indices.rend(); ++it)
+        scene_.lights.erase(scene_.lights.begin() + *it);
+    selectedLights_.clear();
+    emit lightsChanged();
+    emit selectionChanged();
+    emit sceneEdited();
+}
+
+void Document::applyCamera(const lc::Camera& c) {
+    scene_.camera = c;
+    selectedTile_ = -1;
+    emit cameraChanged();
+    emit tileSelectionChanged(-1);
+    emit sceneEdited();
+}
+
+void Document::applyAddMesh(const lc::Mesh& m) {
+    scene_.meshes.push_back(m);
+    emit meshesChanged();
+    emit sceneEdited();
+}
+
+void Document::applyRemoveLastMesh() {
+    scene_.meshes.pop_back();
+    emit meshesChanged();
+    emit sceneEdited();
+}
+
+} // namespace lcui

@@ -1,0 +1,113 @@
+#pragma once
+// The studio's central document: the scene being edited, the selection, the
+// file it came from, the culling settings and the latest finished culling run.
+// Panels and views observe it through signals; every edit of the scene goes
+// through its QUndoStack (the public edit functions below push commands).
+
+#include "culling/params.hpp"
+#include "culling/pipeline.hpp"
+#include "culling/scene.hpp"
+
+#include <QObject>
+#include <QString>
+#include <QUndoStack>
+
+#include <memory>
+#include <vector>
+
+namespace lcui {
+
+class Document : public QObject {
+    Q_OBJECT
+public:
+    explicit Document(QObject* parent = nullptr);
+
+    const lc::Scene& scene() const { return scene_; }
+    QUndoStack* undoStack() { return &undo_; }
+
+    // --- file state ---------------------------------------------------------
+    QString filePath() const { return filePath_; }
+    // Unsaved edits: the undo stack is not at its clean index.
+    bool isDirty() const { return !undo_.isClean(); }
+    // Replaces the whole scene (New, Open, built-in picker): clears the undo
+    // stack, the selection and the last result. Not undoable by design (the
+    // unsaved-changes prompt guards it).
+    void resetScene(lc::Scene scene, const QString& path);
+    // Marks the current state as saved under `path`.
+    void markSaved(const QString& path);
+
+    // --- culling settings (not part of the scene, not undoable) --------------
+    const lc::CullSettings& settings() const { return settings_; }
+    void setSettings(const lc::CullSettings& s);
+
+    // --- selection ----------------------------------------------------------
+    // Selected light indices in selection order; currentLight(): the last one
+    // (what the property panel and the drag handle act on), or -1.
+    const std::vector<int>& selectedLights() const { return selectedLights_; }
+    int currentLight() const { return selectedLights_.empty() ? -1 : selectedLights_.back(); }
+    void setSelectedLights(std::vector<int> lights);
+    bool cameraSelected() const { return cameraSelected_; }
+    void selectCamera();
+    // Tile of the culling grid selected in the camera view (-1: none).
+    int selectedTile() const { return selectedTile_; }
+    void setSelectedTile(int tile);
+
+    // --- edits: each pushes one undo command ----------------------------------
+    // A light drag: every call with the same `dragId` for the same light merges
+    // into one undo step (the handle widget starts a new id per drag).
+    void moveLight(int index, const glm::dvec3& position, int dragId);
+    int newDragId() { return ++dragCounter_; }
+    // Property change of one light (name, colour, intensity, radius, ...).
+    void setLight(int index, const lc::PointLight& light);
+    // Appends lights as one step (add, duplicate, generate) and selects them.
+    void addLights(const std::vector<lc::PointLight>& lights, const QString& text);
+    void duplicateLights(const std::vector<int>& indices);
+    void deleteLights(std::vector<int> indices);
+    void setCamera(const lc::Camera& camera, const QString& text = tr("Edit camera"));
+    void importMesh(lc::Mesh mesh);
+
+    // --- latest culling run ----------------------------------------------------
+    // The newest finished run, or null. `generation` is the request number the
+    // worker answered; older generations than the one shown are dropped.
+    std::shared_ptr<const lc::RunOutput> runOutput() const { return run_; }
+    quint64 runGeneration() const { return runGeneration_; }
+    // Returns false (and ignores it) when `generation` is older than the shown one.
+    bool setRunOutput(std::shared_ptr<const lc::RunOutput> run, quint64 generation);
+
+    // --- used by the undo commands only --------------------------------------
+    void applyLightPosition(int index, const glm::dvec3& p);
+    void applyLight(int index, const lc::PointLight& l);
+    void applyInsertLights(const std::vector<int>& indices, const std::vector<lc::PointLight>& lights);
+    void applyRemoveLights(const std::vector<int>& indices); // ascending
+    void applyCamera(const lc::Camera& c);
+    void applyAddMesh(const lc::Mesh& m);
+    void applyRemoveLastMesh();
+
+signals:
+    void sceneReset();              // whole scene replaced
+    void lightsChanged();           // lights added/removed (indices may shift)
+    void lightChanged(int index);   // one light's values changed
+    void cameraChanged();
+    void meshesChanged();
+    void selectionChanged();
+    void tileSelectionChanged(int tile);
+    void settingsChanged();
+    void sceneEdited();             // any scene edit (for Live re-runs)
+    void runOutputChanged();
+    void filePathChanged(const QString& path);
+    void dirtyChanged(bool dirty);
+
+private:
+    lc::Scene scene_;
+    lc::CullSettings settings_;
+    QUndoStack undo_;
+    QString filePath_;
+    std::vector<int> selectedLights_;
+    bool cameraSelected_ = false;
+    int selectedTile_ = -1;
+    int dragCounter_ = 0;
+    std::shared_ptr<const lc::RunOutput> run_;
+    quint64 runGeneration_ = 0;
+};
+
+} // namespace lcui

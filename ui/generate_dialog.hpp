@@ -1,0 +1,33 @@
+#pragma once
+// The Generate lights dialog: the settings of lc::generateLights (count, seed,
+// placement volume, intensity and colour ranges, I_min), prefilled with the
+// scene's default placement volume.
+
+#include "culling/scene_io.hpp"
+
+#include <QDialog>
+
+class QDoubleSpinBox;
+class QSpinBox;
+
+namespace lcui {
+
+class GenerateLightsDialog : public QDialog {
+    Q_OBJECT
+public:
+    GenerateLightsDialog(const lc::LightGenSettings& initial, QWidget* parent = nullptr);
+    lc::LightGenSettings settings() const;
+
+private:
+    QSpinBox* count_;
+    QSpinBox* seed_;
+    QDoubleSpinBox* boxMin_[3];
+    QDoubleSpinBox* boxMax_[3];
+    QDoubleSpinBox* intensityMin_;
+    QDoubleSpinBox* intensityMax_;
+    QDoubleSpinBox* colorMin_[3];
+    QDoubleSpinBox* colorMax_[3];
+    QDoubleSpinBox* minIntensity_;
+};
+
+} // namespace lcui

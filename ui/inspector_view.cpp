@@ -1,0 +1,376 @@
+#include "inspector_view.hpp"
+
+#include "document.hpp"
+#include "vtk_adapters.hpp"
+
+#include "culling/projection.hpp"
+
+#include <vtkActor.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkCellPicker.h>
+#include <vtkDataArray.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkGlyph3D.h>
+#include <vtkHandleWidget.h>
+#include <vtkIdTypeArray.h>
+#include <vtkInteractorStyleTrackballCamera.h>
+#include <vtkPointData.h>
+#include <vtkPointHandleRepresentation3D.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkRenderer.h>
+#include <vtkSphereSource.h>
+#include <QVTKInteractor.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace lcui {
+
+InspectorView::InspectorView(Document* doc, QWidget* parent)
+    : QVTKOpenGLNativeWidget(parent), doc_(doc) {
+    vtkNew<vtkGenericOpenGLRenderWindow> rw;
+    setRenderWindow(rw);
+    renderer_->SetBackground(0.16, 0.17, 0.2);
+    renderer_->SetBackground2(0.05, 0.05, 0.07);
+    renderer_->GradientBackgroundOn();
+    rw->AddRenderer(renderer_);
+
+    // Light spheres: one glyph actor. Sphere of radius 1 scaled by "radius",
+    // coloured by "color"; 12x8 facets keep 10k lights interactive.
+    sphere_->SetRadius(1.0);
+    sphere_->SetThetaResolution(12);
+    sphere_->SetPhiResolution(8);
+    lightData_ = lightsToPolyData({});
+    glyph_->SetSourceConnection(sphere_->GetOutputPort());
+    glyph_->SetInputData(lightData_);
+    glyph_->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "radius");
+    glyph_->SetInputArrayToProcess(3, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "color");
+    glyph_->SetScaleModeToScaleByScalar();
+    glyph_->SetScaleFactor(1.0);
+    glyph_->ClampingOff();
+    glyph_->SetColorModeToColorByScalar();
+    glyph_->GeneratePointIdsOn(); // "InputPointIds": glyph output point -> light index
+    glyph_->OrientOff();
+    vtkNew<vtkPolyDataMapper> lightMapper;
+    lightMapper->SetInputConnection(glyph_->GetOutputPort());
+    lightMapper->SetScalarModeToUsePointFieldData();
+    lightMapper->SelectColorArray("color");
+    lightMapper->SetColorModeToDirectScalars();
+    lightMapper->ScalarVisibilityOn();
+    lightActor_->SetMapper(lightMapper);
+    lightActor_->GetProperty()->SetOpacity(0.22);
+    renderer_->AddActor(lightActor_);
+
+    // Selected lights: the same spheres as an opaque yellow wireframe.
+    selData_ = lightsToPolyData({});
+    selGlyph_->SetSourceConnection(sphere_->GetOutputPort());
+    selGlyph_->SetInputData(selData_);
+    selGlyph_->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "radius");
+    selGlyph_->SetScaleModeToScaleByScalar();
+    selGlyph_->ClampingOff();
+    vtkNew<vtkPolyDataMapper> selMapper;
+    selMapper->SetInputConnection(selGlyph_->GetOutputPort());
+    selMapper->ScalarVisibilityOff();
+    selActor_->SetMapper(selMapper);
+    selActor_->GetProperty()->SetRepresentationToWireframe();
+    selActor_->GetProperty()->SetColor(1.0, 0.85, 0.1);
+    selActor_->GetProperty()->SetLighting(false);
+    selActor_->PickableOff();
+    renderer_->AddActor(selActor_);
+
+    vtkNew<vtkPolyDataMapper> frustumMapper;
+    frustumMapper->SetInputData(frustumData_);
+    frustumActor_->SetMapper(frustumMapper);
+    frustumActor_->GetProperty()->SetColor(0.3, 0.9, 1.0);
+    frustumActor_->GetProperty()->SetLineWidth(2);
+    frustumActor_->GetProperty()->SetLighting(false);
+    frustumActor_->PickableOff();
+    renderer_->AddActor(frustumActor_);
+
+    vtkNew<vtkInteractorStyleTrackballCamera> style;
+    interactor()->SetInteractorStyle(style);
+
+    handleRep_->SetHandleSize(40);
+    handleRep_->GetProperty()->SetColor(1, 0.85, 0.1);
+    handleRep_->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
+    handleRep_->ActiveRepresentationOff();
+    handle_->SetInteractor(interactor());
+    handle_->SetRepresentation(handleRep_);
+    handle_->AddObserver(vtkCommand::StartInteractionEvent, this, &InspectorView::onHandleStart);
+    handle_->AddObserver(vtkCommand::InteractionEvent, this, &InspectorView::onHandleMove);
+    handle_->AddObserver(vtkCommand::EndInteractionEvent, this, &InspectorView::onHandleEnd);
+    handle_->EnabledOff();
+
+    picker_->SetTolerance(0.0005);
+    picker_->PickFromListOn();
+    // High priority: see the press before the trackball style or the handle take it.
+    interactor()->AddObserver(vtkCommand::LeftButtonPressEvent, this, &InspectorView::onLeftPress, 10.0f);
+    interactor()->AddObserver(vtkCommand::LeftButtonReleaseEvent, this, &InspectorView::onLeftRelease,
+                              10.0f);
+
+    connect(doc_, &Document::sceneReset, this, [this] {
+        cameraFramed_ = false;
+        rebuildMeshes();
+        rebuildLights();
+        updateFrustum();
+        resetCamera();
+    });
+    connect(doc_, &Document::meshesChanged, this, [this] {
+        rebuildMeshes();
+        renderNow();
+    });
+    connect(doc_, &Document::lightsChanged, this, [this] {
+        rebuildLights();
+        updateSelection();
+        renderNow();
+    });
+    connect(doc_, &Document::lightChanged, this, [this](int i) {
+        updateLight(i);
+        updateSelection();
+        renderNow();
+    });
+    connect(doc_, &Document::selectionChanged, this, [this] {
+        updateSelection();
+        renderNow();
+    });
+    connect(doc_, &Document::cameraChanged, this, [this] {
+        updateFrustum();
+        renderNow();
+    });
+    rebuildMeshes();
+    rebuildLights();
+    updateFrustum();
+    updateSelection();
+    resetCamera();
+}
+
+InspectorView::~InspectorView() = default;
+
+vtkRenderer* InspectorView::renderer() const { return renderer_.Get(); }
+vtkHandleWidget* InspectorView::handleWidget() const { return handle_.Get(); }
+vtkPointHandleRepresentation3D* InspectorView::handleRepresentation() const { return handleRep_.Get(); }
+vtkActor* InspectorView::lightActor() const { return lightActor_.Get(); }
+
+void InspectorView::renderNow() {
+    if (renderWindow()) renderWindow()->Render();
+    update();
+}
+
+void InspectorView::resetCamera() {
+    // Frame the meshes (not every light sphere: a generated cloud can be far
+    // larger than the scene) from above and to the side of the culling camera.
+    const auto [lo, hi] = doc_->scene().bounds();
+    const lc::Camera& c = doc_->scene().camera;
+    glm::dvec3 center = 0.5 * (lo + hi);
+    double diag = glm::length(hi - lo);
+    if (diag <= 0) {
+        center = c.target;
+        diag = std::max(1.0, glm::length(c.target - c.position));
+    }
+    glm::dvec3 dir = c.position - c.target;
+    if (glm::length(dir) < 1e-9) dir = {0, 0, 1};
+    dir = glm::normalize(dir);
+    const glm::dvec3 up = glm::normalize(c.up);
+    // Rotate 35 degrees around up and lift: the frustum is seen from outside.
+    const glm::dvec3 side = glm::normalize(glm::cross(up, dir));
+    glm::dvec3 eyeDir = glm::normalize(std::cos(0.6) * dir + std::sin(0.6) * side + 0.55 * up);
+    vtkCamera* vc = renderer_->GetActiveCamera();
+    vc->SetFocalPoint(center.x, center.y, center.z);
+    const glm::dvec3 eye = center + eyeDir * diag;
+    vc->SetPosition(eye.x, eye.y, eye.z);
+    vc->SetViewUp(up.x, up.y, up.z);
+    vc->SetViewAngle(30);
+    vc->ParallelProjectionOff();
+    // Keep the direction, move back until the scene's bounding sphere fits.
+    if (glm::length(hi - lo) > 0) {
+        double b[6] = {lo.x, hi.x, lo.y, hi.y, lo.z, hi.z};
+        renderer_->ResetCamera(b);
+    }
+    renderer_->ResetCameraClippingRange();
+    cameraFramed_ = true;
+    renderNow();
+}
+
+void InspectorView::rebuildMeshes() {
+    for (auto& a : meshActors_) renderer_->RemoveActor(a);
+    meshActors_.clear();
+    picker_->InitializePickList();
+    picker_->AddPickList(lightActor_);
+    for (const auto& m : doc_->scene().meshes) {
+        auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+        mapper->SetInputData(meshToPolyData(m));
+        auto actor = vtkSmartPointer<vtkActor>::New();
+        actor->SetMapper(mapper);
+        actor->GetProperty()->SetColor(0.72, 0.72, 0.7);
+        renderer_->AddActor(actor);
+        meshActors_.push_back(actor);
+        picker_->AddPickList(actor);
+    }
+}
+
+void InspectorView::rebuildLights() {
+    lightData_ = lightsToPolyData(doc_->scene().lights);
+    glyph_->SetInputData(lightData_);
+}
+
+void InspectorView::updateLight(int index) {
+    const auto& lights = doc_->scene().lights;
+    if (index < 0 || index >= int(lights.size()) || lightData_->GetNumberOfPoints() != vtkIdType(lights.size())) {
+        rebuildLights();
+        return;
+    }
+    const auto& l = lights[std::size_t(index)];
+    lightData_->GetPoints()->SetPoint(index, l.position.x, l.position.y, l.position.z);
+    lightData_->GetPoints()->Modified();
+    lightData_->GetPointData()->GetArray("radius")->SetTuple1(index, lightDisplayRadius(l));
+    lightData_->GetPointData()->GetArray("radius")->Modified();
+    unsigned char rgb[3];
+    lightDisplayColor(l, rgb);
+    auto* color = lightData_->GetPointData()->GetArray("color");
+    for (int c = 0; c < 3; ++c) color->SetComponent(index, c, rgb[c]);
+    color->Modified();
+    lightData_->Modified();
+}
+
+void InspectorView::updateSelection() {
+    const auto& lights = doc_->scene().lights;
+    std::vector<lc::PointLight> sel;
+    for (int i : doc_->selectedLights())
+        if (i < int(lights.size())) sel.push_back(lights[std::size_t(i)]);
+    selData_ = lightsToPolyData(sel);
+    selGlyph_->SetInputData(selData_);
+    const int cur = doc_->currentLight();
+    if (cur >= 0 && cur < int(lights.size())) {
+        // Keep the handle where the light is, except while it is being dragged
+        // (then the handle leads and the light follows).
+        if (!handleActive_) {
+            const auto& p = lights[std::size_t(cur)].position;
+            double wp[3] = {p.x, p.y, p.z};
+            handleRep_->SetWorldPosition(wp);
+        }
+        handle_->EnabledOn();
+    } else {
+        handle_->EnabledOff();
+    }
+}
+
+void InspectorView::updateFrustum() {
+    frustumData_->Initialize();
+    const lc::Scene& s = doc_->scene();
+    const lc::Camera& c = s.camera;
+    if (!c.validate().empty()) return;
+    try {
+        const lc::Projection proj(c);
+        const glm::dmat4 worldFromView = glm::inverse(c.viewFromWorld());
+        // Far face drawn at the far plane, pulled in to the scene's extent.
+        const auto [lo, hi] = s.bounds();
+        double farthest = glm::length(c.target - c.position);
+        for (int i = 0; i < 8; ++i) {
+            const glm::dvec3 k((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
+            farthest = std::max(farthest, glm::length(k - c.position));
+        }
+        const double farD = std::min(proj.farPlane(), farthest * 1.05);
+        const double nearD = proj.nearPlane();
+        vtkNew<vtkPoints> pts;
+        const glm::dvec2 px[4] = {{0, 0}, {double(c.width), 0}, {double(c.width), double(c.height)},
+                                  {0, double(c.height)}};
+        for (double d : {nearD, farD})
+            for (const auto& p : px) {
+                const glm::dvec4 w = worldFromView * glm::dvec4(proj.viewPositionAt(p, d), 1.0);
+                pts->InsertNextPoint(w.x, w.y, w.z);
+            }
+        pts->InsertNextPoint(c.position.x, c.position.y, c.position.z); // 8: eye
+        vtkNew<vtkCellArray> lines;
+        auto line = [&](vtkIdType a, vtkIdType b) {
+            const vtkIdType ids[2] = {a, b};
+            lines->InsertNextCell(2, ids);
+        };
+        for (int i = 0; i < 4; ++i) {
+            line(i, (i + 1) % 4);         // near face
+            line(4 + i, 4 + (i + 1) % 4); // far face
+            line(i, 4 + i);               // side edges
+            if (!proj.orthographic()) line(8, i);
+        }
+        frustumData_->SetPoints(pts);
+        frustumData_->SetLines(lines);
+    } catch (const std::exception&) {
+        // An invalid camera shows no frustum; the run reports the error.
+    }
+}
+
+void InspectorView::onHandleStart() {
+    handleActive_ = true;
+    dragLight_ = doc_->currentLight();
+    dragId_ = doc_->newDragId();
+}
+
+void InspectorView::onHandleMove() {
+    if (dragLight_ < 0) return;
+    double p[3];
+    handleRep_->GetWorldPosition(p);
+    doc_->moveLight(dragLight_, {p[0], p[1], p[2]}, dragId_);
+}
+
+void InspectorView::onHandleEnd() {
+    onHandleMove();
+    handleActive_ = false;
+    dragLight_ = -1;
+}
+
+int InspectorView::pickLight(const QPoint& pos) {
+    const double dpr = devicePixelRatioF();
+    const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
+    if (!picker_->Pick(x, y, 0, renderer_)) return -1;
+    if (picker_->GetActor() != lightActor_.Get()) return -1;
+    vtkDataSet* out = picker_->GetDataSet();
+    const vtkIdType pt = picker_->GetPointId();
+    if (!out || pt < 0) return -1;
+    vtkDataArray* ids = out->GetPointData()->GetArray("InputPointIds");
+    if (!ids) return -1;
+    return int(ids->GetTuple1(pt));
+}
+
+bool InspectorView::pickSurface(const QPoint& pos, glm::dvec3* point, glm::dvec3* normal) {
+    const double dpr = devicePixelRatioF();
+    const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
+    lightActor_->PickableOff();
+    const bool hit = picker_->Pick(x, y, 0, renderer_) && picker_->GetActor() != nullptr;
+    lightActor_->PickableOn();
+    if (!hit) return false;
+    double p[3], n[3];
+    picker_->GetPickPosition(p);
+    picker_->GetPickNormal(n);
+    *point = {p[0], p[1], p[2]};
+    if (normal) {
+        glm::dvec3 nn(n[0], n[1], n[2]);
+        double cp[3];
+        renderer_->GetActiveCamera()->GetPosition(cp);
+        if (glm::dot(nn, glm::dvec3(cp[0], cp[1], cp[2]) - *point) < 0) nn = -nn;
+        *normal = glm::length(nn) > 0 ? glm::normalize(nn) : glm::dvec3(0, 1, 0);
+    }
+    return true;
+}
+
+void InspectorView::onLeftPress() { interactor()->GetEventPosition(pressX_, pressY_); }
+
+void InspectorView::onLeftRelease() {
+    int x = 0, y = 0;
+    interactor()->GetEventPosition(x, y);
+    if (std::abs(x - pressX_) > 3 || std::abs(y - pressY_) > 3 || handleActive_) return; // orbit/drag
+    const double dpr = devicePixelRatioF();
+    const QPoint pos(int(x / dpr), int(height() - 1 - y / dpr));
+    const int light = pickLight(pos);
+    if (light >= 0) {
+        const bool add = interactor()->GetControlKey() || interactor()->GetShiftKey();
+        std::vector<int> sel = add ? doc_->selectedLights() : std::vector<int>{};
+        sel.push_back(light);
+        doc_->setSelectedLights(sel);
+    }
+}
+
+} // namespace lcui

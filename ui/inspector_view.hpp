@@ -1,0 +1,89 @@
+#pragma once
+// The inspector view: a free-orbit 3D view of the whole scene. Meshes, every
+// light's bounding sphere as ONE glyph actor (a low-resolution sphere scaled by
+// the radius, coloured by the light's colour, translucent: 10,000 lights stay
+// interactive), the culling camera's frustum as lines, the selection
+// highlighted, and a handle widget to drag the selected light.
+//
+// Picking: a click (press and release without moving) on a sphere selects its
+// light: the cell picker hits the glyph output and the glyph filter's
+// "InputPointIds" array maps the hit back to the light index.
+
+#include <QVTKOpenGLNativeWidget.h>
+
+#include <glm/glm.hpp>
+#include <vtkNew.h>
+#include <vtkSmartPointer.h>
+
+#include <vector>
+
+class vtkActor;
+class vtkCellPicker;
+class vtkGlyph3D;
+class vtkHandleWidget;
+class vtkPointHandleRepresentation3D;
+class vtkPolyData;
+class vtkRenderer;
+class vtkSphereSource;
+
+namespace lcui {
+
+class Document;
+
+class InspectorView : public QVTKOpenGLNativeWidget {
+    Q_OBJECT
+public:
+    explicit InspectorView(Document* doc, QWidget* parent = nullptr);
+    ~InspectorView() override;
+
+    vtkRenderer* renderer() const;
+    // Frames the whole scene (meshes, lights and the culling camera).
+    void resetCamera();
+    // Light whose sphere is under the widget position (logical px), or -1.
+    int pickLight(const QPoint& pos);
+    // Mesh surface point under the widget position; false when none. `normal`
+    // is the surface normal facing the viewer.
+    bool pickSurface(const QPoint& pos, glm::dvec3* point, glm::dvec3* normal = nullptr);
+    // The handle widget that drags the selected light (tests drive it through
+    // its own interaction events, exactly as a mouse drag does).
+    vtkHandleWidget* handleWidget() const;
+    vtkPointHandleRepresentation3D* handleRepresentation() const;
+    // The glyph actor showing every light's sphere.
+    vtkActor* lightActor() const;
+    void renderNow();
+
+private:
+    void rebuildMeshes();
+    void rebuildLights();
+    void updateLight(int index);
+    void updateSelection();
+    void updateFrustum();
+    void onHandleStart();
+    void onHandleMove();
+    void onHandleEnd();
+    void onLeftPress();
+    void onLeftRelease();
+
+    Document* doc_;
+    vtkNew<vtkRenderer> renderer_;
+    std::vector<vtkSmartPointer<vtkActor>> meshActors_;
+    vtkSmartPointer<vtkPolyData> lightData_;
+    vtkNew<vtkSphereSource> sphere_;
+    vtkNew<vtkGlyph3D> glyph_;
+    vtkNew<vtkActor> lightActor_;
+    vtkSmartPointer<vtkPolyData> selData_;
+    vtkNew<vtkGlyph3D> selGlyph_;
+    vtkNew<vtkActor> selActor_;
+    vtkNew<vtkPolyData> frustumData_;
+    vtkNew<vtkActor> frustumActor_;
+    vtkNew<vtkHandleWidget> handle_;
+    vtkNew<vtkPointHandleRepresentation3D> handleRep_;
+    vtkNew<vtkCellPicker> picker_;
+    int dragId_ = 0;
+    int dragLight_ = -1;
+    bool handleActive_ = false;
+    int pressX_ = 0, pressY_ = 0;
+    bool cameraFramed_ = false;
+};
+
+} // namespace lcui

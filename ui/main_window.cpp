@@ -1,0 +1,771 @@
+#include "main_window.hpp"
+
+#include "camera_view.hpp"
+#include "cull_worker.hpp"
+#include "document.hpp"
+#include "generate_dialog.hpp"
+#include "inspector_view.hpp"
+#include "progress_task.hpp"
+#include "property_panel.hpp"
+#include "scene_tree.hpp"
+#include "tile_inspector.hpp"
+
+#include "culling/errors.hpp"
+#include "culling/scene_io.hpp"
+
+#include <QAction>
+#include <QApplication>
+#include <QCheckBox>
+#include <QCloseEvent>
+#include <QComboBox>
+#include <QCursor>
+#include <QDateTime>
+#include <QDockWidget>
+#include <QDragEnterEvent>
+#include <QDropEvent>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QLabel>
+#include <QLineEdit>
+#include <QMenuBar>
+#include <QMimeData>
+#include <QPlainTextEdit>
+#include <QSettings>
+#include <QSpinBox>
+#include <QSplitter>
+#include <QStatusBar>
+#include <QTabBar>
+#include <QToolBar>
+#include <QUndoStack>
+#include <QVBoxLayout>
+
+#include <vtkCamera.h>
+#include <vtkRenderer.h>
+
+#include <cmath>
+
+namespace lcui {
+
+namespace {
+constexpr int kMaxRecent = 8;
+
+QString describe(const std::exception& e) { return QString::fromStdString(e.what()); }
+} // namespace
+
+MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
+    setObjectName("LightCullStudio");
+    doc_ = new Document(this);
+    service_ = new CullService(this);
+
+    prompts.askUnsaved = [](QWidget* parent, const QString& text) {
+        return QMessageBox::question(parent, tr("Unsaved changes"), text,
+                                     QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel,
+                                     QMessageBox::Save);
+    };
+    prompts.showError = [](QWidget* parent, const QString& title, const QString& text) {
+        QMessageBox::critical(parent, title, text);
+    };
+    prompts.openPath = [](QWidget* parent, const QString& caption, const QString& filter) {
+        return QFileDialog::getOpenFileName(parent, caption, {}, filter);
+    };
+    prompts.savePath = [](QWidget* parent, const QString& caption, const QString& filter) {
+        return QFileDialog::getSaveFileName(parent, caption, {}, filter);
+    };
+
+    // Views: side by side in a splitter; "tabbed" shows one at a time through
+    // the tab bar (no re-parenting of the GL widgets).
+    cameraView_ = new CameraView(doc_);
+    cameraView_->setObjectName("cameraView");
+    inspectorView_ = new InspectorView(doc_);
+    inspectorView_->setObjectName("inspectorView");
+    viewSplitter_ = new QSplitter(Qt::Horizontal);
+    viewSplitter_->setObjectName("viewSplitter");
+    viewSplitter_->addWidget(cameraView_);
+    viewSplitter_->addWidget(inspectorView_);
+    viewTabs_ = new QTabBar;
+    viewTabs_->addTab(tr("Camera view"));
+    viewTabs_->addTab(tr("Inspector view"));
+    connect(viewTabs_, &QTabBar::currentChanged, this, [this](int i) {
+        if (!viewTabs_->isVisible()) return;
+        cameraView_->setVisible(i == 0);
+        inspectorView_->setVisible(i == 1);
+    });
+    auto* central = new QWidget;
+    auto* vl = new QVBoxLayout(central);
+    vl->setContentsMargins(0, 0, 0, 0);
+    vl->setSpacing(0);
+    vl->addWidget(viewTabs_);
+    vl->addWidget(viewSplitter_, 1);
+    setCentralWidget(central);
+
+    buildDocks();
+    buildActions();
+    buildMenus();
+    buildToolbar();
+    buildStatusBar();
+    setAcceptDrops(true);
+
+    connect(service_, &CullService::finished, this, &MainWindow::onRunFinished);
+    connect(service_, &CullService::failed, this, &MainWindow::onRunFailed);
+    connect(service_, &CullService::backendReady, this, [this](const QString& name, const QString& device) {
+        lastBackendName_ = name;
+        lastDeviceName_ = device;
+        log(tr("backend %1 on %2").arg(name, device));
+        updateStatus();
+    });
+    connect(doc_, &Document::sceneEdited, this, [this] {
+        if (isLive()) runCulling();
+    });
+    connect(doc_, &Document::settingsChanged, this, [this] {
+        syncParamWidgets();
+        if (isLive()) runCulling();
+    });
+    connect(doc_, &Document::cameraChanged, this, &MainWindow::syncParamWidgets);
+    connect(doc_, &Document::sceneReset, this, &MainWindow::syncParamWidgets);
+    connect(doc_, &Document::dirtyChanged, this, &MainWindow::updateTitle);
+    connect(doc_, &Document::filePathChanged, this, &MainWindow::updateTitle);
+    connect(doc_, &Document::runOutputChanged, this, &MainWindow::updateStatus);
+
+    resize(1600, 900);
+    // First start: views get the room, the log stays a strip at the bottom.
+    resizeDocks({findChild<QDockWidget*>("logDock")}, {110}, Qt::Vertical);
+    resizeDocks({findChild<QDockWidget*>("sceneDock"), findChild<QDockWidget*>("tileDock")}, {260, 220},
+                Qt::Horizontal);
+    restoreSettings();
+    syncParamWidgets();
+    updateTitle();
+    updateStatus();
+}
+
+MainWindow::~MainWindow() = default;
+
+QAction* MainWindow::action(const QString& objectName) const { return findChild<QAction*>(objectName); }
+
+// --- construction ---------------------------------------------------------------
+
+void MainWindow::buildDocks() {
+    auto dock = [this](const QString& title, const char* name, QWidget* w, Qt::DockWidgetArea area) {
+        auto* d = new QDockWidget(title, this);
+        d->setObjectName(name);
+        d->setWidget(w);
+        addDockWidget(area, d);
+        return d;
+    };
+    tree_ = new SceneTree(doc_);
+    tree_->setObjectName("sceneTree");
+    properties_ = new PropertyPanel(doc_);
+    properties_->setObjectName("propertyPanel");
+    tileInspector_ = new TileInspector(doc_);
+    tileInspector_->setObjectName("tileInspector");
+    log_ = new QPlainTextEdit;
+    log_->setObjectName("messageLog");
+    log_->setReadOnly(true);
+    log_->setMaximumBlockCount(5000);
+    dock(tr("Scene"), "sceneDock", tree_, Qt::LeftDockWidgetArea);
+    dock(tr("Properties"), "propertiesDock", properties_, Qt::LeftDockWidgetArea);
+    dock(tr("Tile inspector"), "tileDock", tileInspector_, Qt::RightDockWidgetArea);
+    dock(tr("Message log"), "logDock", log_, Qt::BottomDockWidgetArea);
+}
+
+void MainWindow::buildActions() {
+    auto make = [this](const QString& text, const char* name, QKeySequence key = {}) {
+        auto* a = new QAction(text, this);
+        a->setObjectName(name);
+        if (!key.isEmpty()) a->setShortcut(key);
+        return a;
+    };
+    connect(make(tr("&New"), "actionNew", QKeySequence::New), &QAction::triggered, this, [this] { newScene(); });
+    connect(make(tr("&Open scene..."), "actionOpen", QKeySequence::Open), &QAction::triggered, this, [this] {
+        const QString p = prompts.openPath(this, tr("Open scene"), tr("Scene (*.json)"));
+        if (!p.isEmpty()) openSceneFile(p);
+    });
+    connect(make(tr("&Import mesh..."), "actionImport", QKeySequence(tr("Ctrl+I"))), &QAction::triggered, this,
+            [this] {
+                const QString p = prompts.openPath(this, tr("Import mesh"),
+                                                   tr("Meshes (*.obj *.ply *.off *.stl *.om)"));
+                if (!p.isEmpty()) importMeshFile(p);
+            });
+    connect(make(tr("&Save"), "actionSave", QKeySequence::Save), &QAction::triggered, this, [this] { save(); });
+    connect(make(tr("Save &as..."), "actionSaveAs", QKeySequence::SaveAs), &QAction::triggered, this, [this] {
+        const QString p = prompts.savePath(this, tr("Save scene as"), tr("Scene (*.json)"));
+        if (!p.isEmpty()) saveAs(p);
+    });
+    connect(make(tr("&Quit"), "actionQuit", QKeySequence::Quit), &QAction::triggered, this, &QWidget::close);
+
+    QAction* undo = doc_->undoStack()->createUndoAction(this, tr("&Undo"));
+    undo->setObjectName("actionUndo");
+    undo->setShortcut(QKeySequence::Undo);
+    QAction* redo = doc_->undoStack()->createRedoAction(this, tr("&Redo"));
+    redo->setObjectName("actionRedo");
+    redo->setShortcuts({QKeySequence(tr("Ctrl+Shift+Z")), QKeySequence::Redo});
+
+    connect(make(tr("&Add light"), "actionAddLight", QKeySequence(tr("Ctrl+L"))), &QAction::triggered, this,
+            [this] { addLightAt(inspectorView_->mapFromGlobal(QCursor::pos())); });
+    connect(make(tr("&Duplicate"), "actionDuplicate", QKeySequence(tr("Ctrl+D"))), &QAction::triggered, this,
+            [this] { doc_->duplicateLights(doc_->selectedLights()); });
+    connect(make(tr("De&lete"), "actionDelete", QKeySequence::Delete), &QAction::triggered, this,
+            [this] { doc_->deleteLights(doc_->selectedLights()); });
+    connect(make(tr("&Generate lights..."), "actionGenerate", QKeySequence(tr("Ctrl+G"))), &QAction::triggered,
+            this, [this] {
+                GenerateLightsDialog dlg(lc::defaultLightGen(doc_->scene(), 256, 1), this);
+                if (dlg.exec() == QDialog::Accepted) generateLights(dlg.settings());
+            });
+    connect(make(tr("Set culling camera from this view"), "actionCameraFromView"), &QAction::triggered, this,
+            &MainWindow::setCullingCameraFromInspector);
+    connect(make(tr("Reset inspector camera"), "actionResetView"), &QAction::triggered, this,
+            [this] { inspectorView_->resetCamera(); });
+    QAction* tabbed = make(tr("Tabbed views"), "actionTabbedViews");
+    tabbed->setCheckable(true);
+    connect(tabbed, &QAction::toggled, this, &MainWindow::setTabbedViews);
+
+    connect(make(tr("&Run culling"), "actionRun", QKeySequence(Qt::Key_F5)), &QAction::triggered, this,
+            [this] { runCulling(); });
+    QAction* live = make(tr("Live"), "actionLive");
+    live->setCheckable(true);
+    live->setToolTip(tr("Re-run culling after every edit"));
+    connect(live, &QAction::toggled, this, [this](bool on) {
+        if (on) runCulling();
+    });
+}
+
+void MainWindow::buildMenus() {
+    QMenu* file = menuBar()->addMenu(tr("&File"));
+    file->addAction(action("actionNew"));
+    file->addAction(action("actionOpen"));
+    recentMenu_ = file->addMenu(tr("Open &recent"));
+    QMenu* builtins = file->addMenu(tr("&Built-in scene"));
+    for (const auto& b : lc::builtinScenes()) {
+        QAction* a = builtins->addAction(QString::fromStdString(b.name));
+        a->setToolTip(QString::fromStdString(b.description));
+        a->setStatusTip(QString::fromStdString(b.description));
+        const QString name = QString::fromStdString(b.name);
+        connect(a, &QAction::triggered, this, [this, name] { openBuiltin(name); });
+    }
+    file->addAction(action("actionImport"));
+    file->addSeparator();
+    file->addAction(action("actionSave"));
+    file->addAction(action("actionSaveAs"));
+    file->addSeparator();
+    file->addAction(action("actionQuit"));
+    rebuildRecentMenu();
+
+    QMenu* edit = menuBar()->addMenu(tr("&Edit"));
+    edit->addAction(action("actionUndo"));
+    edit->addAction(action("actionRedo"));
+    edit->addSeparator();
+    edit->addAction(action("actionAddLight"));
+    edit->addAction(action("actionDuplicate"));
+    edit->addAction(action("actionDelete"));
+    edit->addAction(action("actionGenerate"));
+    edit->addSeparator();
+    edit->addAction(action("actionCameraFromView"));
+
+    QMenu* view = menuBar()->addMenu(tr("&View"));
+    view->addAction(action("actionTabbedViews"));
+    view->addAction(action("actionResetView"));
+    view->addSeparator();
+    for (auto* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());
+
+    QMenu* cull = menuBar()->addMenu(tr("&Culling"));
+    cull->addAction(action("actionRun"));
+    cull->addAction(action("actionLive"));
+}
+
+void MainWindow::buildToolbar() {
+    QToolBar* fileBar = addToolBar(tr("File"));
+    fileBar->setObjectName("fileToolbar");
+    fileBar->addAction(action("actionOpen"));
+    fileBar->addAction(action("actionSave"));
+    fileBar->addAction(action("actionUndo"));
+    fileBar->addAction(action("actionRedo"));
+    fileBar->addAction(action("actionAddLight"));
+    fileBar->addAction(action("actionGenerate"));
+
+    // Culling controls, generated from the one parameter table (lc::cullParams)
+    // that also defines CullSettings and the CLI's flags.
+    QToolBar* bar = addToolBar(tr("Culling"));
+    bar->setObjectName("cullToolbar");
+    for (const lc::ParamSpec& p : lc::cullParams()) {
+        const std::string name = p.name;
+        const QString tip = QString::fromStdString(p.help);
+        if (p.type == lc::ParamType::Bool) {
+            auto* cb = new QCheckBox(QString::fromStdString(p.label.empty() ? p.name : p.label));
+            cb->setToolTip(tip);
+            connect(cb, &QCheckBox::toggled, this,
+                    [this, name](bool on) { onParamEdited(name, on ? "true" : "false"); });
+            paramWidgets_[name] = cb;
+            bar->addWidget(cb);
+            continue;
+        }
+        auto* label = new QLabel(QString::fromStdString(p.label.empty() ? p.name : p.label) + " ");
+        label->setToolTip(tip);
+        bar->addWidget(label);
+        QWidget* w = nullptr;
+        if (p.type == lc::ParamType::Choice) {
+            auto* combo = new QComboBox;
+            for (const auto& c : p.choices) combo->addItem(QString::fromStdString(c));
+            connect(combo, &QComboBox::textActivated, this,
+                    [this, name](const QString& v) { onParamEdited(name, v); });
+            w = combo;
+        } else {
+            auto* spin = new QSpinBox;
+            spin->setRange(int(std::max<long long>(p.minValue, -2147483647)),
+                           int(std::min<long long>(p.maxValue, 2147483647)));
+            spin->setKeyboardTracking(false);
+            connect(spin, qOverload<int>(&QSpinBox::valueChanged), this,
+                    [this, name](int v) { onParamEdited(name, QString::number(v)); });
+            w = spin;
+        }
+        w->setToolTip(tip);
+        w->setObjectName(QString::fromStdString("param_" + name));
+        paramWidgets_[name] = w;
+        bar->addWidget(w);
+    }
+    for (auto& [name, w] : paramWidgets_) w->setObjectName(QString::fromStdString("param_" + name));
+
+    bar->addSeparator();
+    bar->addWidget(new QLabel(tr("backend ")));
+    backendCombo_ = new QComboBox;
+    backendCombo_->setObjectName("backendCombo");
+    for (const auto& b : lc::availableBackends()) backendCombo_->addItem(QString::fromStdString(b));
+    backendCombo_->setCurrentText(CullService::defaultBackend());
+    bar->addWidget(backendCombo_);
+    deviceEdit_ = new QLineEdit;
+    deviceEdit_->setObjectName("deviceEdit");
+    deviceEdit_->setPlaceholderText(tr("device (default)"));
+    deviceEdit_->setToolTip(tr("Vulkan device: index or name substring; empty = LIGHTCULL_DEVICE or the first"));
+    deviceEdit_->setMaximumWidth(140);
+    bar->addWidget(deviceEdit_);
+    connect(backendCombo_, &QComboBox::textActivated, this, [this] {
+        if (isLive()) runCulling();
+    });
+    connect(deviceEdit_, &QLineEdit::editingFinished, this, [this] {
+        if (isLive()) runCulling();
+    });
+    bar->addSeparator();
+    bar->addAction(action("actionRun"));
+    bar->addAction(action("actionLive"));
+}
+
+void MainWindow::buildStatusBar() {
+    auto label = [this](const char* name) {
+        auto* l = new QLabel;
+        l->setObjectName(name);
+        statusBar()->addPermanentWidget(l);
+        return l;
+    };
+    statusBackend_ = label("statusBackend");
+    statusTimes_ = label("statusTimes");
+    statusFn_ = label("statusFalseNegatives");
+    statusEfficiency_ = label("statusEfficiency");
+    statusLists_ = label("statusLists");
+}
+
+// --- parameters --------------------------------------------------------------------
+
+void MainWindow::syncParamWidgets() {
+    syncingParams_ = true;
+    for (auto& [name, w] : paramWidgets_) {
+        QString v;
+        try {
+            v = QString::fromStdString(lc::getParam(doc_->settings(), doc_->scene().camera, name));
+        } catch (const lc::Error&) {
+            continue;
+        }
+        if (auto* cb = qobject_cast<QCheckBox*>(w)) cb->setChecked(v == "true" || v == "1");
+        else if (auto* combo = qobject_cast<QComboBox*>(w)) combo->setCurrentText(v);
+        else if (auto* spin = qobject_cast<QSpinBox*>(w)) spin->setValue(v.toInt());
+    }
+    syncingParams_ = false;
+}
+
+void MainWindow::onParamEdited(const std::string& name, const QString& value) {
+    if (syncingParams_) return;
+    lc::CullSettings s = doc_->settings();
+    lc::Camera cam = doc_->scene().camera;
+    try {
+        lc::setParam(s, cam, name, value.toStdString());
+    } catch (const lc::Error& e) {
+        log(describe(e), true);
+        syncParamWidgets();
+        return;
+    }
+    const lc::Camera& old = doc_->scene().camera;
+    if (cam.width != old.width || cam.height != old.height || cam.tileSize != old.tileSize)
+        doc_->setCamera(cam, tr("Set %1").arg(QString::fromStdString(name)));
+    else
+        doc_->setSettings(s);
+}
+
+bool MainWindow::setParamFromUi(const QString& name, const QString& value) {
+    auto it = paramWidgets_.find(name.toStdString());
+    if (it == paramWidgets_.end()) return false;
+    QWidget* w = it->second;
+    if (auto* cb = qobject_cast<QCheckBox*>(w)) cb->setChecked(value == "true" || value == "1");
+    else if (auto* combo = qobject_cast<QComboBox*>(w)) {
+        const int i = combo->findText(value);
+        if (i < 0) return false;
+        combo->setCurrentIndex(i);
+        emit combo->textActivated(value); // what a user's pick emits
+    } else if (auto* spin = qobject_cast<QSpinBox*>(w))
+        spin->setValue(value.toInt());
+    return QString::fromStdString(lc::getParam(doc_->settings(), doc_->scene().camera, name.toStdString())) ==
+           value;
+}
+
+void MainWindow::setBackend(const QString& backend, const QString& device) {
+    backendCombo_->setCurrentText(backend);
+    deviceEdit_->setText(device);
+}
+
+// --- culling -------------------------------------------------------------------------
+
+quint64 MainWindow::runCulling() {
+    const quint64 gen = service_->request(doc_->scene(), doc_->settings(), backendCombo_->currentText(),
+                                          deviceEdit_->text());
+    statusBar()->showMessage(tr("culling (run %1)...").arg(gen));
+    return gen;
+}
+
+void MainWindow::setLive(bool live) { action("actionLive")->setChecked(live); }
+bool MainWindow::isLive() const { return action("actionLive")->isChecked(); }
+
+void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::RunOutput> out) {
+    if (!doc_->setRunOutput(out, generation)) return; // an older run finished late
+    const auto& m = out->truth.metrics;
+    log(tr("run %1: %2, %3 lights, depth %4 ms, cull %5 ms, false negatives %6, efficiency %7")
+            .arg(generation)
+            .arg(lc::toString(out->result.algorithm))
+            .arg(out->lights.size())
+            .arg(out->result.timings.depthMs, 0, 'f', 2)
+            .arg(out->result.timings.cullMs, 0, 'f', 2)
+            .arg(m.falseNegatives)
+            .arg(m.efficiency, 0, 'f', 4),
+        m.falseNegatives > 0);
+    statusBar()->showMessage(tr("culling done (run %1)").arg(generation), 4000);
+    emit runFinished(generation);
+}
+
+void MainWindow::onRunFailed(quint64 generation, const QString& message) {
+    log(tr("run %1 failed: %2").arg(generation).arg(message), true);
+    statusBar()->showMessage(tr("culling failed: %1").arg(message), 10000);
+    emit runFailed(generation, message);
+}
+
+void MainWindow::updateStatus() {
+    const auto run = doc_->runOutput();
+    const QString backend = run ? QString::fromStdString(run->result.backend) : lastBackendName_;
+    const QString device = run ? QString::fromStdString(run->result.device) : lastDeviceName_;
+    statusBackend_->setText(backend.isEmpty() ? tr("no backend yet") : tr("%1 | %2").arg(backend, device));
+    if (!run) {
+        statusTimes_->setText(tr("depth - ms | cull - ms"));
+        statusFn_->setText(tr("FN -"));
+        statusFn_->setStyleSheet({});
+        statusEfficiency_->setText(tr("efficiency -"));
+        statusLists_->setText(tr("mean/max list -"));
+        return;
+    }
+    const auto& m = run->truth.metrics;
+    statusTimes_->setText(tr("depth %1 ms | cull %2 ms")
+                              .arg(run->result.timings.depthMs, 0, 'f', 2)
+                              .arg(run->result.timings.cullMs, 0, 'f', 2));
+    statusFn_->setText(tr("FN %1").arg(m.falseNegatives));
+    statusFn_->setStyleSheet(m.falseNegatives > 0 ? "color: white; background: #c0392b; padding: 0 4px"
+                                                  : "color: #2e7d32");
+    statusEfficiency_->setText(tr("efficiency %1").arg(m.efficiency, 0, 'f', 4));
+    statusLists_->setText(tr("mean/max list %1 / %2").arg(m.meanList, 0, 'f', 2).arg(m.maxList));
+}
+
+// --- files -------------------------------------------------------------------------------
+
+bool MainWindow::maybeSave() {
+    if (!doc_->isDirty()) return true;
+    const QString name = doc_->filePath().isEmpty() ? tr("the scene") : QFileInfo(doc_->filePath()).fileName();
+    switch (prompts.askUnsaved(this, tr("Save changes to %1?").arg(name))) {
+    case QMessageBox::Save: return save();
+    case QMessageBox::Discard: return true;
+    default: return false;
+    }
+}
+
+bool MainWindow::newScene() {
+    if (!maybeSave()) return false;
+    lc::Scene s;
+    s.name = "untitled";
+    doc_->resetScene(std::move(s), {});
+    log(tr("new scene"));
+    return true;
+}
+
+void MainWindow::afterSceneOpened(const QString& what) {
+    const auto& s = doc_->scene();
+    log(tr("opened %1: %2 meshes, %3 triangles, %4 lights")
+            .arg(what)
+            .arg(s.meshes.size())
+            .arg(s.triangleCount())
+            .arg(s.lights.size()));
+    runCulling();
+}
+
+bool MainWindow::openBuiltin(const QString& name) {
+    if (!maybeSave()) return false;
+    try {
+        doc_->resetScene(lc::makeBuiltinScene(name.toStdString()), {});
+    } catch (const std::exception& e) {
+        log(describe(e), true);
+        prompts.showError(this, tr("Built-in scene"), describe(e));
+        return false;
+    }
+    afterSceneOpened(tr("built-in scene %1").arg(name));
+    return true;
+}
+
+bool MainWindow::openSceneFile(const QString& path) {
+    if (!maybeSave()) return false;
+    const std::string p = path.toStdString();
+    try {
+        lc::Scene s = runWithProgressResult<lc::Scene>(
+            this, tr("Loading %1...").arg(QFileInfo(path).fileName()),
+            [p](const lc::CancelToken& c, const lc::Progress& pr) { return lc::loadSceneFile(p, &c, pr); });
+        doc_->resetScene(std::move(s), path);
+    } catch (const lc::Cancelled&) {
+        log(tr("loading %1 cancelled").arg(path));
+        return false;
+    } catch (const std::exception& e) {
+        log(tr("cannot open %1: %2").arg(path, describe(e)), true);
+        prompts.showError(this, tr("Open scene"), describe(e));
+        return false;
+    }
+    addRecentFile(path);
+    afterSceneOpened(path);
+    return true;
+}
+
+bool MainWindow::importMeshFile(const QString& path) {
+    const std::string p = path.toStdString();
+    lc::MeshLoadReport report;
+    try {
+        lc::Mesh m = runWithProgressResult<lc::Mesh>(
+            this, tr("Importing %1...").arg(QFileInfo(path).fileName()),
+            [p, &report](const lc::CancelToken& c, const lc::Progress& pr) {
+                return lc::loadMesh(p, &report, &c, pr);
+            });
+        if (m.name.empty()) m.name = QFileInfo(path).completeBaseName().toStdString();
+        if (m.sourcePath.empty()) m.sourcePath = p;
+        const std::size_t tris = m.triangleCount();
+        doc_->importMesh(std::move(m));
+        log(tr("imported %1: %2 triangles").arg(path).arg(tris));
+        if (!report.warning.empty()) log(QString::fromStdString(report.warning), true);
+    } catch (const lc::Cancelled&) {
+        log(tr("import of %1 cancelled").arg(path));
+        return false;
+    } catch (const std::exception& e) {
+        log(tr("cannot import %1: %2").arg(path, describe(e)), true);
+        prompts.showError(this, tr("Import mesh"), describe(e));
+        return false;
+    }
+    return true;
+}
+
+bool MainWindow::save() {
+    if (doc_->filePath().isEmpty()) {
+        const QString p = prompts.savePath(this, tr("Save scene"), tr("Scene (*.json)"));
+        return !p.isEmpty() && saveAs(p);
+    }
+    return saveAs(doc_->filePath());
+}
+
+bool MainWindow::saveAs(const QString& path) {
+    try {
+        lc::saveSceneFile(doc_->scene(), path.toStdString());
+    } catch (const std::exception& e) {
+        log(tr("cannot save %1: %2").arg(path, describe(e)), true);
+        prompts.showError(this, tr("Save scene"), describe(e));
+        return false;
+    }
+    doc_->markSaved(path);
+    addRecentFile(path);
+    log(tr("saved %1").arg(path));
+    return true;
+}
+
+void MainWindow::addRecentFile(const QString& path) {
+    QSettings st;
+    QStringList recent = st.value("recentFiles").toStringList();
+    const QString abs = QFileInfo(path).absoluteFilePath();
+    recent.removeAll(abs);
+    recent.prepend(abs);
+    while (recent.size() > kMaxRecent) recent.removeLast();
+    st.setValue("recentFiles", recent);
+    rebuildRecentMenu();
+}
+
+void MainWindow::rebuildRecentMenu() {
+    if (!recentMenu_) return;
+    recentMenu_->clear();
+    const QStringList recent = QSettings().value("recentFiles").toStringList();
+    for (const QString& f : recent)
+        connect(recentMenu_->addAction(f), &QAction::triggered, this, [this, f] { openSceneFile(f); });
+    recentMenu_->setEnabled(!recent.isEmpty());
+}
+
+// --- editing ------------------------------------------------------------------------------
+
+int MainWindow::addLightAtCentre() { return addLightAt(QPoint(-1, -1)); }
+
+int MainWindow::addLightAt(const QPoint& pos) {
+    const lc::Scene& s = doc_->scene();
+    const auto [lo, hi] = s.bounds();
+    double diag = glm::length(hi - lo);
+    if (diag <= 0) diag = std::max(1.0, glm::length(s.camera.target - s.camera.position));
+    glm::dvec3 p = diag > 0 && s.triangleCount() > 0 ? 0.5 * (lo + hi) : s.camera.target;
+    glm::dvec3 hit, normal;
+    if (inspectorView_->rect().contains(pos) && inspectorView_->pickSurface(pos, &hit, &normal))
+        p = hit + normal * (0.01 * diag); // just off the surface, on the viewer's side
+    lc::PointLight l;
+    l.name = QStringLiteral("light %1").arg(s.lights.size()).toStdString();
+    l.position = p;
+    l.color = {1, 1, 1};
+    l.minIntensity = 0.05;
+    // Radius a tenth of the scene: r^2 = I / I_min.
+    const double r = 0.1 * diag;
+    l.intensity = r * r * l.minIntensity;
+    doc_->addLights({l}, tr("Add light"));
+    return int(doc_->scene().lights.size()) - 1;
+}
+
+bool MainWindow::generateLights(const lc::LightGenSettings& g) {
+    std::vector<lc::PointLight> lights;
+    try {
+        lights = runWithProgressResult<std::vector<lc::PointLight>>(
+            this, tr("Generating %1 lights...").arg(g.count),
+            [g](const lc::CancelToken&, const lc::Progress&) { return lc::generateLights(g); });
+    } catch (const lc::Cancelled&) {
+        log(tr("light generation cancelled"));
+        return false;
+    } catch (const std::exception& e) {
+        log(tr("cannot generate lights: %1").arg(describe(e)), true);
+        prompts.showError(this, tr("Generate lights"), describe(e));
+        return false;
+    }
+    doc_->addLights(lights, tr("Generate %1 lights").arg(lights.size()));
+    log(tr("generated %1 lights (seed %2)").arg(lights.size()).arg(g.seed));
+    return true;
+}
+
+void MainWindow::setCullingCameraFromInspector() {
+    vtkCamera* vc = inspectorView_->renderer()->GetActiveCamera();
+    lc::Camera c = doc_->scene().camera;
+    double p[3], f[3], u[3];
+    vc->GetPosition(p);
+    vc->GetFocalPoint(f);
+    vc->GetViewUp(u);
+    c.position = {p[0], p[1], p[2]};
+    c.target = {f[0], f[1], f[2]};
+    c.up = {u[0], u[1], u[2]};
+    c.fovYDeg = vc->GetViewAngle();
+    if (vc->GetParallelProjection()) c.orthoHeight = 2 * vc->GetParallelScale();
+    doc_->setCamera(c, tr("Set culling camera from view"));
+}
+
+// --- window ------------------------------------------------------------------------------
+
+QImage MainWindow::grabWindow() {
+    cameraView_->renderNow();
+    inspectorView_->renderNow();
+    return grab().toImage();
+}
+
+void MainWindow::log(const QString& message, bool error) {
+    const QString line = QDateTime::currentDateTime().toString("hh:mm:ss ") + (error ? "ERROR " : "") + message;
+    log_->appendPlainText(line);
+}
+
+void MainWindow::updateTitle() {
+    const QString file = doc_->filePath().isEmpty() ? QString::fromStdString(doc_->scene().name)
+                                                    : QFileInfo(doc_->filePath()).fileName();
+    setWindowTitle(tr("%1[*] - LightCull Studio").arg(file.isEmpty() ? tr("untitled") : file));
+    setWindowModified(doc_->isDirty());
+}
+
+void MainWindow::setTabbedViews(bool tabbed) {
+    viewTabs_->setVisible(tabbed);
+    if (tabbed) {
+        cameraView_->setVisible(viewTabs_->currentIndex() == 0);
+        inspectorView_->setVisible(viewTabs_->currentIndex() == 1);
+    } else {
+        cameraView_->setVisible(true);
+        inspectorView_->setVisible(true);
+    }
+}
+
+void MainWindow::restoreSettings() {
+    QSettings st;
+    restoreGeometry(st.value("window/geometry").toByteArray());
+    restoreState(st.value("window/state").toByteArray());
+    viewSplitter_->restoreState(st.value("window/splitter").toByteArray());
+    const bool tabbed = st.value("window/tabbedViews", false).toBool();
+    action("actionTabbedViews")->setChecked(tabbed);
+    setTabbedViews(tabbed);
+    viewTabs_->setCurrentIndex(st.value("window/currentView", 0).toInt());
+    // Last culling parameters (the camera-owned ones belong to the scene).
+    lc::CullSettings s = doc_->settings();
+    lc::Camera dummy;
+    st.beginGroup("params");
+    for (const auto& p : lc::cullParams()) {
+        if (!st.contains(QString::fromStdString(p.name))) continue;
+        try {
+            lc::setParam(s, dummy, p.name, st.value(QString::fromStdString(p.name)).toString().toStdString());
+        } catch (const lc::Error&) {
+        }
+    }
+    st.endGroup();
+    doc_->setSettings(s);
+    const QString backend = st.value("backend").toString();
+    if (!backend.isEmpty() && backendCombo_->findText(backend) >= 0) backendCombo_->setCurrentText(backend);
+    deviceEdit_->setText(st.value("device").toString());
+    action("actionLive")->setChecked(st.value("live", false).toBool());
+}
+
+void MainWindow::saveSettings() {
+    QSettings st;
+    st.setValue("window/geometry", saveGeometry());
+    st.setValue("window/state", saveState());
+    st.setValue("window/splitter", viewSplitter_->saveState());
+    st.setValue("window/tabbedViews", action("actionTabbedViews")->isChecked());
+    st.setValue("window/currentView", viewTabs_->currentIndex());
+    st.beginGroup("params");
+    lc::Camera dummy;
+    for (const auto& p : lc::cullParams())
+        st.setValue(QString::fromStdString(p.name),
+                    QString::fromStdString(lc::getParam(doc_->settings(), dummy, p.name)));
+    st.endGroup();
+    st.setValue("backend", backendCombo_->currentText());
+    st.setValue("device", deviceEdit_->text());
+    st.setValue("live", isLive());
+}
+
+void MainWindow::closeEvent(QCloseEvent* e) {
+    if (!maybeSave()) {
+        e->ignore();
+        return;
+    }
+    saveSettings();
+    e->accept();
+}
+
+void MainWindow::dragEnterEvent(QDragEnterEvent* e) {
+    if (e->mimeData()->hasUrls()) e->acceptProposedAction();
+}
+
+void MainWindow::dropEvent(QDropEvent* e) {
+    for (const QUrl& url : e->mimeData()->urls()) {
+        if (!url.isLocalFile()) continue;
+        const QString f = url.toLocalFile();
+        if (f.endsWith(".json", Qt::CaseInsensitive)) openSceneFile(f);
+        else importMeshFile(f);
+    }
+    e->acceptProposedAction();
+}
+
+} // namespace lcui

@@ -1,0 +1,155 @@
+#pragma once
+// The studio's main window: the document, the culling worker, the two VTK
+// views, the docks (scene tree, properties, tile inspector, message log), the
+// toolbar generated from lc::cullParams(), the status bar and every action.
+//
+// Dialogs that ask the user something go through the replaceable functions in
+// `prompts`, so tests (and scripts) can answer them without a modal loop.
+
+#include "culling/params.hpp"
+#include "culling/scene_io.hpp"
+
+#include <QMainWindow>
+#include <QMessageBox>
+
+#include <functional>
+#include <map>
+#include <memory>
+
+class QAction;
+class QCheckBox;
+class QComboBox;
+class QLabel;
+class QLineEdit;
+class QMenu;
+class QPlainTextEdit;
+class QSplitter;
+class QTabBar;
+
+namespace lc {
+struct RunOutput;
+}
+
+namespace lcui {
+
+class CameraView;
+class CullService;
+class Document;
+class InspectorView;
+class PropertyPanel;
+class SceneTree;
+class TileInspector;
+
+struct Prompts {
+    // Unsaved changes: Save, Discard or Cancel.
+    std::function<QMessageBox::StandardButton(QWidget*, const QString& text)> askUnsaved;
+    std::function<void(QWidget*, const QString& title, const QString& text)> showError;
+    // File dialogs; an empty string means cancelled.
+    std::function<QString(QWidget*, const QString& caption, const QString& filter)> openPath;
+    std::function<QString(QWidget*, const QString& caption, const QString& filter)> savePath;
+};
+
+class MainWindow : public QMainWindow {
+    Q_OBJECT
+public:
+    explicit MainWindow(QWidget* parent = nullptr);
+    ~MainWindow() override;
+
+    Document* document() const { return doc_; }
+    CullService* cullService() const { return service_; }
+    CameraView* cameraView() const { return cameraView_; }
+    InspectorView* inspectorView() const { return inspectorView_; }
+    SceneTree* sceneTree() const { return tree_; }
+    PropertyPanel* propertyPanel() const { return properties_; }
+    TileInspector* tileInspector() const { return tileInspector_; }
+    QPlainTextEdit* messageLog() const { return log_; }
+    QAction* action(const QString& objectName) const; // e.g. "actionRun"
+    Prompts prompts;
+
+    // --- file operations (return false on failure or cancel; the current
+    // scene is then untouched and the error is logged and shown) -------------
+    bool newScene();
+    bool openBuiltin(const QString& name);
+    bool openSceneFile(const QString& path);
+    bool importMeshFile(const QString& path);
+    bool save();
+    bool saveAs(const QString& path);
+    // Unsaved changes: asks Save/Discard/Cancel. True when it is fine to go on.
+    bool maybeSave();
+
+    // --- culling ----------------------------------------------------------------
+    // Posts a run of the current scene and settings; returns its generation.
+    quint64 runCulling();
+    void setLive(bool live);
+    bool isLive() const;
+    // The backend and device selector the next run uses.
+    void setBackend(const QString& backend, const QString& device = {});
+    // Sets one culling parameter through its toolbar control (as a user would).
+    bool setParamFromUi(const QString& name, const QString& value);
+
+    // --- editing ----------------------------------------------------------------
+    // Adds a light under the inspector-view position `pos` (logical px) when a
+    // surface is there, else at the scene centre. Returns its index.
+    int addLightAt(const QPoint& inspectorPos);
+    int addLightAtCentre();
+    // Generates lights as one undo step (progress + cancel for large counts).
+    bool generateLights(const lc::LightGenSettings& settings);
+    void setCullingCameraFromInspector();
+
+    // Whole-window image with both views' GL content.
+    QImage grabWindow();
+    void log(const QString& message, bool error = false);
+
+signals:
+    void runFinished(quint64 generation);
+    void runFailed(quint64 generation, const QString& message);
+
+protected:
+    void closeEvent(QCloseEvent* e) override;
+    void dragEnterEvent(QDragEnterEvent* e) override;
+    void dropEvent(QDropEvent* e) override;
+
+private:
+    void buildActions();
+    void buildMenus();
+    void buildToolbar();
+    void buildDocks();
+    void buildStatusBar();
+    void syncParamWidgets();
+    void onParamEdited(const std::string& name, const QString& value);
+    void onRunFinished(quint64 generation, std::shared_ptr<const lc::RunOutput> out);
+    void onRunFailed(quint64 generation, const QString& message);
+    void updateStatus();
+    void updateTitle();
+    void addRecentFile(const QString& path);
+    void rebuildRecentMenu();
+    void setTabbedViews(bool tabbed);
+    void restoreSettings();
+    void saveSettings();
+    void afterSceneOpened(const QString& what);
+
+    Document* doc_;
+    CullService* service_;
+    CameraView* cameraView_;
+    InspectorView* inspectorView_;
+    QSplitter* viewSplitter_;
+    QTabBar* viewTabs_;
+    SceneTree* tree_;
+    PropertyPanel* properties_;
+    TileInspector* tileInspector_;
+    QPlainTextEdit* log_;
+    QMenu* recentMenu_ = nullptr;
+    QComboBox* backendCombo_ = nullptr;
+    QLineEdit* deviceEdit_ = nullptr;
+    std::map<std::string, QWidget*> paramWidgets_;
+    bool syncingParams_ = false;
+    QLabel* statusBackend_;
+    QLabel* statusTimes_;
+    QLabel* statusFn_;
+    QLabel* statusEfficiency_;
+    QLabel* statusLists_;
+    QString lastBackendName_, lastDeviceName_;
+    quint64 pendingRuns_ = 0;
+};
+
+} // namespace lcui

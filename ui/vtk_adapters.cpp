@@ -1,0 +1,71 @@
+#include "vtk_adapters.hpp"
+
+#include <vtkCellArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkUnsignedCharArray.h>
+
+#include <algorithm>
+
+namespace lcui {
+
+vtkSmartPointer<vtkPolyData> meshToPolyData(const lc::Mesh& mesh) {
+    auto pts = vtkSmartPointer<vtkPoints>::New();
+    pts->SetDataTypeToFloat();
+    pts->SetNumberOfPoints(vtkIdType(mesh.vertexCount()));
+    for (std::size_t i = 0; i < mesh.vertexCount(); ++i) {
+        const glm::dvec4 w = mesh.transform * glm::dvec4(glm::dvec3(mesh.vertex(i)), 1.0);
+        pts->SetPoint(vtkIdType(i), w.x, w.y, w.z);
+    }
+    auto tris = vtkSmartPointer<vtkCellArray>::New();
+    tris->AllocateExact(vtkIdType(mesh.triangleCount()), vtkIdType(mesh.indices.size()));
+    for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
+        const vtkIdType ids[3] = {mesh.indices[3 * t], mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]};
+        tris->InsertNextCell(3, ids);
+    }
+    auto pd = vtkSmartPointer<vtkPolyData>::New();
+    pd->SetPoints(pts);
+    pd->SetPolys(tris);
+    return pd;
+}
+
+double lightDisplayRadius(const lc::PointLight& l) {
+    return l.validate().empty() ? l.radius() : 0.0;
+}
+
+void lightDisplayColor(const lc::PointLight& l, unsigned char rgb[3]) {
+    const double m = std::max({l.color.r, l.color.g, l.color.b, 1e-12});
+    for (int c = 0; c < 3; ++c)
+        rgb[c] = (unsigned char)(std::clamp(l.color[c] / m, 0.0, 1.0) * 255.0 + 0.5);
+}
+
+vtkSmartPointer<vtkPolyData> lightsToPolyData(const std::vector<lc::PointLight>& lights) {
+    auto pts = vtkSmartPointer<vtkPoints>::New();
+    pts->SetDataTypeToDouble();
+    pts->SetNumberOfPoints(vtkIdType(lights.size()));
+    auto radius = vtkSmartPointer<vtkDoubleArray>::New();
+    radius->SetName("radius");
+    radius->SetNumberOfValues(vtkIdType(lights.size()));
+    auto color = vtkSmartPointer<vtkUnsignedCharArray>::New();
+    color->SetName("color");
+    color->SetNumberOfComponents(3);
+    color->SetNumberOfTuples(vtkIdType(lights.size()));
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+        const auto& l = lights[i];
+        pts->SetPoint(vtkIdType(i), l.position.x, l.position.y, l.position.z);
+        radius->SetValue(vtkIdType(i), lightDisplayRadius(l));
+        unsigned char rgb[3];
+        lightDisplayColor(l, rgb);
+        color->SetTypedTuple(vtkIdType(i), rgb);
+    }
+    auto pd = vtkSmartPointer<vtkPolyData>::New();
+    pd->SetPoints(pts);
+    pd->GetPointData()->AddArray(radius);
+    pd->GetPointData()->AddArray(color);
+    pd->GetPointData()->SetActiveScalars("radius");
+    return pd;
+}
+
+} // namespace lcui
