@@ -311,7 +311,7 @@ RgbImage heatmapImage(const RunOutput& run) {
         }
 
     // Legend band: colour bar from the shortest to the longest list, a white
-    // tick at the mean, and the three numbers.
+    // tick above it at the mean, and the three numbers.
     const int y0 = int(H), m = 4 * scale;
     cv.fill(0, y0, int(W), y0 + legendH, glm::dvec3(0.1));
     const int bx0 = int(W) > 2 * m + 1 ? m : 0, bx1 = int(W) > 2 * m + 1 ? int(W) - m : int(W);
@@ -321,7 +321,8 @@ RgbImage heatmapImage(const RunOutput& run) {
     }
     if (maxList > minList) {
         const int mx = bx0 + int(std::lround((mean - minList) / double(maxList - minList) * (bx1 - bx0 - 1)));
-        cv.fill(mx - scale / 2, y0 + m - 2 * scale, mx - scale / 2 + scale, y0 + m + 12 * scale, glm::dvec3(1.0));
+        // Above the bar only, so that the bar itself stays a clean scale.
+        cv.fill(mx - scale, y0 + scale, mx + scale, y0 + m, glm::dvec3(1.0));
     }
     const int ty = y0 + m + 10 * scale + 3 * scale;
     const std::string left = "MIN " + std::to_string(minList);

@@ -1,0 +1,268 @@
+// Exporters: summary.json, tiles.csv and heatmap.png from real pipeline runs,
+// read back and checked against the run; the atomic folder write on success
+// and on failure.
+#include "culling/errors.hpp"
+#include "culling/export.hpp"
+#include "culling/scene_io.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <png.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+using namespace lc;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string readText(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+    std::vector<std::string> out;
+    std::string cur;
+    for (char c : s) {
+        if (c == sep) out.push_back(cur), cur.clear();
+        else cur += c;
+    }
+    out.push_back(cur);
+    return out;
+}
+
+// A fresh, empty folder under the system temp dir, removed at the end.
+struct TempDir {
+    fs::path path;
+    TempDir() {
+        std::string t = (fs::temp_directory_path() / "lc_export_XXXXXX").string();
+        path = ::mkdtemp(t.data());
+    }
+    ~TempDir() { fs::remove_all(path); }
+    std::vector<std::string> entries() const {
+        std::vector<std::string> names;
+        for (const auto& e : fs::directory_iterator(path)) names.push_back(e.path().filename().string());
+        std::sort(names.begin(), names.end());
+        return names;
+    }
+};
+
+struct PipelineRun {
+    Scene scene;
+    CullSettings settings;
+    RunOutput out;
+};
+
+PipelineRun runBuiltin(const std::string& name, Algorithm alg, std::uint32_t w = 96, std::uint32_t h = 64,
+               bool imageError = true) {
+    PipelineRun r;
+    r.scene = makeBuiltinScene(name);
+    r.scene.camera.width = w;
+    r.scene.camera.height = h;
+    r.scene.camera.tileSize = 16;
+    r.settings.algorithm = alg;
+    r.settings.cells = 8;
+    auto backend = makeCpuBackend();
+    RunOptions opt;
+    opt.truthOptions.imageError = imageError;
+    r.out = runPipeline(r.scene, r.settings, *backend, opt);
+    return r;
+}
+
+struct Png {
+    std::uint32_t width = 0, height = 0;
+    std::vector<std::uint8_t> rgb;
+};
+
+// Reads an 8-bit RGB PNG through libpng's simplified API.
+Png readPng(const fs::path& p) {
+    png_image img{};
+    img.version = PNG_IMAGE_VERSION;
+    EXPECT_TRUE(png_image_begin_read_from_file(&img, p.c_str())) << img.message;
+    img.format = PNG_FORMAT_RGB;
+    Png out;
+    out.width = img.width, out.height = img.height;
+    out.rgb.resize(PNG_IMAGE_SIZE(img));
+    EXPECT_TRUE(png_image_finish_read(&img, nullptr, out.rgb.data(), 0, nullptr)) << img.message;
+    return out;
+}
+
+} // namespace
+
+TEST(Export, SummaryJsonHasEveryKeyConsistentWithTheRun) {
+    const PipelineRun r = runBuiltin("atrium", Algorithm::TwoPointFiveD);
+    const auto j = nlohmann::json::parse(summaryJson(r.scene, r.settings, r.out));
+    for (const char* k : {"scene", "algorithm", "test", "backend", "device", "timing_method", "width",
+                          "height", "tile_size", "tiles_x", "tiles_y", "cells", "slicing", "lights",
+                          "timings_ms", "metrics"})
+        EXPECT_TRUE(j.contains(k)) << k;
+    for (const char* k : {"depth", "cull", "ground_truth"}) {
+        ASSERT_TRUE(j["timings_ms"].contains(k)) << k;
+        EXPECT_GE(j["timings_ms"][k].get<double>(), 0.0) << k;
+    }
+    const auto& m = j["metrics"];
+    for (const char* k : {"false_negatives", "shading_work", "exact_work", "efficiency", "mean_list",
+                          "max_list", "result_bytes", "list_entries", "lists", "geometry_pixels",
+                          "image_rmse", "image_max_error"})
+        EXPECT_TRUE(m.contains(k)) << k;
+
+    const CullResult& res = r.out.result;
+    EXPECT_EQ(j["scene"], r.scene.name);
+    EXPECT_EQ(j["algorithm"], "2.5d");
+    EXPECT_EQ(j["backend"], "cpu");
+    EXPECT_EQ(j["width"], 96);
+    EXPECT_EQ(j["height"], 64);
+    EXPECT_EQ(j["tile_size"], 16);
+    EXPECT_EQ(j["tiles_x"], 6);
+    EXPECT_EQ(j["tiles_y"], 4);
+    EXPECT_EQ(j["cells"], 8);
+    EXPECT_EQ(j["lights"], r.scene.lights.size());
+    EXPECT_EQ(m["false_negatives"], 0);
+    const auto W = m["shading_work"].get<std::uint64_t>(), E = m["exact_work"].get<std::uint64_t>();
+    EXPECT_GT(W, 0u);
+    EXPECT_EQ(m["efficiency"].get<double>(), double(E) / double(W)); // round-trips exactly
+    EXPECT_EQ(m["lists"], res.listCount.size());
+    EXPECT_EQ(m["list_entries"], res.lightIndices.size());
+    EXPECT_EQ(m["mean_list"].get<double>(), double(res.lightIndices.size()) / double(res.listCount.size()));
+    EXPECT_EQ(m["max_list"], *std::max_element(res.listCount.begin(), res.listCount.end()));
+    EXPECT_EQ(m["result_bytes"], res.bytes());
+    EXPECT_EQ(m["geometry_pixels"], r.out.depth.geometryPixelCount());
+    EXPECT_TRUE(m["image_rmse"].is_number());
+    EXPECT_GE(m["image_max_error"].get<double>(), m["image_rmse"].get<double>());
+
+    const PipelineRun noImg = runBuiltin("wall", Algorithm::MinMax, 48, 32, false);
+    const auto j2 = nlohmann::json::parse(summaryJson(noImg.scene, noImg.settings, noImg.out));
+    EXPECT_TRUE(j2["metrics"]["image_rmse"].is_null());
+    EXPECT_TRUE(j2["metrics"]["image_max_error"].is_null());
+}
+
+TEST(Export, TilesCsvHasOneRowPerListMatchingTheResult) {
+    for (Algorithm alg : {Algorithm::All, Algorithm::MinMax, Algorithm::HalfZ, Algorithm::TwoPointFiveD,
+                          Algorithm::Clustered}) {
+        const PipelineRun r = runBuiltin("sky", alg, 100, 70); // partial edge tiles, many empty tiles
+        const CullResult& res = r.out.result;
+        const std::string csv = tilesCsv(r.out);
+        std::vector<std::string> lines = split(csv, '\n');
+        ASSERT_EQ(lines.back(), ""); // ends with a newline
+        lines.pop_back();
+        ASSERT_EQ(lines[0], "tile_x,tile_y,cell,view_depth_min,view_depth_max,cell_mask,count,lights");
+        ASSERT_EQ(lines.size() - 1, res.listCount.size()) << toString(alg);
+        std::size_t emptyDepthRows = 0;
+        for (std::size_t l = 0; l < res.listCount.size(); ++l) {
+            const auto f = split(lines[l + 1], ',');
+            ASSERT_EQ(f.size(), 8u) << lines[l + 1];
+            EXPECT_EQ(std::stoul(f[6]), res.listCount[l]);
+            std::vector<std::uint32_t> listed;
+            if (!f[7].empty())
+                for (const auto& tok : split(f[7], ' ')) listed.push_back(std::uint32_t(std::stoul(tok)));
+            EXPECT_EQ(listed, std::vector<std::uint32_t>(res.lightIndices.begin() + res.listOffset[l],
+                                                         res.lightIndices.begin() + res.listOffset[l] + res.listCount[l]));
+            if (alg == Algorithm::All) {
+                EXPECT_EQ(f[0], "-1");
+                EXPECT_EQ(f[1], "-1");
+                continue;
+            }
+            const std::uint32_t t = std::uint32_t(l / res.listsPerTile);
+            EXPECT_EQ(std::stoul(f[0]), t % res.grid.tilesX);
+            EXPECT_EQ(std::stoul(f[1]), t / res.grid.tilesX);
+            EXPECT_EQ(std::stoul(f[2]), l % res.listsPerTile);
+            const bool empty = !(res.tileDepthMin[t] <= res.tileDepthMax[t]);
+            if (empty) {
+                ++emptyDepthRows;
+                EXPECT_EQ(f[3], "");
+                EXPECT_EQ(f[4], "");
+            } else if (alg == Algorithm::MinMax || alg == Algorithm::TwoPointFiveD) {
+                // Round-trip precision: the text reads back as the same double.
+                EXPECT_EQ(std::strtod(f[3].c_str(), nullptr), res.tileDepthMin[t]);
+                EXPECT_EQ(std::strtod(f[4].c_str(), nullptr), res.tileDepthMax[t]);
+            } else if (alg == Algorithm::HalfZ) {
+                const double split_ = res.halfzSplit[t];
+                EXPECT_EQ(std::strtod(f[l % 2 ? 3 : 4].c_str(), nullptr), split_);
+            }
+            if (alg == Algorithm::TwoPointFiveD || alg == Algorithm::Clustered)
+                EXPECT_EQ(std::stoul(f[5]), res.cellMask[t]);
+        }
+        if (alg != Algorithm::All) EXPECT_GT(emptyDepthRows, 0u) << "sky should have empty tiles";
+    }
+}
+
+TEST(Export, HeatmapPngIsReadableWithImageSizeAndLegend) {
+    TempDir tmp;
+    const PipelineRun r = runBuiltin("atrium", Algorithm::MinMax, 160, 90);
+    const RgbImage img = heatmapImage(r.out);
+    EXPECT_EQ(img.width, 160u);
+    EXPECT_GT(img.height, 90u); // the legend band below the image
+    const fs::path p = tmp.path / "h.png";
+    writePng(img, p.string());
+    const Png back = readPng(p);
+    ASSERT_EQ(back.width, img.width);
+    ASSERT_EQ(back.height, img.height);
+    EXPECT_EQ(back.rgb, img.rgb);
+    // The colour bar runs from viridis' dark purple (left) to its yellow (right).
+    const std::uint32_t barY = 90 + 8;
+    const std::uint8_t* left = &back.rgb[(std::size_t(barY) * 160 + 4) * 3];
+    const std::uint8_t* right = &back.rgb[(std::size_t(barY) * 160 + 155) * 3];
+    EXPECT_LT(left[1], 20);
+    EXPECT_GT(left[2], left[0]);
+    EXPECT_GT(right[0], 200);
+    EXPECT_GT(right[1], 200);
+    EXPECT_LT(right[2], 80);
+    EXPECT_THROW(writePng(img, (tmp.path / "missing" / "h.png").string()), Error);
+}
+
+TEST(Export, DiagnosticsFolderIsWrittenAndReplacedAtomically) {
+    TempDir tmp;
+    const PipelineRun r = runBuiltin("wall", Algorithm::TwoPointFiveD, 64, 48);
+    const fs::path out = tmp.path / "diag";
+    exportDiagnostics(r.scene, r.settings, r.out, out.string());
+    EXPECT_EQ(tmp.entries(), std::vector<std::string>{"diag"});
+    EXPECT_EQ(readText(out / "summary.json"), summaryJson(r.scene, r.settings, r.out));
+    EXPECT_EQ(readText(out / "tiles.csv"), tilesCsv(r.out));
+    EXPECT_EQ(readPng(out / "heatmap.png").width, 64u);
+
+    // A second export replaces the first; nothing else stays beside it.
+    PipelineRun r2 = runBuiltin("wall", Algorithm::Naive, 64, 48);
+    exportDiagnostics(r2.scene, r2.settings, r2.out, out.string() + "/");
+    EXPECT_EQ(tmp.entries(), std::vector<std::string>{"diag"});
+    EXPECT_EQ(readText(out / "summary.json"), summaryJson(r2.scene, r2.settings, r2.out));
+}
+
+TEST(Export, FailureLeavesNothingBehind) {
+    TempDir tmp;
+    const PipelineRun r = runBuiltin("wall", Algorithm::MinMax, 32, 32, false);
+
+    // Parent folder missing.
+    EXPECT_THROW(exportDiagnostics(r.scene, r.settings, r.out, (tmp.path / "no" / "diag").string()), Error);
+    EXPECT_TRUE(tmp.entries().empty());
+
+    // Parent is a regular file.
+    { std::ofstream(tmp.path / "file") << "x"; }
+    EXPECT_THROW(exportDiagnostics(r.scene, r.settings, r.out, (tmp.path / "file" / "diag").string()), Error);
+    EXPECT_EQ(tmp.entries(), std::vector<std::string>{"file"});
+
+    // Target exists as a file, or as a folder holding something else: refused, untouched.
+    EXPECT_THROW(exportDiagnostics(r.scene, r.settings, r.out, (tmp.path / "file").string()), Error);
+    EXPECT_EQ(readText(tmp.path / "file"), "x");
+    fs::create_directory(tmp.path / "mine");
+    { std::ofstream(tmp.path / "mine" / "notes.txt") << "keep"; }
+    EXPECT_THROW(exportDiagnostics(r.scene, r.settings, r.out, (tmp.path / "mine").string()), Error);
+    EXPECT_EQ(readText(tmp.path / "mine" / "notes.txt"), "keep");
+
+    // A failure after the temporary folder was filled halfway (the PNG of an
+    // empty image cannot be written): the previous export stays as it was and
+    // the temporary folder is gone.
+    const fs::path out = tmp.path / "diag";
+    exportDiagnostics(r.scene, r.settings, r.out, out.string());
+    const std::string before = readText(out / "summary.json");
+    RunOutput broken = r.out;
+    broken.depth = DepthImage{};
+    EXPECT_THROW(exportDiagnostics(r.scene, r.settings, broken, out.string()), Error);
+    EXPECT_EQ(readText(out / "summary.json"), before);
+    EXPECT_EQ(tmp.entries(), (std::vector<std::string>{"diag", "file", "mine"}));
+}
