@@ -35,6 +35,68 @@ LC_INLINE float lcViewDepthFromWindowDepth(float d, vec4 p) {
     return (p.z > 0.5f) ? (d - p.x) / p.y : p.y / (d - p.x);
 }
 
+// ---------------------------------------------------------------------------
+// Vulkan culling passes (shaders/*.comp, culling/src/vk/). The enumerations
+// follow the C++ enums' order (Algorithm, SphereTest, Slicing).
+const uint LC_ALG_ALL = 0u;
+const uint LC_ALG_NAIVE = 1u;
+const uint LC_ALG_MINMAX = 2u;
+const uint LC_ALG_HALFZ = 3u;
+const uint LC_ALG_25D = 4u;
+const uint LC_ALG_CLUSTERED = 5u;
+const uint LC_TEST_PLANES = 0u;
+const uint LC_TEST_PLANES_AABB = 1u;
+const uint LC_TEST_EXACT = 2u;
+const uint LC_SLICING_LOG = 0u;
+const uint LC_SLICING_LINEAR = 1u;
+// GpuCullParams.flags bits.
+const uint LC_FLAG_ORTHO = 1u;         // orthographic projection
+const uint LC_FLAG_REVERSED = 2u;      // reversed-Z (nearer = larger window depth)
+const uint LC_FLAG_FAR_INFINITE = 4u;  // camera far plane at +infinity: no far plane
+const uint LC_FLAG_SKIP_EMPTY = 8u;    // clustered: clusters without geometry get no lights
+
+// Per-dispatch parameters of the culling passes (one read-only storage buffer,
+// std430). Sizes and modes that shape the code (tile size, cells, slicing,
+// sphere test, algorithm) are specialisation constants instead.
+struct GpuCullParams {
+    uvec4 size;       // width, height, tilesX, tilesY (pixels, tiles)
+    uvec4 counts;     // lightCount, listsPerTile, listCount, flags (LC_FLAG_*)
+    // Window depth -> view depth, split for precision: A = aHi + aLo exactly
+    // enough that (d - aHi) - aLo keeps float precision near the far plane,
+    // where d - A cancels. x = aHi, y = B, z = aLo, w = clear depth.
+    vec4 depth;
+    // Perspective: x = tan(fovX/2), y = tan(fovY/2) (view position at depth z
+    // of NDC (u,v): (u*x*z, -v*y*z, -z)). Orthographic: half width/height.
+    // z = camera near, w = the far depth of `naive`: the camera's far plane,
+    // or with an infinite far plane the farthest depth any light reaches (as
+    // the CPU reference does; LC_FLAG_FAR_INFINITE then records the fact).
+    vec4 lens;
+    // x = clusterNear, y = clusterFar (clustered slicing range, view depth),
+    // z = relative epsilon, w = absolute epsilon (view units) by which depth
+    // bounds and radii are widened so the GPU lists are a superset of the
+    // double-precision reference's.
+    vec4 cluster;
+};
+
+// Per-tile output of the bounds pass (std430, 16 bytes). View depths of the
+// tile's geometry pixels (float): depthMin > depthMax marks an empty tile.
+struct GpuTileBounds {
+    float depthMin;
+    float depthMax;
+    float split;      // halfz: (depthMin + depthMax) / 2, computed in float
+    uint cellMask;    // 2.5d: occupied cells; clustered: occupied slices
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(GpuCullParams) == 80, "GpuCullParams must match std430");
+static_assert(offsetof(GpuCullParams, counts) == 16, "GpuCullParams.counts offset");
+static_assert(offsetof(GpuCullParams, depth) == 32, "GpuCullParams.depth offset");
+static_assert(offsetof(GpuCullParams, lens) == 48, "GpuCullParams.lens offset");
+static_assert(offsetof(GpuCullParams, cluster) == 64, "GpuCullParams.cluster offset");
+static_assert(sizeof(GpuTileBounds) == 16, "GpuTileBounds must match std430");
+static_assert(offsetof(GpuTileBounds, cellMask) == 12, "GpuTileBounds.cellMask offset");
+#endif
+
 #ifdef __cplusplus
 inline double lcViewDepthFromWindowDepthD(double d, double a, double b, bool ortho) {
     return ortho ? (d - a) / b : b / (d - a);

@@ -1,10 +1,613 @@
-// Placeholder until the Vulkan passes land (issue 3).
+// The Vulkan backend: the depth pre-pass as a depth-only graphics pipeline and
+// the culling passes as compute, headless (no window, no swapchain).
+//
+// Culling, per call (shaders/*.comp; one workgroup = one subgroup everywhere):
+//   1. tile_bounds  (tilesX x tilesY groups): per-tile view-depth min/max over
+//      the geometry pixels, halfz split, 2.5d cell / clustered slice masks.
+//   2. cull_lists count pass (one group per list): lights tested in strides of
+//      the subgroup size, counted by ballot.
+//   3. prefix_sum: counts -> offsets, total in offsets[N].
+//   -- the host reads the total and allocates the index array exactly --
+//   4. cull_lists write pass: the same tests, indices written ascending.
+// So memory is the entries the scene produces, with no per-list cap and no
+// tiles x lights x cells allocation.
 #include "vk/vulkan_backend.hpp"
+
 #include "culling/errors.hpp"
+#include "culling/gpu_shared.h"
+#include "embedded_spirv.hpp"
+#include "vk/vk_context.hpp"
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
+
+// Vulkan create-info structs are value-initialised as {VK_STRUCTURE_TYPE_...}:
+// the remaining members are zero on purpose.
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 
 namespace lc {
-std::unique_ptr<CullBackend> makeVulkanBackend(const std::string&) {
-    throw DeviceError("the Vulkan backend is not built yet");
+
+namespace {
+
+using namespace vk;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Widening of every float comparison (see cull_common.glsl): relative 2e-5 is
+// ~170 float ulps, far above the rounding of the float passes and far below any
+// distance a scene cares about; the absolute term covers values near zero.
+constexpr float kRelEps = 2e-5f;
+constexpr float kAbsEps = 1e-6f;
+
+constexpr std::uint32_t kBindings = 8; // cull_common.glsl bindings 0..7
+enum Binding : std::uint32_t { bParams, bDepth, bTiles, bLights, bCounts, bOffsets, bIndices, bStatus };
+
+// Memory barrier between two compute dispatches of one command buffer.
+void computeBarrier(VkCommandBuffer cmd, VkAccessFlags dstAccess, VkPipelineStageFlags dstStage) {
+    VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    mb.dstAccessMask = dstAccess;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, dstStage, 0, 1, &mb, 0, nullptr, 0,
+                         nullptr);
 }
-std::vector<std::string> vulkanDeviceNames() { return {}; }
+
+// Window depth d = A + B / v (perspective) or A + B * v (orthographic), with A
+// and B recovered in double from the projection itself (two exact samples).
+void depthConstants(const Projection& proj, double& a, double& b) {
+    const double v1 = proj.nearPlane(), v2 = proj.orthographic() ? proj.nearPlane() + 1.0 : 2.0 * proj.nearPlane();
+    const double d1 = proj.windowDepthFromViewDepth(v1), d2 = proj.windowDepthFromViewDepth(v2);
+    if (proj.orthographic()) {
+        b = (d2 - d1) / (v2 - v1);
+        a = d1 - b * v1;
+    } else {
+        b = (d1 - d2) / (1.0 / v1 - 1.0 / v2);
+        a = d1 - b / v1;
+    }
+}
+
+class VulkanBackend final : public CullBackend {
+public:
+    explicit VulkanBackend(const std::string& device) : ctx_(ContextOptions{device, "lc"}) {
+        createComputeObjects();
+    }
+    std::string name() const override { return "vulkan"; }
+    std::string deviceName() const override { return ctx_.deviceName(); }
+    // Compute timestamps read wrong on lavapipe once the device has rendered
+    // (DESIGN.md), and this device renders the depth pre-pass: take CPU time
+    // around submit + fence wait instead, for both passes.
+    std::string timingMethod() const override { return "cpu-wall-clock around vkQueueSubmit+vkWaitForFences"; }
+
+    DepthImage renderDepth(const Scene& scene, const Projection& proj) override;
+    CullResult cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
+                    const ViewLights& lights, const CullSettings& settings) override;
+
+private:
+    void createComputeObjects();
+    VkPipeline computePipeline(const char* what, VkShaderModule module, const std::array<std::uint32_t, 7>& spec);
+    VkPipeline depthPipeline(bool reversed);
+    VkRenderPass depthRenderPass(bool reversed);
+
+    Context ctx_;
+    DescriptorSetLayoutHandle setLayout_;
+    PipelineLayoutHandle computeLayout_;
+    ShaderModuleHandle boundsShader_, cullShader_, scanShader_, vertShader_;
+    std::map<std::string, PipelineHandle> computePipelines_;
+    PipelineLayoutHandle depthLayout_;
+    RenderPassHandle renderPass_[2];
+    PipelineHandle depthPipeline_[2];
+};
+
+void VulkanBackend::createComputeObjects() {
+    VkDevice dev = ctx_.device();
+    std::array<VkDescriptorSetLayoutBinding, kBindings> b{};
+    for (std::uint32_t i = 0; i < kBindings; ++i) {
+        b[i].binding = i;
+        b[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        b[i].descriptorCount = 1;
+        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    }
+    VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    lci.bindingCount = kBindings;
+    lci.pBindings = b.data();
+    VkDescriptorSetLayout sl;
+    LC_VK(vkCreateDescriptorSetLayout(dev, &lci, nullptr, &sl));
+    setLayout_ = DescriptorSetLayoutHandle(dev, sl);
+    ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, sl, "cull.setLayout");
+    VkPipelineLayoutCreateInfo pci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    pci.setLayoutCount = 1;
+    pci.pSetLayouts = &sl;
+    VkPipelineLayout pl;
+    LC_VK(vkCreatePipelineLayout(dev, &pci, nullptr, &pl));
+    computeLayout_ = PipelineLayoutHandle(dev, pl);
+    ctx_.name(VK_OBJECT_TYPE_PIPELINE_LAYOUT, pl, "cull.pipelineLayout");
+
+    auto mk = [&](spirv::Code c, const char* n) { return ctx_.createShader(c.words, c.wordCount, n); };
+    boundsShader_ = mk(spirv::tileBounds(), "shader.tile_bounds");
+    cullShader_ = mk(spirv::cullLists(), "shader.cull_lists");
+    scanShader_ = mk(spirv::prefixSum(), "shader.prefix_sum");
+    vertShader_ = mk(spirv::depthVert(), "shader.depth_vert");
+}
+
+// Specialisation constants, ids as in cull_common.glsl: 0 local size (= the
+// subgroup size), 1 tile size, 2 cells, 3 slicing, 4 algorithm, 5 sphere
+// test, 6 write pass. Pipelines are cached per combination.
+VkPipeline VulkanBackend::computePipeline(const char* what, VkShaderModule module,
+                                          const std::array<std::uint32_t, 7>& spec) {
+    std::string key = what;
+    for (auto v : spec) key += "." + std::to_string(v);
+    auto it = computePipelines_.find(key);
+    if (it != computePipelines_.end()) return it->second;
+    std::array<VkSpecializationMapEntry, 7> entries{};
+    for (std::uint32_t i = 0; i < 7; ++i) entries[i] = {i, i * 4u, 4u};
+    VkSpecializationInfo si{};
+    si.mapEntryCount = 7;
+    si.pMapEntries = entries.data();
+    si.dataSize = sizeof(spec);
+    si.pData = spec.data();
+    VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    ci.stage.module = module;
+    ci.stage.pName = "main";
+    ci.stage.pSpecializationInfo = &si;
+    // Full subgroups: a workgroup of subgroupSize invocations is one subgroup.
+    if (ctx_.fullSubgroupsSupported()) ci.stage.flags = VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT;
+    ci.layout = computeLayout_;
+    VkPipeline p;
+    LC_VK(vkCreateComputePipelines(ctx_.device(), VK_NULL_HANDLE, 1, &ci, nullptr, &p));
+    ctx_.name(VK_OBJECT_TYPE_PIPELINE, p, "pipeline." + key);
+    return computePipelines_.emplace(key, PipelineHandle(ctx_.device(), p)).first->second;
+}
+
+VkRenderPass VulkanBackend::depthRenderPass(bool reversed) {
+    RenderPassHandle& rp = renderPass_[reversed ? 1 : 0];
+    if (rp) return rp;
+    VkAttachmentDescription att{};
+    att.format = VK_FORMAT_D32_SFLOAT;
+    att.samples = VK_SAMPLE_COUNT_1_BIT;
+    att.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    att.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    att.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
+    att.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    att.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    att.finalLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    VkAttachmentReference ref{0, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
+    VkSubpassDescription sub{};
+    sub.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+    sub.pDepthStencilAttachment = &ref;
+    std::array<VkSubpassDependency, 2> deps{};
+    // Before: the clear (a depth write at early fragment tests) after the
+    // UNDEFINED -> attachment layout transition of a fresh image.
+    deps[0].srcSubpass = VK_SUBPASS_EXTERNAL;
+    deps[0].dstSubpass = 0;
+    deps[0].srcStageMask = VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+    deps[0].dstStageMask = VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+    deps[0].srcAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+    deps[0].dstAccessMask =
+        VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+    // After: the copy to the readback buffer reads what the depth test wrote
+    // (read-after-write on the attachment, and the layout transition to
+    // TRANSFER_SRC ordered between them).
+    deps[1].srcSubpass = 0;
+    deps[1].dstSubpass = VK_SUBPASS_EXTERNAL;
+    deps[1].srcStageMask = VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+    deps[1].dstStageMask = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    deps[1].srcAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+    deps[1].dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+    VkRenderPassCreateInfo ci{VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
+    ci.attachmentCount = 1;
+    ci.pAttachments = &att;
+    ci.subpassCount = 1;
+    ci.pSubpasses = &sub;
+    ci.dependencyCount = std::uint32_t(deps.size());
+    ci.pDependencies = deps.data();
+    VkRenderPass r;
+    LC_VK(vkCreateRenderPass(ctx_.device(), &ci, nullptr, &r));
+    ctx_.name(VK_OBJECT_TYPE_RENDER_PASS, r, reversed ? "depth.renderPass.reversed" : "depth.renderPass");
+    rp = RenderPassHandle(ctx_.device(), r);
+    return rp;
+}
+
+VkPipeline VulkanBackend::depthPipeline(bool reversed) {
+    PipelineHandle& pipe = depthPipeline_[reversed ? 1 : 0];
+    if (pipe) return pipe;
+    VkDevice dev = ctx_.device();
+    if (!depthLayout_) {
+        VkPushConstantRange pc{VK_SHADER_STAGE_VERTEX_BIT, 0, 64};
+        VkPipelineLayoutCreateInfo lci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+        lci.pushConstantRangeCount = 1;
+        lci.pPushConstantRanges = &pc;
+        VkPipelineLayout l;
+        LC_VK(vkCreatePipelineLayout(dev, &lci, nullptr, &l));
+        depthLayout_ = PipelineLayoutHandle(dev, l);
+        ctx_.name(VK_OBJECT_TYPE_PIPELINE_LAYOUT, l, "depth.pipelineLayout");
+    }
+    VkPipelineShaderStageCreateInfo stage{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    stage.stage = VK_SHADER_STAGE_VERTEX_BIT;
+    stage.module = vertShader_;
+    stage.pName = "main";
+    VkVertexInputBindingDescription vb{0, 12, VK_VERTEX_INPUT_RATE_VERTEX};
+    VkVertexInputAttributeDescription va{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0};
+    VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    vi.vertexBindingDescriptionCount = 1;
+    vi.pVertexBindingDescriptions = &vb;
+    vi.vertexAttributeDescriptionCount = 1;
+    vi.pVertexAttributeDescriptions = &va;
+    VkPipelineInputAssemblyStateCreateInfo ia{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+    VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    vp.viewportCount = 1;
+    vp.scissorCount = 1;
+    VkPipelineRasterizationStateCreateInfo rs{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    rs.depthClampEnable = VK_FALSE; // clip at near (and far) like the CPU rasteriser
+    rs.polygonMode = VK_POLYGON_MODE_FILL;
+    rs.cullMode = VK_CULL_MODE_NONE; // both faces, as the CPU rasteriser
+    rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    rs.lineWidth = 1.0f;
+    VkPipelineMultisampleStateCreateInfo ms{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+    VkPipelineDepthStencilStateCreateInfo ds{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+    ds.depthTestEnable = VK_TRUE;
+    ds.depthWriteEnable = VK_TRUE;
+    ds.depthCompareOp = reversed ? VK_COMPARE_OP_GREATER : VK_COMPARE_OP_LESS;
+    VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    std::array<VkDynamicState, 2> dyn{VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dsi{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    dsi.dynamicStateCount = std::uint32_t(dyn.size());
+    dsi.pDynamicStates = dyn.data();
+    VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+    ci.stageCount = 1; // depth only: no fragment shader
+    ci.pStages = &stage;
+    ci.pVertexInputState = &vi;
+    ci.pInputAssemblyState = &ia;
+    ci.pViewportState = &vp;
+    ci.pRasterizationState = &rs;
+    ci.pMultisampleState = &ms;
+    ci.pDepthStencilState = &ds;
+    ci.pColorBlendState = &cb;
+    ci.pDynamicState = &dsi;
+    ci.layout = depthLayout_;
+    ci.renderPass = depthRenderPass(reversed);
+    VkPipeline p;
+    LC_VK(vkCreateGraphicsPipelines(dev, VK_NULL_HANDLE, 1, &ci, nullptr, &p));
+    ctx_.name(VK_OBJECT_TYPE_PIPELINE, p, reversed ? "depth.pipeline.reversed" : "depth.pipeline");
+    pipe = PipelineHandle(dev, p);
+    return pipe;
+}
+
+DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj) {
+    const std::uint32_t W = proj.width(), H = proj.height();
+    if (W == 0 || H == 0) throw SettingsError("camera.width", "resolution must be at least 1x1");
+    const auto& lim = ctx_.properties().limits;
+    if (W > lim.maxFramebufferWidth || H > lim.maxFramebufferHeight || W > lim.maxImageDimension2D ||
+        H > lim.maxImageDimension2D)
+        throw SettingsError("camera.width", "resolution " + std::to_string(W) + "x" + std::to_string(H) +
+                                                " exceeds the device's framebuffer limit");
+    const bool reversed = isReversed(proj.kind());
+    const float clearDepth = float(proj.clearDepth());
+    VkDevice dev = ctx_.device();
+
+    // All meshes in one vertex and one index buffer; one draw per mesh.
+    struct Draw {
+        glm::mat4 clipFromModel;
+        std::uint32_t firstIndex, indexCount;
+        std::int32_t vertexOffset;
+    };
+    std::vector<Draw> draws;
+    std::size_t vertexFloats = 0, indexCount = 0;
+    const glm::dmat4 clipFromWorld = proj.clipFromView() * scene.camera.viewFromWorld();
+    for (const Mesh& m : scene.meshes) {
+        if (m.triangleCount() == 0) continue;
+        // Composed in double, rounded once to float.
+        draws.push_back({glm::mat4(clipFromWorld * m.transform), std::uint32_t(indexCount),
+                         std::uint32_t(m.triangleCount() * 3), std::int32_t(vertexFloats / 3)});
+        vertexFloats += m.vertexCount() * 3;
+        indexCount += m.triangleCount() * 3;
+    }
+    Buffer vbuf = ctx_.createBuffer(vertexFloats * 4, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "depth.vertices");
+    Buffer ibuf = ctx_.createBuffer(indexCount * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "depth.indices");
+    {
+        float* v = vbuf.as<float>();
+        std::uint32_t* ix = ibuf.as<std::uint32_t>();
+        for (const Mesh& m : scene.meshes) {
+            if (m.triangleCount() == 0) continue;
+            std::memcpy(v, m.positions.data(), m.vertexCount() * 12);
+            v += m.vertexCount() * 3;
+            std::memcpy(ix, m.indices.data(), m.triangleCount() * 12);
+            ix += m.triangleCount() * 3;
+        }
+    }
+    Image img = ctx_.createDepthImage(W, H, VK_FORMAT_D32_SFLOAT, "depth.image");
+    Buffer readback = ctx_.createBuffer(VkDeviceSize(W) * H * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "depth.readback");
+    VkRenderPass rp = depthRenderPass(reversed);
+    VkPipeline pipe = depthPipeline(reversed);
+    VkFramebufferCreateInfo fci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+    fci.renderPass = rp;
+    fci.attachmentCount = 1;
+    VkImageView view = img.view;
+    fci.pAttachments = &view;
+    fci.width = W;
+    fci.height = H;
+    fci.layers = 1;
+    VkFramebuffer fbRaw;
+    LC_VK(vkCreateFramebuffer(dev, &fci, nullptr, &fbRaw));
+    FramebufferHandle fb(dev, fbRaw);
+    ctx_.name(VK_OBJECT_TYPE_FRAMEBUFFER, fbRaw, "depth.framebuffer");
+
+    lastDepthMs_ = ctx_.submitAndWait(
+        [&](VkCommandBuffer cmd) {
+            VkClearValue clear{};
+            clear.depthStencil.depth = clearDepth;
+            VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+            rbi.renderPass = rp;
+            rbi.framebuffer = fb;
+            rbi.renderArea = {{0, 0}, {W, H}};
+            rbi.clearValueCount = 1;
+            rbi.pClearValues = &clear;
+            vkCmdBeginRenderPass(cmd, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+            if (!draws.empty()) {
+                vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
+                VkViewport vpt{0.0f, 0.0f, float(W), float(H), 0.0f, 1.0f};
+                VkRect2D sc{{0, 0}, {W, H}};
+                vkCmdSetViewport(cmd, 0, 1, &vpt);
+                vkCmdSetScissor(cmd, 0, 1, &sc);
+                VkDeviceSize off = 0;
+                VkBuffer vb = vbuf.buffer;
+                vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &off);
+                vkCmdBindIndexBuffer(cmd, ibuf.buffer, 0, VK_INDEX_TYPE_UINT32);
+                for (const Draw& d : draws) {
+                    vkCmdPushConstants(cmd, depthLayout_, VK_SHADER_STAGE_VERTEX_BIT, 0, 64,
+                                       glm::value_ptr(d.clipFromModel));
+                    vkCmdDrawIndexed(cmd, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
+                }
+            }
+            vkCmdEndRenderPass(cmd);
+            VkBufferImageCopy region{};
+            region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+            region.imageExtent = {W, H, 1};
+            vkCmdCopyImageToBuffer(cmd, img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1, &region);
+            // Host reads the readback buffer after the copy wrote it.
+            VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+            mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+            mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0,
+                                 nullptr, 0, nullptr);
+        },
+        "depth.commands");
+
+    DepthImage out;
+    out.width = W;
+    out.height = H;
+    out.clearDepth = clearDepth;
+    out.depth.resize(std::size_t(W) * H);
+    std::memcpy(out.depth.data(), readback.mapped, out.depth.size() * 4);
+    return out;
+}
+
+CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
+                               const ViewLights& lights, const CullSettings& settings) {
+    if (std::string e = settings.validate(); !e.empty()) throw SettingsError("settings", e);
+    if (depth.width != proj.width() || depth.height != proj.height() ||
+        depth.depth.size() != std::size_t(depth.width) * depth.height)
+        throw Error("depth image is " + std::to_string(depth.width) + "x" + std::to_string(depth.height) +
+                    ", the camera's resolution " + std::to_string(proj.width()) + "x" +
+                    std::to_string(proj.height()));
+    if (grid.width != proj.width() || grid.height != proj.height())
+        throw Error("tile grid does not match the camera's resolution");
+    if (lights.centers.size() != lights.size()) throw Error("view lights: centres and radii differ in count");
+
+    const Algorithm algo = settings.algorithm;
+    const std::uint32_t tiles = grid.tileCount(), cells = settings.cells;
+    const std::uint32_t n = std::uint32_t(lights.size());
+    const auto& lim = ctx_.properties().limits;
+    if (grid.tilesX > lim.maxComputeWorkGroupCount[0] || grid.tilesY > lim.maxComputeWorkGroupCount[1])
+        throw SettingsError("tile", "too many tiles for one dispatch on this device");
+
+    CullResult res;
+    res.algorithm = algo;
+    res.settings = settings;
+    res.grid = grid;
+    res.listsPerTile = algo == Algorithm::HalfZ ? 2 : algo == Algorithm::Clustered ? cells : 1;
+    const std::uint64_t listTotal64 = algo == Algorithm::All ? 1 : std::uint64_t(tiles) * res.listsPerTile;
+    if (listTotal64 >= std::numeric_limits<std::uint32_t>::max())
+        throw SettingsError("tile", "more than 2^32 light lists");
+    const std::uint32_t listTotal = std::uint32_t(listTotal64);
+
+    // The depth ranges of naive and clustered, exactly as the CPU reference.
+    double lightFar = 0.0;
+    for (std::size_t l = 0; l < n; ++l) lightFar = std::max(lightFar, -lights.centers[l].z + lights.radii[l]);
+    const double camNear = proj.nearPlane();
+    const bool farInfinite = !std::isfinite(proj.farPlane());
+    const double naiveFar = farInfinite ? std::max(lightFar, camNear) : proj.farPlane();
+    if (algo == Algorithm::Clustered) {
+        res.clusterNear = camNear;
+        res.clusterFar = farInfinite ? std::max(lightFar, 2.0 * camNear) : proj.farPlane();
+    }
+
+    // Buffers (sizes from the inputs; the index array comes after the count).
+    Buffer params = ctx_.createBuffer(sizeof(GpuCullParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.params");
+    Buffer depthBuf = ctx_.createBuffer(depth.depth.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.depth");
+    Buffer tileBuf = ctx_.createBuffer(std::size_t(tiles) * sizeof(GpuTileBounds), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                       "cull.tiles");
+    Buffer lightBuf = ctx_.createBuffer(std::size_t(n) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.lights");
+    Buffer countBuf = ctx_.createBuffer(std::size_t(listTotal) * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.counts");
+    Buffer offsetBuf =
+        ctx_.createBuffer((std::size_t(listTotal) + 1) * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.offsets");
+    Buffer statusBuf = ctx_.createBuffer(4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.status");
+    Buffer placeholder = ctx_.createBuffer(4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.indices.placeholder");
+
+    {
+        GpuCullParams& p = *params.as<GpuCullParams>();
+        p = GpuCullParams{};
+        std::uint32_t flags = 0;
+        if (proj.orthographic()) flags |= LC_FLAG_ORTHO;
+        if (isReversed(proj.kind())) flags |= LC_FLAG_REVERSED;
+        if (farInfinite) flags |= LC_FLAG_FAR_INFINITE;
+        if (settings.skipEmpty) flags |= LC_FLAG_SKIP_EMPTY;
+        p.size = glm::uvec4(grid.width, grid.height, grid.tilesX, grid.tilesY);
+        p.counts = glm::uvec4(n, res.listsPerTile, listTotal, flags);
+        double a, b;
+        depthConstants(proj, a, b);
+        const float aHi = float(a);
+        p.depth = glm::vec4(aHi, float(b), float(a - double(aHi)), depth.clearDepth);
+        const glm::dvec3 corner = proj.viewPositionAt({double(proj.width()), 0.0}, 1.0);
+        p.lens = glm::vec4(float(corner.x), float(corner.y), float(camNear), float(naiveFar));
+        p.cluster = glm::vec4(float(res.clusterNear), float(res.clusterFar), kRelEps, kAbsEps);
+        std::memcpy(depthBuf.mapped, depth.depth.data(), depth.depth.size() * 4);
+        float* L = lightBuf.as<float>();
+        for (std::uint32_t l = 0; l < n; ++l) {
+            L[4 * l + 0] = float(lights.centers[l].x);
+            L[4 * l + 1] = float(lights.centers[l].y);
+            L[4 * l + 2] = float(lights.centers[l].z);
+            L[4 * l + 3] = float(lights.radii[l]);
+        }
+        *statusBuf.as<std::uint32_t>() = 0;
+    }
+
+    // Descriptor sets: one for passes 1-3, one with the sized index array for pass 4.
+    VkDevice dev = ctx_.device();
+    VkDescriptorPoolSize ps{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 * kBindings};
+    VkDescriptorPoolCreateInfo dpci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    dpci.maxSets = 2;
+    dpci.poolSizeCount = 1;
+    dpci.pPoolSizes = &ps;
+    VkDescriptorPool poolRaw;
+    LC_VK(vkCreateDescriptorPool(dev, &dpci, nullptr, &poolRaw));
+    DescriptorPoolHandle pool(dev, poolRaw);
+    ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_POOL, poolRaw, "cull.descriptorPool");
+    auto makeSet = [&](const Buffer& indices, const char* nm) {
+        VkDescriptorSetLayout sl = setLayout_;
+        VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+        ai.descriptorPool = pool;
+        ai.descriptorSetCount = 1;
+        ai.pSetLayouts = &sl;
+        VkDescriptorSet set;
+        LC_VK(vkAllocateDescriptorSets(dev, &ai, &set));
+        ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_SET, set, nm);
+        const Buffer* bufs[kBindings] = {&params, &depthBuf, &tileBuf, &lightBuf, &countBuf, &offsetBuf, &indices,
+                                         &statusBuf};
+        std::array<VkDescriptorBufferInfo, kBindings> infos{};
+        std::array<VkWriteDescriptorSet, kBindings> writes{};
+        for (std::uint32_t i = 0; i < kBindings; ++i) {
+            infos[i] = {bufs[i]->buffer, 0, VK_WHOLE_SIZE};
+            writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+            writes[i].dstSet = set;
+            writes[i].dstBinding = i;
+            writes[i].descriptorCount = 1;
+            writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+            writes[i].pBufferInfo = &infos[i];
+        }
+        vkUpdateDescriptorSets(dev, kBindings, writes.data(), 0, nullptr);
+        return set;
+    };
+    VkDescriptorSet set1 = makeSet(placeholder, "cull.set.count");
+
+    const std::uint32_t sg = ctx_.subgroupSize();
+    const std::uint32_t algoId = std::uint32_t(algo), testId = std::uint32_t(settings.test),
+                        slicingId = std::uint32_t(settings.slicing);
+    auto spec = [&](std::uint32_t write) {
+        return std::array<std::uint32_t, 7>{sg, grid.tileSize, cells, slicingId, algoId, testId, write};
+    };
+    VkPipeline boundsPipe = computePipeline("tile_bounds", boundsShader_, spec(0));
+    VkPipeline countPipe = computePipeline("cull_lists.count", cullShader_, spec(0));
+    VkPipeline scanPipe = computePipeline("prefix_sum", scanShader_, spec(0));
+    VkPipeline writePipe = computePipeline("cull_lists.write", cullShader_, spec(1));
+    const std::uint32_t gx = std::min<std::uint32_t>(listTotal, lim.maxComputeWorkGroupCount[0]);
+    const std::uint32_t gy = (listTotal + gx - 1) / gx;
+    if (gy > lim.maxComputeWorkGroupCount[1]) throw SettingsError("tile", "too many light lists for one dispatch");
+
+    double ms = ctx_.submitAndWait(
+        [&](VkCommandBuffer cmd) {
+            vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, computeLayout_, 0, 1, &set1, 0, nullptr);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, boundsPipe);
+            vkCmdDispatch(cmd, grid.tilesX, grid.tilesY, 1);
+            // The count pass reads the tile bounds (and ORs status) the bounds pass wrote.
+            computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, countPipe);
+            vkCmdDispatch(cmd, gx, gy, 1);
+            // The scan reads the counts the count pass wrote.
+            computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scanPipe);
+            vkCmdDispatch(cmd, 1, 1, 1);
+            // The host reads the total, counts, bounds and status after this submit.
+            computeBarrier(cmd, VK_ACCESS_HOST_READ_BIT, VK_PIPELINE_STAGE_HOST_BIT);
+        },
+        "cull.commands.count");
+
+    const std::uint32_t status = *statusBuf.as<std::uint32_t>();
+    if (status & 1u)
+        throw DeviceError("Vulkan device '" + ctx_.deviceName() +
+                          "' split a subgroup-sized workgroup into several subgroups; the culling passes need one");
+    const std::uint32_t* counts = countBuf.as<std::uint32_t>();
+    std::uint64_t total64 = 0;
+    for (std::uint32_t l = 0; l < listTotal; ++l) total64 += counts[l];
+    const std::uint32_t total = offsetBuf.as<std::uint32_t>()[listTotal];
+    if (total64 != total || total64 * 4 > lim.maxStorageBufferRange)
+        throw DeviceError("culling produced " + std::to_string(total64) +
+                          " list entries, more than one storage buffer of this device holds (" +
+                          std::to_string(lim.maxStorageBufferRange / 4) + ")");
+
+    Buffer indexBuf = ctx_.createBuffer(std::size_t(total) * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.indices");
+    if (total > 0) {
+        VkDescriptorSet set2 = makeSet(indexBuf, "cull.set.write");
+        ms += ctx_.submitAndWait(
+            [&](VkCommandBuffer cmd) {
+                // The write pass reads counts/offsets/bounds written by the previous submission.
+                computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+                vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, computeLayout_, 0, 1, &set2, 0,
+                                        nullptr);
+                vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, writePipe);
+                vkCmdDispatch(cmd, gx, gy, 1);
+                // The host reads the indices and status after this submit.
+                computeBarrier(cmd, VK_ACCESS_HOST_READ_BIT, VK_PIPELINE_STAGE_HOST_BIT);
+            },
+            "cull.commands.write");
+        if (*statusBuf.as<std::uint32_t>() & 2u)
+            throw DeviceError("Vulkan write pass found a different entry count than the count pass");
+    }
+
+    // Results out of the mapped buffers.
+    const GpuTileBounds* tb = tileBuf.as<GpuTileBounds>();
+    res.tileDepthMin.resize(tiles);
+    res.tileDepthMax.resize(tiles);
+    if (algo == Algorithm::HalfZ) res.halfzSplit.resize(tiles);
+    if (algo == Algorithm::TwoPointFiveD || algo == Algorithm::Clustered) res.cellMask.resize(tiles);
+    for (std::uint32_t t = 0; t < tiles; ++t) {
+        const bool empty = !(tb[t].depthMin <= tb[t].depthMax);
+        res.tileDepthMin[t] = empty ? kInf : double(tb[t].depthMin);
+        res.tileDepthMax[t] = empty ? -kInf : double(tb[t].depthMax);
+        if (algo == Algorithm::HalfZ) res.halfzSplit[t] = empty ? kInf : double(tb[t].split);
+        if (!res.cellMask.empty()) res.cellMask[t] = tb[t].cellMask;
+    }
+    res.listCount.assign(counts, counts + listTotal);
+    const std::uint32_t* offs = offsetBuf.as<std::uint32_t>();
+    res.listOffset.assign(offs, offs + listTotal);
+    const std::uint32_t* idx = indexBuf.as<std::uint32_t>();
+    res.lightIndices.assign(idx, idx + total);
+
+    res.backend = name();
+    res.device = deviceName();
+    res.timingMethod = timingMethod();
+    res.timings.cullMs = ms;
+    res.timings.depthMs = lastDepthMs_;
+    return res;
+}
+
+} // namespace
+
+std::unique_ptr<CullBackend> makeVulkanBackend(const std::string& device) {
+    return std::make_unique<VulkanBackend>(device);
+}
+
+std::vector<std::string> vulkanDeviceNames() { return vk::physicalDeviceNames(); }
+
 } // namespace lc

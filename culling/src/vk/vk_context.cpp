@@ -1,0 +1,456 @@
+#include "vk/vk_context.hpp"
+
+#include "vk/validation.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+
+// Vulkan create-info structs are value-initialised as {VK_STRUCTURE_TYPE_...}:
+// the remaining members are zero on purpose.
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+
+namespace lc::vk {
+
+const char* resultName(VkResult r) {
+    switch (r) {
+#define LC_CASE(x) case x: return #x;
+        LC_CASE(VK_SUCCESS) LC_CASE(VK_NOT_READY) LC_CASE(VK_TIMEOUT) LC_CASE(VK_INCOMPLETE)
+        LC_CASE(VK_ERROR_OUT_OF_HOST_MEMORY) LC_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
+        LC_CASE(VK_ERROR_INITIALIZATION_FAILED) LC_CASE(VK_ERROR_DEVICE_LOST)
+        LC_CASE(VK_ERROR_MEMORY_MAP_FAILED) LC_CASE(VK_ERROR_LAYER_NOT_PRESENT)
+        LC_CASE(VK_ERROR_EXTENSION_NOT_PRESENT) LC_CASE(VK_ERROR_FEATURE_NOT_PRESENT)
+        LC_CASE(VK_ERROR_INCOMPATIBLE_DRIVER) LC_CASE(VK_ERROR_TOO_MANY_OBJECTS)
+        LC_CASE(VK_ERROR_FORMAT_NOT_SUPPORTED) LC_CASE(VK_ERROR_FRAGMENTED_POOL)
+        LC_CASE(VK_ERROR_UNKNOWN) LC_CASE(VK_ERROR_OUT_OF_POOL_MEMORY)
+        LC_CASE(VK_ERROR_INVALID_EXTERNAL_HANDLE) LC_CASE(VK_ERROR_FRAGMENTATION)
+        LC_CASE(VK_ERROR_INVALID_SHADER_NV)
+#undef LC_CASE
+    default: return "VkResult(unknown)";
+    }
+}
+
+void throwVkError(const char* call, VkResult r, const char* file, int line) {
+    throw DeviceError(std::string("Vulkan call failed: ") + call + " returned " + resultName(r) + " (" +
+                      resultName(r) + " = " + std::to_string(int(r)) + ") at " + file + ":" +
+                      std::to_string(line));
+}
+
+namespace {
+
+VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                             VkDebugUtilsMessageTypeFlagsEXT,
+                                             const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
+    if (severity & (VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                    VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT)) {
+        std::string m = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error: " : "warning: ";
+        if (data && data->pMessageIdName) m += std::string(data->pMessageIdName) + ": ";
+        if (data && data->pMessage) m += data->pMessage;
+        recordValidationMessage(m);
+    }
+    return VK_FALSE; // never abort the call
+}
+
+std::string lower(std::string s) {
+    std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return s;
+}
+
+bool hasExtension(const std::vector<VkExtensionProperties>& exts, const char* name) {
+    return std::any_of(exts.begin(), exts.end(),
+                       [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+}
+
+std::vector<VkPhysicalDevice> enumerateDevices(VkInstance inst) {
+    std::uint32_t n = 0;
+    LC_VK(vkEnumeratePhysicalDevices(inst, &n, nullptr));
+    std::vector<VkPhysicalDevice> devs(n);
+    if (n) LC_VK(vkEnumeratePhysicalDevices(inst, &n, devs.data()));
+    devs.resize(n);
+    return devs;
+}
+
+// Picks the device per vulkan_backend.hpp's rule; throws naming what exists.
+VkPhysicalDevice chooseDevice(const std::vector<VkPhysicalDevice>& devs, std::string want) {
+    if (devs.empty()) throw DeviceError("no Vulkan device found (is mesa-vulkan-drivers installed?)");
+    if (want.empty()) {
+        if (const char* env = std::getenv("LIGHTCULL_DEVICE")) want = env;
+    }
+    std::vector<std::string> names;
+    for (auto d : devs) {
+        VkPhysicalDeviceProperties p;
+        vkGetPhysicalDeviceProperties(d, &p);
+        names.push_back(p.deviceName);
+    }
+    auto listing = [&] {
+        std::string s;
+        for (std::size_t i = 0; i < names.size(); ++i) s += (i ? ", " : "") + std::to_string(i) + ": " + names[i];
+        return s;
+    };
+    if (!want.empty()) {
+        bool digits = std::all_of(want.begin(), want.end(), [](unsigned char c) { return std::isdigit(c); });
+        if (digits) {
+            unsigned long idx = std::strtoul(want.c_str(), nullptr, 10);
+            if (idx >= devs.size())
+                throw DeviceError("Vulkan device index " + want + " out of range (devices: " + listing() + ")");
+            return devs[idx];
+        }
+        for (std::size_t i = 0; i < devs.size(); ++i)
+            if (lower(names[i]).find(lower(want)) != std::string::npos) return devs[i];
+        throw DeviceError("no Vulkan device matches '" + want + "' (devices: " + listing() + ")");
+    }
+    for (auto d : devs) {
+        VkPhysicalDeviceProperties p;
+        vkGetPhysicalDeviceProperties(d, &p);
+        if (p.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU) return d;
+    }
+    return devs.front();
+}
+
+// Creates an instance (with validation when requested). Returns the instance
+// and whether VK_EXT_debug_utils is enabled.
+VkInstance createInstance(bool& debugUtils, bool& validation) {
+    std::uint32_t n = 0;
+    LC_VK(vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr));
+    std::vector<VkExtensionProperties> exts(n);
+    LC_VK(vkEnumerateInstanceExtensionProperties(nullptr, &n, exts.data()));
+    std::vector<const char*> enabled;
+    debugUtils = hasExtension(exts, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+
+    validation = validationRequested();
+    std::vector<const char*> layers;
+    bool validationFeatures = false;
+    if (validation) {
+        std::uint32_t ln = 0;
+        LC_VK(vkEnumerateInstanceLayerProperties(&ln, nullptr));
+        std::vector<VkLayerProperties> lps(ln);
+        LC_VK(vkEnumerateInstanceLayerProperties(&ln, lps.data()));
+        const char* kLayer = "VK_LAYER_KHRONOS_validation";
+        bool found = std::any_of(lps.begin(), lps.end(),
+                                 [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, kLayer) == 0; });
+        if (!found)
+            throw DeviceError("LIGHTCULL_VALIDATION=1 but VK_LAYER_KHRONOS_validation is not installed "
+                              "(Debian: vulkan-validationlayers)");
+        layers.push_back(kLayer);
+        std::uint32_t en = 0;
+        LC_VK(vkEnumerateInstanceExtensionProperties(kLayer, &en, nullptr));
+        std::vector<VkExtensionProperties> lexts(en);
+        LC_VK(vkEnumerateInstanceExtensionProperties(kLayer, &en, lexts.data()));
+        validationFeatures = hasExtension(lexts, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+        if (!debugUtils) debugUtils = hasExtension(lexts, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        if (validationFeatures) enabled.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+        if (!debugUtils)
+            throw DeviceError("LIGHTCULL_VALIDATION=1 needs VK_EXT_debug_utils to record messages");
+    }
+    if (debugUtils) enabled.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+
+    std::uint32_t apiVersion = VK_API_VERSION_1_1;
+    auto enumVersion = reinterpret_cast<PFN_vkEnumerateInstanceVersion>(
+        vkGetInstanceProcAddr(nullptr, "vkEnumerateInstanceVersion"));
+    if (enumVersion) {
+        std::uint32_t v = 0;
+        if (enumVersion(&v) == VK_SUCCESS && v >= VK_API_VERSION_1_3) apiVersion = VK_API_VERSION_1_3;
+    }
+    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    app.pApplicationName = "LightCull Studio";
+    app.pEngineName = "lightcull";
+    app.apiVersion = apiVersion;
+
+    // Chain: messenger (catches instance creation messages) -> validation features.
+    VkValidationFeatureEnableEXT syncEnable = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+    VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+    features.enabledValidationFeatureCount = 1;
+    features.pEnabledValidationFeatures = &syncEnable;
+    VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    mci.pfnUserCallback = debugCallback;
+    if (validation && validationFeatures) mci.pNext = &features;
+
+    VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    ci.pApplicationInfo = &app;
+    ci.enabledLayerCount = std::uint32_t(layers.size());
+    ci.ppEnabledLayerNames = layers.data();
+    ci.enabledExtensionCount = std::uint32_t(enabled.size());
+    ci.ppEnabledExtensionNames = enabled.data();
+    if (validation) ci.pNext = &mci;
+    VkInstance inst = VK_NULL_HANDLE;
+    LC_VK(vkCreateInstance(&ci, nullptr, &inst));
+    if (validation) {
+        markValidationLayerActive();
+        if (validationFeatures) markSyncValidationActive();
+    }
+    return inst;
+}
+
+} // namespace
+
+std::vector<std::string> physicalDeviceNames() {
+    std::vector<std::string> out;
+    try {
+        VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+        app.apiVersion = VK_API_VERSION_1_1;
+        VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+        ci.pApplicationInfo = &app;
+        VkInstance inst = VK_NULL_HANDLE;
+        if (vkCreateInstance(&ci, nullptr, &inst) != VK_SUCCESS) return out;
+        std::uint32_t n = 0;
+        if (vkEnumeratePhysicalDevices(inst, &n, nullptr) == VK_SUCCESS && n) {
+            std::vector<VkPhysicalDevice> devs(n);
+            if (vkEnumeratePhysicalDevices(inst, &n, devs.data()) == VK_SUCCESS)
+                for (std::uint32_t i = 0; i < n; ++i) {
+                    VkPhysicalDeviceProperties p;
+                    vkGetPhysicalDeviceProperties(devs[i], &p);
+                    out.push_back(p.deviceName);
+                }
+        }
+        vkDestroyInstance(inst, nullptr);
+    } catch (...) {
+    }
+    return out;
+}
+
+Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
+    bool validation = false;
+    instance_ = createInstance(debugUtils_, validation);
+    try {
+        if (validation) {
+            VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+            mci.messageSeverity =
+                VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+            mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                              VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                              VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+            mci.pfnUserCallback = debugCallback;
+            auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+                vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+            if (!create) throw DeviceError("vkCreateDebugUtilsMessengerEXT unavailable");
+            LC_VK(create(instance_, &mci, nullptr, &messenger_));
+        }
+        if (debugUtils_)
+            setName_ = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
+                vkGetInstanceProcAddr(instance_, "vkSetDebugUtilsObjectNameEXT"));
+
+        physical_ = chooseDevice(enumerateDevices(instance_), opt.device);
+        vkGetPhysicalDeviceProperties(physical_, &props_);
+        vkGetPhysicalDeviceMemoryProperties(physical_, &memProps_);
+        if (props_.apiVersion < VK_API_VERSION_1_1)
+            throw DeviceError(std::string("Vulkan device '") + props_.deviceName + "' is older than Vulkan 1.1");
+
+        // Subgroup operations the culling passes rely on (compute stage).
+        VkPhysicalDeviceSubgroupProperties sg{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+        VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+        p2.pNext = &sg;
+        vkGetPhysicalDeviceProperties2(physical_, &p2);
+        const VkSubgroupFeatureFlags need = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT |
+                                            VK_SUBGROUP_FEATURE_BALLOT_BIT;
+        if (!(sg.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) || (sg.supportedOperations & need) != need)
+            throw DeviceError(std::string("Vulkan device '") + props_.deviceName +
+                              "' lacks subgroup basic/arithmetic/ballot operations in compute shaders");
+        subgroupSize_ = std::max<std::uint32_t>(1, sg.subgroupSize);
+
+        std::uint32_t qn = 0;
+        vkGetPhysicalDeviceQueueFamilyProperties(physical_, &qn, nullptr);
+        std::vector<VkQueueFamilyProperties> qf(qn);
+        vkGetPhysicalDeviceQueueFamilyProperties(physical_, &qn, qf.data());
+        bool found = false;
+        for (std::uint32_t i = 0; i < qn && !found; ++i)
+            if ((qf[i].queueFlags & (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) ==
+                (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) {
+                queueFamily_ = i;
+                found = true;
+            }
+        if (!found)
+            throw DeviceError(std::string("Vulkan device '") + props_.deviceName +
+                              "' has no queue family with both graphics and compute");
+
+        // Full subgroups for compute (Vulkan 1.3 core feature): with the local
+        // size equal to the subgroup size a workgroup is then exactly one subgroup.
+        VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+        VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+        bool v13 = props_.apiVersion >= VK_API_VERSION_1_3;
+        if (v13) {
+            f2.pNext = &f13;
+            vkGetPhysicalDeviceFeatures2(physical_, &f2);
+        }
+        fullSubgroups_ = v13 && f13.computeFullSubgroups;
+        VkPhysicalDeviceVulkan13Features enable13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+        enable13.computeFullSubgroups = fullSubgroups_ ? VK_TRUE : VK_FALSE;
+        enable13.subgroupSizeControl = (v13 && f13.subgroupSizeControl) ? VK_TRUE : VK_FALSE;
+
+        float prio = 1.0f;
+        VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+        qci.queueFamilyIndex = queueFamily_;
+        qci.queueCount = 1;
+        qci.pQueuePriorities = &prio;
+        VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+        dci.queueCreateInfoCount = 1;
+        dci.pQueueCreateInfos = &qci;
+        if (v13) dci.pNext = &enable13;
+        LC_VK(vkCreateDevice(physical_, &dci, nullptr, &device_));
+        vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
+        name(VK_OBJECT_TYPE_DEVICE, device_, "device");
+        name(VK_OBJECT_TYPE_QUEUE, queue_, "queue");
+
+        VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+        pci.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT | VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+        pci.queueFamilyIndex = queueFamily_;
+        VkCommandPool pool;
+        LC_VK(vkCreateCommandPool(device_, &pci, nullptr, &pool));
+        commandPool_ = CommandPoolHandle(device_, pool);
+        name(VK_OBJECT_TYPE_COMMAND_POOL, pool, "commandPool");
+        VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+        VkFence fence;
+        LC_VK(vkCreateFence(device_, &fci, nullptr, &fence));
+        fence_ = FenceHandle(device_, fence);
+        name(VK_OBJECT_TYPE_FENCE, fence, "submitFence");
+    } catch (...) {
+        release();
+        throw;
+    }
+}
+
+Context::~Context() { release(); }
+
+void Context::release() {
+    fence_.reset();
+    commandPool_.reset();
+    if (device_) vkDestroyDevice(device_, nullptr);
+    device_ = VK_NULL_HANDLE;
+    if (messenger_) {
+        auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+            vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+        if (destroy) destroy(instance_, messenger_, nullptr);
+    }
+    messenger_ = VK_NULL_HANDLE;
+    if (instance_) vkDestroyInstance(instance_, nullptr);
+    instance_ = VK_NULL_HANDLE;
+}
+
+void Context::name(VkObjectType type, std::uint64_t handle, const std::string& n) const {
+    if (!setName_ || !device_) return;
+    std::string full = purpose_.empty() ? n : purpose_ + "." + n;
+    VkDebugUtilsObjectNameInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT};
+    info.objectType = type;
+    info.objectHandle = handle;
+    info.pObjectName = full.c_str();
+    LC_VK(setName_(device_, &info));
+}
+
+std::uint32_t Context::findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags want) const {
+    for (std::uint32_t i = 0; i < memProps_.memoryTypeCount; ++i)
+        if ((typeBits & (1u << i)) && (memProps_.memoryTypes[i].propertyFlags & want) == want) return i;
+    throw DeviceError("no Vulkan memory type with the required properties");
+}
+
+Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& n) const {
+    Buffer b;
+    b.size = std::max<VkDeviceSize>(size, 4);
+    VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    bci.size = b.size;
+    bci.usage = usage;
+    bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    VkBuffer buf;
+    LC_VK(vkCreateBuffer(device_, &bci, nullptr, &buf));
+    b.buffer = BufferHandle(device_, buf);
+    name(VK_OBJECT_TYPE_BUFFER, buf, n);
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(device_, buf, &req);
+    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    ai.allocationSize = req.size;
+    ai.memoryTypeIndex =
+        findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    VkDeviceMemory mem;
+    LC_VK(vkAllocateMemory(device_, &ai, nullptr, &mem));
+    b.memory = MemoryHandle(device_, mem);
+    name(VK_OBJECT_TYPE_DEVICE_MEMORY, mem, n + ".memory");
+    LC_VK(vkBindBufferMemory(device_, buf, mem, 0));
+    LC_VK(vkMapMemory(device_, mem, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+    return b;
+}
+
+Image Context::createDepthImage(std::uint32_t w, std::uint32_t h, VkFormat format, const std::string& n) const {
+    Image img;
+    VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    ici.imageType = VK_IMAGE_TYPE_2D;
+    ici.format = format;
+    ici.extent = {w, h, 1};
+    ici.mipLevels = 1;
+    ici.arrayLayers = 1;
+    ici.samples = VK_SAMPLE_COUNT_1_BIT;
+    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
+    ici.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    VkImage im;
+    LC_VK(vkCreateImage(device_, &ici, nullptr, &im));
+    img.image = ImageHandle(device_, im);
+    name(VK_OBJECT_TYPE_IMAGE, im, n);
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(device_, im, &req);
+    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    ai.allocationSize = req.size;
+    ai.memoryTypeIndex = findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    VkDeviceMemory mem;
+    LC_VK(vkAllocateMemory(device_, &ai, nullptr, &mem));
+    img.memory = MemoryHandle(device_, mem);
+    name(VK_OBJECT_TYPE_DEVICE_MEMORY, mem, n + ".memory");
+    LC_VK(vkBindImageMemory(device_, im, mem, 0));
+    VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    vci.image = im;
+    vci.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    vci.format = format;
+    vci.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+    VkImageView view;
+    LC_VK(vkCreateImageView(device_, &vci, nullptr, &view));
+    img.view = ImageViewHandle(device_, view);
+    name(VK_OBJECT_TYPE_IMAGE_VIEW, view, n + ".view");
+    return img;
+}
+
+ShaderModuleHandle Context::createShader(const std::uint32_t* words, std::size_t wordCount,
+                                         const std::string& n) const {
+    VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    ci.codeSize = wordCount * 4;
+    ci.pCode = words;
+    VkShaderModule m;
+    LC_VK(vkCreateShaderModule(device_, &ci, nullptr, &m));
+    name(VK_OBJECT_TYPE_SHADER_MODULE, m, n);
+    return ShaderModuleHandle(device_, m);
+}
+
+double Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record, const std::string& n) {
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = commandPool_;
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = 1;
+    VkCommandBuffer cmd;
+    LC_VK(vkAllocateCommandBuffers(device_, &ai, &cmd));
+    // Freed on every exit path (the pool owns it; this returns it early).
+    struct FreeCmd {
+        VkDevice d;
+        VkCommandPool p;
+        VkCommandBuffer c;
+        ~FreeCmd() { vkFreeCommandBuffers(d, p, 1, &c); }
+    } freeCmd{device_, commandPool_, cmd};
+    name(VK_OBJECT_TYPE_COMMAND_BUFFER, cmd, n);
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    LC_VK(vkBeginCommandBuffer(cmd, &bi));
+    record(cmd);
+    LC_VK(vkEndCommandBuffer(cmd));
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cmd;
+    VkFence f = fence_;
+    LC_VK(vkResetFences(device_, 1, &f));
+    auto t0 = std::chrono::steady_clock::now();
+    LC_VK(vkQueueSubmit(queue_, 1, &si, f));
+    LC_VK(vkWaitForFences(device_, 1, &f, VK_TRUE, UINT64_MAX));
+    auto t1 = std::chrono::steady_clock::now();
+    return std::chrono::duration<double, std::milli>(t1 - t0).count();
+}
+
+} // namespace lc::vk

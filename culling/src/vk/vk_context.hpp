@@ -1,0 +1,155 @@
+#pragma once
+// Internal Vulkan plumbing of the backend: checked calls, move-only RAII owners
+// with debug names, and the headless context (instance, physical device, one
+// compute+graphics queue). Nothing here leaks into culling/include.
+#include "culling/errors.hpp"
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace lc::vk {
+
+const char* resultName(VkResult r);
+[[noreturn]] void throwVkError(const char* call, VkResult r, const char* file, int line);
+
+// Every Vulkan call that returns a VkResult goes through this: failure throws
+// lc::DeviceError naming the call, the result and the source position.
+#define LC_VK(call)                                                       \
+    do {                                                                  \
+        VkResult lc_vk_result_ = (call);                                  \
+        if (lc_vk_result_ != VK_SUCCESS)                                  \
+            ::lc::vk::throwVkError(#call, lc_vk_result_, __FILE__, __LINE__); \
+    } while (0)
+
+// Move-only owner of a device-level handle destroyed by Destroy(device, h, nullptr).
+template <typename T, void (*Destroy)(VkDevice, T, const VkAllocationCallbacks*)>
+class DeviceHandle {
+public:
+    DeviceHandle() = default;
+    DeviceHandle(VkDevice device, T handle) : device_(device), handle_(handle) {}
+    DeviceHandle(const DeviceHandle&) = delete;
+    DeviceHandle& operator=(const DeviceHandle&) = delete;
+    DeviceHandle(DeviceHandle&& o) noexcept
+        : device_(o.device_), handle_(std::exchange(o.handle_, VK_NULL_HANDLE)) {}
+    DeviceHandle& operator=(DeviceHandle&& o) noexcept {
+        if (this != &o) {
+            reset();
+            device_ = o.device_;
+            handle_ = std::exchange(o.handle_, VK_NULL_HANDLE);
+        }
+        return *this;
+    }
+    ~DeviceHandle() { reset(); }
+    void reset() {
+        if (handle_ != VK_NULL_HANDLE) Destroy(device_, handle_, nullptr);
+        handle_ = VK_NULL_HANDLE;
+    }
+    T get() const { return handle_; }
+    operator T() const { return handle_; }
+    explicit operator bool() const { return handle_ != VK_NULL_HANDLE; }
+
+private:
+    VkDevice device_ = VK_NULL_HANDLE;
+    T handle_ = VK_NULL_HANDLE;
+};
+
+using BufferHandle = DeviceHandle<VkBuffer, vkDestroyBuffer>;
+using MemoryHandle = DeviceHandle<VkDeviceMemory, vkFreeMemory>;
+using ImageHandle = DeviceHandle<VkImage, vkDestroyImage>;
+using ImageViewHandle = DeviceHandle<VkImageView, vkDestroyImageView>;
+using ShaderModuleHandle = DeviceHandle<VkShaderModule, vkDestroyShaderModule>;
+using PipelineHandle = DeviceHandle<VkPipeline, vkDestroyPipeline>;
+using PipelineLayoutHandle = DeviceHandle<VkPipelineLayout, vkDestroyPipelineLayout>;
+using DescriptorSetLayoutHandle = DeviceHandle<VkDescriptorSetLayout, vkDestroyDescriptorSetLayout>;
+using DescriptorPoolHandle = DeviceHandle<VkDescriptorPool, vkDestroyDescriptorPool>;
+using CommandPoolHandle = DeviceHandle<VkCommandPool, vkDestroyCommandPool>;
+using FenceHandle = DeviceHandle<VkFence, vkDestroyFence>;
+using RenderPassHandle = DeviceHandle<VkRenderPass, vkDestroyRenderPass>;
+using FramebufferHandle = DeviceHandle<VkFramebuffer, vkDestroyFramebuffer>;
+
+class Context;
+
+// A buffer with its own memory, persistently mapped (host-visible memory; see
+// docs/VULKAN.md for why this first version keeps every buffer host-visible).
+struct Buffer {
+    BufferHandle buffer;
+    MemoryHandle memory;
+    void* mapped = nullptr;
+    VkDeviceSize size = 0;
+    template <typename T> T* as() const { return static_cast<T*>(mapped); }
+};
+
+struct Image {
+    ImageHandle image;
+    MemoryHandle memory;
+    ImageViewHandle view;
+};
+
+// What a caller asks of the context (see vulkan_backend.hpp for `device`).
+struct ContextOptions {
+    std::string device;   // index or case-insensitive name substring; empty: default rule
+    std::string purpose;  // prefix of debug names, e.g. "lc.render"
+};
+
+// Instance, chosen physical device, logical device and its one queue. The
+// validation layer and messenger are enabled when LIGHTCULL_VALIDATION=1.
+class Context {
+public:
+    explicit Context(const ContextOptions& opt);
+    ~Context();
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
+
+    VkDevice device() const { return device_; }
+    VkPhysicalDevice physicalDevice() const { return physical_; }
+    const VkPhysicalDeviceProperties& properties() const { return props_; }
+    std::string deviceName() const { return props_.deviceName; }
+    std::uint32_t subgroupSize() const { return subgroupSize_; }
+    bool fullSubgroupsSupported() const { return fullSubgroups_; }
+
+    // Gives `handle` the debug name `purpose.name` when VK_EXT_debug_utils is on.
+    void name(VkObjectType type, std::uint64_t handle, const std::string& name) const;
+    template <typename T> void name(VkObjectType type, T handle, const std::string& n) const {
+        name(type, reinterpret_cast<std::uint64_t>(handle), n);
+    }
+
+    // Host-visible, coherent, persistently mapped buffer (size 0 -> 4 bytes).
+    Buffer createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name) const;
+    Image createDepthImage(std::uint32_t w, std::uint32_t h, VkFormat format, const std::string& name) const;
+    ShaderModuleHandle createShader(const std::uint32_t* words, std::size_t wordCount,
+                                    const std::string& name) const;
+
+    // Records a one-time command buffer, submits it, waits. Returns the CPU
+    // wall-clock milliseconds from submit to the fence signalling.
+    double submitAndWait(const std::function<void(VkCommandBuffer)>& record, const std::string& name);
+
+private:
+    void release(); // destroys everything, in reverse order of creation
+    std::uint32_t findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags want) const;
+
+    VkInstance instance_ = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+    VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+    VkDevice device_ = VK_NULL_HANDLE;
+    VkQueue queue_ = VK_NULL_HANDLE;
+    std::uint32_t queueFamily_ = 0;
+    VkPhysicalDeviceProperties props_{};
+    VkPhysicalDeviceMemoryProperties memProps_{};
+    std::uint32_t subgroupSize_ = 1;
+    bool fullSubgroups_ = false;
+    bool debugUtils_ = false;
+    std::string purpose_;
+    PFN_vkSetDebugUtilsObjectNameEXT setName_ = nullptr;
+    CommandPoolHandle commandPool_;
+    FenceHandle fence_;
+};
+
+// Names of the physical devices the loader reports (empty when none / no ICD).
+std::vector<std::string> physicalDeviceNames();
+
+} // namespace lc::vk

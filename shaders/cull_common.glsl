@@ -1,0 +1,180 @@
+// Shared by the culling compute shaders: bindings, specialisation constants,
+// depth linearisation, slicing and the sphere-versus-chunk tests.
+//
+// Spaces: depth buffer = window depth in [0,1]; everything else is VIEW space
+// (right-handed, y up, camera looks down -z, view depth = -z > 0).
+//
+// Conservative float: every comparison that decides whether a light enters a
+// list is widened by eps = params.cluster.z (relative) + params.cluster.w
+// (absolute), so a light the double-precision CPU reference keeps is always
+// kept here too; the GPU lists may only hold MORE entries near a bound.
+#include "culling/gpu_shared.h"
+
+// One workgroup is one subgroup (local size = the device's subgroup size): the
+// passes reduce and compact with subgroup operations only, no shared memory and
+// no barrier() (each costs tens of ms on lavapipe). A device that splits the
+// workgroup into several subgroups is reported through status bit 1.
+layout(local_size_x_id = 0) in;
+layout(constant_id = 1) const uint TILE_SIZE = 16u;
+layout(constant_id = 2) const uint CELLS = 32u;
+layout(constant_id = 3) const uint SLICING = 0u;      // LC_SLICING_*
+layout(constant_id = 4) const uint ALGORITHM = 0u;    // LC_ALG_*
+layout(constant_id = 5) const uint SPHERE_TEST = 0u;  // LC_TEST_*
+layout(constant_id = 6) const uint WRITE_PASS = 0u;   // cull_lists: 0 count, 1 write
+
+layout(std430, binding = 0) readonly buffer Params { GpuCullParams P; };
+layout(std430, binding = 1) readonly buffer DepthBuf { float depthBuf[]; };
+layout(std430, binding = 2) buffer TileBuf { GpuTileBounds tiles[]; };
+layout(std430, binding = 3) readonly buffer LightBuf { vec4 lights[]; }; // view centre xyz, radius
+layout(std430, binding = 4) buffer CountBuf { uint listCount[]; };
+layout(std430, binding = 5) buffer OffsetBuf { uint listOffset[]; };    // listCount + 1 (total)
+layout(std430, binding = 6) buffer IndexBuf { uint lightIndices[]; };
+layout(std430, binding = 7) buffer StatusBuf { uint status; };
+
+const uint STATUS_SPLIT_WORKGROUP = 1u; // more than one subgroup per workgroup
+const uint STATUS_COUNT_MISMATCH = 2u;  // write pass found a different count
+
+bool isOrtho() { return (P.counts.w & LC_FLAG_ORTHO) != 0u; }
+
+// View depth of window depth d, float. A = aHi + aLo so that d - A keeps its
+// precision where it cancels (perspective, d near A at the far plane).
+float viewDepthOf(float d) {
+    precise float t = (d - P.depth.x) - P.depth.z;
+    return isOrtho() ? t / P.depth.y : P.depth.y / t;
+}
+
+float widenDown(float v) { return v - (abs(v) * P.cluster.z + P.cluster.w); }
+float widenUp(float v) { return v + (abs(v) * P.cluster.z + P.cluster.w); }
+
+// Slice of view depth d among `cells` slices over [lo, hi] (tile_math.hpp's
+// sliceOfDepth in float): clamped to [0, cells-1], lo == hi -> 0, no NaN cast.
+uint sliceOf(float lo, float hi, float d) {
+    if (!(hi > lo)) return 0u;
+    float t;
+    if (SLICING == LC_SLICING_LOG && lo > 0.0) {
+        if (!(d > lo)) return 0u;
+        t = log(d / lo) / log(hi / lo);
+    } else {
+        t = (d - lo) / (hi - lo);
+    }
+    t = clamp(t * float(CELLS), 0.0, float(CELLS - 1u));
+    return uint(t);
+}
+
+// Cells that [a, b] overlaps (a <= b), 0 when it misses [lo, hi]; callers
+// widen a and b first.
+uint sliceRangeMask(float lo, float hi, float a, float b) {
+    if (b < lo || a > hi) return 0u;
+    uint c0 = sliceOf(lo, hi, a), c1 = sliceOf(lo, hi, b);
+    uint n = c1 - c0 + 1u;
+    uint bits = (n >= 32u) ? 0xffffffffu : ((1u << n) - 1u);
+    return bits << c0;
+}
+
+// View position seen at NDC (u, v) (x right, y DOWN) at view depth z.
+vec3 viewAt(float u, float v, float z) {
+    return isOrtho() ? vec3(u * P.lens.x, -v * P.lens.y, -z)
+                     : vec3(u * P.lens.x * z, -v * P.lens.y * z, -z);
+}
+
+// A tile's frustum cut at view depths [zlo, zhi]: six inward planes n.p + w >= 0
+// (left, right, top, bottom, near, far; unit normals) and eight corners (near:
+// tl, tr, br, bl; far: tl, tr, br, bl), as tile_math.hpp's FrustumChunk.
+struct Chunk {
+    vec4 planes[6];
+    vec3 corners[8];
+};
+
+Chunk makeChunk(uint tileIndex, float zlo, float zhi) {
+    uint tx = tileIndex % P.size.z, ty = tileIndex / P.size.z;
+    float W = float(P.size.x), H = float(P.size.y);
+    // Tile rectangle clipped to the image (partial edge tiles), in NDC.
+    float ul = 2.0 * float(tx * TILE_SIZE) / W - 1.0;
+    float ur = 2.0 * float(min((tx + 1u) * TILE_SIZE, P.size.x)) / W - 1.0;
+    float vt = 2.0 * float(ty * TILE_SIZE) / H - 1.0;
+    float vb = 2.0 * float(min((ty + 1u) * TILE_SIZE, P.size.y)) / H - 1.0;
+    Chunk c;
+    if (isOrtho()) {
+        c.planes[0] = vec4(1, 0, 0, -ul * P.lens.x);   // x >= ul*halfW
+        c.planes[1] = vec4(-1, 0, 0, ur * P.lens.x);   // x <= ur*halfW
+        c.planes[2] = vec4(0, -1, 0, -vt * P.lens.y);  // y <= -vt*halfH
+        c.planes[3] = vec4(0, 1, 0, vb * P.lens.y);    // y >= -vb*halfH
+    } else {
+        // x = u*tanX*depth = -u*tanX*z  =>  left: x + kl*z >= 0 with kl = ul*tanX.
+        float kl = ul * P.lens.x, kr = ur * P.lens.x;
+        float kt = vt * P.lens.y, kb = vb * P.lens.y;
+        c.planes[0] = vec4(normalize(vec3(1, 0, kl)), 0);
+        c.planes[1] = vec4(normalize(vec3(-1, 0, -kr)), 0);
+        // y = -v*tanY*depth = v*tanY*z: top (v = vt) keeps y <= kt*z.
+        c.planes[2] = vec4(normalize(vec3(0, -1, kt)), 0);
+        c.planes[3] = vec4(normalize(vec3(0, 1, -kb)), 0);
+    }
+    c.planes[4] = vec4(0, 0, -1, -zlo); // depth >= zlo
+    c.planes[5] = vec4(0, 0, 1, zhi);   // depth <= zhi
+    c.corners[0] = viewAt(ul, vt, zlo);
+    c.corners[1] = viewAt(ur, vt, zlo);
+    c.corners[2] = viewAt(ur, vb, zlo);
+    c.corners[3] = viewAt(ul, vb, zlo);
+    c.corners[4] = viewAt(ul, vt, zhi);
+    c.corners[5] = viewAt(ur, vt, zhi);
+    c.corners[6] = viewAt(ur, vb, zhi);
+    c.corners[7] = viewAt(ul, vb, zhi);
+    return c;
+}
+
+float dist2ToSegment(vec3 p, vec3 a, vec3 b) {
+    vec3 ab = b - a;
+    float t = clamp(dot(p - a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
+    vec3 q = a + t * ab - p;
+    return dot(q, q);
+}
+
+// Squared distance from p to the planar convex quad q0 q1 q2 q3 (in cyclic
+// order): the plane distance when p projects inside, else the nearest edge.
+float dist2ToQuad(vec3 p, vec3 q0, vec3 q1, vec3 q2, vec3 q3) {
+    vec3 n = cross(q1 - q0, q2 - q1) + cross(q3 - q2, q0 - q3);
+    float nn = dot(n, n);
+    if (nn > 0.0) {
+        bool inside = dot(cross(q1 - q0, p - q0), n) >= 0.0 && dot(cross(q2 - q1, p - q1), n) >= 0.0 &&
+                      dot(cross(q3 - q2, p - q2), n) >= 0.0 && dot(cross(q0 - q3, p - q3), n) >= 0.0;
+        if (inside) {
+            float h = dot(p - q0, n);
+            return h * h / nn;
+        }
+    }
+    return min(min(dist2ToSegment(p, q0, q1), dist2ToSegment(p, q1, q2)),
+               min(dist2ToSegment(p, q2, q3), dist2ToSegment(p, q3, q0)));
+}
+
+// Sphere (centre s, radius r, already widened) against the chunk, per
+// SPHERE_TEST: planes; planes + the corners' bounding box; exact distance
+// (the nearest point of a convex polytope to an outside point lies on a face
+// whose plane the point is outside of, so the minimum over those faces is exact).
+bool sphereHitsChunk(Chunk c, vec3 s, float r) {
+    float sd[6];
+    bool inside = true;
+    for (int i = 0; i < 6; ++i) {
+        sd[i] = dot(c.planes[i].xyz, s) + c.planes[i].w;
+        if (sd[i] < -r) return false;
+        inside = inside && sd[i] >= 0.0;
+    }
+    if (SPHERE_TEST == LC_TEST_PLANES || inside) return true;
+    if (SPHERE_TEST == LC_TEST_PLANES_AABB) {
+        vec3 lo = c.corners[0], hi = c.corners[0];
+        for (int i = 1; i < 8; ++i) {
+            lo = min(lo, c.corners[i]);
+            hi = max(hi, c.corners[i]);
+        }
+        vec3 d = max(max(lo - s, s - hi), vec3(0.0));
+        return dot(d, d) <= r * r;
+    }
+    // Exact: faces in plane order left, right, top, bottom, near, far.
+    float best = 3.4e38;
+    if (sd[0] < 0.0) best = min(best, dist2ToQuad(s, c.corners[0], c.corners[3], c.corners[7], c.corners[4]));
+    if (sd[1] < 0.0) best = min(best, dist2ToQuad(s, c.corners[1], c.corners[2], c.corners[6], c.corners[5]));
+    if (sd[2] < 0.0) best = min(best, dist2ToQuad(s, c.corners[0], c.corners[1], c.corners[5], c.corners[4]));
+    if (sd[3] < 0.0) best = min(best, dist2ToQuad(s, c.corners[3], c.corners[2], c.corners[6], c.corners[7]));
+    if (sd[4] < 0.0) best = min(best, dist2ToQuad(s, c.corners[0], c.corners[1], c.corners[2], c.corners[3]));
+    if (sd[5] < 0.0) best = min(best, dist2ToQuad(s, c.corners[4], c.corners[5], c.corners[6], c.corners[7]));
+    return best <= r * r;
+}

@@ -1,0 +1,20 @@
+#pragma once
+// The SPIR-V of every shader in shaders/, compiled at build time (see
+// shaders/CMakeLists.txt) and embedded as 32-bit words.
+#include <cstddef>
+#include <cstdint>
+
+namespace lc::spirv {
+
+struct Code {
+    const std::uint32_t* words;
+    std::size_t wordCount;
+    std::size_t bytes() const { return wordCount * sizeof(std::uint32_t); }
+};
+
+Code depthVert();   // depth pre-pass vertex shader (no fragment shader)
+Code tileBounds();  // per-tile depth bounds, halfz split, cell / slice masks
+Code cullLists();   // per-list light tests: count pass and write pass
+Code prefixSum();   // exclusive scan of the list counts into offsets
+
+} // namespace lc::spirv

@@ -1,0 +1,44 @@
+#pragma once
+// Shared by the gpu-tier tests: every test runs with the Khronos validation
+// layer (synchronisation validation included) and fails on any message.
+//
+// LIGHTCULL_VALIDATION=1 is set before the first Vulkan instance is created;
+// one backend is shared per test executable (instance creation with the layer
+// costs a few hundred milliseconds on lavapipe).
+#include "culling/backend.hpp"
+#include "vk/validation.hpp"
+#include "vk/vulkan_backend.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+namespace lc::gputest {
+
+inline CullBackend& vulkan() {
+    static std::unique_ptr<CullBackend> backend = [] {
+        setenv("LIGHTCULL_VALIDATION", "1", 1);
+        return makeVulkanBackend("");
+    }();
+    return *backend;
+}
+
+inline std::string joinedMessages() {
+    std::string s;
+    for (const auto& m : vk::validationMessages()) s += m + "\n";
+    return s;
+}
+
+// Base fixture: asserts that the test left no validation message behind.
+class GpuTest : public ::testing::Test {
+protected:
+    void SetUp() override { setenv("LIGHTCULL_VALIDATION", "1", 1); }
+    void TearDown() override {
+        EXPECT_TRUE(vk::validationMessages().empty()) << "validation messages:\n" << joinedMessages();
+        vk::clearValidationMessages();
+    }
+};
+
+} // namespace lc::gputest

@@ -1,0 +1,88 @@
+// The Vulkan context: the validation layer really loads (and catches a
+// deliberately invalid call), device choice by index / name / environment,
+// and typed errors naming the failed call, its result and the source line.
+#include "gpu_test_env.hpp"
+
+#include "culling/errors.hpp"
+#include "vk/vk_context.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+using namespace lc;
+using lc::gputest::GpuTest;
+
+namespace {
+
+TEST_F(GpuTest, ValidationLayerAndSyncValidationAreEnabled) {
+    CullBackend& b = gputest::vulkan();
+    EXPECT_EQ(b.name(), "vulkan");
+    EXPECT_FALSE(b.deviceName().empty());
+    EXPECT_TRUE(vk::validationRequested());
+    EXPECT_TRUE(vk::validationLayerActive()) << "VK_LAYER_KHRONOS_validation was not enabled";
+    EXPECT_TRUE(vk::syncValidationActive()) << "synchronisation validation was not enabled";
+    std::printf("[ vulkan   ] device: %s, timing: %s\n", b.deviceName().c_str(), b.timingMethod().c_str());
+}
+
+// A buffer of size 0 violates VUID-VkBufferCreateInfo-size-00912: the layer
+// must report it through our messenger (proving messages reach the tests).
+TEST_F(GpuTest, LayerReportsADeliberatelyInvalidCall) {
+    vk::Context ctx(vk::ContextOptions{"", "lc.test"});
+    vk::clearValidationMessages();
+    VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    bci.size = 0; // invalid on purpose
+    bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    VkBuffer buf = VK_NULL_HANDLE;
+    VkResult r = vkCreateBuffer(ctx.device(), &bci, nullptr, &buf);
+    if (r == VK_SUCCESS && buf) vkDestroyBuffer(ctx.device(), buf, nullptr);
+    auto msgs = vk::validationMessages();
+    const bool found = std::any_of(msgs.begin(), msgs.end(), [](const std::string& m) {
+        return m.find("VUID-VkBufferCreateInfo-size-00912") != std::string::npos;
+    });
+    EXPECT_TRUE(found) << "the layer did not report the invalid call; got:\n" << gputest::joinedMessages();
+    vk::clearValidationMessages(); // the expected message must not fail TearDown
+}
+
+VkResult failingCall() { return VK_ERROR_OUT_OF_DEVICE_MEMORY; }
+
+TEST_F(GpuTest, FailedCallThrowsDeviceErrorWithCallResultFileAndLine) {
+    try {
+        LC_VK(failingCall());
+        FAIL() << "no throw";
+    } catch (const DeviceError& e) {
+        const std::string w = e.what();
+        EXPECT_NE(w.find("failingCall()"), std::string::npos) << w;
+        EXPECT_NE(w.find("VK_ERROR_OUT_OF_DEVICE_MEMORY"), std::string::npos) << w;
+        EXPECT_NE(w.find("test_vulkan_context.cpp:"), std::string::npos) << w;
+    }
+}
+
+TEST_F(GpuTest, DeviceChoiceByIndexNameAndEnvironment) {
+    const auto names = vulkanDeviceNames();
+    ASSERT_FALSE(names.empty());
+    // By index.
+    EXPECT_EQ(makeVulkanBackend("0")->deviceName(), names[0]);
+    EXPECT_THROW(makeVulkanBackend(std::to_string(names.size() + 7)), DeviceError);
+    // By case-insensitive name substring: the middle of device 0's name, upper-cased.
+    std::string sub = names[0].substr(0, std::min<std::size_t>(names[0].size(), 6));
+    std::transform(sub.begin(), sub.end(), sub.begin(), [](unsigned char c) { return char(std::toupper(c)); });
+    EXPECT_EQ(makeVulkanBackend(sub)->deviceName(), names[0]); // first match wins
+    try {
+        makeVulkanBackend("no-such-gpu-xyz");
+        FAIL() << "no throw";
+    } catch (const DeviceError& e) {
+        EXPECT_NE(std::string(e.what()).find("no-such-gpu-xyz"), std::string::npos) << e.what();
+    }
+    // LIGHTCULL_DEVICE applies when the argument is empty; the argument wins.
+    setenv("LIGHTCULL_DEVICE", "no-such-gpu-xyz", 1);
+    EXPECT_THROW(makeVulkanBackend(""), DeviceError);
+    EXPECT_NO_THROW(makeVulkanBackend("0"));
+    unsetenv("LIGHTCULL_DEVICE");
+    // Through the public registry too.
+    EXPECT_EQ(makeBackend("vulkan", "0")->name(), "vulkan");
+    const auto avail = availableBackends();
+    EXPECT_NE(std::find(avail.begin(), avail.end(), "vulkan"), avail.end());
+}
+
+} // namespace

@@ -1,0 +1,184 @@
+// The Vulkan depth pre-pass against the CPU rasteriser, on the built-in scenes
+// and every projection kind (reversed-Z with an infinite far plane included):
+// the max depth difference over pixels both cover is reported and bounded, and
+// coverage is identical except on triangle edges.
+#include "gpu_test_env.hpp"
+
+#include "culling/depth.hpp"
+#include "culling/scene_io.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+using namespace lc;
+using lc::gputest::GpuTest;
+
+namespace {
+
+// Every triangle of the scene in window space (x right, y down, pixels),
+// clipped against the near and far planes (0 <= z <= w in clip space, as both
+// rasterisers clip) so that clipped edges count as edges too.
+std::vector<std::vector<glm::dvec2>> screenPolygons(const Scene& scene, const Projection& proj) {
+    std::vector<std::vector<glm::dvec2>> out;
+    const glm::dmat4 clipFromWorld = proj.clipFromView() * scene.camera.viewFromWorld();
+    const double W = proj.width(), H = proj.height();
+    for (const Mesh& m : scene.meshes) {
+        const glm::dmat4 M = clipFromWorld * m.transform;
+        for (std::size_t t = 0; t < m.triangleCount(); ++t) {
+            std::vector<glm::dvec4> poly;
+            for (int k = 0; k < 3; ++k) poly.push_back(M * glm::dvec4(glm::dvec3(m.vertex(m.indices[3 * t + k])), 1.0));
+            // Sutherland-Hodgman against z >= 0 and w - z >= 0.
+            for (int plane = 0; plane < 2 && !poly.empty(); ++plane) {
+                auto dist = [&](const glm::dvec4& v) { return plane == 0 ? v.z : v.w - v.z; };
+                std::vector<glm::dvec4> next;
+                for (std::size_t i = 0; i < poly.size(); ++i) {
+                    const glm::dvec4 a = poly[i], b = poly[(i + 1) % poly.size()];
+                    const double da = dist(a), db = dist(b);
+                    if (da >= 0) next.push_back(a);
+                    if ((da >= 0) != (db >= 0)) next.push_back(a + (b - a) * (da / (da - db)));
+                }
+                poly = std::move(next);
+            }
+            if (poly.size() < 3) continue;
+            std::vector<glm::dvec2> s;
+            for (const auto& v : poly)
+                s.push_back({(v.x / v.w * 0.5 + 0.5) * W, (v.y / v.w * 0.5 + 0.5) * H});
+            out.push_back(std::move(s));
+        }
+    }
+    return out;
+}
+
+double segmentDistance(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b) {
+    const glm::dvec2 ab = b - a;
+    const double len2 = glm::dot(ab, ab);
+    const double t = len2 > 0 ? std::clamp(glm::dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
+    return glm::length(p - (a + t * ab));
+}
+
+struct DepthCase {
+    const char* scene;
+    ProjectionKind kind;
+    double far;
+};
+
+class VulkanDepth : public GpuTest, public ::testing::WithParamInterface<DepthCase> {};
+
+TEST_P(VulkanDepth, AgreesWithCpuRasteriser) {
+    const DepthCase dc = GetParam();
+    Scene scene = makeBuiltinScene(dc.scene);
+    scene.camera.projection = dc.kind;
+    scene.camera.width = 320;
+    scene.camera.height = 180;
+    scene.camera.farPlane = dc.far;
+    if (isOrthographic(dc.kind)) scene.camera.orthoHeight = 40.0;
+    const Projection proj(scene.camera);
+
+    const DepthImage cpu = rasterizeDepthCpu(scene, proj);
+    const DepthImage gpu = gputest::vulkan().renderDepth(scene, proj);
+    ASSERT_EQ(gpu.width, cpu.width);
+    ASSERT_EQ(gpu.height, cpu.height);
+    EXPECT_EQ(gpu.clearDepth, cpu.clearDepth);
+    EXPECT_GE(gputest::vulkan().lastDepthMs(), 0.0);
+
+    // Pixels whose centre lies within this distance of a triangle edge may be
+    // covered by one rasteriser and not the other: lavapipe snaps vertices to
+    // 1/256 pixel (8 sub-pixel bits), the CPU rasteriser works in double.
+    constexpr double kEdgeTolerancePx = 1.0 / 256.0;
+    // Both interpolate the same plane; float interpolation of depth costs a few
+    // ulps of the window depth. A larger difference means a different triangle
+    // won the pixel, which is only allowed where one rasteriser's coverage of
+    // a nearer triangle differs from the other's: on an edge.
+    constexpr double kDepthTolerance = 2e-5;
+    std::vector<std::vector<glm::dvec2>> polys;
+    auto nearEdge = [&](std::uint32_t x, std::uint32_t y, double& dist) {
+        if (polys.empty()) polys = screenPolygons(scene, proj);
+        const glm::dvec2 p(x + 0.5, y + 0.5);
+        dist = std::numeric_limits<double>::infinity();
+        for (const auto& poly : polys)
+            for (std::size_t i = 0; i < poly.size(); ++i)
+                dist = std::min(dist, segmentDistance(p, poly[i], poly[(i + 1) % poly.size()]));
+        return dist <= kEdgeTolerancePx;
+    };
+    double maxDiff = 0, maxSameDiff = 0, maxDiffAwayFromEdges = 0, maxViewRel = 0, maxEdgeDist = 0;
+    std::size_t both = 0, coverageDiffers = 0, depthWinnerDiffers = 0, notOnEdge = 0;
+    for (std::uint32_t y = 0; y < cpu.height; ++y) {
+        for (std::uint32_t x = 0; x < cpu.width; ++x) {
+            const bool c = cpu.hasGeometry(x, y), g = gpu.hasGeometry(x, y);
+            double diff = 0;
+            if (c && g) {
+                ++both;
+                diff = std::abs(double(cpu.at(x, y)) - double(gpu.at(x, y)));
+                maxDiff = std::max(maxDiff, diff);
+                if (diff <= kDepthTolerance) {
+                    maxSameDiff = std::max(maxSameDiff, diff);
+                    const double vc = proj.viewDepthFromWindowDepth(cpu.at(x, y));
+                    const double vg = proj.viewDepthFromWindowDepth(gpu.at(x, y));
+                    maxViewRel = std::max(maxViewRel, std::abs(vc - vg) / vc);
+                    continue;
+                }
+                ++depthWinnerDiffers;
+            } else if (c != g) {
+                ++coverageDiffers;
+            } else {
+                continue;
+            }
+            double dist;
+            if (!nearEdge(x, y, dist)) {
+                ++notOnEdge;
+                maxDiffAwayFromEdges = std::max(maxDiffAwayFromEdges, diff);
+                ADD_FAILURE() << "pixel (" << x << "," << y << ") differs " << (c != g ? "in coverage" : "in depth")
+                              << " (cpu " << cpu.at(x, y) << ", gpu " << gpu.at(x, y)
+                              << ") yet lies " << dist << " px from the nearest triangle edge";
+            }
+            maxEdgeDist = std::max(maxEdgeDist, dist);
+        }
+    }
+    std::printf("[ depth    ] %s %s: %zu pixels both cover, max |depth diff| %.3g (%.3g where the same "
+                "surface won: view depth rel %.3g); %zu coverage and %zu winner differences, all within "
+                "%.3g px of an edge: %s\n",
+                dc.scene, toString(dc.kind), both, maxDiff, maxSameDiff, maxViewRel,
+                coverageDiffers, depthWinnerDiffers, maxEdgeDist, notOnEdge ? "NO" : "yes");
+    EXPECT_GT(both, 0u);
+    EXPECT_EQ(notOnEdge, 0u);
+    EXPECT_LE(coverageDiffers + depthWinnerDiffers, both / 100) << "edge differences should be rare";
+}
+
+const double kInfFar = std::numeric_limits<double>::infinity();
+INSTANTIATE_TEST_SUITE_P(Scenes, VulkanDepth,
+                         ::testing::Values(DepthCase{"atrium", ProjectionKind::Perspective, 1000},
+                                           DepthCase{"forest", ProjectionKind::PerspectiveGL, 1000},
+                                           DepthCase{"mountain", ProjectionKind::ReversedZ, kInfFar},
+                                           DepthCase{"mountain", ProjectionKind::Perspective, 1000},
+                                           DepthCase{"wall", ProjectionKind::ReversedZ, 500},
+                                           DepthCase{"atrium", ProjectionKind::Orthographic, 1000},
+                                           DepthCase{"forest", ProjectionKind::OrthographicGL, 1000},
+                                           DepthCase{"sky", ProjectionKind::ReversedZ, kInfFar}),
+                         [](const auto& info) {
+                             return std::string(info.param.scene) + "_" + std::to_string(info.index);
+                         });
+
+// The framebuffer's top row is image row 0: a triangle covering only the top
+// half of the view lands only in the top rows (one place handles the y flip).
+TEST_F(GpuTest, DepthImageIsTopRowFirst) {
+    Scene scene;
+    scene.camera.position = {0, 0, 5};
+    scene.camera.target = {0, 0, 0};
+    scene.camera.width = 64;
+    scene.camera.height = 32;
+    Mesh m;
+    m.positions = {-100, 0.5f, 0, 100, 0.5f, 0, 0, 100, 0}; // only above y = 0.5 (world up)
+    m.indices = {0, 1, 2};
+    scene.meshes.push_back(m);
+    const Projection proj(scene.camera);
+    const DepthImage gpu = gputest::vulkan().renderDepth(scene, proj);
+    std::size_t top = 0, bottom = 0;
+    for (std::uint32_t y = 0; y < gpu.height; ++y)
+        for (std::uint32_t x = 0; x < gpu.width; ++x)
+            (y < gpu.height / 2 ? top : bottom) += gpu.hasGeometry(x, y);
+    EXPECT_GT(top, 0u);
+    EXPECT_EQ(bottom, 0u);
+}
+
+} // namespace
