@@ -135,6 +135,10 @@ int main(int argc, char** argv) {
         ->type_name("DIR")
         ->required();
 
+    // CLI11 reports a missing subcommand before an unknown word; name the word.
+    if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "scenes" && std::string(argv[1]) != "run")
+        return fail(2, std::string("unknown command '") + argv[1] + "' (commands: scenes, run; see --help)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

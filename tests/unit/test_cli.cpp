@@ -1,0 +1,151 @@
+// The `lightcull` CLI as a user runs it: listing scenes, help, a run from a
+// scene file, and every kind of bad input -> a one-line error naming the
+// thing, a non-zero exit, and no output folder.
+#include "cli_support.hpp"
+
+#include "culling/params.hpp"
+#include "culling/scene_io.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+using lc_test::CliResult;
+using lc_test::lineCount;
+using lc_test::runCli;
+using lc_test::ScratchDir;
+namespace fs = std::filesystem;
+
+TEST(Cli, ScenesListsEveryBuiltin) {
+    ScratchDir s;
+    const CliResult r = runCli({"scenes"}, s.path);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(lineCount(r.out), lc::builtinScenes().size());
+    for (const auto& b : lc::builtinScenes()) {
+        EXPECT_NE(r.out.find(b.name + " "), std::string::npos) << b.name;
+        EXPECT_NE(r.out.find(b.description), std::string::npos) << b.name;
+    }
+}
+
+TEST(Cli, HelpDocumentsEveryFlagAndVersionPrints) {
+    ScratchDir s;
+    const CliResult r = runCli({"run", "--help"}, s.path);
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const auto& p : lc::cullParams()) {
+        EXPECT_NE(r.out.find("--" + p.name + " "), std::string::npos) << p.name;
+        EXPECT_NE(r.out.find(p.help), std::string::npos) << p.name;
+    }
+    for (const char* f : {"--scene", "--builtin", "--lights", "--seed", "--backend", "--device",
+                          "--no-image-error", "--out"})
+        EXPECT_NE(r.out.find(f), std::string::npos) << f;
+    const CliResult top = runCli({"--help"}, s.path);
+    EXPECT_EQ(top.code, 0);
+    EXPECT_NE(top.out.find("scenes"), std::string::npos);
+    const CliResult v = runCli({"--version"}, s.path);
+    EXPECT_EQ(v.code, 0);
+    EXPECT_EQ(v.out.rfind("lightcull ", 0), 0u) << v.out;
+}
+
+TEST(Cli, RunFromASceneFileWritesTheDiagnostics) {
+    ScratchDir s;
+    lc::Scene scene = lc::makeBuiltinScene("wall");
+    scene.name = "wall-from-file";
+    lc::saveSceneFile(scene, (s.path / "scene.json").string());
+    const fs::path out = s.path / "out";
+    const CliResult r = runCli({"run", "--scene", (s.path / "scene.json").string(), "--width", "80",
+                                "--height", "48", "--tile", "8", "--algorithm", "halfz", "--lights",
+                                "50", "--seed", "9", "--backend", "cpu", "--out", out.string()},
+                               s.path);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("false negatives 0"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(out.string()), std::string::npos) << r.out;
+    const auto j = nlohmann::json::parse(lc_test::slurp(out / "summary.json"));
+    EXPECT_EQ(j["scene"], "wall-from-file");
+    EXPECT_EQ(j["algorithm"], "halfz");
+    EXPECT_EQ(j["width"], 80);
+    EXPECT_EQ(j["height"], 48);
+    EXPECT_EQ(j["tile_size"], 8);
+    EXPECT_EQ(j["lights"], 50);
+    EXPECT_EQ(j["backend"], "cpu");
+    EXPECT_EQ(j["metrics"]["lists"], 10 * 6 * 2);
+    EXPECT_TRUE(fs::is_regular_file(out / "tiles.csv"));
+    EXPECT_TRUE(fs::is_regular_file(out / "heatmap.png"));
+
+    // --lights with the same seed is deterministic; another seed differs.
+    const CliResult again = runCli({"run", "--scene", (s.path / "scene.json").string(), "--width", "80",
+                                    "--height", "48", "--tile", "8", "--algorithm", "halfz", "--lights",
+                                    "50", "--seed", "9", "--backend", "cpu", "--no-image-error",
+                                    "--out", (s.path / "out2").string()},
+                                   s.path);
+    ASSERT_EQ(again.code, 0) << again.err;
+    EXPECT_EQ(lc_test::slurp(out / "tiles.csv"), lc_test::slurp(s.path / "out2" / "tiles.csv"));
+    EXPECT_TRUE(nlohmann::json::parse(lc_test::slurp(s.path / "out2" / "summary.json"))["metrics"]["image_rmse"].is_null());
+}
+
+namespace {
+
+// Runs a command expected to fail: non-zero exit, exactly one line on stderr
+// mentioning `needle`, nothing on stdout, and the output folder not created.
+void expectCleanFailure(std::vector<std::string> args, const std::string& needle) {
+    ScratchDir s;
+    const fs::path out = s.path / "out";
+    bool hasOut = false;
+    for (auto& a : args) {
+        if (a == "OUT") a = out.string(), hasOut = true;
+    }
+    const CliResult r = runCli(args, s.path);
+    std::string joined;
+    for (const auto& a : args) joined += a + " ";
+    EXPECT_NE(r.code, 0) << joined;
+    EXPECT_EQ(lineCount(r.err), 1u) << joined << "\nstderr: " << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << joined << "\nstderr: " << r.err;
+    EXPECT_EQ(r.err.find("terminate"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    if (hasOut) EXPECT_FALSE(fs::exists(out)) << joined;
+    // Nothing at all besides what the harness itself made.
+    for (const auto& e : fs::directory_iterator(s.path))
+        ADD_FAILURE() << joined << ": left behind " << e.path();
+}
+
+} // namespace
+
+TEST(Cli, BadCommandLinesFailWithOneLineNamingTheProblem) {
+    const std::vector<std::string> base = {"run", "--builtin", "wall", "--width", "32", "--height", "24",
+                                           "--backend", "cpu", "--out", "OUT"};
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> a = base;
+        a.insert(a.end(), extra.begin(), extra.end());
+        return a;
+    };
+    expectCleanFailure(with({"--bogus", "3"}), "--bogus");
+    expectCleanFailure(with({"--cells", "99"}), "cells");
+    expectCleanFailure(with({"--cells", "many"}), "cells");
+    expectCleanFailure(with({"--algorithm", "quadtree"}), "algorithm");
+    expectCleanFailure(with({"--test", "sphere"}), "test");
+    expectCleanFailure(with({"--slicing", "cubic"}), "slicing");
+    expectCleanFailure(with({"--skip-empty", "maybe"}), "skip-empty");
+    expectCleanFailure(with({"--tile", "0"}), "tile");
+    expectCleanFailure(with({"--width", "-5"}), "width");
+    expectCleanFailure(with({"--lights", "-3"}), "lights");
+    expectCleanFailure({"run", "--builtin", "wall", "--backend", "metal", "--out", "OUT"}, "metal");
+    expectCleanFailure({"run", "--builtin", "nowhere", "--out", "OUT"}, "nowhere");
+    expectCleanFailure({"run", "--scene", "/nonexistent/scene.json", "--out", "OUT"}, "/nonexistent/scene.json");
+    expectCleanFailure({"run", "--builtin", "wall", "--scene", "x.json", "--out", "OUT"}, "--scene");
+    expectCleanFailure({"run", "--builtin", "wall"}, "--out");
+    expectCleanFailure({"run", "--out", "OUT"}, "--builtin");
+    expectCleanFailure({"run", "--builtin", "wall", "--out", "/nonexistent/parent/out"}, "/nonexistent/parent");
+    expectCleanFailure({"frobnicate"}, "frobnicate");
+    expectCleanFailure({}, "subcommand");
+}
+
+TEST(Cli, BadSceneFileFailsNamingTheFileAndNothingIsWritten) {
+    ScratchDir s;
+    {
+        std::ofstream(s.path / "broken.json") << "{ \"version\": 1, \"lights\": [ { \"position\": [0, 1";
+    }
+    const fs::path out = s.path / "out";
+    const CliResult r = runCli({"run", "--scene", (s.path / "broken.json").string(), "--out", out.string()}, s.path);
+    EXPECT_NE(r.code, 0);
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("broken.json"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+}
