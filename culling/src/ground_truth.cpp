@@ -328,8 +328,17 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
             a.w.assign(lists, 0), a.e.assign(lists, 0), a.fn.assign(lists, 0);
             a.tilePixels.assign(tiles, 0);
         }
+        // Membership of a needed light in the pixel's list: stamp[i] == the
+        // current stamp when light i is listed. Neighbouring pixels mostly share
+        // a list, so re-stamping on a change costs less than a binary search
+        // per needed light.
+        std::vector<std::vector<std::uint32_t>> stamps(workers, std::vector<std::uint32_t>(lights.size(), 0));
+        std::vector<std::uint32_t> stampNow(workers, 0);
         forEachRowBand(depth.height, 16, workers, cancel, [&](unsigned w, std::uint32_t y0, std::uint32_t y1) {
             Acc& a = acc[w];
+            std::vector<std::uint32_t>& stamp = stamps[w];
+            std::uint32_t& now = stampNow[w];
+            std::uint32_t stampedList = std::numeric_limits<std::uint32_t>::max();
             for (std::uint32_t y = y0; y < y1; ++y)
                 for (std::uint32_t x = 0; x < depth.width; ++x) {
                     if (!depth.hasGeometry(x, y)) continue;
@@ -338,13 +347,23 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
                     const std::uint32_t l = result.listOfPixel(x, y, proj.viewDepthFromWindowDepth(d));
                     if (l >= lists) throw Error("ground truth: listOfPixel gave list " + std::to_string(l));
                     ++a.tilePixels[result.grid.tileOfPixel(x, y)];
-                    const std::uint32_t* first = result.lightIndices.data() + result.listOffset[l];
-                    const std::uint32_t* last = first + result.listCount[l];
+                    if (l != stampedList) {
+                        if (++now == 0) { // wrapped: clear old stamps
+                            std::fill(stamp.begin(), stamp.end(), 0);
+                            now = 1;
+                        }
+                        const std::uint32_t* first = result.lightIndices.data() + result.listOffset[l];
+                        for (std::uint32_t k = 0; k < result.listCount[l]; ++k) stamp[first[k]] = now;
+                        stampedList = l;
+                    }
                     a.w[l] += result.listCount[l];
+                    std::uint64_t needed = 0, missed = 0;
                     grid.forEachContaining(p, [&](std::uint32_t i) {
-                        ++a.e[l];
-                        if (!std::binary_search(first, last, i)) ++a.fn[l];
+                        ++needed;
+                        missed += stamp[i] != now;
                     });
+                    a.e[l] += needed;
+                    a.fn[l] += missed;
                 }
         });
         for (const Acc& a : acc) {

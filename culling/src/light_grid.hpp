@@ -35,8 +35,9 @@ public:
         origin_ = bmin;
         const glm::dvec3 ext = bmax - bmin;
         const double maxExt = std::max({ext.x, ext.y, ext.z, 0.0});
-        // Cell edge: about the median radius (a typical light then covers ~3^3
-        // cells), but never finer than maxExt / kMaxCellsPerAxis.
+        // Cell edge: half the median radius (a typical light then covers ~5^3
+        // cells and a cell's candidates are ~4x the lights that contain a point
+        // in it), but never finer than maxExt / kMaxCellsPerAxis.
         std::vector<double> radii;
         radii.reserve(lights.size());
         for (std::size_t i = 0; i < lights.size(); ++i)
@@ -48,7 +49,7 @@ public:
         }
         const double scale = std::max({std::abs(bmin.x), std::abs(bmin.y), std::abs(bmin.z),
                                        std::abs(bmax.x), std::abs(bmax.y), std::abs(bmax.z), 1.0});
-        cell_ = std::max({median, maxExt / kMaxCellsPerAxis, scale * 1e-9});
+        cell_ = std::max({0.5 * median, maxExt / kMaxCellsPerAxis, scale * 1e-9});
         for (int a = 0; a < 3; ++a)
             dims_[a] = std::uint32_t(std::clamp(std::ceil(ext[a] / cell_), 1.0, double(kMaxCellsPerAxis)));
 
@@ -61,6 +62,7 @@ public:
             if (pass == 1) {
                 for (std::size_t c = 0; c < cellCount; ++c) cellStart_[c + 1] += cellStart_[c];
                 cellLights_.resize(cellStart_[cellCount]);
+                cellSpheres_.resize(cellStart_[cellCount]);
                 cursor.assign(cellStart_.begin(), cellStart_.end() - 1);
             }
             for (std::uint32_t i = 0; i < lights.size(); ++i) {
@@ -78,7 +80,12 @@ public:
                         for (std::uint32_t x = lo[0]; x <= hi[0]; ++x) {
                             const std::size_t c = cellIndex(x, y, z);
                             if (pass == 0) ++cellStart_[c + 1];
-                            else cellLights_[cursor[c]++] = i;
+                            else {
+                                const glm::dvec3& lc = lights.centers[i];
+                                const double lr = lights.radii[i];
+                                cellSpheres_[cursor[c]] = {lc.x, lc.y, lc.z, lr * lr};
+                                cellLights_[cursor[c]++] = i;
+                            }
                         }
             }
         }
@@ -89,9 +96,12 @@ public:
     // each group is ascending.
     template <class F> void forEachContaining(const glm::dvec3& p, F&& f) const {
         const std::size_t c = cellIndex(axisCell(p.x, 0), axisCell(p.y, 1), axisCell(p.z, 2));
+        // Same arithmetic as lightContains, on a copy of the sphere stored with
+        // the cell entry (streams through memory instead of gathering).
         for (std::uint32_t k = cellStart_[c]; k < cellStart_[c + 1]; ++k) {
-            const std::uint32_t i = cellLights_[k];
-            if (lightContains(lights_->centers[i], lights_->radii[i], p)) f(i);
+            const Sphere& s = cellSpheres_[k];
+            const double dx = p.x - s.x, dy = p.y - s.y, dz = p.z - s.z;
+            if (dx * dx + dy * dy + dz * dz <= s.r2) f(cellLights_[k]);
         }
         for (std::uint32_t i : always_)
             if (lightContains(lights_->centers[i], lights_->radii[i], p)) f(i);
@@ -140,7 +150,11 @@ private:
         return (std::size_t(z) * dims_[1] + y) * dims_[0] + x;
     }
 
+    struct Sphere {
+        double x, y, z, r2;
+    };
     const ViewLights* lights_;
+    std::vector<Sphere> cellSpheres_;
     glm::dvec3 origin_{0.0};
     double cell_ = 1;
     std::uint32_t dims_[3] = {1, 1, 1};
