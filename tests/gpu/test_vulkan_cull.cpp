@@ -1,0 +1,367 @@
+// The Vulkan culling passes against the CPU reference on IDENTICAL depth input
+// (the CPU rasteriser's depth fed to both culls, and separately the GPU's):
+// every GPU list is a superset of the CPU list (the GPU is conservative near
+// planes and bounds, within float rounding), the number of extra entries is
+// reported and small, and false_negatives = 0 against the ground truth. Also:
+// edge tiles, 0 / 1 / 65,536 lights, more lights than a workgroup has
+// invocations, and determinism. Validation is on; any message fails.
+#include "gpu_test_env.hpp"
+
+#include "culling/depth.hpp"
+#include "culling/ground_truth.hpp"
+#include "culling/scene_io.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+using namespace lc;
+using lc::gputest::GpuTest;
+
+namespace {
+
+const Algorithm kAlgorithms[] = {Algorithm::All,    Algorithm::Naive,         Algorithm::MinMax,
+                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered};
+const SphereTest kTests[] = {SphereTest::Planes, SphereTest::PlanesAabb, SphereTest::Exact};
+
+struct Comparison {
+    std::uint64_t cpuEntries = 0, gpuEntries = 0, extra = 0, missing = 0;
+    std::string firstMissing;
+};
+
+// GPU lists must contain every CPU entry (both sorted ascending).
+Comparison compareLists(const CullResult& cpu, const CullResult& gpu) {
+    Comparison c;
+    c.cpuEntries = cpu.entries();
+    c.gpuEntries = gpu.entries();
+    const std::size_t lists = std::min(cpu.listCount.size(), gpu.listCount.size());
+    for (std::size_t l = 0; l < lists; ++l) {
+        const auto cb = cpu.lightIndices.begin() + cpu.listOffset[l], ce = cb + cpu.listCount[l];
+        const auto gb = gpu.lightIndices.begin() + gpu.listOffset[l], ge = gb + gpu.listCount[l];
+        std::vector<std::uint32_t> lost;
+        std::set_difference(cb, ce, gb, ge, std::back_inserter(lost));
+        if (!lost.empty() && c.firstMissing.empty())
+            c.firstMissing = "list " + std::to_string(l) + " (tile " + std::to_string(l / cpu.listsPerTile) +
+                             ") lacks light " + std::to_string(lost[0]);
+        c.missing += lost.size();
+        c.extra += gpu.listCount[l] - (cpu.listCount[l] - lost.size());
+    }
+    return c;
+}
+
+struct CaseReport {
+    std::uint64_t extra = 0, entries = 0;
+};
+
+// Culls `depth` on both backends with `settings` and checks everything the
+// issue asks; returns the extras for the caller's summary.
+CaseReport checkCase(const std::string& label, const DepthImage& depth, const Projection& proj,
+                     const TileGrid& grid, const ViewLights& lights, const CullSettings& settings,
+                     CullBackend& cpuBackend) {
+    SCOPED_TRACE(label);
+    const CullResult cpu = cpuBackend.cull(depth, proj, grid, lights, settings);
+    const CullResult gpu = gputest::vulkan().cull(depth, proj, grid, lights, settings);
+    EXPECT_EQ(gpu.validate(lights.size()), "");
+    EXPECT_EQ(gpu.backend, "vulkan");
+    EXPECT_FALSE(gpu.timingMethod.empty());
+    EXPECT_GE(gpu.timings.cullMs, 0.0);
+    EXPECT_EQ(gpu.listsPerTile, cpu.listsPerTile);
+    EXPECT_EQ(gpu.listCountTotal(), cpu.listCountTotal());
+    if (gpu.listCountTotal() != cpu.listCountTotal()) return {};
+
+    // Per-tile bounds: the same tiles are empty; float bounds within rounding.
+    for (std::uint32_t t = 0; t < grid.tileCount(); ++t) {
+        const bool ce = !(cpu.tileDepthMin[t] <= cpu.tileDepthMax[t]);
+        const bool ge = !(gpu.tileDepthMin[t] <= gpu.tileDepthMax[t]);
+        EXPECT_EQ(ce, ge) << "tile " << t;
+        if (ce || ge) continue;
+        EXPECT_NEAR(gpu.tileDepthMin[t], cpu.tileDepthMin[t], 1e-5 * cpu.tileDepthMin[t] + 1e-6) << "tile " << t;
+        EXPECT_NEAR(gpu.tileDepthMax[t], cpu.tileDepthMax[t], 1e-5 * cpu.tileDepthMax[t] + 1e-6) << "tile " << t;
+        // Clustered slices share one range: the GPU marks every slice the CPU
+        // marks (and, within rounding of a boundary, its neighbour too).
+        if (settings.algorithm == Algorithm::Clustered)
+            EXPECT_EQ(gpu.cellMask[t] & cpu.cellMask[t], cpu.cellMask[t]) << "tile " << t;
+    }
+    if (settings.algorithm == Algorithm::Clustered) {
+        EXPECT_EQ(gpu.clusterNear, cpu.clusterNear);
+        EXPECT_EQ(gpu.clusterFar, cpu.clusterFar);
+    }
+
+    const Comparison cmp = compareLists(cpu, gpu);
+    EXPECT_EQ(cmp.missing, 0u) << "GPU lists lack " << cmp.missing << " CPU entries; first: " << cmp.firstMissing;
+    // "Small": extras only arise where a light touches a plane or bound within
+    // float rounding (relative 2e-5 widening), a tiny share of the entries.
+    EXPECT_LE(cmp.extra, 8 + cmp.cpuEntries / 200) << "too many extra GPU entries";
+
+    GroundTruthOptions opt;
+    opt.imageError = false;
+    const GroundTruth truth = computeGroundTruth(depth, proj, lights, gpu, opt);
+    EXPECT_EQ(truth.metrics.falseNegatives, 0u);
+    return {cmp.extra, cmp.cpuEntries};
+}
+
+Scene sized(const std::string& name, std::uint32_t w, std::uint32_t h, std::uint32_t tile = 16) {
+    Scene s = makeBuiltinScene(name);
+    s.camera.width = w;
+    s.camera.height = h;
+    s.camera.tileSize = tile;
+    return s;
+}
+
+class VulkanCullScene : public GpuTest, public ::testing::WithParamInterface<std::string> {};
+
+// Every built-in scene x every algorithm x every sphere test x both depth sources.
+TEST_P(VulkanCullScene, SupersetOfCpuAndNoFalseNegatives) {
+    const Scene scene = sized(GetParam(), 320, 180);
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
+    const ViewLights lights = makeViewLights(scene);
+    auto cpuBackend = makeCpuBackend();
+    const DepthImage depths[2] = {rasterizeDepthCpu(scene, proj), gputest::vulkan().renderDepth(scene, proj)};
+    const char* depthNames[2] = {"cpu-depth", "gpu-depth"};
+    for (int d = 0; d < 2; ++d) {
+        for (Algorithm a : kAlgorithms) {
+            for (SphereTest t : kTests) {
+                if (a == Algorithm::All && t != SphereTest::Planes) continue; // no test involved
+                CullSettings s;
+                s.algorithm = a;
+                s.test = t;
+                s.cells = 16;
+                const std::string label = GetParam() + " " + depthNames[d] + " " + toString(a) + " " + toString(t);
+                const CaseReport r = checkCase(label, depths[d], proj, grid, lights, s, *cpuBackend);
+                std::printf("[ cull     ] %-44s entries %8llu  extra on GPU %5llu\n", label.c_str(),
+                            (unsigned long long)r.entries, (unsigned long long)r.extra);
+            }
+        }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Builtins, VulkanCullScene,
+                         ::testing::Values("atrium", "forest", "mountain", "wall", "sky"));
+
+// Projection kinds other than the default, including reversed-Z with an
+// infinite far plane (naive and clustered then use the farthest light reach),
+// linear slicing and clustered without skip-empty.
+TEST_F(GpuTest, ProjectionKindsAndSlicing) {
+    auto cpuBackend = makeCpuBackend();
+    struct K {
+        ProjectionKind kind;
+        double far;
+    };
+    const K kinds[] = {{ProjectionKind::ReversedZ, std::numeric_limits<double>::infinity()},
+                       {ProjectionKind::ReversedZ, 800.0},
+                       {ProjectionKind::PerspectiveGL, 1000.0},
+                       {ProjectionKind::Orthographic, 1000.0},
+                       {ProjectionKind::OrthographicGL, 1000.0}};
+    for (const K& k : kinds) {
+        Scene scene = sized("mountain", 256, 144);
+        scene.camera.projection = k.kind;
+        scene.camera.farPlane = k.far;
+        if (isOrthographic(k.kind)) scene.camera.orthoHeight = 60.0;
+        const Projection proj(scene.camera);
+        const TileGrid grid = TileGrid::make(256, 144, 16);
+        const ViewLights lights = makeViewLights(scene);
+        const DepthImage depth = rasterizeDepthCpu(scene, proj);
+        for (Algorithm a : kAlgorithms) {
+            for (Slicing sl : {Slicing::Log, Slicing::Linear}) {
+                if (sl == Slicing::Linear && a != Algorithm::TwoPointFiveD && a != Algorithm::Clustered) continue;
+                for (bool skip : {true, false}) {
+                    if (!skip && a != Algorithm::Clustered) continue;
+                    CullSettings s;
+                    s.algorithm = a;
+                    s.test = SphereTest::Exact;
+                    s.slicing = sl;
+                    s.skipEmpty = skip;
+                    s.cells = 32;
+                    const std::string label = std::string(toString(k.kind)) + (std::isinf(k.far) ? "-inf " : " ") +
+                                              toString(a) + " " + toString(sl) + (skip ? "" : " no-skip");
+                    const CaseReport r = checkCase(label, depth, proj, grid, lights, s, *cpuBackend);
+                    std::printf("[ cull     ] %-44s entries %8llu  extra on GPU %5llu\n", label.c_str(),
+                                (unsigned long long)r.entries, (unsigned long long)r.extra);
+                }
+            }
+        }
+    }
+}
+
+// Partial edge tiles: 1366 = 85*16 + 6 columns; and a size partial both ways.
+TEST_F(GpuTest, EdgeTilesOfNonMultipleResolutions) {
+    auto cpuBackend = makeCpuBackend();
+    for (auto [w, h] : {std::pair<std::uint32_t, std::uint32_t>{1366, 768}, {333, 187}}) {
+        const Scene scene = sized("atrium", w, h);
+        const Projection proj(scene.camera);
+        const TileGrid grid = TileGrid::make(w, h, 16);
+        const ViewLights lights = makeViewLights(scene);
+        const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+        for (Algorithm a : {Algorithm::MinMax, Algorithm::TwoPointFiveD, Algorithm::Clustered}) {
+            CullSettings s;
+            s.algorithm = a;
+            s.test = SphereTest::PlanesAabb;
+            const std::string label = std::to_string(w) + "x" + std::to_string(h) + " " + toString(a);
+            const CaseReport r = checkCase(label, depth, proj, grid, lights, s, *cpuBackend);
+            std::printf("[ cull     ] %-44s entries %8llu  extra on GPU %5llu\n", label.c_str(),
+                        (unsigned long long)r.entries, (unsigned long long)r.extra);
+        }
+    }
+}
+
+// Lights built to touch a tile's far bound or a side plane within float
+// rounding (the sphere reaches it by 1e-7 of its radius): the CPU
+// reference keeps them, so the GPU must too. This is where the relative
+// widening of the float passes matters (with it off, this test fails).
+TEST_F(GpuTest, LightsTouchingBoundsWithinRounding) {
+    auto cpuBackend = makeCpuBackend();
+    Scene scene = sized("wall", 320, 180);
+    scene.lights.clear();
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(320, 180, 16);
+    const DepthImage depth = rasterizeDepthCpu(scene, proj);
+    CullSettings mm;
+    mm.algorithm = Algorithm::MinMax;
+    const CullResult bounds = cpuBackend->cull(depth, proj, grid, makeViewLights(scene), mm);
+    const glm::dmat4 worldFromView = glm::inverse(scene.camera.viewFromWorld());
+    const double r = 0.37, touch = 1.0 - 1e-7;
+    for (std::uint32_t ty = 0; ty < grid.tilesY; ty += 2) {
+        for (std::uint32_t tx = 0; tx < grid.tilesX; tx += 3) {
+            const std::uint32_t t = grid.tileIndex(tx, ty);
+            const auto rect = grid.tileRect(tx, ty);
+            const glm::dvec2 centre(0.5 * (rect.x0 + rect.x1), 0.5 * (rect.y0 + rect.y1));
+            const double dmax = bounds.tileDepthMax[t];
+            // Behind the wall, reaching the tile's far bound by a hair.
+            const glm::dvec3 behind = proj.viewPositionAt(centre, dmax + r * touch);
+            // On the wall, left of the tile's left edge: the nearest point of the
+            // (flat, min == max) chunk is on that edge, r * touch away.
+            const glm::dvec3 onEdge = proj.viewPositionAt({double(rect.x0), centre.y}, dmax);
+            const glm::dvec3 outside = onEdge - glm::dvec3(r * touch, 0.0, 0.0);
+            for (const glm::dvec3& v : {behind, outside}) {
+                PointLight l;
+                l.position = glm::dvec3(worldFromView * glm::dvec4(v, 1.0));
+                l.explicitRadius = r;
+                scene.lights.push_back(l);
+            }
+        }
+    }
+    const ViewLights lights = makeViewLights(scene);
+    for (Algorithm a : {Algorithm::MinMax, Algorithm::HalfZ, Algorithm::TwoPointFiveD, Algorithm::Clustered})
+        for (SphereTest t : kTests) {
+            CullSettings s;
+            s.algorithm = a;
+            s.test = t;
+            const std::string label = std::string("touching ") + toString(a) + " " + toString(t);
+            const CaseReport rep = checkCase(label, depth, proj, grid, lights, s, *cpuBackend);
+            std::printf("[ cull     ] %-44s entries %8llu  extra on GPU %5llu\n", label.c_str(),
+                        (unsigned long long)rep.entries, (unsigned long long)rep.extra);
+        }
+}
+
+TEST_F(GpuTest, ZeroLightsGiveEmptyLists) {
+    Scene scene = sized("wall", 200, 120);
+    scene.lights.clear();
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(200, 120, 16);
+    const ViewLights lights = makeViewLights(scene);
+    const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+    for (Algorithm a : kAlgorithms) {
+        CullSettings s;
+        s.algorithm = a;
+        const CullResult r = gputest::vulkan().cull(depth, proj, grid, lights, s);
+        EXPECT_EQ(r.validate(0), "") << toString(a);
+        EXPECT_EQ(r.entries(), 0u) << toString(a);
+        EXPECT_EQ(r.listCountTotal(), a == Algorithm::All ? 1u : grid.tileCount() * r.listsPerTile);
+        // The wall fills the screen: every tile still gets its depth bounds.
+        for (std::uint32_t t = 0; t < grid.tileCount(); ++t) EXPECT_LE(r.tileDepthMin[t], r.tileDepthMax[t]);
+    }
+}
+
+TEST_F(GpuTest, OneLight) {
+    auto cpuBackend = makeCpuBackend();
+    Scene scene = sized("atrium", 320, 180);
+    scene.lights.resize(1);
+    scene.lights[0].position = 0.5 * (scene.bounds().first + scene.bounds().second);
+    scene.lights[0].explicitRadius = 4.0;
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(320, 180, 16);
+    const ViewLights lights = makeViewLights(scene);
+    const DepthImage depth = rasterizeDepthCpu(scene, proj);
+    std::uint64_t entries = 0;
+    for (Algorithm a : kAlgorithms)
+        for (SphereTest t : kTests) {
+            CullSettings s;
+            s.algorithm = a;
+            s.test = t;
+            entries += checkCase(std::string("one light ") + toString(a) + " " + toString(t), depth, proj, grid,
+                                 lights, s, *cpuBackend)
+                           .entries;
+        }
+    EXPECT_GT(entries, 0u) << "the light should touch some tiles";
+}
+
+// 65,536 lights (a small resolution keeps the CPU reference quick).
+TEST_F(GpuTest, SixtyFiveThousandLights) {
+    auto cpuBackend = makeCpuBackend();
+    Scene scene = sized("atrium", 128, 72);
+    scene.lights = generateLights(defaultLightGen(scene, 65536, 11));
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(128, 72, 16);
+    const ViewLights lights = makeViewLights(scene);
+    ASSERT_EQ(lights.size(), 65536u);
+    const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+    for (Algorithm a : {Algorithm::All, Algorithm::MinMax, Algorithm::TwoPointFiveD, Algorithm::Clustered}) {
+        CullSettings s;
+        s.algorithm = a;
+        s.cells = 8;
+        const std::string label = std::string("65536 lights ") + toString(a);
+        const CaseReport r = checkCase(label, depth, proj, grid, lights, s, *cpuBackend);
+        std::printf("[ cull     ] %-44s entries %8llu  extra on GPU %5llu\n", label.c_str(),
+                    (unsigned long long)r.entries, (unsigned long long)r.extra);
+    }
+}
+
+// Far more lights than invocations per workgroup, all touching every tile:
+// every list must hold all of them, ascending (the classic one-light-per-
+// invocation bug keeps only the first workgroup-size lights).
+TEST_F(GpuTest, MoreLightsThanWorkgroupInvocations) {
+    Scene scene = sized("wall", 96, 64);
+    const std::uint32_t n = 1000;
+    scene.lights.assign(n, PointLight{});
+    for (std::uint32_t i = 0; i < n; ++i) {
+        scene.lights[i].position = {0.001 * i, 0.0, 5.0};
+        scene.lights[i].explicitRadius = 500.0;
+    }
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(96, 64, 16);
+    const ViewLights lights = makeViewLights(scene);
+    const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+    for (Algorithm a : kAlgorithms) {
+        CullSettings s;
+        s.algorithm = a;
+        const CullResult r = gputest::vulkan().cull(depth, proj, grid, lights, s);
+        ASSERT_EQ(r.validate(n), "");
+        std::size_t full = 0;
+        for (std::size_t l = 0; l < r.listCount.size(); ++l) {
+            if (r.listCount[l] == 0) continue; // clustered: slices without geometry
+            ASSERT_EQ(r.listCount[l], n) << toString(a) << " list " << l;
+            for (std::uint32_t i = 0; i < n; ++i) ASSERT_EQ(r.lightIndices[r.listOffset[l] + i], i);
+            ++full;
+        }
+        EXPECT_GE(full, a == Algorithm::All ? 1u : grid.tileCount()) << toString(a);
+    }
+}
+
+TEST_F(GpuTest, ResultsAreDeterministic) {
+    const Scene scene = sized("forest", 240, 136);
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(240, 136, 16);
+    const ViewLights lights = makeViewLights(scene);
+    const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+    CullSettings s;
+    s.algorithm = Algorithm::Clustered;
+    const CullResult a = gputest::vulkan().cull(depth, proj, grid, lights, s);
+    const CullResult b = gputest::vulkan().cull(depth, proj, grid, lights, s);
+    EXPECT_EQ(a.listOffset, b.listOffset);
+    EXPECT_EQ(a.listCount, b.listCount);
+    EXPECT_EQ(a.lightIndices, b.lightIndices);
+    EXPECT_EQ(a.cellMask, b.cellMask);
+}
+
+} // namespace
