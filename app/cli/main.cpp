@@ -3,6 +3,8 @@
 //   lightcull scenes
 //   lightcull run (--scene FILE.json | --builtin NAME) [culling flags] [--lights N [--seed S]]
 //                 [--backend cpu|vulkan] [--device D] [--no-image-error] --out DIR
+//   lightcull bench (--scene FILE.json | --builtin NAME) [run flags] [--repeat N] [--warmup N]
+//                   [--sweep KEY=V1,V2,...]... [--json FILE]
 //
 // The culling flags are generated from lc::cullParams(), the one parameter
 // table (see docs/CLI.md). Errors print one line on stderr and exit non-zero:
@@ -15,10 +17,12 @@
 #include "culling/scene_io.hpp"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -88,6 +92,250 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
               << "wrote " << out << "/summary.json, tiles.csv, heatmap.png\n";
 }
 
+
+// Flags shared by `run` and `bench`: the scene, the culling parameters (from
+// the one table), generated lights and the backend.
+struct SceneFlags {
+    std::string sceneFile, builtin, backendName, device;
+    long long lightCount = -1;
+    unsigned long long seed = 1;
+    std::map<std::string, std::string> paramValues;
+    std::vector<std::pair<std::string, CLI::Option*>> paramOptions;
+    CLI::Option* optLights = nullptr;
+
+    void addTo(CLI::App* cmd) {
+        CLI::Option* optScene =
+            cmd->add_option("--scene", sceneFile, "Scene JSON file to load")->type_name("FILE.json");
+        CLI::Option* optBuiltin = cmd->add_option("--builtin", builtin, "Built-in scene to use (see `lightcull scenes`)")
+                                      ->type_name("NAME");
+        optScene->excludes(optBuiltin);
+        // One flag per culling parameter, straight from the parameter table.
+        for (const lc::ParamSpec& p : lc::cullParams()) {
+            CLI::Option* o = cmd->add_option("--" + p.name, paramValues[p.name], paramDescription(p));
+            o->type_name(p.type == lc::ParamType::Int ? "INT" : p.type == lc::ParamType::Bool ? "BOOL" : "CHOICE");
+            paramOptions.emplace_back(p.name, o);
+        }
+        optLights = cmd->add_option(
+            "--lights", lightCount,
+            "Replace the scene's lights with N generated ones (deterministic, placed in the scene's bounds)");
+        optLights->type_name("N");
+        cmd->add_option("--seed", seed, "Seed of the light generator used by --lights (default: 1)")
+            ->type_name("S")
+            ->needs(optLights);
+        std::string backendHelp = "Backend running depth and culling: ";
+        for (const std::string& b : lc::availableBackends()) backendHelp += b + " ";
+        backendHelp += "(default: vulkan where available, else cpu)";
+        cmd->add_option("--backend", backendName, backendHelp)->type_name("NAME");
+        cmd->add_option("--device", device,
+                        "Vulkan device: index or name substring (default: LIGHTCULL_DEVICE, else the first discrete GPU)")
+            ->type_name("D");
+    }
+
+    bool hasScene() const { return !sceneFile.empty() || !builtin.empty(); }
+
+    lc::Scene loadScene() const {
+        lc::Scene scene = sceneFile.empty() ? lc::makeBuiltinScene(builtin) : lc::loadSceneFile(sceneFile);
+        if (optLights->count()) replaceLights(scene, lightCount);
+        return scene;
+    }
+
+    void replaceLights(lc::Scene& scene, long long count) const {
+        if (count < 0 || count > 1000000)
+            throw lc::SettingsError("lights", "must be in 0..1000000, got " + std::to_string(count));
+        scene.lights = lc::generateLights(lc::defaultLightGen(scene, std::uint32_t(count), seed));
+    }
+
+    void applyParams(lc::CullSettings& settings, lc::Camera& camera) const {
+        for (const auto& [name, opt] : paramOptions)
+            if (opt->count()) lc::setParam(settings, camera, name, paramValues.at(name));
+    }
+
+    std::unique_ptr<lc::CullBackend> openBackend() const {
+        if (!backendName.empty()) return lc::makeBackend(backendName, device);
+        // Default: Vulkan where this build has it and a device opens, else the CPU reference.
+        const auto avail = lc::availableBackends();
+        if (std::find(avail.begin(), avail.end(), "vulkan") != avail.end()) {
+            try {
+                return lc::makeBackend("vulkan", device);
+            } catch (const lc::Error& e) {
+                std::cerr << "lightcull: note: no Vulkan device (" << oneLine(e.what()) << "), using the cpu backend\n";
+            }
+        }
+        return lc::makeBackend("cpu");
+    }
+};
+
+
+// ---- bench -----------------------------------------------------------------
+
+struct BenchOptions {
+    int repeat = 10, warmup = 2;
+    std::vector<std::string> sweeps; // KEY=V1,V2,...
+    std::string jsonFile;
+};
+
+void addBenchOptions(CLI::App* cmd, BenchOptions& o) {
+    cmd->add_option("--repeat", o.repeat, "Timed repeats per configuration (default: 10)")
+        ->type_name("N")
+        ->check(CLI::Range(1, 100000));
+    cmd->add_option("--warmup", o.warmup, "Untimed runs before the repeats (default: 2)")
+        ->type_name("N")
+        ->check(CLI::Range(0, 100000));
+    cmd->add_option("--sweep", o.sweeps,
+                    "KEY=V1,V2,... run every value; several --sweep flags form a cross product. KEY: lights, "
+                    "resolution (WxH), or any culling parameter (algorithm, test, cells, slicing, skip-empty, "
+                    "tile, width, height)")
+        ->type_name("KEY=V1,V2,...");
+    cmd->add_option("--json", o.jsonFile, "Also write the results as JSON to FILE")->type_name("FILE");
+}
+
+struct Sweep {
+    std::string key;
+    std::vector<std::string> values;
+};
+
+std::vector<Sweep> parseSweeps(const std::vector<std::string>& specs) {
+    std::vector<Sweep> sweeps;
+    for (const std::string& spec : specs) {
+        const auto eq = spec.find('=');
+        if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size())
+            throw lc::SettingsError("sweep", "expected KEY=V1,V2,..., got '" + spec + "'");
+        Sweep sw{spec.substr(0, eq), {}};
+        std::stringstream values(spec.substr(eq + 1));
+        for (std::string v; std::getline(values, v, ',');) {
+            if (v.empty()) throw lc::SettingsError("sweep", "empty value in '" + spec + "'");
+            sw.values.push_back(v);
+        }
+        if (sw.key != "lights" && sw.key != "resolution") lc::cullParam(sw.key); // throws for unknown keys
+        for (const Sweep& other : sweeps)
+            if (other.key == sw.key) throw lc::SettingsError("sweep", "key '" + sw.key + "' swept twice");
+        sweeps.push_back(std::move(sw));
+    }
+    return sweeps;
+}
+
+struct Stats {
+    double median = 0, min = 0, max = 0;
+};
+
+Stats stats(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return {n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]), v.front(), v.back()};
+}
+
+nlohmann::json statsJson(const Stats& s) { return {{"median", s.median}, {"min", s.min}, {"max", s.max}}; }
+
+int runBench(const SceneFlags& flags, const BenchOptions& opt) {
+    const std::vector<Sweep> sweeps = parseSweeps(opt.sweeps);
+    const lc::Scene base = flags.loadScene();
+    lc::CullSettings baseSettings;
+    lc::Scene baseWithParams = base;
+    flags.applyParams(baseSettings, baseWithParams.camera);
+    std::unique_ptr<lc::CullBackend> backend = flags.openBackend();
+
+    std::cout << "bench " << base.name << ": backend " << backend->name() << ", device " << backend->deviceName()
+              << ", timing " << backend->timingMethod() << ", " << opt.warmup << " warm-up + " << opt.repeat
+              << " timed runs per configuration (ms: median [min..max])\n";
+
+    nlohmann::json configs = nlohmann::json::array();
+    std::vector<std::size_t> index(sweeps.size(), 0);
+    for (;;) {
+        lc::Scene scene = baseWithParams;
+        lc::CullSettings settings = baseSettings;
+        nlohmann::json params = nlohmann::json::object();
+        std::string label;
+        for (std::size_t k = 0; k < sweeps.size(); ++k) {
+            const std::string& key = sweeps[k].key;
+            const std::string& value = sweeps[k].values[index[k]];
+            if (key == "lights") {
+                long long n = 0;
+                try {
+                    n = std::stoll(value);
+                } catch (const std::exception&) {
+                    throw lc::SettingsError("sweep", "lights: not an integer: '" + value + "'");
+                }
+                flags.replaceLights(scene, n);
+            } else if (key == "resolution") {
+                const auto x = value.find('x');
+                if (x == std::string::npos)
+                    throw lc::SettingsError("sweep", "resolution: expected WxH, got '" + value + "'");
+                lc::setParam(settings, scene.camera, "width", value.substr(0, x));
+                lc::setParam(settings, scene.camera, "height", value.substr(x + 1));
+            } else {
+                lc::setParam(settings, scene.camera, key, value);
+            }
+            params[key] = value;
+            label += (label.empty() ? "" : " ") + key + "=" + value;
+        }
+        if (label.empty()) label = "(scene settings)";
+        scene.validate();
+        if (const std::string bad = settings.validate(); !bad.empty()) throw lc::SettingsError("settings", bad);
+
+        const lc::Projection proj(scene.camera);
+        const lc::TileGrid grid = lc::TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
+        const lc::ViewLights lights = lc::makeViewLights(scene);
+        std::vector<double> depthMs, cullMs;
+        lc::CullResult last;
+        for (int i = 0; i < opt.warmup + opt.repeat; ++i) {
+            const lc::DepthImage depth = backend->renderDepth(scene, proj);
+            const double d = backend->lastDepthMs();
+            last = backend->cull(depth, proj, grid, lights, settings);
+            if (i >= opt.warmup) {
+                depthMs.push_back(d);
+                cullMs.push_back(last.timings.cullMs);
+            }
+        }
+        const Stats ds = stats(depthMs), cs = stats(cullMs);
+        std::cout << label << ": depth " << fmt("%.3f", ds.median) << " [" << fmt("%.3f", ds.min) << ".."
+                  << fmt("%.3f", ds.max) << "], cull " << fmt("%.3f", cs.median) << " [" << fmt("%.3f", cs.min)
+                  << ".." << fmt("%.3f", cs.max) << "], " << last.entries() << " entries, "
+                  << last.listCountTotal() << " lists, " << last.bytes() << " bytes\n";
+        configs.push_back({{"params", params},
+                           {"algorithm", lc::toString(settings.algorithm)},
+                           {"test", lc::toString(settings.test)},
+                           {"cells", settings.cells},
+                           {"slicing", lc::toString(settings.slicing)},
+                           {"width", scene.camera.width},
+                           {"height", scene.camera.height},
+                           {"tile_size", scene.camera.tileSize},
+                           {"lights", lights.size()},
+                           {"depth_ms", statsJson(ds)},
+                           {"cull_ms", statsJson(cs)},
+                           {"list_entries", last.entries()},
+                           {"lists", last.listCountTotal()},
+                           {"result_bytes", last.bytes()}});
+
+        std::size_t k = 0;
+        while (k < sweeps.size() && ++index[k] == sweeps[k].values.size()) index[k++] = 0;
+        if (k == sweeps.size()) break;
+    }
+
+    if (!opt.jsonFile.empty()) {
+        const nlohmann::json doc = {{"scene", base.name},
+                                    {"backend", backend->name()},
+                                    {"device", backend->deviceName()},
+                                    {"timing_method", backend->timingMethod()},
+                                    {"repeat", opt.repeat},
+                                    {"warmup", opt.warmup},
+                                    {"configs", configs}};
+        const std::string tmp = opt.jsonFile + ".tmp";
+        {
+            std::ofstream out(tmp, std::ios::trunc);
+            out << doc.dump(2) << "\n";
+            if (!out) throw lc::Error("cannot write " + opt.jsonFile);
+        }
+        std::error_code ec;
+        std::filesystem::rename(tmp, opt.jsonFile, ec);
+        if (ec) {
+            std::filesystem::remove(tmp, ec);
+            throw lc::Error("cannot write " + opt.jsonFile + ": " + ec.message());
+        }
+        std::cout << "wrote " << opt.jsonFile << "\n";
+    }
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -100,44 +348,28 @@ int main(int argc, char** argv) {
     CLI::App* run = app.add_subcommand(
         "run", "Run depth pre-pass, culling and ground truth on a scene; write summary.json, "
                "tiles.csv and heatmap.png into --out DIR");
-    std::string sceneFile, builtin, outDir, backendName, device;
-    long long lightCount = -1;
-    unsigned long long seed = 1;
+    SceneFlags runFlags;
+    runFlags.addTo(run);
+    std::string outDir;
     bool noImageError = false;
-    CLI::Option* optScene = run->add_option("--scene", sceneFile, "Scene JSON file to load")->type_name("FILE.json");
-    CLI::Option* optBuiltin =
-        run->add_option("--builtin", builtin, "Built-in scene to use (see `lightcull scenes`)")->type_name("NAME");
-    optScene->excludes(optBuiltin);
-
-    // One flag per culling parameter, straight from the parameter table.
-    std::map<std::string, std::string> paramValues;
-    std::vector<std::pair<std::string, CLI::Option*>> paramOptions;
-    for (const lc::ParamSpec& p : lc::cullParams()) {
-        CLI::Option* o = run->add_option("--" + p.name, paramValues[p.name], paramDescription(p));
-        o->type_name(p.type == lc::ParamType::Int ? "INT" : p.type == lc::ParamType::Bool ? "BOOL" : "CHOICE");
-        paramOptions.emplace_back(p.name, o);
-    }
-    CLI::Option* optLights = run->add_option(
-        "--lights", lightCount, "Replace the scene's lights with N generated ones (deterministic, placed in the scene's bounds)");
-    optLights->type_name("N");
-    run->add_option("--seed", seed, "Seed of the light generator used by --lights (default: 1)")
-        ->type_name("S")
-        ->needs(optLights);
-    std::string backendHelp = "Backend running depth and culling: ";
-    for (const std::string& b : lc::availableBackends()) backendHelp += b + " ";
-    backendHelp += "(default: vulkan where available, else cpu)";
-    run->add_option("--backend", backendName, backendHelp)->type_name("NAME");
-    run->add_option("--device", device, "Vulkan device: index or name substring (default: LIGHTCULL_DEVICE, else the first discrete GPU)")
-        ->type_name("D");
     run->add_flag("--no-image-error", noImageError,
                   "Skip the Lambert image error (it costs pixels x lights); JSON gets null");
     run->add_option("--out", outDir, "Folder to write the diagnostics into (written atomically; its parent must exist)")
         ->type_name("DIR")
         ->required();
 
+    CLI::App* bench = app.add_subcommand(
+        "bench", "Time the depth pre-pass and the culling pass over repeats (median/min/max), "
+                 "optionally sweeping parameters; no ground truth");
+    SceneFlags benchFlags;
+    benchFlags.addTo(bench);
+    BenchOptions benchOptions;
+    addBenchOptions(bench, benchOptions);
+
     // CLI11 reports a missing subcommand before an unknown word; name the word.
-    if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "scenes" && std::string(argv[1]) != "run")
-        return fail(2, std::string("unknown command '") + argv[1] + "' (commands: scenes, run; see --help)");
+    if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "scenes" && std::string(argv[1]) != "run" &&
+        std::string(argv[1]) != "bench")
+        return fail(2, std::string("unknown command '") + argv[1] + "' (commands: scenes, run, bench; see --help)");
 
     try {
         app.parse(argc, argv);
@@ -156,8 +388,12 @@ int main(int argc, char** argv) {
             return 0;
         }
 
-        if (sceneFile.empty() && builtin.empty())
-            return fail(2, "run: give --scene FILE.json or --builtin NAME");
+        if (app.got_subcommand("bench")) {
+            if (!benchFlags.hasScene()) return fail(2, "bench: give --scene FILE.json or --builtin NAME");
+            return runBench(benchFlags, benchOptions);
+        }
+
+        if (!runFlags.hasScene()) return fail(2, "run: give --scene FILE.json or --builtin NAME");
         {
             // Fail before the (possibly long) run when the output cannot be written.
             namespace fs = std::filesystem;
@@ -170,32 +406,10 @@ int main(int argc, char** argv) {
                 return fail(2, "--out: parent folder " + parent.string() + " of " + outDir + " does not exist");
         }
 
-        lc::Scene scene = sceneFile.empty() ? lc::makeBuiltinScene(builtin) : lc::loadSceneFile(sceneFile);
-        if (optLights->count()) {
-            if (lightCount < 0 || lightCount > 1000000)
-                throw lc::SettingsError("lights", "must be in 0..1000000, got " + std::to_string(lightCount));
-            scene.lights = lc::generateLights(lc::defaultLightGen(scene, std::uint32_t(lightCount), seed));
-        }
+        lc::Scene scene = runFlags.loadScene();
         lc::CullSettings settings;
-        for (const auto& [name, opt] : paramOptions)
-            if (opt->count()) lc::setParam(settings, scene.camera, name, paramValues[name]);
-
-        std::unique_ptr<lc::CullBackend> backend;
-        if (backendName.empty()) {
-            // Default: Vulkan where this build has it and a device opens, else the CPU reference.
-            const auto avail = lc::availableBackends();
-            if (std::find(avail.begin(), avail.end(), "vulkan") != avail.end()) {
-                try {
-                    backend = lc::makeBackend("vulkan", device);
-                } catch (const lc::Error& e) {
-                    std::cerr << "lightcull: note: no Vulkan device (" << oneLine(e.what())
-                              << "), using the cpu backend\n";
-                }
-            }
-            if (!backend) backend = lc::makeBackend("cpu");
-        } else {
-            backend = lc::makeBackend(backendName, device);
-        }
+        runFlags.applyParams(settings, scene.camera);
+        std::unique_ptr<lc::CullBackend> backend = runFlags.openBackend();
 
         lc::RunOptions options;
         options.truthOptions.imageError = !noImageError;
