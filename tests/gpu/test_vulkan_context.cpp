@@ -86,3 +86,32 @@ TEST_F(GpuTest, DeviceChoiceByIndexNameAndEnvironment) {
 }
 
 } // namespace
+
+namespace {
+
+// No driver at all (the loader pointed at a missing ICD file): a DeviceError
+// with a clear message, no crash, and no device names, so callers can fall
+// back to the CPU backend.
+TEST_F(GpuTest, NoDriverIsAClearDeviceError) {
+    ASSERT_TRUE(vk::validationMessages().empty()) << gputest::joinedMessages();
+    setenv("VK_ICD_FILENAMES", "/nonexistent/lightcull_no_icd.json", 1);
+    setenv("VK_DRIVER_FILES", "/nonexistent/lightcull_no_icd.json", 1);
+    EXPECT_TRUE(vulkanDeviceNames().empty());
+    try {
+        makeVulkanBackend("");
+        ADD_FAILURE() << "no throw without a driver";
+    } catch (const DeviceError& e) {
+        const std::string w = e.what();
+        EXPECT_TRUE(w.find("no Vulkan driver") != std::string::npos ||
+                    w.find("no Vulkan device") != std::string::npos)
+            << w;
+    }
+    unsetenv("VK_ICD_FILENAMES");
+    unsetenv("VK_DRIVER_FILES");
+    EXPECT_FALSE(vulkanDeviceNames().empty());
+    // The loader itself may warn about the missing ICD file; that is the point
+    // of this test, not a validation finding.
+    vk::clearValidationMessages();
+}
+
+} // namespace

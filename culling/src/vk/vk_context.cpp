@@ -178,7 +178,13 @@ VkInstance createInstance(bool& debugUtils, bool& validation) {
     ci.ppEnabledExtensionNames = enabled.data();
     if (validation) ci.pNext = &mci;
     VkInstance inst = VK_NULL_HANDLE;
-    LC_VK(vkCreateInstance(&ci, nullptr, &inst));
+    const VkResult r = vkCreateInstance(&ci, nullptr, &inst);
+    if (r == VK_ERROR_INCOMPATIBLE_DRIVER)
+        throw DeviceError(std::string("no Vulkan driver found: vkCreateInstance returned "
+                                      "VK_ERROR_INCOMPATIBLE_DRIVER at ") +
+                          __FILE__ + ":" + std::to_string(__LINE__) +
+                          " (install mesa-vulkan-drivers for lavapipe, or use the cpu backend)");
+    if (r != VK_SUCCESS) throwVkError("vkCreateInstance(&ci, nullptr, &inst)", r, __FILE__, __LINE__);
     if (validation) {
         markValidationLayerActive();
         if (validationFeatures) markSyncValidationActive();
