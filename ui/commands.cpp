@@ -26,19 +26,20 @@ void SetLightCommand::undo() { doc_->applyLight(index_, from_); }
 void SetLightCommand::redo() { doc_->applyLight(index_, to_); }
 
 InsertLightsCommand::InsertLightsCommand(Document* doc, std::vector<int> indices,
-                                         std::vector<lc::PointLight> lights, const QString& text)
-    : doc_(doc), indices_(std::move(indices)), lights_(std::move(lights)) {
+                                         std::vector<lc::PointLight> lights, const QString& text,
+                                         bool select)
+    : doc_(doc), indices_(std::move(indices)), lights_(std::move(lights)), select_(select) {
     setText(text);
 }
 void InsertLightsCommand::undo() { doc_->applyRemoveLights(indices_); }
-void InsertLightsCommand::redo() { doc_->applyInsertLights(indices_, lights_); }
+void InsertLightsCommand::redo() { doc_->applyInsertLights(indices_, lights_, select_); }
 
 RemoveLightsCommand::RemoveLightsCommand(Document* doc, std::vector<int> indices,
                                          std::vector<lc::PointLight> lights)
     : doc_(doc), indices_(std::move(indices)), lights_(std::move(lights)) {
     setText(QObject::tr("Delete %n light(s)", nullptr, int(indices_.size())));
 }
-void RemoveLightsCommand::undo() { doc_->applyInsertLights(indices_, lights_); }
+void RemoveLightsCommand::undo() { doc_->applyInsertLights(indices_, lights_, true); }
 void RemoveLightsCommand::redo() { doc_->applyRemoveLights(indices_); }
 
 SetCameraCommand::SetCameraCommand(Document* doc, lc::Camera from, lc::Camera to,

@@ -44,10 +44,12 @@ private:
 };
 
 // Inserts lights at the given (ascending, final) indices; undo removes them.
+// `select`: the inserted lights become the selection (add, duplicate; not a
+// generated cloud of thousands).
 class InsertLightsCommand : public QUndoCommand {
 public:
     InsertLightsCommand(Document* doc, std::vector<int> indices, std::vector<lc::PointLight> lights,
-                        const QString& text);
+                        const QString& text, bool select = true);
     void undo() override;
     void redo() override;
 
@@ -55,6 +57,7 @@ private:
     Document* doc_;
     std::vector<int> indices_;
     std::vector<lc::PointLight> lights_;
+    bool select_;
 };
 
 // Removes lights (ascending indices); undo puts them back where they were.

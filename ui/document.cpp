@@ -79,11 +79,11 @@ void Document::setLight(int index, const lc::PointLight& light) {
     undo_.push(new SetLightCommand(this, index, scene_.lights[std::size_t(index)], light));
 }
 
-void Document::addLights(const std::vector<lc::PointLight>& lights, const QString& text) {
+void Document::addLights(const std::vector<lc::PointLight>& lights, const QString& text, bool select) {
     if (lights.empty()) return;
     std::vector<int> idx(lights.size());
     for (std::size_t i = 0; i < lights.size(); ++i) idx[i] = int(scene_.lights.size() + i);
-    undo_.push(new InsertLightsCommand(this, std::move(idx), lights, text));
+    undo_.push(new InsertLightsCommand(this, std::move(idx), lights, text, select));
 }
 
 void Document::duplicateLights(const std::vector<int>& indices) {
@@ -138,11 +138,11 @@ void Document::applyLight(int index, const lc::PointLight& l) {
 }
 
 void Document::applyInsertLights(const std::vector<int>& indices,
-                                 const std::vector<lc::PointLight>& lights) {
+                                 const std::vector<lc::PointLight>& lights, bool select) {
     // Ascending final indices: inserting in order puts each light exactly there.
     for (std::size_t k = 0; k < indices.size(); ++k)
         scene_.lights.insert(scene_.lights.begin() + indices[k], lights[k]);
-    selectedLights_ = indices;
+    selectedLights_ = select ? indices : std::vector<int>{};
     cameraSelected_ = false;
     emit lightsChanged();
     emit selectionChanged();

@@ -59,8 +59,9 @@ public:
     int newDragId() { return ++dragCounter_; }
     // Property change of one light (name, colour, intensity, radius, ...).
     void setLight(int index, const lc::PointLight& light);
-    // Appends lights as one step (add, duplicate, generate) and selects them.
-    void addLights(const std::vector<lc::PointLight>& lights, const QString& text);
+    // Appends lights as one step (add, duplicate, generate); `select` makes
+    // them the selection.
+    void addLights(const std::vector<lc::PointLight>& lights, const QString& text, bool select = true);
     void duplicateLights(const std::vector<int>& indices);
     void deleteLights(std::vector<int> indices);
     void setCamera(const lc::Camera& camera, const QString& text = tr("Edit camera"));
@@ -77,7 +78,8 @@ public:
     // --- used by the undo commands only --------------------------------------
     void applyLightPosition(int index, const glm::dvec3& p);
     void applyLight(int index, const lc::PointLight& l);
-    void applyInsertLights(const std::vector<int>& indices, const std::vector<lc::PointLight>& lights);
+    void applyInsertLights(const std::vector<int>& indices, const std::vector<lc::PointLight>& lights,
+                           bool select);
     void applyRemoveLights(const std::vector<int>& indices); // ascending
     void applyCamera(const lc::Camera& c);
     void applyAddMesh(const lc::Mesh& m);

@@ -64,6 +64,8 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     lightMapper->ScalarVisibilityOn();
     lightActor_->SetMapper(lightMapper);
     lightActor_->GetProperty()->SetOpacity(0.22);
+    // Back faces add nothing but overdraw to a translucent convex shell.
+    lightActor_->GetProperty()->BackfaceCullingOn();
     renderer_->AddActor(lightActor_);
 
     // Selected lights: the same spheres as an opaque yellow wireframe.
@@ -239,9 +241,13 @@ void InspectorView::updateLight(int index) {
 
 void InspectorView::updateSelection() {
     const auto& lights = doc_->scene().lights;
+    // Outline at most kMaxOutlined selected lights: wireframes of thousands
+    // of spheres hide the scene and cost more than the spheres themselves.
+    constexpr std::size_t kMaxOutlined = 256;
     std::vector<lc::PointLight> sel;
-    for (int i : doc_->selectedLights())
-        if (i < int(lights.size())) sel.push_back(lights[std::size_t(i)]);
+    const auto& selected = doc_->selectedLights();
+    for (std::size_t k = selected.size() > kMaxOutlined ? selected.size() - kMaxOutlined : 0; k < selected.size(); ++k)
+        if (selected[k] < int(lights.size())) sel.push_back(lights[std::size_t(selected[k])]);
     selData_ = lightsToPolyData(sel);
     selGlyph_->SetInputData(selData_);
     const int cur = doc_->currentLight();
@@ -322,7 +328,7 @@ void InspectorView::onHandleEnd() {
     dragLight_ = -1;
 }
 
-int InspectorView::pickLight(const QPoint& pos) {
+int InspectorView::pickLight(const QPoint& pos, glm::dvec3* hit) {
     const double dpr = devicePixelRatioF();
     const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
     if (!picker_->Pick(x, y, 0, renderer_)) return -1;
@@ -332,6 +338,11 @@ int InspectorView::pickLight(const QPoint& pos) {
     if (!out || pt < 0) return -1;
     vtkDataArray* ids = out->GetPointData()->GetArray("InputPointIds");
     if (!ids) return -1;
+    if (hit) {
+        double p[3];
+        picker_->GetPickPosition(p);
+        *hit = {p[0], p[1], p[2]};
+    }
     return int(ids->GetTuple1(pt));
 }
 

@@ -39,8 +39,9 @@ public:
     vtkRenderer* renderer() const;
     // Frames the whole scene (meshes, lights and the culling camera).
     void resetCamera();
-    // Light whose sphere is under the widget position (logical px), or -1.
-    int pickLight(const QPoint& pos);
+    // Light whose sphere is under the widget position (logical px), or -1;
+    // `hit` receives the picked point on its sphere.
+    int pickLight(const QPoint& pos, glm::dvec3* hit = nullptr);
     // Mesh surface point under the widget position; false when none. `normal`
     // is the surface normal facing the viewer.
     bool pickSurface(const QPoint& pos, glm::dvec3* point, glm::dvec3* normal = nullptr);

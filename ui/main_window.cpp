@@ -504,7 +504,7 @@ void MainWindow::afterSceneOpened(const QString& what) {
             .arg(s.meshes.size())
             .arg(s.triangleCount())
             .arg(s.lights.size()));
-    runCulling();
+    if (runOnOpen) runCulling();
 }
 
 bool MainWindow::openBuiltin(const QString& name) {
@@ -648,7 +648,7 @@ bool MainWindow::generateLights(const lc::LightGenSettings& g) {
         prompts.showError(this, tr("Generate lights"), describe(e));
         return false;
     }
-    doc_->addLights(lights, tr("Generate %1 lights").arg(lights.size()));
+    doc_->addLights(lights, tr("Generate %1 lights").arg(lights.size()), /*select=*/false);
     log(tr("generated %1 lights (seed %2)").arg(lights.size()).arg(g.seed));
     return true;
 }

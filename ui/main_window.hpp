@@ -65,6 +65,8 @@ public:
     QPlainTextEdit* messageLog() const { return log_; }
     QAction* action(const QString& objectName) const; // e.g. "actionRun"
     Prompts prompts;
+    // Opening a scene runs culling once (tests turn this off to set up first).
+    bool runOnOpen = true;
 
     // --- file operations (return false on failure or cancel; the current
     // scene is then untouched and the error is logged and shown) -------------

@@ -1,0 +1,49 @@
+#pragma once
+// Shared by the ui and render tests: their own main (the GL surface format
+// must be set before QApplication, so QTEST_MAIN cannot be used), isolated
+// QSettings, and small waiting helpers.
+
+#include <QApplication>
+#include <QDir>
+#include <QSignalSpy>
+#include <QSurfaceFormat>
+#include <QTemporaryDir>
+#include <QTest>
+#include <QVTKOpenGLNativeWidget.h>
+
+#include <cstdio>
+#include <cstdlib>
+
+namespace lctest {
+
+// Tests need a real X server (VTK renders through GLX; Qt's offscreen platform
+// does not render VTK reliably). No display is a FAILURE, never a skip.
+inline int runQtTest(QObject* (*make)(), int argc, char** argv) {
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display) {
+        std::fprintf(stderr,
+                     "FAIL: no X display. The ui/render tests need one; run them under Xvfb:\n"
+                     "  xvfb-run -a -s \"-screen 0 1920x1080x24\" ctest -L 'ui|render'\n");
+        return 1;
+    }
+    qputenv("QT_QPA_PLATFORM", "xcb");
+    // Settings of the test run go to a throw-away folder, not the user's.
+    static QTemporaryDir config;
+    qputenv("XDG_CONFIG_HOME", config.path().toUtf8());
+    QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+    QApplication::setAttribute(Qt::AA_ShareOpenGLContexts);
+    QApplication app(argc, argv);
+    QApplication::setOrganizationName("LightCullTest");
+    QApplication::setApplicationName("studio-tests");
+    QObject* test = make();
+    const int rc = QTest::qExec(test, argc, argv);
+    delete test;
+    return rc;
+}
+
+} // namespace lctest
+
+#define LC_STUDIO_TEST_MAIN(TestClass)                                                          \
+    int main(int argc, char** argv) {                                                           \
+        return lctest::runQtTest([]() -> QObject* { return new TestClass; }, argc, argv);      \
+    }

@@ -1,0 +1,464 @@
+// UI tests of the studio under Xvfb: the document, its undo stack, the worker
+// and the panels, driven through the same code paths a user's mouse takes.
+// Backend "cpu" keeps them deterministic and fast; 320x180 keeps runs short.
+
+#include "studio_test_support.hpp"
+
+#include "camera_view.hpp"
+#include "cull_worker.hpp"
+#include "document.hpp"
+#include "inspector_view.hpp"
+#include "main_window.hpp"
+#include "property_panel.hpp"
+#include "scene_tree.hpp"
+#include "tile_inspector.hpp"
+
+#include "culling/scene_io.hpp"
+
+#include <QAction>
+#include <QDoubleSpinBox>
+#include <QFile>
+#include <QItemSelectionModel>
+#include <QLabel>
+#include <QLineEdit>
+#include <QMessageBox>
+#include <QPlainTextEdit>
+#include <QProcess>
+#include <QPushButton>
+#include <QRegularExpression>
+#include <QTimer>
+#include <QUndoStack>
+
+#include <nlohmann/json.hpp>
+#include <vtkAlgorithm.h>
+#include <vtkCommand.h>
+#include <vtkHandleWidget.h>
+#include <vtkMapper.h>
+#include <vtkPointHandleRepresentation3D.h>
+#include <vtkPolyData.h>
+#include <vtkActor.h>
+#include <vtkRenderer.h>
+#include <vtkProperty.h>
+#include <vtkInteractorObserver.h>
+#include <vtkRenderWindowInteractor.h>
+#include <QVTKInteractor.h>
+#include <QElapsedTimer>
+
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+using namespace lcui;
+
+namespace {
+
+constexpr int kRunTimeoutMs = 120000; // generous: 2 shared cores, CPU backend
+
+std::string sceneText(const Document* d) { return lc::serializeScene(d->scene()); }
+
+double labelNumber(MainWindow* w, const char* name, int which = 0) {
+    auto* l = w->findChild<QLabel*>(name);
+    if (!l) return -1e300;
+    QRegularExpression re("[-+]?[0-9]*\\.?[0-9]+");
+    auto it = re.globalMatch(l->text());
+    for (int i = 0; it.hasNext(); ++i) {
+        const auto m = it.next();
+        if (i == which) return m.captured().toDouble();
+    }
+    return -1e300;
+}
+
+} // namespace
+
+class StudioTest : public QObject {
+    Q_OBJECT
+
+    std::unique_ptr<MainWindow> w_;
+    QTemporaryDir tmp_;
+
+    Document* doc() { return w_->document(); }
+
+    // Waits for the run with `generation` (or a newer one) to be shown.
+    bool waitRun(quint64 generation) {
+        QSignalSpy done(w_.get(), &MainWindow::runFinished);
+        QSignalSpy failed(w_.get(), &MainWindow::runFailed);
+        QElapsedTimer t;
+        t.start();
+        while (doc()->runGeneration() < generation && t.elapsed() < kRunTimeoutMs) {
+            if (!failed.isEmpty() && failed.last().at(0).toULongLong() >= generation) return false;
+            done.wait(200);
+        }
+        return doc()->runGeneration() >= generation;
+    }
+
+    // Opens the built-in scene at 320x180 on the CPU backend and waits for its run.
+    void openSmall(const QString& builtin = "atrium") {
+        QVERIFY(w_->openBuiltin(builtin));
+        QVERIFY(w_->setParamFromUi("width", "320"));
+        QVERIFY(w_->setParamFromUi("height", "180"));
+        doc()->undoStack()->clear(); // the resolution change is set-up, not an edit under test
+        QVERIFY(waitRun(w_->runCulling()));
+    }
+
+private slots:
+    void init() {
+        w_ = std::make_unique<MainWindow>();
+        w_->prompts.showError = [](QWidget*, const QString& t, const QString& m) {
+            QFAIL(qPrintable("unexpected error dialog: " + t + ": " + m));
+        };
+        w_->setBackend("cpu");
+        w_->setLive(false);
+        w_->runOnOpen = false; // tests shrink the resolution before the first run
+        w_->resize(1400, 850);
+        w_->show();
+        QVERIFY(QTest::qWaitForWindowExposed(w_.get()));
+    }
+
+    void cleanup() {
+        doc()->undoStack()->setClean(); // no prompt on close
+        w_.reset();
+    }
+
+    void opensBuiltinAndSelectsLightInTree() {
+        openSmall();
+        QVERIFY(doc()->scene().lights.size() > 10);
+        SceneTree* tree = w_->sceneTree();
+        const QModelIndex idx = tree->lightIndex(3);
+        QVERIFY(idx.isValid());
+        tree->setCurrentIndex(idx); // what a click on the row does
+        QCOMPARE(doc()->selectedLights(), std::vector<int>{3});
+        QCOMPARE(doc()->currentLight(), 3);
+        auto* name = w_->propertyPanel()->findChild<QLineEdit*>("lightName");
+        QCOMPARE(name->text().toStdString(), doc()->scene().lights[3].name);
+        // The drag handle sits on the selected light.
+        QVERIFY(w_->inspectorView()->handleWidget()->GetEnabled());
+        double p[3];
+        w_->inspectorView()->handleRepresentation()->GetWorldPosition(p);
+        const auto& lp = doc()->scene().lights[3].position;
+        QVERIFY(std::abs(p[0] - lp.x) < 1e-9 && std::abs(p[1] - lp.y) < 1e-9 && std::abs(p[2] - lp.z) < 1e-9);
+        // Multi-select in the tree selects several lights.
+        tree->selectionModel()->select(tree->lightIndex(5), QItemSelectionModel::Select);
+        QCOMPARE(doc()->selectedLights().size(), std::size_t(2));
+    }
+
+    void dragMovesLightAsOneUndoStep() {
+        openSmall();
+        doc()->setSelectedLights({2});
+        const glm::dvec3 start = doc()->scene().lights[2].position;
+        vtkHandleWidget* handle = w_->inspectorView()->handleWidget();
+        vtkPointHandleRepresentation3D* rep = w_->inspectorView()->handleRepresentation();
+        const int before = doc()->undoStack()->count();
+        // The widget's own event sequence during a mouse drag.
+        handle->InvokeEvent(vtkCommand::StartInteractionEvent);
+        glm::dvec3 p = start;
+        for (int i = 1; i <= 5; ++i) {
+            p = start + glm::dvec3(0.3 * i, 0.1 * i, -0.2 * i);
+            double wp[3] = {p.x, p.y, p.z};
+            rep->SetWorldPosition(wp);
+            handle->InvokeEvent(vtkCommand::InteractionEvent);
+            QCOMPARE(doc()->scene().lights[2].position, p); // the light follows during the drag
+        }
+        handle->InvokeEvent(vtkCommand::EndInteractionEvent);
+        QCOMPARE(doc()->undoStack()->count(), before + 1); // one step for the whole drag
+        QVERIFY(doc()->isDirty());
+        // The glyph input (what the view draws) moved too.
+        auto* glyphInput = vtkPolyData::SafeDownCast(
+            w_->inspectorView()->lightActor()->GetMapper()->GetInputAlgorithm()->GetInputDataObject(0, 0));
+        QVERIFY(glyphInput);
+        double gp[3];
+        glyphInput->GetPoint(2, gp);
+        QVERIFY(std::abs(gp[0] - p.x) < 1e-9 && std::abs(gp[2] - p.z) < 1e-9);
+
+        doc()->undoStack()->undo();
+        QCOMPARE(doc()->scene().lights[2].position, start);
+        doc()->undoStack()->redo();
+        QCOMPARE(doc()->scene().lights[2].position, p);
+        // A second drag is a second step.
+        handle->InvokeEvent(vtkCommand::StartInteractionEvent);
+        double wp[3] = {start.x, start.y, start.z};
+        rep->SetWorldPosition(wp);
+        handle->InvokeEvent(vtkCommand::InteractionEvent);
+        handle->InvokeEvent(vtkCommand::EndInteractionEvent);
+        QCOMPARE(doc()->undoStack()->count(), before + 2);
+    }
+
+    void runMatchesCli() {
+        openSmall();
+        const auto run = doc()->runOutput();
+        QVERIFY(run);
+        QCOMPARE(QString::fromStdString(run->result.backend), QString("cpu"));
+        QCOMPARE(run->result.grid.width, 320u);
+
+        const QString out = tmp_.path() + "/cli";
+        QProcess cli;
+        cli.start(LC_CLI_PATH, {"run", "--builtin", "atrium", "--width", "320", "--height", "180", "--tile",
+                                "16", "--algorithm", "2.5d", "--cells", "32", "--slicing", "log", "--test",
+                                "planes", "--backend", "cpu", "--no-image-error", "--out", out});
+        QVERIFY(cli.waitForFinished(kRunTimeoutMs));
+        QVERIFY2(cli.exitCode() == 0, cli.readAllStandardError().constData());
+        std::ifstream sf((out + "/summary.json").toStdString());
+        const auto summary = nlohmann::json::parse(sf);
+        const auto& m = summary["metrics"];
+
+        // Status bar figures, as shown (FN exact, efficiency to 4 decimals,
+        // mean list to 2, max exact).
+        QCOMPARE(labelNumber(w_.get(), "statusFalseNegatives"), double(m["false_negatives"].get<std::uint64_t>()));
+        QVERIFY(std::abs(labelNumber(w_.get(), "statusEfficiency") - m["efficiency"].get<double>()) < 0.6e-4);
+        QVERIFY(std::abs(labelNumber(w_.get(), "statusLists", 0) - m["mean_list"].get<double>()) < 0.006);
+        QCOMPARE(labelNumber(w_.get(), "statusLists", 1), double(m["max_list"].get<int>()));
+        QVERIFY(w_->findChild<QLabel*>("statusBackend")->text().startsWith("cpu"));
+
+        // The tile with the longest list in tiles.csv, picked by a click in the camera view.
+        QFile csv(out + "/tiles.csv");
+        QVERIFY(csv.open(QIODevice::ReadOnly));
+        csv.readLine();
+        int bestX = -1, bestY = -1, bestCount = -1;
+        std::vector<int> bestLights;
+        while (!csv.atEnd()) {
+            const QStringList f = QString::fromUtf8(csv.readLine()).trimmed().split(',');
+            QCOMPARE(f.size(), 8);
+            if (f[6].toInt() > bestCount) {
+                bestCount = f[6].toInt();
+                bestX = f[0].toInt();
+                bestY = f[1].toInt();
+                bestLights.clear();
+                for (const QString& s : f[7].split(' ', Qt::SkipEmptyParts)) bestLights.push_back(s.toInt());
+            }
+        }
+        QVERIFY(bestCount > 0);
+        CameraView* cv = w_->cameraView();
+        cv->renderNow();
+        const double* vp = cv->sceneRenderer()->GetViewport();
+        const double u = (bestX * 16 + 8) / 320.0, v = (bestY * 16 + 8) / 180.0; // tile centre, image fraction
+        const QPoint click(int((vp[0] + u * (vp[2] - vp[0])) * cv->width()),
+                           int((1.0 - (vp[3] - v * (vp[3] - vp[1]))) * cv->height()));
+        QTest::mouseClick(cv, Qt::LeftButton, {}, click);
+        QTRY_COMPARE(doc()->selectedTile(), bestY * 20 + bestX);
+        QCOMPARE(w_->tileInspector()->listedLights(), bestLights);
+    }
+
+    void undoRedoEveryEditKind() {
+        openSmall();
+        QUndoStack* undo = doc()->undoStack();
+        auto check = [&](const char* what, const std::function<void()>& edit) {
+            const std::string before = sceneText(doc());
+            const int count = undo->count();
+            edit();
+            const std::string after = sceneText(doc());
+            QVERIFY2(after != before, what);
+            QVERIFY2(undo->count() == count + 1, what);
+            undo->undo();
+            QVERIFY2(sceneText(doc()) == before, what);
+            undo->redo();
+            QVERIFY2(sceneText(doc()) == after, what);
+        };
+        check("move", [&] { doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(1, 0, 0), doc()->newDragId()); });
+        check("property", [&] {
+            doc()->setSelectedLights({1});
+            auto* spin = w_->propertyPanel()->findChild<QDoubleSpinBox*>("lightIntensity");
+            spin->setValue(spin->value() + 2.5);
+        });
+        check("colour", [&] {
+            doc()->setSelectedLights({1});
+            w_->propertyPanel()->pickColor = [](QWidget*, QColor) { return QColor(255, 0, 0); };
+            w_->propertyPanel()->findChild<QPushButton*>("lightColor")->click();
+            QCOMPARE(doc()->scene().lights[1].color, glm::dvec3(1, 0, 0));
+        });
+        check("add", [&] { w_->addLightAtCentre(); });
+        check("duplicate", [&] {
+            doc()->setSelectedLights({0, 4});
+            w_->action("actionDuplicate")->trigger();
+        });
+        check("delete", [&] {
+            doc()->setSelectedLights({1, 3, 7});
+            const std::string l2 = doc()->scene().lights[2].name;
+            w_->action("actionDelete")->trigger();
+            QCOMPARE(doc()->scene().lights[1].name, l2);
+        });
+        check("generate", [&] {
+            const std::size_t n = doc()->scene().lights.size();
+            QVERIFY(w_->generateLights(lc::defaultLightGen(doc()->scene(), 1000, 7)));
+            QCOMPARE(doc()->scene().lights.size(), n + 1000);
+        });
+        check("camera", [&] {
+            doc()->selectCamera();
+            auto* fov = w_->propertyPanel()->findChild<QDoubleSpinBox*>("cameraFov");
+            fov->setValue(fov->value() - 10);
+        });
+        check("camera from view", [&] { w_->setCullingCameraFromInspector(); });
+        check("import", [&] {
+            QVERIFY(w_->importMeshFile(LC_ASSETS_DIR "/stanford_bunny/bun_zipper.ply"));
+        });
+    }
+
+    void unsavedChangesPrompt() {
+        openSmall();
+        doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(0, 1, 0), doc()->newDragId());
+        QVERIFY(doc()->isDirty());
+        const std::string edited = sceneText(doc());
+
+        // The real prompt: find the modal message box and press Cancel.
+        bool seen = false;
+        QTimer::singleShot(100, [&] {
+            auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget());
+            if (!box) return;
+            seen = box->text().contains("Save changes");
+            box->button(QMessageBox::Cancel)->click();
+        });
+        QVERIFY(!w_->openBuiltin("wall"));
+        QVERIFY(seen);
+        QCOMPARE(sceneText(doc()), edited); // cancelled: the edit is still there
+        QVERIFY(doc()->isDirty());
+
+        // Closing asks too; Cancel keeps the window open.
+        int asked = 0;
+        w_->prompts.askUnsaved = [&](QWidget*, const QString&) {
+            ++asked;
+            return QMessageBox::Cancel;
+        };
+        QVERIFY(!w_->close());
+        QCOMPARE(asked, 1);
+        QVERIFY(w_->isVisible());
+
+        // Save: goes through the save path prompt, writes the file, then proceeds.
+        const QString path = tmp_.path() + "/saved.json";
+        w_->prompts.askUnsaved = [&](QWidget*, const QString&) {
+            ++asked;
+            return QMessageBox::Save;
+        };
+        w_->prompts.savePath = [&](QWidget*, const QString&, const QString&) { return path; };
+        QVERIFY(w_->newScene());
+        QCOMPARE(asked, 2);
+        QVERIFY(QFile::exists(path));
+        QCOMPARE(lc::serializeScene(lc::loadSceneFile(path.toStdString())), edited);
+        QCOMPARE(doc()->scene().lights.size(), std::size_t(0)); // the new, empty scene
+        QVERIFY(!doc()->isDirty());
+
+        // Discard: no file written, the other scene opens.
+        doc()->addLights({lc::PointLight{}}, "add");
+        w_->prompts.askUnsaved = [&](QWidget*, const QString&) {
+            ++asked;
+            return QMessageBox::Discard;
+        };
+        QVERIFY(w_->openSceneFile(path));
+        QCOMPARE(asked, 3);
+        QCOMPARE(sceneText(doc()), edited);
+        QCOMPARE(doc()->filePath(), path);
+    }
+
+    void failedImportLeavesSceneIntact() {
+        openSmall();
+        const std::string before = sceneText(doc());
+        const int count = doc()->undoStack()->count();
+        QStringList errors;
+        w_->prompts.showError = [&](QWidget*, const QString&, const QString& m) { errors << m; };
+
+        const QString broken = tmp_.path() + "/broken.obj";
+        QFile f(broken);
+        QVERIFY(f.open(QIODevice::WriteOnly));
+        f.write("v 0 0 0\nv nan 1 0\nv 1 1 0\nf 1 2 3\n");
+        f.close();
+        QVERIFY(!w_->importMeshFile(broken));
+        QVERIFY(!w_->importMeshFile(tmp_.path() + "/does_not_exist.ply"));
+        QCOMPARE(errors.size(), 2);
+        QCOMPARE(sceneText(doc()), before);
+        QCOMPARE(doc()->undoStack()->count(), count);
+        const QString log = w_->messageLog()->toPlainText();
+        QVERIFY(log.contains("cannot import " + broken));
+        QVERIFY(log.contains("does_not_exist.ply"));
+        // A failed scene open leaves the scene as it was too.
+        QVERIFY(!w_->openSceneFile(broken));
+        QCOMPARE(sceneText(doc()), before);
+    }
+
+    void cullingErrorIsLoggedAndSceneKept() {
+        openSmall();
+        lc::PointLight bad = doc()->scene().lights[4];
+        bad.minIntensity = 0; // I_min must be > 0
+        doc()->setLight(4, bad);
+        const std::string before = sceneText(doc());
+        QSignalSpy failed(w_.get(), &MainWindow::runFailed);
+        w_->runCulling();
+        QVERIFY(failed.wait(kRunTimeoutMs));
+        const QString msg = failed.last().at(1).toString();
+        QVERIFY2(msg.contains(QString::fromStdString(bad.name)), qPrintable(msg));
+        QVERIFY(w_->messageLog()->toPlainText().contains("failed"));
+        QCOMPARE(sceneText(doc()), before);
+    }
+
+    void newestResultWins() {
+        openSmall();
+        QSignalSpy finished(w_->cullService(), &CullService::finished);
+        quint64 last = 0;
+        for (int i = 0; i < 6; ++i) {
+            doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(0.1, 0, 0), doc()->newDragId());
+            last = w_->runCulling();
+        }
+        QVERIFY(waitRun(last));
+        QCOMPARE(doc()->runGeneration(), last);
+        QTest::qWait(100);
+        // Every request either ran or was replaced while still queued.
+        QCOMPARE(quint64(finished.size()) + w_->cullService()->worker()->droppedRequests(), quint64(6));
+        // A late, older result is not shown over the newer one.
+        QVERIFY(!doc()->setRunOutput(doc()->runOutput(), last - 1));
+        QCOMPARE(doc()->runGeneration(), last);
+    }
+
+    void liveModeRerunsAfterEdit() {
+        openSmall();
+        const quint64 gen = doc()->runGeneration();
+        w_->setLive(true);
+        QVERIFY(waitRun(gen + 1)); // turning Live on runs once
+        const quint64 g2 = doc()->runGeneration();
+        doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(0, 0.5, 0), doc()->newDragId());
+        QVERIFY(waitRun(g2 + 1));
+        QCOMPARE(doc()->runOutput()->lights.centers.size(), doc()->scene().lights.size());
+        w_->setLive(false);
+    }
+
+    void tenThousandLightsStayOneActor() {
+        openSmall();
+        // Radii up to sqrt(10 / 1) = 3.2: a dense but readable cloud.
+        lc::LightGenSettings g = lc::defaultLightGen(doc()->scene(), 10000, 3);
+        g.minIntensity = 1.0;
+        QVERIFY(w_->generateLights(g));
+        auto* glyphInput = vtkPolyData::SafeDownCast(
+            w_->inspectorView()->lightActor()->GetMapper()->GetInputAlgorithm()->GetInputDataObject(0, 0));
+        QCOMPARE(glyphInput->GetNumberOfPoints(), vtkIdType(doc()->scene().lights.size()));
+        // Not an assertion (benchmarks are not tests): the figures go to the log.
+        InspectorView* view = w_->inspectorView();
+        view->renderNow(); // builds the glyphs
+        QElapsedTimer t;
+        t.start();
+        for (int i = 0; i < 3; ++i) view->renderNow();
+        qInfo("inspector view %dx%d, %zu light spheres in one glyph actor: %.0f ms per frame (Xvfb, llvmpipe)",
+              view->width(), view->height(), doc()->scene().lights.size(), t.elapsed() / 3.0);
+        QVERIFY(doc()->selectedLights().empty()); // a generated cloud is not selected wholesale
+        // Picking a light through the glyph maps back to the light index: aim
+        // at a light's centre; the hit lies on the picked light's sphere (the
+        // 12x8 facets sit up to 8% inside it).
+        InspectorView* iv = w_->inspectorView();
+        vtkRenderer* ren = iv->renderer();
+        const auto& lights = doc()->scene().lights;
+        int tried = 0;
+        for (std::size_t i = lights.size(); i-- > 0 && tried < 3;) {
+            ren->SetWorldPoint(lights[i].position.x, lights[i].position.y, lights[i].position.z, 1.0);
+            ren->WorldToDisplay();
+            double d[3];
+            ren->GetDisplayPoint(d);
+            const QPoint pos(int(d[0] / iv->devicePixelRatioF()), int(iv->height() - 1 - d[1] / iv->devicePixelRatioF()));
+            if (!iv->rect().adjusted(5, 5, -5, -5).contains(pos)) continue;
+            ++tried;
+            glm::dvec3 hit;
+            const int picked = iv->pickLight(pos, &hit);
+            QVERIFY(picked >= 0 && picked < int(lights.size()));
+            const double r = lights[std::size_t(picked)].radius();
+            const double dist = glm::length(hit - lights[std::size_t(picked)].position);
+            QVERIFY2(dist <= r * 1.001 && dist >= r * 0.9, qPrintable(QString("picked %1: |hit-c| %2, r %3").arg(picked).arg(dist).arg(r)));
+        }
+        QVERIFY(tried > 0);
+    }
+};
+
+LC_STUDIO_TEST_MAIN(StudioTest)
+#include "test_studio.moc"
