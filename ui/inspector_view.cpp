@@ -188,10 +188,13 @@ void InspectorView::resetCamera() {
     vc->SetViewUp(up.x, up.y, up.z);
     vc->SetViewAngle(30);
     vc->ParallelProjectionOff();
-    // Keep the direction, move back until the scene's bounding sphere fits.
+    // Keep the direction, move back until the scene and the culling camera's
+    // eye (the apex of the frustum) fit.
     if (glm::length(hi - lo) > 0) {
-        double b[6] = {lo.x, hi.x, lo.y, hi.y, lo.z, hi.z};
+        const glm::dvec3 blo = glm::min(lo, c.position), bhi = glm::max(hi, c.position);
+        double b[6] = {blo.x, bhi.x, blo.y, bhi.y, blo.z, bhi.z};
         renderer_->ResetCamera(b);
+        vc->Zoom(1.15); // ResetCamera frames the bounding sphere, which leaves a wide margin
     }
     renderer_->ResetCameraClippingRange();
     cameraFramed_ = true;

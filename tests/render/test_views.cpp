@@ -1,0 +1,189 @@
+// Render tests: screenshots of the camera view (shaded scene, tile grid, heat
+// map, legend, selected tile) and the inspector view (meshes, translucent light
+// spheres, selected light, culling frustum, drag handle) of a fixed scene built
+// here (independent of the built-in scenes), compared with PNG baselines.
+//
+// Tolerance: a pixel differs when any channel differs by more than 40 (of
+// 255); a view fails when more than 0.5% of its pixels differ. Why: Mesa's
+// llvmpipe is deterministic for one build, but another Mesa/VTK/FreeType
+// version moves anti-aliased edges and glyph outlines by a pixel and shifts
+// blended colours by a few levels; a real regression (camera framing, colour
+// map, a missing or misplaced actor, a wrong tile) changes far more than 0.5%.
+//
+// A missing baseline FAILS and writes the candidate (and, on a mismatch, a
+// diff image) to LC_RENDER_OUT_DIR in the build tree; look at it, then copy it
+// to tests/render/baselines/.
+
+#include "../ui/studio_test_support.hpp"
+
+#include "camera_view.hpp"
+#include "document.hpp"
+#include "inspector_view.hpp"
+
+#include "culling/backend.hpp"
+#include "culling/pipeline.hpp"
+
+#include <QDir>
+#include <QImage>
+
+#include <vtkRenderWindow.h>
+
+#include <cmath>
+#include <memory>
+
+using namespace lcui;
+
+namespace {
+
+constexpr int kChannelTolerance = 40;
+constexpr double kMaxDifferingFraction = 0.005;
+
+void addBox(lc::Mesh& m, glm::vec3 lo, glm::vec3 hi) {
+    const auto base = std::uint32_t(m.vertexCount());
+    for (int i = 0; i < 8; ++i) {
+        m.positions.push_back((i & 1) ? hi.x : lo.x);
+        m.positions.push_back((i & 2) ? hi.y : lo.y);
+        m.positions.push_back((i & 4) ? hi.z : lo.z);
+    }
+    const std::uint32_t faces[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                                        {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+    for (const auto& f : faces)
+        for (std::uint32_t v : f) m.indices.push_back(base + v);
+}
+
+// A ground slab, three blocks and a tall column; six coloured lights; a
+// camera looking down at it. Asymmetric on purpose (a flipped image shows).
+lc::Scene fixedScene() {
+    lc::Scene s;
+    s.name = "render-test";
+    lc::Mesh m;
+    m.name = "blocks";
+    addBox(m, {-8, -0.2f, -8}, {8, 0, 8});
+    addBox(m, {-5, 0, -4}, {-3, 2, -2});
+    addBox(m, {1, 0, -6}, {4, 1, -3});
+    addBox(m, {2, 0, 1}, {3, 1.5f, 2});
+    addBox(m, {-1.5f, 0, -1.5f}, {-0.5f, 5, -0.5f});
+    s.meshes.push_back(m);
+    const glm::dvec3 pos[6] = {{-4, 2.5, -3}, {2.5, 1.5, -4.5}, {2.5, 2, 1.5}, {-1, 5.5, -1}, {5, 0.5, 5}, {-6, 1, 4}};
+    const glm::dvec3 col[6] = {{1, 0.2, 0.2}, {0.2, 1, 0.3}, {0.3, 0.4, 1}, {1, 1, 0.3}, {1, 0.5, 0.1}, {0.7, 0.3, 1}};
+    for (int i = 0; i < 6; ++i) {
+        lc::PointLight l;
+        l.name = "light " + std::to_string(i);
+        l.position = pos[i];
+        l.color = col[i];
+        l.intensity = 1.0 + i;
+        l.minIntensity = 0.25; // radii sqrt(I/0.25): 2 .. 4.9
+        s.lights.push_back(l);
+    }
+    s.camera.position = {3, 7, 13};
+    s.camera.target = {0, 1, -1};
+    s.camera.up = {0, 1, 0};
+    s.camera.fovYDeg = 50;
+    s.camera.nearPlane = 0.5;
+    s.camera.farPlane = 100;
+    s.camera.width = 320;
+    s.camera.height = 180;
+    s.camera.tileSize = 16;
+    return s;
+}
+
+struct Comparison {
+    bool ok = false;
+    QString message;
+};
+
+Comparison compareWithBaseline(const QImage& shot, const QString& name) {
+    const QString baselinePath = QString(LC_RENDER_BASELINES) + "/" + name + ".png";
+    QDir().mkpath(LC_RENDER_OUT_DIR);
+    const QString candidatePath = QString(LC_RENDER_OUT_DIR) + "/" + name + ".png";
+    const QImage img = shot.convertToFormat(QImage::Format_RGB32);
+    img.save(candidatePath);
+    QImage base;
+    if (!base.load(baselinePath))
+        return {false, "missing baseline " + baselinePath + "; candidate written to " + candidatePath};
+    base = base.convertToFormat(QImage::Format_RGB32);
+    if (base.size() != img.size())
+        return {false, QString("size %1x%2, baseline %3x%4; candidate %5")
+                           .arg(img.width()).arg(img.height()).arg(base.width()).arg(base.height()).arg(candidatePath)};
+    QImage diff(img.size(), QImage::Format_RGB32);
+    diff.fill(Qt::black);
+    qint64 differing = 0;
+    for (int y = 0; y < img.height(); ++y) {
+        const QRgb* a = reinterpret_cast<const QRgb*>(img.constScanLine(y));
+        const QRgb* b = reinterpret_cast<const QRgb*>(base.constScanLine(y));
+        for (int x = 0; x < img.width(); ++x) {
+            const int d = std::max({std::abs(qRed(a[x]) - qRed(b[x])), std::abs(qGreen(a[x]) - qGreen(b[x])),
+                                    std::abs(qBlue(a[x]) - qBlue(b[x]))});
+            if (d > kChannelTolerance) {
+                ++differing;
+                diff.setPixel(x, y, qRgb(255, 0, 0));
+            }
+        }
+    }
+    const double fraction = double(differing) / (double(img.width()) * img.height());
+    if (fraction > kMaxDifferingFraction) {
+        const QString diffPath = QString(LC_RENDER_OUT_DIR) + "/" + name + "_diff.png";
+        diff.save(diffPath);
+        return {false, QString("%1: %2% of pixels differ (limit %3%); candidate %4, diff %5")
+                           .arg(name).arg(fraction * 100, 0, 'f', 3).arg(kMaxDifferingFraction * 100)
+                           .arg(candidatePath, diffPath)};
+    }
+    return {true, QString("%1: %2% of pixels differ").arg(name).arg(fraction * 100, 0, 'f', 3)};
+}
+
+} // namespace
+
+class RenderTest : public QObject {
+    Q_OBJECT
+
+    std::unique_ptr<Document> doc_;
+
+private slots:
+    void initTestCase() {
+        doc_ = std::make_unique<Document>();
+        doc_->resetScene(fixedScene(), {});
+        auto backend = lc::makeBackend("cpu");
+        lc::RunOptions opt;
+        opt.truthOptions.imageError = false;
+        auto run = std::make_shared<lc::RunOutput>(lc::runPipeline(doc_->scene(), doc_->settings(), *backend, opt));
+        QCOMPARE(run->truth.metrics.falseNegatives, std::uint64_t(0));
+        QVERIFY(doc_->setRunOutput(run, 1));
+        doc_->setSelectedLights({1});
+        doc_->setSelectedTile(int(run->result.grid.tileIndex(9, 6)));
+    }
+
+    void cameraView() {
+        CameraView view(doc_.get());
+        view.resize(720, 360);
+        view.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&view));
+        view.renderNow();
+        QTest::qWait(50);
+        view.renderNow();
+        const QImage shot = view.grabFramebuffer();
+        QVERIFY(!shot.isNull());
+        QCOMPARE(shot.size(), QSize(720, 360) * view.devicePixelRatio());
+        const Comparison c = compareWithBaseline(shot, "camera_view");
+        QVERIFY2(c.ok, qPrintable(c.message));
+        qInfo("%s", qPrintable(c.message));
+    }
+
+    void inspectorView() {
+        InspectorView view(doc_.get());
+        view.resize(640, 480);
+        view.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&view));
+        view.resetCamera();
+        view.renderNow();
+        QTest::qWait(50);
+        view.renderNow();
+        const QImage shot = view.grabFramebuffer();
+        QVERIFY(!shot.isNull());
+        const Comparison c = compareWithBaseline(shot, "inspector_view");
+        QVERIFY2(c.ok, qPrintable(c.message));
+        qInfo("%s", qPrintable(c.message));
+    }
+};
+
+LC_STUDIO_TEST_MAIN(RenderTest)
+#include "test_views.moc"
