@@ -283,6 +283,7 @@ void MainWindow::buildToolbar() {
 
     // Culling controls, generated from the one parameter table (lc::cullParams)
     // that also defines CullSettings and the CLI's flags.
+    addToolBarBreak(); // the generated controls get a row of their own
     QToolBar* bar = addToolBar(tr("Culling"));
     bar->setObjectName("cullToolbar");
     for (const lc::ParamSpec& p : lc::cullParams()) {

@@ -38,7 +38,8 @@ void runWithProgress(QWidget* parent, const QString& label,
     QObject::connect(thread, &QThread::finished, &loop, &QEventLoop::quit);
     QTimer poll;
     QObject::connect(&poll, &QTimer::timeout, [&] {
-        if (!dialog.wasCanceled()) dialog.setValue(int(fraction.load() * 1000));
+        if (dialog.wasCanceled()) cancel.cancelled = true; // also when cancel() is called directly
+        else dialog.setValue(int(fraction.load() * 1000));
     });
     poll.start(50);
     thread->start();
@@ -46,6 +47,7 @@ void runWithProgress(QWidget* parent, const QString& label,
     thread->wait();
     delete thread;
     poll.stop();
+    if (dialog.wasCanceled()) cancel.cancelled = true;
     dialog.reset();
     if (error) std::rethrow_exception(error);
     if (cancel.cancelled) throw lc::Cancelled();

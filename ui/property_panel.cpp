@@ -22,11 +22,18 @@
 namespace lcui {
 
 namespace {
+// x, y, z in one row: no arrow buttons and a modest width keep the dock narrow.
 QWidget* row3(QDoubleSpinBox* const (&s)[3]) {
     auto* w = new QWidget;
     auto* h = new QHBoxLayout(w);
     h->setContentsMargins(0, 0, 0, 0);
-    for (auto* b : s) h->addWidget(b);
+    h->setSpacing(2);
+    for (auto* b : s) {
+        b->setButtonSymbols(QAbstractSpinBox::NoButtons);
+        b->setMinimumWidth(50);
+        b->setMaximumWidth(90);
+        h->addWidget(b);
+    }
     return w;
 }
 // Linear RGB is shown as is (clamped to 1 for the swatch); the picker edits [0,1].

@@ -43,6 +43,10 @@
 #include <vtkRenderWindowInteractor.h>
 #include <QVTKInteractor.h>
 #include <QElapsedTimer>
+#include <QFileInfo>
+#include <QMimeData>
+#include <QProgressDialog>
+#include <QUrl>
 
 #include <fstream>
 #include <memory>
@@ -414,6 +418,79 @@ private slots:
         QVERIFY(waitRun(g2 + 1));
         QCOMPARE(doc()->runOutput()->lights.centers.size(), doc()->scene().lights.size());
         w_->setLive(false);
+    }
+
+    void addLightOnSurfaceUnderCursor() {
+        openSmall();
+        InspectorView* iv = w_->inspectorView();
+        iv->renderNow();
+        const QPoint centre(iv->width() / 2, iv->height() / 2);
+        glm::dvec3 hit, normal;
+        doc()->setSelectedLights({});
+        // Aim at the mesh, not at a light sphere: hide none, the picker ignores spheres here.
+        QVERIFY(iv->pickSurface(centre, &hit, &normal));
+        const int n = int(doc()->scene().lights.size());
+        const int added = w_->addLightAt(centre);
+        QCOMPARE(added, n);
+        const auto [lo, hi] = doc()->scene().bounds();
+        const double dist = glm::length(doc()->scene().lights[std::size_t(added)].position - hit);
+        QVERIFY2(dist <= 0.011 * glm::length(hi - lo), qPrintable(QString::number(dist)));
+        QCOMPARE(doc()->selectedLights(), std::vector<int>{added});
+        // Outside the view: the scene centre.
+        const int atCentre = w_->addLightAtCentre();
+        QCOMPARE(doc()->scene().lights[std::size_t(atCentre)].position, 0.5 * (lo + hi));
+    }
+
+    void cancelledImportLeavesSceneIntact() {
+        openSmall();
+        const std::string before = sceneText(doc());
+        // Press Cancel on the progress dialog as soon as it exists.
+        QTimer poll;
+        connect(&poll, &QTimer::timeout, [&] {
+            if (auto* dlg = w_->findChild<QProgressDialog*>()) dlg->cancel();
+        });
+        poll.start(10);
+        QVERIFY(!w_->importMeshFile(LC_ASSETS_DIR "/buildings/buildings.obj"));
+        poll.stop();
+        QCOMPARE(sceneText(doc()), before);
+        QVERIFY(w_->messageLog()->toPlainText().contains("cancelled"));
+    }
+
+    void dropImportsMesh() {
+        openSmall();
+        const std::size_t meshes = doc()->scene().meshes.size();
+        QMimeData mime;
+        mime.setUrls({QUrl::fromLocalFile(LC_ASSETS_DIR "/stanford_bunny/bun_zipper.ply")});
+        // What a drag from a file manager delivers: enter (accepted), then drop.
+        QDragEnterEvent enter(QPoint(200, 200), Qt::CopyAction, &mime, Qt::LeftButton, Qt::NoModifier);
+        QApplication::sendEvent(w_.get(), &enter);
+        QVERIFY(enter.isAccepted());
+        QDropEvent drop(QPointF(200, 200), Qt::CopyAction, &mime, Qt::LeftButton, Qt::NoModifier);
+        QApplication::sendEvent(w_.get(), &drop);
+        QVERIFY2(doc()->scene().meshes.size() == meshes + 1, qPrintable(w_->messageLog()->toPlainText()));
+        QCOMPARE(doc()->undoStack()->count(), 1);
+    }
+
+    void settingsPersist() {
+        openSmall();
+        QVERIFY(w_->setParamFromUi("algorithm", "halfz"));
+        QVERIFY(w_->setParamFromUi("cells", "8"));
+        w_->action("actionTabbedViews")->setChecked(true);
+        const QString path = tmp_.path() + "/persist.json";
+        QVERIFY(w_->saveAs(path));
+        QVERIFY(w_->close());
+        w_ = std::make_unique<MainWindow>();
+        QVERIFY(doc()->settings().algorithm == lc::Algorithm::HalfZ);
+        QCOMPARE(doc()->settings().cells, 8u);
+        QVERIFY(w_->action("actionTabbedViews")->isChecked());
+        bool listed = false;
+        for (QAction* a : w_->findChildren<QAction*>())
+            if (a->text() == QFileInfo(path).absoluteFilePath()) listed = true;
+        QVERIFY(listed); // recent files
+        w_->action("actionTabbedViews")->setChecked(false);
+        QVERIFY(w_->setParamFromUi("algorithm", "2.5d"));
+        QVERIFY(w_->setParamFromUi("cells", "32"));
+        w_->close(); // leave default settings for the next tests
     }
 
     void tenThousandLightsStayOneActor() {
