@@ -18,6 +18,19 @@ bool MoveLightCommand::mergeWith(const QUndoCommand* other) {
     return true;
 }
 
+ResizeLightCommand::ResizeLightCommand(Document* doc, int index, double from, double to, int dragId)
+    : doc_(doc), index_(index), dragId_(dragId), from_(from), to_(to) {
+    setText(QObject::tr("Resize light"));
+}
+void ResizeLightCommand::undo() { doc_->applyLightRadius(index_, from_); }
+void ResizeLightCommand::redo() { doc_->applyLightRadius(index_, to_); }
+bool ResizeLightCommand::mergeWith(const QUndoCommand* other) {
+    auto* o = static_cast<const ResizeLightCommand*>(other);
+    if (o->index_ != index_ || o->dragId_ != dragId_) return false;
+    to_ = o->to_;
+    return true;
+}
+
 SetLightCommand::SetLightCommand(Document* doc, int index, lc::PointLight from, lc::PointLight to)
     : doc_(doc), index_(index), from_(std::move(from)), to_(std::move(to)) {
     setText(QObject::tr("Edit light %1").arg(QString::fromStdString(to_.name)));

@@ -13,7 +13,7 @@ namespace lcui {
 
 class Document;
 
-enum CommandId { kMoveLightId = 1 };
+enum CommandId { kMoveLightId = 1, kResizeLightId = 2 };
 
 // Moves one light. Successive moves of the same light with the same drag id
 // merge, so a whole drag is one undo step.
@@ -29,6 +29,21 @@ private:
     Document* doc_;
     int index_, dragId_;
     glm::dvec3 from_, to_;
+};
+
+// Sets a light's explicit radius (dragging its sphere); merges like a move.
+class ResizeLightCommand : public QUndoCommand {
+public:
+    ResizeLightCommand(Document* doc, int index, double from, double to, int dragId);
+    void undo() override;
+    void redo() override;
+    int id() const override { return kResizeLightId; }
+    bool mergeWith(const QUndoCommand* other) override;
+
+private:
+    Document* doc_;
+    int index_, dragId_;
+    double from_, to_;
 };
 
 class SetLightCommand : public QUndoCommand {

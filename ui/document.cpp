@@ -3,6 +3,7 @@
 #include "commands.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace lcui {
 
@@ -74,6 +75,13 @@ void Document::moveLight(int index, const glm::dvec3& position, int dragId) {
     undo_.push(new MoveLightCommand(this, index, from, position, dragId));
 }
 
+void Document::resizeLight(int index, double radius, int dragId) {
+    if (index < 0 || index >= int(scene_.lights.size()) || !(radius > 0) || !std::isfinite(radius)) return;
+    const double from = scene_.lights[std::size_t(index)].explicitRadius;
+    if (from == radius) return;
+    undo_.push(new ResizeLightCommand(this, index, from, radius, dragId));
+}
+
 void Document::setLight(int index, const lc::PointLight& light) {
     if (index < 0 || index >= int(scene_.lights.size())) return;
     undo_.push(new SetLightCommand(this, index, scene_.lights[std::size_t(index)], light));
@@ -127,6 +135,12 @@ bool Document::setRunOutput(std::shared_ptr<const lc::RunOutput> run, quint64 ge
 
 void Document::applyLightPosition(int index, const glm::dvec3& p) {
     scene_.lights[std::size_t(index)].position = p;
+    emit lightChanged(index);
+    emit sceneEdited();
+}
+
+void Document::applyLightRadius(int index, double explicitRadius) {
+    scene_.lights[std::size_t(index)].explicitRadius = explicitRadius;
     emit lightChanged(index);
     emit sceneEdited();
 }

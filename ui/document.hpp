@@ -57,6 +57,8 @@ public:
     // into one undo step (the handle widget starts a new id per drag).
     void moveLight(int index, const glm::dvec3& position, int dragId);
     int newDragId() { return ++dragCounter_; }
+    // Dragging a light's sphere: sets its explicit radius (> 0), merging per drag id.
+    void resizeLight(int index, double radius, int dragId);
     // Property change of one light (name, colour, intensity, radius, ...).
     void setLight(int index, const lc::PointLight& light);
     // Appends lights as one step (add, duplicate, generate); `select` makes
@@ -78,6 +80,7 @@ public:
     // --- used by the undo commands only --------------------------------------
     void applyLightPosition(int index, const glm::dvec3& p);
     void applyLight(int index, const lc::PointLight& l);
+    void applyLightRadius(int index, double explicitRadius);
     void applyInsertLights(const std::vector<int>& indices, const std::vector<lc::PointLight>& lights,
                            bool select);
     void applyRemoveLights(const std::vector<int>& indices); // ascending

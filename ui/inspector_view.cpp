@@ -98,7 +98,9 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     interactor()->SetInteractorStyle(style);
 
     handleRep_->SetHandleSize(40);
-    handleRep_->GetProperty()->SetColor(1, 0.85, 0.1);
+    handleRep_->GetProperty()->SetColor(1, 0.45, 0.1);
+    handleRep_->GetProperty()->SetLineWidth(3);
+    handleRep_->GetSelectedProperty()->SetLineWidth(3);
     handleRep_->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
     handleRep_->ActiveRepresentationOff();
     handle_->SetInteractor(interactor());
@@ -107,6 +109,21 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     handle_->AddObserver(vtkCommand::InteractionEvent, this, &InspectorView::onHandleMove);
     handle_->AddObserver(vtkCommand::EndInteractionEvent, this, &InspectorView::onHandleEnd);
     handle_->EnabledOff();
+
+    radiusRep_->SetHandleSize(25);
+    radiusRep_->GetProperty()->SetColor(0.2, 1.0, 0.9);
+    radiusRep_->GetProperty()->SetLineWidth(3);
+    radiusRep_->GetSelectedProperty()->SetLineWidth(3);
+    radiusRep_->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
+    radiusRep_->ActiveRepresentationOff();
+    radiusHandle_->SetInteractor(interactor());
+    radiusHandle_->SetRepresentation(radiusRep_);
+    radiusHandle_->AddObserver(vtkCommand::StartInteractionEvent, this, &InspectorView::onRadiusStart);
+    radiusHandle_->AddObserver(vtkCommand::InteractionEvent, this, &InspectorView::onRadiusMove);
+    radiusHandle_->AddObserver(vtkCommand::EndInteractionEvent, this, &InspectorView::onRadiusEnd);
+    radiusHandle_->EnabledOff();
+    // After an orbit, the radius handle goes back to the right of the centre.
+    style->AddObserver(vtkCommand::EndInteractionEvent, this, &InspectorView::placeRadiusHandle);
 
     picker_->SetTolerance(0.0005);
     picker_->PickFromListOn();
@@ -156,6 +173,8 @@ InspectorView::~InspectorView() = default;
 vtkRenderer* InspectorView::renderer() const { return renderer_.Get(); }
 vtkHandleWidget* InspectorView::handleWidget() const { return handle_.Get(); }
 vtkPointHandleRepresentation3D* InspectorView::handleRepresentation() const { return handleRep_.Get(); }
+vtkHandleWidget* InspectorView::radiusHandleWidget() const { return radiusHandle_.Get(); }
+vtkPointHandleRepresentation3D* InspectorView::radiusHandleRepresentation() const { return radiusRep_.Get(); }
 vtkActor* InspectorView::lightActor() const { return lightActor_.Get(); }
 
 void InspectorView::renderNow() {
@@ -263,8 +282,11 @@ void InspectorView::updateSelection() {
             handleRep_->SetWorldPosition(wp);
         }
         handle_->EnabledOn();
+        radiusHandle_->EnabledOn();
+        placeRadiusHandle();
     } else {
         handle_->EnabledOff();
+        radiusHandle_->EnabledOff();
     }
 }
 
@@ -331,6 +353,44 @@ void InspectorView::onHandleEnd() {
     dragLight_ = -1;
 }
 
+void InspectorView::placeRadiusHandle() {
+    const int cur = doc_->currentLight();
+    const auto& lights = doc_->scene().lights;
+    if (radiusActive_ || cur < 0 || cur >= int(lights.size())) return;
+    // The view's right vector: direction of projection x view up.
+    vtkCamera* vc = renderer_->GetActiveCamera();
+    double dop[3], up[3];
+    vc->GetDirectionOfProjection(dop);
+    vc->GetViewUp(up);
+    glm::dvec3 right = glm::cross(glm::dvec3(dop[0], dop[1], dop[2]), glm::dvec3(up[0], up[1], up[2]));
+    right = glm::length(right) > 0 ? glm::normalize(right) : glm::dvec3(1, 0, 0);
+    const auto& l = lights[std::size_t(cur)];
+    const glm::dvec3 p = l.position + right * lightDisplayRadius(l);
+    double wp[3] = {p.x, p.y, p.z};
+    radiusRep_->SetWorldPosition(wp);
+}
+
+void InspectorView::onRadiusStart() {
+    radiusActive_ = true;
+    dragLight_ = doc_->currentLight();
+    dragId_ = doc_->newDragId();
+}
+
+void InspectorView::onRadiusMove() {
+    if (dragLight_ < 0 || dragLight_ >= int(doc_->scene().lights.size())) return;
+    double p[3];
+    radiusRep_->GetWorldPosition(p);
+    const glm::dvec3 c = doc_->scene().lights[std::size_t(dragLight_)].position;
+    doc_->resizeLight(dragLight_, glm::length(glm::dvec3(p[0], p[1], p[2]) - c), dragId_);
+}
+
+void InspectorView::onRadiusEnd() {
+    onRadiusMove();
+    radiusActive_ = false;
+    dragLight_ = -1;
+    placeRadiusHandle();
+}
+
 int InspectorView::pickLight(const QPoint& pos, glm::dvec3* hit) {
     const double dpr = devicePixelRatioF();
     const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
@@ -375,7 +435,8 @@ void InspectorView::onLeftPress() { interactor()->GetEventPosition(pressX_, pres
 void InspectorView::onLeftRelease() {
     int x = 0, y = 0;
     interactor()->GetEventPosition(x, y);
-    if (std::abs(x - pressX_) > 3 || std::abs(y - pressY_) > 3 || handleActive_) return; // orbit/drag
+    if (std::abs(x - pressX_) > 3 || std::abs(y - pressY_) > 3 || handleActive_ || radiusActive_)
+        return; // an orbit or a handle drag, not a click
     const double dpr = devicePixelRatioF();
     const QPoint pos(int(x / dpr), int(height() - 1 - y / dpr));
     const int light = pickLight(pos);

@@ -49,6 +49,10 @@ public:
     // its own interaction events, exactly as a mouse drag does).
     vtkHandleWidget* handleWidget() const;
     vtkPointHandleRepresentation3D* handleRepresentation() const;
+    // The second handle, on the current light's sphere (to the right of its
+    // centre as seen from this view): dragging it sets the explicit radius.
+    vtkHandleWidget* radiusHandleWidget() const;
+    vtkPointHandleRepresentation3D* radiusHandleRepresentation() const;
     // The glyph actor showing every light's sphere.
     vtkActor* lightActor() const;
     void renderNow();
@@ -62,6 +66,10 @@ private:
     void onHandleStart();
     void onHandleMove();
     void onHandleEnd();
+    void placeRadiusHandle();
+    void onRadiusStart();
+    void onRadiusMove();
+    void onRadiusEnd();
     void onLeftPress();
     void onLeftRelease();
 
@@ -79,6 +87,9 @@ private:
     vtkNew<vtkActor> frustumActor_;
     vtkNew<vtkHandleWidget> handle_;
     vtkNew<vtkPointHandleRepresentation3D> handleRep_;
+    vtkNew<vtkHandleWidget> radiusHandle_;
+    vtkNew<vtkPointHandleRepresentation3D> radiusRep_;
+    bool radiusActive_ = false;
     vtkNew<vtkCellPicker> picker_;
     int dragId_ = 0;
     int dragLight_ = -1;

@@ -186,6 +186,34 @@ private slots:
         QCOMPARE(doc()->undoStack()->count(), before + 2);
     }
 
+    void dragSphereSetsRadiusAsOneUndoStep() {
+        openSmall();
+        doc()->setSelectedLights({6});
+        const lc::PointLight before = doc()->scene().lights[6];
+        vtkHandleWidget* handle = w_->inspectorView()->radiusHandleWidget();
+        vtkPointHandleRepresentation3D* rep = w_->inspectorView()->radiusHandleRepresentation();
+        QVERIFY(handle->GetEnabled());
+        double wp[3];
+        rep->GetWorldPosition(wp);
+        // The handle starts on the sphere.
+        QVERIFY(std::abs(glm::length(glm::dvec3(wp[0], wp[1], wp[2]) - before.position) - before.radius()) < 1e-9);
+        const int count = doc()->undoStack()->count();
+        handle->InvokeEvent(vtkCommand::StartInteractionEvent);
+        for (double r : {1.5, 2.0, 2.5}) {
+            const glm::dvec3 p = before.position + glm::dvec3(0, r, 0);
+            double q[3] = {p.x, p.y, p.z};
+            rep->SetWorldPosition(q);
+            handle->InvokeEvent(vtkCommand::InteractionEvent);
+        }
+        handle->InvokeEvent(vtkCommand::EndInteractionEvent);
+        QCOMPARE(doc()->scene().lights[6].radius(), 2.5);
+        QCOMPARE(doc()->scene().lights[6].position, before.position);
+        QCOMPARE(doc()->undoStack()->count(), count + 1);
+        doc()->undoStack()->undo();
+        QCOMPARE(doc()->scene().lights[6].explicitRadius, before.explicitRadius);
+        QCOMPARE(doc()->scene().lights[6].radius(), before.radius());
+    }
+
     void runMatchesCli() {
         openSmall();
         const auto run = doc()->runOutput();
