@@ -13,6 +13,7 @@
 #include "scene_tree.hpp"
 #include "tile_inspector.hpp"
 
+#include "culling/projection.hpp"
 #include "culling/scene_io.hpp"
 
 #include <QAction>
@@ -38,6 +39,7 @@
 #include <vtkPolyData.h>
 #include <vtkActor.h>
 #include <vtkRenderer.h>
+#include <vtkRenderWindow.h>
 #include <vtkProperty.h>
 #include <vtkInteractorObserver.h>
 #include <vtkRenderWindowInteractor.h>
@@ -267,6 +269,77 @@ private slots:
         QTest::mouseClick(cv, Qt::LeftButton, {}, click);
         QTRY_COMPARE(doc()->selectedTile(), bestY * 20 + bestX);
         QCOMPARE(w_->tileInspector()->listedLights(), bestLights);
+    }
+
+    // The VTK camera of the camera view must see exactly what the culling
+    // camera saw: a world point lands on the same pixel of the letterboxed
+    // viewport as lc::Projection puts it, for perspective and orthographic.
+    void cameraViewMatchesCullingCamera() {
+        openSmall();
+        CameraView* cv = w_->cameraView();
+        for (auto kind : {lc::ProjectionKind::Perspective, lc::ProjectionKind::Orthographic}) {
+            lc::Camera cam = doc()->scene().camera;
+            cam.projection = kind;
+            doc()->setCamera(cam);
+            cv->renderNow();
+            const lc::Projection proj(cam);
+            const glm::dmat4 view = cam.viewFromWorld();
+            vtkRenderer* ren = cv->sceneRenderer();
+            const double* vp = ren->GetViewport();
+            int checked = 0;
+            for (const auto& l : doc()->scene().lights) {
+                const glm::dvec3 pv = glm::dvec3(view * glm::dvec4(l.position, 1.0));
+                if (-pv.z <= cam.nearPlane) continue;
+                const glm::dvec2 px = proj.pixelFromView(pv);
+                if (px.x < 0 || px.y < 0 || px.x > cam.width || px.y > cam.height) continue;
+                ren->SetWorldPoint(l.position.x, l.position.y, l.position.z, 1.0);
+                ren->WorldToDisplay();
+                double d[3];
+                ren->GetDisplayPoint(d);
+                // Display (y up) -> culling pixel (y down) through the viewport.
+                const int* size = cv->renderWindow()->GetSize();
+                const double u = (d[0] / size[0] - vp[0]) / (vp[2] - vp[0]);
+                const double v = (d[1] / size[1] - vp[1]) / (vp[3] - vp[1]);
+                const glm::dvec2 got(u * cam.width, (1.0 - v) * cam.height);
+                QVERIFY2(glm::length(got - px) < 0.05 * cam.height / 10,
+                         qPrintable(QString("%1: vtk (%2, %3) vs culling (%4, %5)")
+                                        .arg(lc::toString(kind)).arg(got.x).arg(got.y).arg(px.x).arg(px.y)));
+                if (++checked == 20) break;
+            }
+            QVERIFY(checked > 0);
+            // Clicking on a pixel selects the tile that holds it.
+            // (a fraction of the image well inside a tile, not on a tile border)
+            const QPoint click(int(cv->width() * (vp[0] + 0.33 * (vp[2] - vp[0]))),
+                               int(cv->height() * (1 - (vp[1] + 0.67 * (vp[3] - vp[1])))));
+            const int expected = int(lc::TileGrid::make(cam.width, cam.height, cam.tileSize)
+                                         .tileOfPixel(std::uint32_t(0.33 * cam.width), std::uint32_t(0.33 * cam.height)));
+            QCOMPARE(cv->tileAtWidgetPos(click), expected);
+        }
+    }
+
+    void backendSwitchAndBadBackend() {
+        openSmall();
+        const auto cpu = doc()->runOutput();
+        const auto names = lc::availableBackends();
+        if (std::find(names.begin(), names.end(), "vulkan") != names.end()) {
+            // The worker recreates its backend; the same scene gives the same lists.
+            w_->setBackend("vulkan");
+            QVERIFY(waitRun(w_->runCulling()));
+            QCOMPARE(QString::fromStdString(doc()->runOutput()->result.backend), QString("vulkan"));
+            QCOMPARE(doc()->runOutput()->truth.metrics.falseNegatives, std::uint64_t(0));
+            QVERIFY(w_->findChild<QLabel*>("statusBackend")->text().startsWith("vulkan"));
+            w_->setBackend("cpu");
+        }
+        // An unknown backend is an error in the log; the last result stays.
+        w_->setBackend("cpu", "");
+        QSignalSpy failed(w_.get(), &MainWindow::runFailed);
+        const quint64 shown = doc()->runGeneration();
+        w_->cullService()->request(doc()->scene(), doc()->settings(), "no-such-backend", "");
+        QVERIFY(failed.wait(kRunTimeoutMs));
+        QCOMPARE(doc()->runGeneration(), shown);
+        QVERIFY(w_->messageLog()->toPlainText().contains("no-such-backend"));
+        QVERIFY(waitRun(w_->runCulling())); // and cpu works again
+        QCOMPARE(QString::fromStdString(doc()->runOutput()->result.backend), QString("cpu"));
     }
 
     void undoRedoEveryEditKind() {
