@@ -17,8 +17,9 @@ function(lc_add_studio_tests dir label timeout)
     target_compile_definitions(${target} PRIVATE
       LC_ASSETS_DIR="${LIGHTCULL_ASSETS_DIR}" LC_TEST_DATA_DIR="${LC_TEST_DATA_DIR}"
       LC_SOURCE_DIR="${CMAKE_SOURCE_DIR}" LC_CLI_PATH="$<TARGET_FILE:lightcull>"
-      LC_RENDER_BASELINES="${LC_RENDER_BASELINES}" LC_RENDER_OUT_DIR="${CMAKE_CURRENT_BINARY_DIR}/render_out")
-    add_dependencies(${target} lightcull)
+      LC_RENDER_BASELINES="${LC_RENDER_BASELINES}" LC_RENDER_OUT_DIR="${CMAKE_CURRENT_BINARY_DIR}/render_out"
+      LC_STUDIO_PATH="$<TARGET_FILE:lightcull-studio>")
+    add_dependencies(${target} lightcull lightcull-studio)
     vtk_module_autoinit(TARGETS ${target} MODULES
       VTK::RenderingOpenGL2 VTK::InteractionStyle VTK::RenderingFreeType VTK::GUISupportQt)
     add_test(NAME ${target} COMMAND ${target})

@@ -25,6 +25,9 @@
 #include <QMessageBox>
 #include <QPlainTextEdit>
 #include <QProcess>
+#include <QProcessEnvironment>
+#include <QSet>
+#include <QImage>
 #include <QPushButton>
 #include <QRegularExpression>
 #include <QTimer>
@@ -592,6 +595,35 @@ private slots:
         QVERIFY(w_->setParamFromUi("algorithm", "2.5d"));
         QVERIFY(w_->setParamFromUi("cells", "32"));
         w_->close(); // leave default settings for the next tests
+    }
+
+    // The scriptable start: a screenshot of the whole window after the run.
+    void scriptedScreenshot() {
+        const QString shot = tmp_.path() + "/wall.png";
+        QProcess studio;
+        studio.start(LC_STUDIO_PATH, {"--builtin", "wall", "--run", "--screenshot", shot, "--quit"});
+        QVERIFY(studio.waitForFinished(kRunTimeoutMs));
+        QVERIFY2(studio.exitCode() == 0, studio.readAllStandardError().constData());
+        QImage img(shot);
+        QVERIFY(!img.isNull());
+        QVERIFY(img.width() >= 800 && img.height() >= 500);
+        // Not a blank grab: the window has many distinct colours (views, heat map, widgets).
+        QSet<QRgb> colours;
+        for (int y = 0; y < img.height(); y += 7)
+            for (int x = 0; x < img.width(); x += 7) colours.insert(img.pixel(x, y));
+        QVERIFY(colours.size() > 50);
+
+        // Without a display: a clear message, a non-zero exit, no crash.
+        QProcess headless;
+        QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+        env.remove("DISPLAY");
+        env.remove("QT_QPA_PLATFORM");
+        headless.setProcessEnvironment(env);
+        headless.start(LC_STUDIO_PATH, {"--builtin", "wall"});
+        QVERIFY(headless.waitForFinished(30000));
+        QCOMPARE(headless.exitStatus(), QProcess::NormalExit);
+        QCOMPARE(headless.exitCode(), 2);
+        QVERIFY(QString::fromUtf8(headless.readAllStandardError()).contains("xvfb-run"));
     }
 
     void tenThousandLightsStayOneActor() {
