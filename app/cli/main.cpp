@@ -12,6 +12,7 @@
 
 #include "culling/errors.hpp"
 #include "culling/export.hpp"
+#include "culling/file_io.hpp"
 #include "culling/params.hpp"
 #include "culling/pipeline.hpp"
 #include "culling/scene_io.hpp"
@@ -22,7 +23,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -319,18 +319,7 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
                                     {"repeat", opt.repeat},
                                     {"warmup", opt.warmup},
                                     {"configs", configs}};
-        const std::string tmp = opt.jsonFile + ".tmp";
-        {
-            std::ofstream out(tmp, std::ios::trunc);
-            out << doc.dump(2) << "\n";
-            if (!out) throw lc::Error("cannot write " + opt.jsonFile);
-        }
-        std::error_code ec;
-        std::filesystem::rename(tmp, opt.jsonFile, ec);
-        if (ec) {
-            std::filesystem::remove(tmp, ec);
-            throw lc::Error("cannot write " + opt.jsonFile + ": " + ec.message());
-        }
+        lc::writeFileAtomic(opt.jsonFile, doc.dump(2) + "\n");
         std::cout << "wrote " << opt.jsonFile << "\n";
     }
     return 0;

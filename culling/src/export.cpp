@@ -3,6 +3,7 @@
 // documented in docs/CLI.md.
 
 #include "culling/export.hpp"
+#include "culling/file_io.hpp"
 
 #include "culling/errors.hpp"
 #include "font5x7.hpp"
@@ -103,24 +104,6 @@ void fsyncPath(const fs::path& p, bool directory) {
     const int err = errno;
     ::close(fd);
     if (rc != 0) throw Error("cannot sync " + p.string() + ": " + std::strerror(err));
-}
-
-void writeFileSynced(const fs::path& p, const std::string& text) {
-    const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) throw Error("cannot create " + p.string() + ": " + std::strerror(errno));
-    std::size_t done = 0;
-    while (done < text.size()) {
-        const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-        if (n < 0) {
-            if (errno == EINTR) continue;
-            const int err = errno;
-            ::close(fd);
-            throw Error("cannot write " + p.string() + ": " + std::strerror(err));
-        }
-        done += std::size_t(n);
-    }
-    if (::fsync(fd) != 0 || ::close(fd) != 0)
-        throw Error("cannot write " + p.string() + ": " + std::strerror(errno));
 }
 
 // libpng reports errors by longjmp; this function holds no C++ object with a
@@ -391,8 +374,8 @@ void exportDiagnostics(const Scene& scene, const CullSettings& settings, const R
     const fs::path tmp = tmpl;
     fs::path aside;
     try {
-        writeFileSynced(tmp / "summary.json", summaryJson(scene, settings, run));
-        writeFileSynced(tmp / "tiles.csv", tilesCsv(run));
+        writeFileSynced((tmp / "summary.json").string(), summaryJson(scene, settings, run));
+        writeFileSynced((tmp / "tiles.csv").string(), tilesCsv(run));
         writePng(heatmapImage(run), (tmp / "heatmap.png").string());
         fsyncPath(tmp, true);
         if (exists) {

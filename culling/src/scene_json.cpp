@@ -12,19 +12,18 @@
 
 #include "culling/errors.hpp"
 #include "culling/scene_io.hpp"
+#include "culling/file_io.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
-#include <unistd.h>
 
 namespace lc {
 
@@ -554,39 +553,10 @@ std::string serializeScene(const Scene& scene) {
 
 void saveSceneFile(const Scene& scene, const std::string& path) {
     const std::string text = serializeScene(scene);
-    const fs::path target(path);
-    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    const std::string tmp = (dir / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()))).string();
-    auto sysFail = [&](const std::string& what) {
-        const std::string err = std::strerror(errno);
-        ::unlink(tmp.c_str());
-        throw InputError(path, "", 0, what + ": " + err);
-    };
-    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        throw InputError(path, "", 0, std::string("cannot create temporary file: ") + std::strerror(errno));
-    }
-    std::size_t done = 0;
-    while (done < text.size()) {
-        const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-        if (n < 0) {
-            if (errno == EINTR) continue;
-            ::close(fd);
-            sysFail("write failed");
-        }
-        done += std::size_t(n);
-    }
-    // fsync before rename: otherwise a crash can leave the new name pointing
-    // at an empty file, losing the old scene too.
-    if (::fsync(fd) != 0) {
-        ::close(fd);
-        sysFail("fsync failed");
-    }
-    if (::close(fd) != 0) sysFail("close failed");
-    if (::rename(tmp.c_str(), path.c_str()) != 0) sysFail("rename failed");
-    if (const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dfd >= 0) {
-        ::fsync(dfd);  // make the rename itself durable; best effort
-        ::close(dfd);
+    try {
+        writeFileAtomic(path, text);
+    } catch (const Error& e) {
+        throw InputError(path, "", 0, e.what());
     }
 }
 
