@@ -391,6 +391,7 @@ Mesh loadMesh(const std::string& path, MeshLoadReport* report, const CancelToken
     Mesh mesh;
     mesh.name = fs::path(path).stem().string();
     mesh.sourcePath = path;
+    mesh.resolvedPath = fs::absolute(fs::path(path)).lexically_normal().string();
     mesh.positions = std::move(imp.positions);
     mesh.indices.reserve(imp.polyIndices.size());
 

@@ -491,7 +491,17 @@ Scene loadSceneFile(const std::string& path, const CancelToken* cancel, const Pr
     return parseSceneImpl(text, path, cancel, progress);
 }
 
-std::string serializeScene(const Scene& scene) {
+namespace {
+// The "path" written for a mesh loaded from a file: relative to the folder the
+// scene is saved in, so the scene and its meshes can move together.
+std::string meshPathFor(const Mesh& m, const std::string& baseDir) {
+    if (baseDir.empty() || m.resolvedPath.empty()) return m.sourcePath;
+    const fs::path base = fs::absolute(fs::path(baseDir)).lexically_normal();
+    return fs::path(m.resolvedPath).lexically_proximate(base).generic_string();
+}
+} // namespace
+
+std::string serializeScene(const Scene& scene, const std::string& baseDir) {
     using ojson = nlohmann::ordered_json;
     auto v3 = [](const glm::dvec3& v) { return ojson::array({v.x, v.y, v.z}); };
     ojson root;
@@ -520,7 +530,7 @@ std::string serializeScene(const Scene& scene) {
         ojson jm;
         jm["name"] = m.name;
         if (!m.sourcePath.empty()) {
-            jm["path"] = m.sourcePath;
+            jm["path"] = meshPathFor(m, baseDir);
         } else {
             // float -> double is exact and nlohmann prints the shortest text
             // that reads back to the same double, so the floats survive.

@@ -17,6 +17,10 @@ namespace lc {
 struct Mesh {
     std::string name;
     std::string sourcePath;          // as written in the scene file (relative); empty if built in
+    // Absolute, normalised path of the file the mesh was loaded from; empty if
+    // built in or inline. Saving writes the path relative to the new scene
+    // file's folder from this, so a scene saved elsewhere still finds it.
+    std::string resolvedPath;
     std::vector<float> positions;    // 3 per vertex
     std::vector<std::uint32_t> indices; // 3 per triangle
     glm::dmat4 transform{1.0};

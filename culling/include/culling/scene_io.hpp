@@ -37,9 +37,12 @@ Scene loadSceneFile(const std::string& path, const CancelToken* cancel = nullptr
 Scene parseScene(const std::string& json, const std::string& path);
 // Serialises a scene. Lossless: parseScene(serializeScene(s)) == s in every
 // field (doubles written with round-trip precision; meshes by their sourcePath,
-// built-in meshes inline).
-std::string serializeScene(const Scene& scene);
-// Atomic save: writes a temporary file beside `path`, then renames it.
+// built-in meshes inline). With `baseDir` set, a mesh loaded from a file is
+// written by its path relative to `baseDir` (absolute when no relative path
+// exists), so the scene can be saved into any folder.
+std::string serializeScene(const Scene& scene, const std::string& baseDir = {});
+// Atomic save: writes a temporary file beside `path`, then renames it. Mesh
+// paths are written relative to the folder of `path`.
 void saveSceneFile(const Scene& scene, const std::string& path);
 
 // Built-in procedural scenes (no files needed).
