@@ -4,8 +4,10 @@
 
 #include "culling/export.hpp"
 #include "culling/file_io.hpp"
+#include "culling/overlays.hpp"
 
 #include "culling/errors.hpp"
+#include "culling/shade.hpp"
 #include "font5x7.hpp"
 
 #include <nlohmann/json.hpp>
@@ -158,7 +160,8 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     j["lights"] = run.lights.size();
     j["timings_ms"] = {{"depth", msOrNull(r.timings.depthMs)},
                        {"cull", msOrNull(r.timings.cullMs)},
-                       {"ground_truth", msOrNull(r.timings.groundTruthMs)}};
+                       {"ground_truth", msOrNull(r.timings.groundTruthMs)},
+                       {"shade", msOrNull(r.timings.shadeMs)}};
     nlohmann::ordered_json mj;
     mj["false_negatives"] = m.falseNegatives;
     mj["shading_work"] = m.shadingWork;
@@ -341,8 +344,25 @@ void writePng(const RgbImage& img, const std::string& path) {
     }
 }
 
+void writeShadedImages(const RunOutput& run, const std::string& dir) {
+    const DepthImage& d = run.depth;
+    const std::size_t n = std::size_t(d.width) * d.height * 3;
+    if (run.shadedCulled.size() != n || run.shadedAll.size() != n)
+        throw Error("cannot write the shaded images: they do not match the " + std::to_string(d.width) + "x" +
+                    std::to_string(d.height) + " depth image");
+    // One exposure for both shaded images so they compare by eye; the
+    // difference is scaled so that the largest error is white.
+    const double exposure = exposureFor(d, run.shadedAll);
+    const ImageError e = compareShadedImages(d, run.shadedCulled, run.shadedAll);
+    const fs::path base(dir);
+    writePng({d.width, d.height, shadedPicture(run.shadedCulled, exposure)}, (base / "shaded_culled.png").string());
+    writePng({d.width, d.height, shadedPicture(run.shadedAll, exposure)}, (base / "shaded_all.png").string());
+    writePng({d.width, d.height, differencePicture(run.shadedCulled, run.shadedAll, e.maxAbs)},
+             (base / "shaded_diff.png").string());
+}
+
 void exportDiagnostics(const Scene& scene, const CullSettings& settings, const RunOutput& run,
-                       const std::string& dir) {
+                       const std::string& dir, const std::vector<NamedImage>& viewImages) {
     fs::path target = fs::path(dir).lexically_normal();
     if (!target.has_filename()) target = target.parent_path();
     const std::string name = target.filename().string();
@@ -356,7 +376,15 @@ void exportDiagnostics(const Scene& scene, const CullSettings& settings, const R
                     parent.string() + " does not exist");
     // Replacing a folder removes it: only allow it when it holds nothing but
     // a previous export (so that `--out ~` cannot wipe a home folder).
-    static const std::set<std::string> kOutputs = {"summary.json", "tiles.csv", "heatmap.png"};
+    static const std::set<std::string> kOutputs = {"summary.json", "tiles.csv", "heatmap.png",
+                                                   "overlays.vtm", "overlays", kExportViewImages[0],
+                                                   kExportViewImages[1],
+                                                   // writeShadedImages
+                                                   "shaded_culled.png", "shaded_all.png", "shaded_diff.png"};
+    for (const NamedImage& v : viewImages)
+        if (std::find(std::begin(kExportViewImages), std::end(kExportViewImages), v.fileName) ==
+            std::end(kExportViewImages))
+            throw Error("cannot export diagnostics image '" + v.fileName + "': not a view image name");
     const bool exists = fs::exists(fs::symlink_status(target, ec));
     if (exists) {
         if (!fs::is_directory(fs::symlink_status(target, ec)))
@@ -377,6 +405,9 @@ void exportDiagnostics(const Scene& scene, const CullSettings& settings, const R
         writeFileSynced((tmp / "summary.json").string(), summaryJson(scene, settings, run));
         writeFileSynced((tmp / "tiles.csv").string(), tilesCsv(run));
         writePng(heatmapImage(run), (tmp / "heatmap.png").string());
+        if (!run.shadedAll.empty()) writeShadedImages(run, tmp.string());
+        writeOverlaysVtm(scene, run, tmp.string());
+        for (const NamedImage& v : viewImages) writePng(v.image, (tmp / v.fileName).string());
         fsyncPath(tmp, true);
         if (exists) {
             std::string asideTmpl = (parent / ("." + name + ".old-XXXXXX")).string();

@@ -20,11 +20,27 @@ struct RgbImage {
 RgbImage heatmapImage(const RunOutput& run);
 void writePng(const RgbImage& img, const std::string& path);
 
-// Writes summary.json, tiles.csv and heatmap.png into `dir` atomically: all
-// files go to a temporary sibling folder that is renamed onto `dir` at the end;
-// on any failure nothing is left behind and an existing `dir` is untouched
-// until the rename. Throws Error naming the path.
+// shaded_culled.png, shaded_all.png (one exposure: the all-lights image's
+// 99th percentile at 0.9, sRGB) and shaded_diff.png (|culled - all| scaled so
+// the largest error is white) of run.shadedCulled / run.shadedAll, into `dir`.
+// exportDiagnostics writes them too when the run kept its shaded images
+// (RunOptions::keepShadedImages).
+void writeShadedImages(const RunOutput& run, const std::string& dir);
+
+// An extra image a caller adds to the export (the studio's view screenshots):
+// `fileName` must be one of kExportViewImages.
+struct NamedImage {
+    std::string fileName;
+    RgbImage image;
+};
+inline constexpr const char* kExportViewImages[] = {"camera_view.png", "inspector_view.png"};
+
+// Writes summary.json, tiles.csv, heatmap.png, overlays.vtm with its pieces in
+// overlays/ (culling/overlays.hpp) and any `viewImages` into `dir` atomically:
+// all files go to a temporary sibling folder that is renamed onto `dir` at the
+// end; on any failure nothing is left behind and an existing `dir` is
+// untouched until the rename. Throws Error naming the path.
 void exportDiagnostics(const Scene& scene, const CullSettings& settings, const RunOutput& run,
-                       const std::string& dir);
+                       const std::string& dir, const std::vector<NamedImage>& viewImages = {});
 
 } // namespace lc
