@@ -19,6 +19,15 @@ ViewLights makeViewLights(const Scene& scene) {
         out.centers.push_back(glm::dvec3(viewFromWorld * glm::dvec4(l.position, 1.0)));
         out.radii.push_back(l.radius());
         out.power.push_back(l.color * l.intensity);
+        if (l.isSpot()) {
+            if (out.spotAngles.empty()) {
+                out.spotAxes.assign(scene.lights.size(), glm::dvec3(0.0, 0.0, -1.0));
+                out.spotAngles.assign(scene.lights.size(), 0.0);
+            }
+            // Directions rotate with the view matrix's upper 3x3 (no translation).
+            out.spotAxes[i] = glm::normalize(glm::dmat3(viewFromWorld) * l.direction);
+            out.spotAngles[i] = glm::radians(l.outerAngleDeg);
+        }
     }
     return out;
 }

@@ -156,8 +156,19 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
 
     // Camera depth range for naive (and clustered): an infinite far plane is
     // replaced by the farthest depth any light reaches.
+    // Each light's culling sphere: its range sphere, or for a spot light the
+    // sphere its spot test uses; spot tests may refine it per chunk below.
+    std::vector<glm::dvec3> sphereCenter(n);
+    std::vector<double> sphereRadius(n);
+    for (std::size_t l = 0; l < n; ++l) {
+        const BoundingSphere b = lights.cullSphere(l, settings.spotTest);
+        sphereCenter[l] = b.center;
+        sphereRadius[l] = b.radius;
+    }
+    const bool coneRefines =
+        settings.spotTest == SpotTest::ConeSphere || settings.spotTest == SpotTest::ConePlanes;
     double lightFar = 0.0;
-    for (std::size_t l = 0; l < n; ++l) lightFar = std::max(lightFar, -lights.centers[l].z + lights.radii[l]);
+    for (std::size_t l = 0; l < n; ++l) lightFar = std::max(lightFar, -sphereCenter[l].z + sphereRadius[l]);
     const double camNear = proj.nearPlane();
     const double naiveFar = std::isfinite(proj.farPlane()) ? proj.farPlane() : std::max(lightFar, camNear);
     if (algo == Algorithm::Clustered) {
@@ -196,14 +207,21 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
         std::vector<TileRange> ranges(n);
         std::vector<std::uint32_t> clusterMask(algo == Algorithm::Clustered ? n : 0);
         for (std::size_t l = 0; l < n; ++l) {
-            ranges[l] = lightTileRange(proj, grid, lights.centers[l], lights.radii[l]);
+            ranges[l] = lightTileRange(proj, grid, sphereCenter[l], sphereRadius[l]);
             if (algo == Algorithm::Clustered) {
-                const double cd = -lights.centers[l].z, r = lights.radii[l];
+                const double cd = -sphereCenter[l].z, r = sphereRadius[l];
                 clusterMask[l] = sliceRangeMask(settings.slicing, res.clusterNear, res.clusterFar,
                                                 cells, cd - r, cd + r);
             }
         }
         const SphereTest test = settings.test;
+        // The one per-chunk test: the culling sphere, then for a spot light
+        // under a cone test the cone refinement (spot_tests.hpp).
+        auto intersects = [&](const FrustumChunk& chunk, std::uint32_t l) {
+            if (!sphereIntersectsChunk(test, chunk, sphereCenter[l], sphereRadius[l])) return false;
+            if (!coneRefines || !lights.isSpot(l)) return true;
+            return spotIntersectsChunk(settings.spotTest, test, lights.spotCone(l), chunk);
+        };
         parallelRows(grid.tilesY, [&](std::uint32_t ty) {
             std::vector<std::uint32_t> candidates;
             for (std::size_t l = 0; l < n; ++l)
@@ -232,22 +250,22 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
                 for (std::uint32_t l : candidates) {
                     const TileRange& rg = ranges[l];
                     if (tx < rg.tx0 || tx > rg.tx1) continue;
-                    const glm::dvec3& c = lights.centers[l];
-                    const double r = lights.radii[l];
+                    const glm::dvec3& c = sphereCenter[l];
+                    const double r = sphereRadius[l];
                     switch (algo) {
                     case Algorithm::Naive:
                     case Algorithm::MinMax:
-                        if (sphereIntersectsChunk(test, chunkA, c, r)) lists[t].push_back(l);
+                        if (intersects(chunkA, l)) lists[t].push_back(l);
                         break;
                     case Algorithm::HalfZ:
-                        if (sphereIntersectsChunk(test, chunkA, c, r)) lists[2 * t].push_back(l);
-                        if (sphereIntersectsChunk(test, chunkB, c, r)) lists[2 * t + 1].push_back(l);
+                        if (intersects(chunkA, l)) lists[2 * t].push_back(l);
+                        if (intersects(chunkB, l)) lists[2 * t + 1].push_back(l);
                         break;
                     case Algorithm::TwoPointFiveD: {
                         const double cd = -c.z;
                         const std::uint32_t m =
                             sliceRangeMask(settings.slicing, tmin, tmax, cells, cd - r, cd + r);
-                        if ((m & res.cellMask[t]) && sphereIntersectsChunk(test, chunkA, c, r))
+                        if ((m & res.cellMask[t]) && intersects(chunkA, l))
                             lists[t].push_back(l);
                         break;
                     }
@@ -263,7 +281,7 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
                                     sliceBoundary(settings.slicing, res.clusterNear, res.clusterFar, cells, k + 1));
                                 sliceBuilt[k] = 1;
                             }
-                            if (sphereIntersectsChunk(test, sliceChunk[k], c, r))
+                            if (intersects(sliceChunk[k], l))
                                 lists[std::size_t(t) * cells + k].push_back(l);
                         }
                         break;

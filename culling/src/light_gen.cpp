@@ -6,6 +6,7 @@
 #include "culling/errors.hpp"
 #include "culling/scene_io.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace lc {
@@ -46,6 +47,12 @@ std::vector<PointLight> generateLights(const LightGenSettings& s) {
     if (!(s.minIntensity > 0) || !std::isfinite(s.minIntensity))
         throw SettingsError("lights.min_intensity", "must be finite and > 0");
 
+    if (!(s.spotFraction >= 0.0 && s.spotFraction <= 1.0))
+        throw SettingsError("lights.spot_fraction", "must be in [0, 1]");
+    checkRange("lights.spot_angle", s.spotAngleMinDeg, s.spotAngleMaxDeg);
+    if (s.spotFraction > 0 && !(s.spotAngleMinDeg > 0.0 && s.spotAngleMaxDeg <= 90.0))
+        throw SettingsError("lights.spot_angle", "must lie in (0, 90] degrees");
+
     SplitMix64 rng{s.seed};
     std::vector<PointLight> out;
     out.reserve(s.count);
@@ -58,6 +65,19 @@ std::vector<PointLight> generateLights(const LightGenSettings& s) {
         for (int k = 0; k < 3; ++k) l.color[k] = rng.range(s.colorMin[k], s.colorMax[k]);
         l.intensity = rng.range(s.intensityMin, s.intensityMax);
         l.minIntensity = s.minIntensity;
+        if (s.spotFraction > 0.0) {
+            // Four more draws per light, spot or not (kind, z, azimuth,
+            // angle), so one light's kind never shifts the next light's draws.
+            const bool spot = rng.unit() < s.spotFraction;
+            const double z = rng.range(-1.0, 1.0), phi = rng.range(0.0, 2.0 * 3.14159265358979323846);
+            const double ring = std::sqrt(std::max(0.0, 1.0 - z * z));
+            const double angle = rng.range(s.spotAngleMinDeg, s.spotAngleMaxDeg);
+            if (spot) {
+                l.kind = LightKind::Spot;
+                l.direction = {ring * std::cos(phi), ring * std::sin(phi), z};
+                l.outerAngleDeg = angle;
+            }
+        }
         out.push_back(std::move(l));
     }
     return out;

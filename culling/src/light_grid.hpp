@@ -2,6 +2,7 @@
 // Internal to ground_truth.cpp (and its unit test): a uniform 3D grid over view
 // space that bins each light sphere's axis-aligned box, so that "which lights
 // contain point P" costs a handful of sphere tests instead of one per light.
+// A spot light is binned by its range sphere and needed only inside its cone.
 //
 // It is deliberately independent of the tile, frustum and slicing math that
 // the ground truth checks: only axis-aligned boxes and Euclidean distance.
@@ -20,6 +21,24 @@ namespace lc::detail {
 inline bool lightContains(const glm::dvec3& c, double r, const glm::dvec3& p) {
     const glm::dvec3 d = p - c;
     return d.x * d.x + d.y * d.y + d.z * d.z <= r * r;
+}
+
+// Light i's cone at p (true for point lights): the angle between p - apex and
+// the axis is at most the outer angle, i.e. d.axis >= |d| cos(angle). Written
+// here, not taken from spot_tests.hpp, so that the ground truth does not share
+// arithmetic with the tests it checks.
+inline bool insideSpotCone(const ViewLights& l, std::size_t i, const glm::dvec3& p) {
+    if (!l.isSpot(i)) return true;
+    const glm::dvec3 d = p - l.centers[i];
+    const glm::dvec3& a = l.spotAxes[i];
+    const double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    return d.x * a.x + d.y * a.y + d.z * a.z >= len * std::cos(l.spotAngles[i]);
+}
+
+// Whether light i reaches p: inside its range sphere and, for a spot light,
+// inside its cone (the exact spherical sector).
+inline bool lightNeeds(const ViewLights& l, std::size_t i, const glm::dvec3& p) {
+    return lightContains(l.centers[i], l.radii[i], p) && insideSpotCone(l, i, p);
 }
 
 class LightGrid {
@@ -91,7 +110,7 @@ public:
         }
     }
 
-    // Calls f(lightIndex) for every light whose sphere contains p (p inside
+    // Calls f(lightIndex) for every light that reaches p (lightNeeds; p inside
     // the grid's box). Binned lights come first, then the always-tested ones;
     // each group is ascending.
     template <class F> void forEachContaining(const glm::dvec3& p, F&& f) const {
@@ -101,10 +120,11 @@ public:
         for (std::uint32_t k = cellStart_[c]; k < cellStart_[c + 1]; ++k) {
             const Sphere& s = cellSpheres_[k];
             const double dx = p.x - s.x, dy = p.y - s.y, dz = p.z - s.z;
-            if (dx * dx + dy * dy + dz * dz <= s.r2) f(cellLights_[k]);
+            if (dx * dx + dy * dy + dz * dz <= s.r2 && insideSpotCone(*lights_, cellLights_[k], p))
+                f(cellLights_[k]);
         }
         for (std::uint32_t i : always_)
-            if (lightContains(lights_->centers[i], lights_->radii[i], p)) f(i);
+            if (lightNeeds(*lights_, i, p)) f(i);
     }
 
     // Needed lights at p, ascending.

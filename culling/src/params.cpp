@@ -15,6 +15,8 @@ constexpr std::pair<Algorithm, const char*> kAlgorithms[] = {
     {Algorithm::TwoPointFiveD, "2.5d"}, {Algorithm::Clustered, "clustered"}};
 constexpr SphereTest kTests[] = {SphereTest::Planes, SphereTest::PlanesAabb, SphereTest::Exact};
 constexpr Slicing kSlicings[] = {Slicing::Log, Slicing::Linear};
+constexpr SpotTest kSpotTests[] = {SpotTest::ApexSphere, SpotTest::TightSphere, SpotTest::ConeSphere,
+                                   SpotTest::ConePlanes};
 
 std::string joined(const std::vector<std::string>& v) {
     std::string s;
@@ -46,6 +48,13 @@ std::vector<ParamSpec> buildTable() {
                  "depth slicing of 2.5d cells and clustered slices: log or linear", "Slicing"});
     t.push_back({"skip-empty", ParamType::Bool, "true", {}, 0, 1,
                  "clustered: clusters holding no geometry get empty lists", "Skip empty"});
+    std::vector<std::string> spotTests;
+    for (auto x : kSpotTests) spotTests.push_back(toString(x));
+    t.push_back({"spot-test", ParamType::Choice, "apex-sphere", spotTests, 0, 0,
+                 "spot-light test: apex-sphere (range sphere at the apex), tight-sphere (smallest "
+                 "sphere around the cone), cone-sphere (tight sphere, then cone vs the cell's "
+                 "bounding sphere), cone-planes (tight sphere, then cone vs each cell plane)",
+                 "Spot test"});
     t.push_back({"tile", ParamType::Int, "16", {}, 1, 256, "tile size in pixels", "Tile"});
     t.push_back({"width", ParamType::Int, "1280", {}, 1, 16384, "render width in pixels", "Width"});
     t.push_back({"height", ParamType::Int, "720", {}, 1, 16384, "render height in pixels", "Height"});
@@ -98,6 +107,9 @@ std::string CullSettings::validate() const {
     if (test != SphereTest::Planes && test != SphereTest::PlanesAabb && test != SphereTest::Exact)
         return "test: unknown value";
     if (slicing != Slicing::Log && slicing != Slicing::Linear) return "slicing: unknown value";
+    bool knownSpot = false;
+    for (auto x : kSpotTests) knownSpot |= x == spotTest;
+    if (!knownSpot) return "spot-test: unknown value";
     return {};
 }
 
@@ -121,6 +133,7 @@ void setParam(CullSettings& s, Camera& camera, const std::string& name, const st
     else if (name == "cells") s.cells = std::uint32_t(parseInt(p, value));
     else if (name == "slicing") s.slicing = kSlicings[parseChoice(p, value)];
     else if (name == "skip-empty") s.skipEmpty = parseBool(p, value);
+    else if (name == "spot-test") s.spotTest = kSpotTests[parseChoice(p, value)];
     else if (name == "tile") camera.tileSize = std::uint32_t(parseInt(p, value));
     else if (name == "width") camera.width = std::uint32_t(parseInt(p, value));
     else if (name == "height") camera.height = std::uint32_t(parseInt(p, value));
@@ -133,6 +146,7 @@ std::string getParam(const CullSettings& s, const Camera& camera, const std::str
     if (name == "cells") return std::to_string(s.cells);
     if (name == "slicing") return toString(s.slicing);
     if (name == "skip-empty") return s.skipEmpty ? "true" : "false";
+    if (name == "spot-test") return toString(s.spotTest);
     if (name == "tile") return std::to_string(camera.tileSize);
     if (name == "width") return std::to_string(camera.width);
     return std::to_string(camera.height);

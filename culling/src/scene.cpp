@@ -72,8 +72,18 @@ std::string PointLight::validate() const {
     // kept valid in both cases so that clearing the radius never yields NaN.
     if (!std::isfinite(minIntensity)) return "min_intensity: must be finite";
     if (minIntensity <= 0) return "min_intensity: must be > 0 (got " + fmt(minIntensity) + ")";
+    if (kind == LightKind::Spot) {
+        if (!finite3(direction)) return "direction: must be finite";
+        if (glm::length(direction) == 0.0) return "direction: must not be zero";
+        if (!std::isfinite(outerAngleDeg) || !(outerAngleDeg > 0.0) || outerAngleDeg > 90.0)
+            return "outer_angle_deg: must be in (0, 90] degrees (got " + fmt(outerAngleDeg) + ")";
+    } else if (kind != LightKind::Point) {
+        return "type: unknown light kind";
+    }
     return {};
 }
+
+const char* toString(LightKind k) { return k == LightKind::Spot ? "spot" : "point"; }
 
 // ---------------------------------------------------------------- ProjectionKind
 

@@ -10,7 +10,7 @@ TEST(Params, TableOrderAndDefaultsMatchTheStructs) {
     const auto& t = cullParams();
     std::vector<std::string> names;
     for (const auto& p : t) names.push_back(p.name);
-    EXPECT_EQ(names, (std::vector<std::string>{"algorithm", "test", "cells", "slicing", "skip-empty", "tile",
+    EXPECT_EQ(names, (std::vector<std::string>{"algorithm", "test", "cells", "slicing", "skip-empty", "spot-test", "tile",
                                                "width", "height"}));
     // The table's defaults are the structs' defaults.
     const CullSettings s;

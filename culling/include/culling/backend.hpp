@@ -5,6 +5,7 @@
 
 #include "culling/cull_result.hpp"
 #include "culling/depth.hpp"
+#include "culling/spot_tests.hpp"
 
 #include <memory>
 #include <string>
@@ -13,11 +14,27 @@
 namespace lc {
 
 // Lights transformed to view space with their radii, the input of every pass.
+// centers/radii are each light's range sphere (a spot light's apex sphere).
 struct ViewLights {
     std::vector<glm::dvec3> centers; // view space
     std::vector<double> radii;
     std::vector<glm::dvec3> power;   // colour * intensity (linear RGB), for shading
+    // Spot lights (docs/SPOT_LIGHTS.md): both empty when no light is a spot
+    // (then every light is a point light); otherwise one entry per light, and
+    // spotAngles[i] == 0 marks light i as a point light.
+    std::vector<glm::dvec3> spotAxes; // view space, unit length
+    std::vector<double> spotAngles;   // outer half-angle in radians, (0, pi/2]
     std::size_t size() const { return radii.size(); }
+    bool isSpot(std::size_t i) const { return i < spotAngles.size() && spotAngles[i] > 0.0; }
+    // Light i's cone. Precondition: isSpot(i).
+    SpotCone spotCone(std::size_t i) const {
+        return makeSpotCone(centers[i], spotAxes[i], radii[i], spotAngles[i]);
+    }
+    // The sphere a culling pass tests for light i under `test`: the range
+    // sphere for point lights, spotCullSphere for spot lights.
+    BoundingSphere cullSphere(std::size_t i, SpotTest test) const {
+        return isSpot(i) ? spotCullSphere(test, spotCone(i)) : BoundingSphere{centers[i], radii[i]};
+    }
 };
 // Validates every light (LightError naming it) and transforms it to view space.
 ViewLights makeViewLights(const Scene& scene);

@@ -3,6 +3,7 @@
 // the CLI's flags and the studio's toolbar controls: add a parameter here and
 // it appears in all three.
 
+#include "culling/spot_tests.hpp"
 #include "culling/tile_math.hpp"
 
 #include <cstdint>
@@ -23,6 +24,7 @@ struct CullSettings {
     std::uint32_t cells = 32;        // 2.5d occupancy cells, clustered depth slices (1..32)
     Slicing slicing = Slicing::Log;
     bool skipEmpty = true;           // clustered: empty clusters (no geometry) get empty lists
+    SpotTest spotTest = SpotTest::ApexSphere; // how spot lights are culled (point lights ignore it)
 
     // Empty when valid, else names the field.
     std::string validate() const;
@@ -44,7 +46,7 @@ struct ParamSpec {
 };
 
 // Every culling parameter, in display order: algorithm, test, cells, slicing,
-// skip-empty, tile, width, height.
+// skip-empty, spot-test, tile, width, height.
 const std::vector<ParamSpec>& cullParams();
 const ParamSpec& cullParam(const std::string& name); // throws SettingsError
 

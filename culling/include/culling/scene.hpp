@@ -1,5 +1,5 @@
 #pragma once
-// The scene model: triangle meshes with a transform, point lights and the
+// The scene model: triangle meshes with a transform, point and spot lights and the
 // culling camera. Plain structs of flat arrays; conversions from OpenMesh (and,
 // in the studio, to VTK) live in adapters at the edges.
 
@@ -35,21 +35,37 @@ struct Mesh {
     std::string validate() const;
 };
 
-// A point light. Its bounding sphere radius follows the inverse-square law,
+enum class LightKind { Point, Spot };
+const char* toString(LightKind k); // "point", "spot"
+
+// A light: a point light, or a spot light (kind == Spot) that adds a
+// direction and an outer half-angle. Both kinds share one light index space
+// (light lists index Scene::lights) and the same range rule: the bounding
+// sphere radius follows the inverse-square law,
 // r = sqrt(max(I*c.r, I*c.g, I*c.b) / I_min), unless `explicitRadius` > 0.
+// A spot light lights the spherical sector of points within that range of its
+// position whose angle to `direction` is at most `outerAngleDeg`
+// (docs/SPOT_LIGHTS.md). (The struct keeps its historical name.)
 struct PointLight {
     std::string name;
-    glm::dvec3 position{0.0};        // world space
+    glm::dvec3 position{0.0};        // world space; a spot light's apex
     glm::dvec3 color{1.0};           // linear RGB, each >= 0
     double intensity = 1.0;          // >= 0
     double minIntensity = 0.01;      // I_min > 0: the cut-off that defines the radius
     double explicitRadius = 0.0;     // > 0 overrides the inverse-square radius
+    LightKind kind = LightKind::Point;
+    glm::dvec3 direction{0.0, -1.0, 0.0}; // spot: cone axis, world space, non-zero (normalised on use)
+    double outerAngleDeg = 30.0;     // spot: half-angle of the cone, in (0, 90] degrees
 
-    // Bounding-sphere radius in world units. Precondition: validate() is empty.
+    bool isSpot() const { return kind == LightKind::Spot; }
+    // Bounding-sphere radius in world units (a spot light's range).
+    // Precondition: validate() is empty.
     double radius() const;
-    // Empty when valid; otherwise names the bad field.
+    // Empty when valid; otherwise names the bad field ("outer_angle_deg: ...").
+    // Spot fields are checked only for spot lights.
     std::string validate() const;
 };
+using Light = PointLight;
 
 enum class ProjectionKind {
     Perspective,       // [0,1] window depth, near -> 0, far -> 1

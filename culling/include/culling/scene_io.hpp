@@ -63,6 +63,11 @@ struct LightGenSettings {
     double intensityMin = 1, intensityMax = 10;
     double minIntensity = 0.05;                         // I_min of every light
     glm::dvec3 colorMin{0.2}, colorMax{1.0};            // per channel
+    // Spot lights: each light is a spot with probability spotFraction (0: all
+    // point lights, drawn exactly as before spots existed); a spot gets a
+    // direction uniform on the sphere and an outer angle uniform in degrees.
+    double spotFraction = 0.0;                          // [0, 1]
+    double spotAngleMinDeg = 15, spotAngleMaxDeg = 45;  // within (0, 90]
 };
 std::vector<PointLight> generateLights(const LightGenSettings& s);
 // A placement volume suited to a scene: its mesh bounds, slightly grown.
