@@ -10,10 +10,12 @@
 // kept here too; the GPU lists may only hold MORE entries near a bound.
 #include "culling/gpu_shared.h"
 
-// One workgroup is one subgroup (local size = the device's subgroup size): the
-// passes reduce and compact with subgroup operations only, no shared memory and
-// no barrier() (each costs tens of ms on lavapipe). A device that splits the
-// workgroup into several subgroups is reported through status bit 1.
+// Local size is a specialisation constant. tile_bounds and prefix_sum run one
+// workgroup = one subgroup (local size = the device's subgroup size) and reduce
+// with subgroup operations only: no shared memory and no barrier() (each costs
+// tens of ms on lavapipe); a device that splits such a workgroup is reported
+// through status bit 1. light_bins and cull_lists use one invocation per mask
+// word / per list and no subgroup operations, so any local size works.
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint TILE_SIZE = 16u;
 layout(constant_id = 2) const uint CELLS = 32u;
@@ -22,14 +24,25 @@ layout(constant_id = 4) const uint ALGORITHM = 0u;    // LC_ALG_*
 layout(constant_id = 5) const uint SPHERE_TEST = 0u;  // LC_TEST_*
 layout(constant_id = 6) const uint WRITE_PASS = 0u;   // cull_lists: 0 count, 1 write
 
-layout(std430, binding = 0) readonly buffer Params { GpuCullParams P; };
+layout(std430, binding = 0) readonly buffer Params { GpuCullParams params; };
+// A private copy of the parameters, filled by loadParams() at the top of every
+// main(): lavapipe does not hoist storage-buffer loads out of loops, and a
+// load per pixel or per light is a per-lane scalar loop there (measured: the
+// 2.5d cell walk over 1080p went from ~50 ms to a few ms).
+GpuCullParams P;
+void loadParams() { P = params; }
 layout(std430, binding = 1) readonly buffer DepthBuf { float depthBuf[]; };
 layout(std430, binding = 2) buffer TileBuf { GpuTileBounds tiles[]; };
-layout(std430, binding = 3) readonly buffer LightBuf { vec4 lights[]; }; // view centre xyz, radius
+layout(std430, binding = 3) readonly buffer LightBuf { GpuLight lights[]; };
 layout(std430, binding = 4) buffer CountBuf { uint listCount[]; };
 layout(std430, binding = 5) buffer OffsetBuf { uint listOffset[]; };    // listCount + 1 (total)
 layout(std430, binding = 6) buffer IndexBuf { uint lightIndices[]; };
 layout(std430, binding = 7) buffer StatusBuf { uint status; };
+// Light bins (light_bins.comp): one bit per light. Column tx's word w is
+// binMask[w * tilesX + tx], row ty's word w is binMask[P.bins.y + w * tilesY + ty].
+// A set bit means the light's sphere is not outside either side plane of that
+// tile column / row; (tilesX + tilesY) x lightCount bits in all.
+layout(std430, binding = 8) buffer BinBuf { uint binMask[]; };
 
 const uint STATUS_SPLIT_WORKGROUP = 1u; // more than one subgroup per workgroup
 const uint STATUS_COUNT_MISMATCH = 2u;  // write pass found a different count
@@ -85,30 +98,51 @@ struct Chunk {
     vec3 corners[8];
 };
 
-Chunk makeChunk(uint tileIndex, float zlo, float zhi) {
-    uint tx = tileIndex % P.size.z, ty = tileIndex / P.size.z;
-    float W = float(P.size.x), H = float(P.size.y);
-    // Tile rectangle clipped to the image (partial edge tiles), in NDC.
-    float ul = 2.0 * float(tx * TILE_SIZE) / W - 1.0;
-    float ur = 2.0 * float(min((tx + 1u) * TILE_SIZE, P.size.x)) / W - 1.0;
-    float vt = 2.0 * float(ty * TILE_SIZE) / H - 1.0;
-    float vb = 2.0 * float(min((ty + 1u) * TILE_SIZE, P.size.y)) / H - 1.0;
-    Chunk c;
+// NDC of a tile column's left/right edges (x) or a tile row's top/bottom
+// edges (y), clipped to the image (partial edge tiles).
+vec2 columnNdc(uint tx) {
+    float W = float(P.size.x);
+    return vec2(2.0 * float(tx * TILE_SIZE) / W - 1.0, 2.0 * float(min((tx + 1u) * TILE_SIZE, P.size.x)) / W - 1.0);
+}
+vec2 rowNdc(uint ty) {
+    float H = float(P.size.y);
+    return vec2(2.0 * float(ty * TILE_SIZE) / H - 1.0, 2.0 * float(min((ty + 1u) * TILE_SIZE, P.size.y)) / H - 1.0);
+}
+
+// Inward side planes (unit normals) of a column: [0] left, [1] right; of a
+// row: [0] top, [1] bottom. The one place these planes are computed, so the
+// binning pass and the chunk test agree.
+void columnPlanes(vec2 u, out vec4 left, out vec4 right) {
     if (isOrtho()) {
-        c.planes[0] = vec4(1, 0, 0, -ul * P.lens.x);   // x >= ul*halfW
-        c.planes[1] = vec4(-1, 0, 0, ur * P.lens.x);   // x <= ur*halfW
-        c.planes[2] = vec4(0, -1, 0, -vt * P.lens.y);  // y <= -vt*halfH
-        c.planes[3] = vec4(0, 1, 0, vb * P.lens.y);    // y >= -vb*halfH
+        left = vec4(1, 0, 0, -u.x * P.lens.x);   // x >= ul*halfW
+        right = vec4(-1, 0, 0, u.y * P.lens.x);  // x <= ur*halfW
     } else {
         // x = u*tanX*depth = -u*tanX*z  =>  left: x + kl*z >= 0 with kl = ul*tanX.
-        float kl = ul * P.lens.x, kr = ur * P.lens.x;
-        float kt = vt * P.lens.y, kb = vb * P.lens.y;
-        c.planes[0] = vec4(normalize(vec3(1, 0, kl)), 0);
-        c.planes[1] = vec4(normalize(vec3(-1, 0, -kr)), 0);
-        // y = -v*tanY*depth = v*tanY*z: top (v = vt) keeps y <= kt*z.
-        c.planes[2] = vec4(normalize(vec3(0, -1, kt)), 0);
-        c.planes[3] = vec4(normalize(vec3(0, 1, -kb)), 0);
+        left = vec4(normalize(vec3(1, 0, u.x * P.lens.x)), 0);
+        right = vec4(normalize(vec3(-1, 0, -u.y * P.lens.x)), 0);
     }
+}
+void rowPlanes(vec2 v, out vec4 top, out vec4 bottom) {
+    if (isOrtho()) {
+        top = vec4(0, -1, 0, -v.x * P.lens.y);   // y <= -vt*halfH
+        bottom = vec4(0, 1, 0, v.y * P.lens.y);  // y >= -vb*halfH
+    } else {
+        // y = -v*tanY*depth = v*tanY*z: top (v = vt) keeps y <= kt*z.
+        top = vec4(normalize(vec3(0, -1, v.x * P.lens.y)), 0);
+        bottom = vec4(normalize(vec3(0, 1, -v.y * P.lens.y)), 0);
+    }
+}
+
+// A light's radius widened for float rounding (see the top of this file).
+float widenedRadius(vec4 L) { return L.w + (length(L.xyz) + L.w) * P.cluster.z + P.cluster.w; }
+
+Chunk makeChunk(uint tileIndex, float zlo, float zhi) {
+    uint tx = tileIndex % P.size.z, ty = tileIndex / P.size.z;
+    vec2 u = columnNdc(tx), v = rowNdc(ty);
+    float ul = u.x, ur = u.y, vt = v.x, vb = v.y;
+    Chunk c;
+    columnPlanes(u, c.planes[0], c.planes[1]);
+    rowPlanes(v, c.planes[2], c.planes[3]);
     c.planes[4] = vec4(0, 0, -1, -zlo); // depth >= zlo
     c.planes[5] = vec4(0, 0, 1, zhi);   // depth <= zhi
     c.corners[0] = viewAt(ul, vt, zlo);

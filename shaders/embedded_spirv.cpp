@@ -2,6 +2,7 @@
 
 #include "cull_lists_comp.spv.h"
 #include "depth_vert.spv.h"
+#include "light_bins_comp.spv.h"
 #include "prefix_sum_comp.spv.h"
 #include "tile_bounds_comp.spv.h"
 
@@ -10,6 +11,7 @@ namespace lc::spirv {
     Code fn() { return {arr, sizeof(arr) / sizeof(arr[0])}; }
 LC_SPV(depthVert, lc_spv_depth_vert)
 LC_SPV(tileBounds, lc_spv_tile_bounds_comp)
+LC_SPV(lightBins, lc_spv_light_bins_comp)
 LC_SPV(cullLists, lc_spv_cull_lists_comp)
 LC_SPV(prefixSum, lc_spv_prefix_sum_comp)
 #undef LC_SPV

@@ -9,6 +9,7 @@
 #include "cull_common.glsl"
 
 void main() {
+    loadParams();
     if (gl_NumSubgroups != 1u) atomicOr(status, STATUS_SPLIT_WORKGROUP);
     uint N = P.counts.z;
     uint stride = gl_WorkGroupSize.x, lane = gl_LocalInvocationIndex;

@@ -1,35 +1,64 @@
 #version 450
 // Pass 1 of the culling: per tile, the view-depth bounds of the pixels holding
 // geometry (clear-valued pixels skipped), the halfz split, and the occupancy
-// mask of the 2.5d cells / clustered slices. One workgroup (= one subgroup)
-// per tile, several pixels per invocation, reductions by subgroup operations.
+// mask of the 2.5d cells / clustered slices.
+//
+// LANES_PER_TILE lanes share a tile. On a GPU: a whole subgroup (workgroup =
+// one subgroup), several pixels per lane, reductions by subgroup operations;
+// the lanes cover min(lanes, TILE_SIZE) columns x the rest rows at a time, so
+// no pixel address needs an integer division, and the column loop has a
+// constant trip count (unrolled; x < tw masks partial edge tiles). On a CPU device (lavapipe):
+// one invocation per tile walks all its pixels, so SIMD lanes are tiles and a
+// workgroup holds many tiles (per-workgroup cost dominated otherwise).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #include "cull_common.glsl"
 
+layout(constant_id = 7) const uint LANES_PER_TILE = 1u;
+
 void main() {
-    if (gl_NumSubgroups != 1u) atomicOr(status, STATUS_SPLIT_WORKGROUP);
-    uint tx = gl_WorkGroupID.x, ty = gl_WorkGroupID.y;
+    loadParams();
+    uint tx, ty, lane, stride;
+    if (LANES_PER_TILE == 1u) {
+        tx = gl_GlobalInvocationID.x;
+        ty = gl_WorkGroupID.y;
+        lane = 0u;
+        stride = 1u;
+        if (tx >= P.size.z) return;
+    } else {
+        // A subgroup per tile, gl_NumSubgroups tiles per workgroup along x.
+        if (gl_SubgroupSize != LANES_PER_TILE) atomicOr(status, STATUS_SPLIT_WORKGROUP);
+        tx = gl_WorkGroupID.x * gl_NumSubgroups + gl_SubgroupID;
+        ty = gl_WorkGroupID.y;
+        lane = gl_SubgroupInvocationID;
+        stride = LANES_PER_TILE; // = the subgroup size
+        if (tx >= P.size.z) return;
+    }
     uint W = P.size.x;
     uint x0 = tx * TILE_SIZE, y0 = ty * TILE_SIZE;
     uint tw = min(x0 + TILE_SIZE, W) - x0, th = min(y0 + TILE_SIZE, P.size.y) - y0;
-    uint n = tw * th;
-    uint lane = gl_LocalInvocationIndex, stride = gl_WorkGroupSize.x;
+    uint laneCols = min(stride, TILE_SIZE), laneRows = max(stride / laneCols, 1u);
+    uint lx = lane % laneCols, ly = lane / laneCols;
     float clearDepth = P.depth.w;
 
     // Window depth extremes: linearising only the two extremes is exact
     // because window depth is monotonic in view depth for every kind.
     float wLo = 2.0, wHi = -1.0;
-    for (uint i = lane; i < n; i += stride) {
-        float d = depthBuf[(y0 + i / tw) * W + x0 + i % tw];
-        if (d != clearDepth) {
-            wLo = min(wLo, d);
-            wHi = max(wHi, d);
+    for (uint y = ly; y < th; y += laneRows) {
+        uint row = (y0 + y) * W + x0;
+        for (uint x = lx; x < TILE_SIZE; x += laneCols) {
+            float d = x < tw ? depthBuf[row + x] : clearDepth;
+            if (d != clearDepth) {
+                wLo = min(wLo, d);
+                wHi = max(wHi, d);
+            }
         }
     }
-    wLo = subgroupMin(wLo);
-    wHi = subgroupMax(wHi);
+    if (LANES_PER_TILE != 1u) {
+        wLo = subgroupMin(wLo);
+        wHi = subgroupMax(wHi);
+    }
 
     GpuTileBounds tb;
     tb.cellMask = 0u;
@@ -46,16 +75,51 @@ void main() {
             float lo = (ALGORITHM == LC_ALG_25D) ? tb.depthMin : P.cluster.x;
             float hi = (ALGORITHM == LC_ALG_25D) ? tb.depthMax : P.cluster.y;
             uint mask = 0u;
-            for (uint i = lane; i < n; i += stride) {
-                float d = depthBuf[(y0 + i / tw) * W + x0 + i % tw];
-                if (d != clearDepth) {
-                    float v = viewDepthOf(d);
-                    // Widened: a pixel within rounding of a cell boundary marks both cells.
-                    mask |= sliceRangeMask(lo, hi, widenDown(v), widenUp(v));
+            if (!(hi > lo)) {
+                mask = 1u; // one depth: every pixel in cell 0 (as sliceOf)
+            } else {
+                // Cell coordinate of view depth v: c = k * (log2(v) - log2(lo))
+                // (log slicing) or k * (v - lo) (linear). With log slicing, v =
+                // B / w (perspective) or w / B (orthographic) for the window
+                // offset w = d - A, so c = s * k * (log2(|w|) - L0) with L0 =
+                // log2(|B| / lo) (or log2(lo |B|)), s = -1 (or +1): one log and
+                // no division per pixel, and no cancellation of large terms.
+                // The pixel marks every cell of [c - dc, c + dc] clamped to the
+                // range, where dc covers the widening of v (relative eps +
+                // absolute eps / v <= eps + abs / lo, in log2 units / ln 2, x 1.5
+                // for second-order terms and rounding), float rounding of the
+                // two logs (2e-5 in log2 units) and of c (1e-4 of a cell).
+                bool useLog = SLICING == LC_SLICING_LOG && lo > 0.0;
+                float k = float(CELLS) / (useLog ? log2(hi / lo) : (hi - lo));
+                float dc = useLog ? k * ((P.cluster.z + P.cluster.w / lo) * 2.17 + 2e-5) + 1e-4
+                                  : k * (max(abs(lo), abs(hi)) * P.cluster.z + P.cluster.w) * 1.01 + 1e-4;
+                bool ortho = isOrtho();
+                float sk = ortho ? k : -k;
+                float L0 = ortho ? log2(lo * abs(P.depth.y)) : log2(abs(P.depth.y) / lo);
+                float cellMax = float(CELLS - 1u);
+                for (uint y = ly; y < th; y += laneRows) {
+                    uint row = (y0 + y) * W + x0;
+                    for (uint x = lx; x < TILE_SIZE; x += laneCols) {
+                        float d = x < tw ? depthBuf[row + x] : clearDepth;
+                        if (d != clearDepth) {
+                            float c;
+                            if (useLog) {
+                                precise float w = (d - P.depth.x) - P.depth.z;
+                                c = sk * (log2(abs(w)) - L0);
+                            } else {
+                                c = k * (viewDepthOf(d) - lo);
+                            }
+                            uint c0 = uint(int(clamp(c - dc, 0.0, cellMax)));
+                            uint c1 = uint(int(clamp(c + dc, 0.0, cellMax)));
+                            // (2 << (c1 - c0)) - 1: c1 - c0 + 1 ones (all 32: 0 - 1).
+                            mask |= ((2u << (c1 - c0)) - 1u) << c0;
+                        }
+                    }
                 }
             }
-            tb.cellMask = subgroupOr(mask);
+            if (LANES_PER_TILE != 1u) mask = subgroupOr(mask);
+            tb.cellMask = mask;
         }
     }
-    if (subgroupElect()) tiles[ty * P.size.z + tx] = tb;
+    if (LANES_PER_TILE == 1u || subgroupElect()) tiles[ty * P.size.z + tx] = tb;
 }

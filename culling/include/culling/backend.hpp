@@ -51,6 +51,13 @@ public:
                             const ViewLights& lights, const CullSettings& settings) = 0;
     double lastDepthMs() const { return lastDepthMs_; }
     virtual std::string timingMethod() const = 0;
+    // CPU wall-clock milliseconds of the last cull() around its submissions
+    // (equal to its cullMs where that is the timing method; -1: not run).
+    virtual double lastCullWallMs() const { return -1; }
+    // Most device memory (buffers and images, as allocated) alive at once
+    // since the last resetPeakDeviceBytes(); 0 for backends without a device.
+    virtual std::size_t peakDeviceBytes() const { return 0; }
+    virtual void resetPeakDeviceBytes() {}
 
 protected:
     double lastDepthMs_ = -1;

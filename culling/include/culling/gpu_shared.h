@@ -76,6 +76,17 @@ struct GpuCullParams {
     // bounds and radii are widened so the GPU lists are a superset of the
     // double-precision reference's.
     vec4 cluster;
+    // Light binning (light_bins.comp): x = mask words per column/row (one bit
+    // per light: ceil(lightCount / 32)), y = index of the first row mask in the
+    // bin buffer (= x * tilesX); z, w unused.
+    uvec4 bins;
+};
+
+// One light as the culling passes read it (std430, 16 bytes per light; binding
+// 3). View-space centre and bounding radius. Extend by appending members (and
+// updating the static_asserts below); the passes read lights by index only.
+struct GpuLight {
+    vec4 centerRadius; // xyz: view-space centre, w: bounding-sphere radius
 };
 
 // Per-tile output of the bounds pass (std430, 16 bytes). View depths of the
@@ -88,11 +99,13 @@ struct GpuTileBounds {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(GpuCullParams) == 80, "GpuCullParams must match std430");
+static_assert(sizeof(GpuCullParams) == 96, "GpuCullParams must match std430");
 static_assert(offsetof(GpuCullParams, counts) == 16, "GpuCullParams.counts offset");
 static_assert(offsetof(GpuCullParams, depth) == 32, "GpuCullParams.depth offset");
 static_assert(offsetof(GpuCullParams, lens) == 48, "GpuCullParams.lens offset");
 static_assert(offsetof(GpuCullParams, cluster) == 64, "GpuCullParams.cluster offset");
+static_assert(offsetof(GpuCullParams, bins) == 80, "GpuCullParams.bins offset");
+static_assert(sizeof(GpuLight) == 16, "GpuLight must match std430");
 static_assert(sizeof(GpuTileBounds) == 16, "GpuTileBounds must match std430");
 static_assert(offsetof(GpuTileBounds, cellMask) == 12, "GpuTileBounds.cellMask offset");
 #endif

@@ -272,6 +272,9 @@ Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
         if (!found)
             throw DeviceError(std::string("Vulkan device '") + props_.deviceName +
                               "' has no queue family with both graphics and compute");
+        timestampValidBits_ = qf[queueFamily_].timestampValidBits;
+        timestamps_ = timestampValidBits_ > 0 && props_.limits.timestampPeriod > 0.0f &&
+                      props_.limits.timestampComputeAndGraphics;
 
         // Full subgroups for compute (Vulkan 1.3 core feature): with the local
         // size equal to the subgroup size a workgroup is then exactly one subgroup.
@@ -352,7 +355,44 @@ std::uint32_t Context::findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFl
     throw DeviceError("no Vulkan memory type with the required properties");
 }
 
+TrackedBytes::TrackedBytes(std::shared_ptr<MemoryStats> stats, std::uint64_t bytes)
+    : stats_(std::move(stats)), bytes_(bytes) {
+    stats_->live += bytes_;
+    stats_->peak = std::max(stats_->peak, stats_->live);
+}
+
+TrackedBytes& TrackedBytes::operator=(TrackedBytes&& o) noexcept {
+    if (this != &o) {
+        release();
+        stats_ = std::move(o.stats_);
+        bytes_ = std::exchange(o.bytes_, 0);
+    }
+    return *this;
+}
+
+void TrackedBytes::release() {
+    if (stats_) stats_->live -= bytes_;
+    stats_.reset();
+    bytes_ = 0;
+}
+
+bool Context::hasMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags want) const {
+    for (std::uint32_t i = 0; i < memProps_.memoryTypeCount; ++i)
+        if ((typeBits & (1u << i)) && (memProps_.memoryTypes[i].propertyFlags & want) == want) return true;
+    return false;
+}
+
 Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& n) const {
+    return allocateBuffer(size, usage, n, false);
+}
+
+Buffer Context::createDeviceBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& n) const {
+    return allocateBuffer(size, usage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, n,
+                          true);
+}
+
+Buffer Context::allocateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& n,
+                               bool deviceLocal) const {
     Buffer b;
     b.size = std::max<VkDeviceSize>(size, 4);
     VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
@@ -365,17 +405,62 @@ Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const 
     name(VK_OBJECT_TYPE_BUFFER, buf, n);
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(device_, buf, &req);
+    const VkMemoryPropertyFlags hostFlags = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    VkMemoryPropertyFlags want = hostFlags;
+    if (deviceLocal) {
+        // A CPU device's memory is the host's: keep it mapped. A GPU's
+        // device-local memory is mapped only where the host sees it anyway.
+        const VkMemoryPropertyFlags both = hostFlags | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+        want = isCpuDevice() && hasMemoryType(req.memoryTypeBits, both) ? both
+                                                                      : VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    }
     VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     ai.allocationSize = req.size;
-    ai.memoryTypeIndex =
-        findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    ai.memoryTypeIndex = findMemoryType(req.memoryTypeBits, want);
     VkDeviceMemory mem;
     LC_VK(vkAllocateMemory(device_, &ai, nullptr, &mem));
     b.memory = MemoryHandle(device_, mem);
+    b.tracked = TrackedBytes(memory_, req.size);
     name(VK_OBJECT_TYPE_DEVICE_MEMORY, mem, n + ".memory");
     LC_VK(vkBindBufferMemory(device_, buf, mem, 0));
-    LC_VK(vkMapMemory(device_, mem, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+    const VkMemoryPropertyFlags got = memProps_.memoryTypes[ai.memoryTypeIndex].propertyFlags;
+    if ((got & hostFlags) == hostFlags) LC_VK(vkMapMemory(device_, mem, 0, VK_WHOLE_SIZE, 0, &b.mapped));
     return b;
+}
+
+TimestampPool::TimestampPool(const Context& ctx, std::uint32_t spans, const std::string& n)
+    : device_(ctx.device()), spans_(spans) {
+    VkQueryPoolCreateInfo ci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    ci.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    ci.queryCount = 2 * spans;
+    VkQueryPool qp;
+    LC_VK(vkCreateQueryPool(device_, &ci, nullptr, &qp));
+    pool_ = QueryPoolHandle(device_, qp);
+    ctx.name(VK_OBJECT_TYPE_QUERY_POOL, qp, n);
+    nsPerTick_ = ctx.properties().limits.timestampPeriod;
+    const std::uint32_t bits = ctx.timestampValidBits();
+    validMask_ = bits >= 64 ? ~0ull : ((1ull << bits) - 1);
+}
+
+void TimestampPool::reset(VkCommandBuffer cmd) const { vkCmdResetQueryPool(cmd, pool_, 0, 2 * spans_); }
+
+// Both ends at bottom of pipe: written once every earlier command of the
+// queue has completed, so a span starts after the uploads recorded before it
+// and ends after the last pass inside it.
+void TimestampPool::begin(VkCommandBuffer cmd, std::uint32_t span) const {
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, 2 * span);
+}
+
+void TimestampPool::end(VkCommandBuffer cmd, std::uint32_t span) const {
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, 2 * span + 1);
+}
+
+double TimestampPool::milliseconds(std::uint32_t span) const {
+    std::uint64_t t[2] = {0, 0};
+    LC_VK(vkGetQueryPoolResults(device_, pool_, 2 * span, 2, sizeof(t), t, sizeof(std::uint64_t),
+                                VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+    const std::uint64_t ticks = ((t[1] & validMask_) - (t[0] & validMask_)) & validMask_;
+    return double(ticks) * nsPerTick_ * 1e-6;
 }
 
 Image Context::createDepthImage(std::uint32_t w, std::uint32_t h, VkFormat format, const std::string& n) const {
@@ -402,6 +487,7 @@ Image Context::createDepthImage(std::uint32_t w, std::uint32_t h, VkFormat forma
     VkDeviceMemory mem;
     LC_VK(vkAllocateMemory(device_, &ai, nullptr, &mem));
     img.memory = MemoryHandle(device_, mem);
+    img.tracked = TrackedBytes(memory_, req.size);
     name(VK_OBJECT_TYPE_DEVICE_MEMORY, mem, n + ".memory");
     LC_VK(vkBindImageMemory(device_, im, mem, 0));
     VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};

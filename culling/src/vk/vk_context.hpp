@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -74,13 +75,41 @@ using FramebufferHandle = DeviceHandle<VkFramebuffer, vkDestroyFramebuffer>;
 
 class Context;
 
-// A buffer with its own memory, persistently mapped (host-visible memory; see
-// docs/VULKAN.md for why this first version keeps every buffer host-visible).
+// Device memory a context has allocated: bytes alive now and the most alive
+// at once since the last resetPeak() (VkMemoryRequirements sizes, so
+// alignment padding counts).
+struct MemoryStats {
+    std::uint64_t live = 0, peak = 0;
+};
+
+// Move-only share of MemoryStats.live held by one allocation: added when the
+// memory is allocated, removed when its owner goes away. Shared ownership of
+// the stats, so the order in which a context and its buffers die is free.
+class TrackedBytes {
+public:
+    TrackedBytes() = default;
+    TrackedBytes(std::shared_ptr<MemoryStats> stats, std::uint64_t bytes);
+    TrackedBytes(const TrackedBytes&) = delete;
+    TrackedBytes& operator=(const TrackedBytes&) = delete;
+    TrackedBytes(TrackedBytes&& o) noexcept : stats_(std::move(o.stats_)), bytes_(std::exchange(o.bytes_, 0)) {}
+    TrackedBytes& operator=(TrackedBytes&& o) noexcept;
+    ~TrackedBytes() { release(); }
+
+private:
+    void release();
+    std::shared_ptr<MemoryStats> stats_;
+    std::uint64_t bytes_ = 0;
+};
+
+// A buffer with its own memory. `mapped` is the persistent host mapping, or
+// null for device-local memory the host cannot see (copy through a staging
+// buffer then).
 struct Buffer {
     BufferHandle buffer;
     MemoryHandle memory;
     void* mapped = nullptr;
     VkDeviceSize size = 0;
+    TrackedBytes tracked; // declared last: leaves the stats first
     template <typename T> T* as() const { return static_cast<T*>(mapped); }
 };
 
@@ -88,6 +117,29 @@ struct Image {
     ImageHandle image;
     MemoryHandle memory;
     ImageViewHandle view;
+    TrackedBytes tracked;
+};
+
+// GPU timestamps around a recorded span of commands (vkCmdWriteTimestamp at
+// bottom of pipe at both ends). Queries 2i, 2i+1 time span i.
+class TimestampPool {
+public:
+    TimestampPool() = default;
+    TimestampPool(const Context& ctx, std::uint32_t spans, const std::string& name);
+    void reset(VkCommandBuffer cmd) const;              // record before the first begin()
+    void begin(VkCommandBuffer cmd, std::uint32_t span) const;
+    void end(VkCommandBuffer cmd, std::uint32_t span) const;
+    // Milliseconds of span `span` (after its submission completed).
+    double milliseconds(std::uint32_t span) const;
+    explicit operator bool() const { return bool(pool_); }
+
+private:
+    using QueryPoolHandle = DeviceHandle<VkQueryPool, vkDestroyQueryPool>;
+    QueryPoolHandle pool_;
+    VkDevice device_ = VK_NULL_HANDLE;
+    std::uint32_t spans_ = 0;
+    double nsPerTick_ = 1.0;
+    std::uint64_t validMask_ = ~0ull;
 };
 
 // What a caller asks of the context (see vulkan_backend.hpp for `device`).
@@ -111,6 +163,16 @@ public:
     std::string deviceName() const { return props_.deviceName; }
     std::uint32_t subgroupSize() const { return subgroupSize_; }
     bool fullSubgroupsSupported() const { return fullSubgroups_; }
+    // A CPU implementation (lavapipe): device memory is host memory, so
+    // buffers stay host-visible and mapped, and compute timestamps are not
+    // trusted (DESIGN.md). Elsewhere: device-local buffers, GPU timestamps.
+    bool isCpuDevice() const { return props_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+    // The queue writes timestamps in compute and graphics (and the device
+    // reports a tick period): GPU timing is possible.
+    bool timestampsSupported() const { return timestamps_; }
+    std::uint32_t timestampValidBits() const { return timestampValidBits_; }
+    const MemoryStats& memoryStats() const { return *memory_; }
+    void resetPeakMemory() const { memory_->peak = memory_->live; }
 
     // Gives `handle` the debug name `purpose.name` when VK_EXT_debug_utils is on.
     void name(VkObjectType type, std::uint64_t handle, const std::string& name) const;
@@ -120,6 +182,11 @@ public:
 
     // Host-visible, coherent, persistently mapped buffer (size 0 -> 4 bytes).
     Buffer createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name) const;
+    // Buffer for work on the device: device-local memory; mapped when that
+    // memory is also host-visible and coherent (lavapipe, resizable BAR),
+    // else `mapped` is null and data moves through staging copies (usage
+    // gets TRANSFER_SRC | TRANSFER_DST for that).
+    Buffer createDeviceBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name) const;
     Image createDepthImage(std::uint32_t w, std::uint32_t h, VkFormat format, const std::string& name) const;
     ShaderModuleHandle createShader(const std::uint32_t* words, std::size_t wordCount,
                                     const std::string& name) const;
@@ -131,6 +198,9 @@ public:
 private:
     void release(); // destroys everything, in reverse order of creation
     std::uint32_t findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags want) const;
+    bool hasMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags want) const;
+    Buffer allocateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name,
+                          bool deviceLocal) const;
 
     VkInstance instance_ = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
@@ -142,6 +212,9 @@ private:
     VkPhysicalDeviceMemoryProperties memProps_{};
     std::uint32_t subgroupSize_ = 1;
     bool fullSubgroups_ = false;
+    bool timestamps_ = false;
+    std::uint32_t timestampValidBits_ = 0;
+    std::shared_ptr<MemoryStats> memory_ = std::make_shared<MemoryStats>();
     bool debugUtils_ = false;
     std::string purpose_;
     PFN_vkSetDebugUtilsObjectNameEXT setName_ = nullptr;

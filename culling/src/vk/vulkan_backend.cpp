@@ -17,6 +17,7 @@
 #include "culling/gpu_shared.h"
 #include "embedded_spirv.hpp"
 #include "vk/vk_context.hpp"
+#include "vk/shade_pass.hpp"
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -45,8 +46,114 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr float kRelEps = 2e-5f;
 constexpr float kAbsEps = 1e-6f;
 
-constexpr std::uint32_t kBindings = 8; // cull_common.glsl bindings 0..7
-enum Binding : std::uint32_t { bParams, bDepth, bTiles, bLights, bCounts, bOffsets, bIndices, bStatus };
+constexpr std::uint32_t kBindings = 9; // cull_common.glsl bindings 0..8
+enum Binding : std::uint32_t { bParams, bDepth, bTiles, bLights, bCounts, bOffsets, bIndices, bStatus, bBins };
+// Local size of the one-invocation-per-item passes (light_bins, cull_lists):
+// a multiple of every subgroup size in practice (8 on lavapipe, 32 on NVIDIA,
+// 64 on AMD), so no partial subgroups.
+constexpr std::uint32_t kLocal = 64;
+
+// Workgroup counts (x, y) for `invocations` invocations of kLocal each,
+// folded into y when x would exceed the device's limit.
+struct Grid {
+    std::uint32_t x = 1, y = 1;
+};
+Grid groupsFor(std::uint64_t invocations, const VkPhysicalDeviceLimits& lim) {
+    const std::uint64_t groups = std::max<std::uint64_t>(1, (invocations + kLocal - 1) / kLocal);
+    Grid g;
+    g.x = std::uint32_t(std::min<std::uint64_t>(groups, lim.maxComputeWorkGroupCount[0]));
+    const std::uint64_t y = (groups + g.x - 1) / g.x;
+    if (y > lim.maxComputeWorkGroupCount[1]) throw SettingsError("tile", "too much work for one dispatch");
+    g.y = std::uint32_t(y);
+    return g;
+}
+
+void computeBarrier(VkCommandBuffer cmd, VkAccessFlags dstAccess, VkPipelineStageFlags dstStage);
+
+// Host <-> device data of one submission. Buffers the host can map are
+// written and read in place (lavapipe: no copies at all); others go through
+// host-visible staging buffers copied at the start / end of the commands.
+class Staging {
+public:
+    explicit Staging(const Context& ctx) : ctx_(ctx) {}
+    // Writes `bytes` of `data` into `dst`: now when mapped, else at recordUploads().
+    void upload(const Buffer& dst, const void* data, std::size_t bytes) {
+        if (bytes == 0) return;
+        if (dst.mapped) {
+            std::memcpy(dst.mapped, data, bytes);
+            return;
+        }
+        Buffer st = ctx_.createBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "staging.upload");
+        std::memcpy(st.mapped, data, bytes);
+        copies_.push_back({dst.buffer, st.buffer, bytes, true});
+        staging_.push_back(std::move(st));
+    }
+    // Host pointer to `src`'s first `bytes`, valid once the submission that
+    // ran recordDownloads() has completed.
+    const void* download(const Buffer& src, std::size_t bytes) {
+        if (src.mapped) {
+            mappedReads_ = true;
+            return src.mapped;
+        }
+        Buffer st = ctx_.createBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "staging.download");
+        copies_.push_back({src.buffer, st.buffer, bytes, false});
+        staging_.push_back(std::move(st));
+        return staging_.back().mapped;
+    }
+    // Records the staged copies and a barrier making them visible to
+    // `dstAccess` at `dstStage` (by default: the compute passes).
+    void recordUploads(VkCommandBuffer cmd, VkPipelineStageFlags dstStage = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VkAccessFlags dstAccess = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT) const {
+        bool any = false;
+        for (const Copy& c : copies_)
+            if (c.up) {
+                VkBufferCopy region{0, 0, c.bytes};
+                vkCmdCopyBuffer(cmd, c.staging, c.device, 1, &region);
+                any = true;
+            }
+        if (!any) return;
+        // The passes read (status: also OR into) what the copies wrote.
+        VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+        mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        mb.dstAccessMask = dstAccess;
+        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, dstStage, 0, 1, &mb, 0, nullptr, 0, nullptr);
+    }
+    void recordDownloads(VkCommandBuffer cmd) const {
+        bool anyCopy = false;
+        for (const Copy& c : copies_) anyCopy = anyCopy || !c.up;
+        if (anyCopy) {
+            // The copies read what the compute passes wrote.
+            VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+            mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+            mb.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1,
+                                 &mb, 0, nullptr, 0, nullptr);
+            for (const Copy& c : copies_)
+                if (!c.up) {
+                    VkBufferCopy region{0, 0, c.bytes};
+                    vkCmdCopyBuffer(cmd, c.device, c.staging, 1, &region);
+                }
+            // The host reads the staging buffers the copies wrote.
+            mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+            mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0,
+                                 nullptr, 0, nullptr);
+        }
+        // The host reads the mapped buffers the compute passes wrote.
+        if (mappedReads_) computeBarrier(cmd, VK_ACCESS_HOST_READ_BIT, VK_PIPELINE_STAGE_HOST_BIT);
+    }
+
+private:
+    struct Copy {
+        VkBuffer device, staging;
+        VkDeviceSize bytes;
+        bool up;
+    };
+    const Context& ctx_;
+    std::vector<Copy> copies_;
+    std::vector<Buffer> staging_;
+    bool mappedReads_ = false;
+};
 
 // Memory barrier between two compute dispatches of one command buffer.
 void computeBarrier(VkCommandBuffer cmd, VkAccessFlags dstAccess, VkPipelineStageFlags dstStage) {
@@ -78,29 +185,48 @@ public:
     }
     std::string name() const override { return "vulkan"; }
     std::string deviceName() const override { return ctx_.deviceName(); }
-    // Compute timestamps read wrong on lavapipe once the device has rendered
-    // (DESIGN.md), and this device renders the depth pre-pass: take CPU time
-    // around submit + fence wait instead, for both passes.
-    std::string timingMethod() const override { return "cpu-wall-clock around vkQueueSubmit+vkWaitForFences"; }
+    // Per device. Compute timestamps read wrong on lavapipe once the device
+    // has rendered (DESIGN.md), and this device renders the depth pre-pass:
+    // there, CPU time around submit + fence wait. A GPU with timestamps in
+    // compute and graphics: device time between timestamps written around
+    // the passes (uploads and readbacks excluded).
+    std::string timingMethod() const override {
+        return useGpuTimestamps() ? "gpu-timestamps (vkCmdWriteTimestamp around the passes, sum of submissions)"
+                                  : "cpu-wall-clock around vkQueueSubmit+vkWaitForFences";
+    }
+    std::size_t peakDeviceBytes() const override { return std::size_t(ctx_.memoryStats().peak); }
+    void resetPeakDeviceBytes() override { ctx_.resetPeakMemory(); }
+    double lastCullWallMs() const override { return lastCullWallMs_; }
 
     DepthImage renderDepth(const Scene& scene, const Projection& proj) override;
     CullResult cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
                     const ViewLights& lights, const CullSettings& settings) override;
+    // The Lambert shading pass (vk/shade_pass.cpp), created on first use.
+    std::vector<float> shade(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled) override {
+        if (!shadePass_) shadePass_ = std::make_unique<ShadePass>(ctx_);
+        return shadePass_->run(in, lights, culled, lastShadeMs_);
+    }
 
 private:
+    bool useGpuTimestamps() const { return !ctx_.isCpuDevice() && ctx_.timestampsSupported(); }
     void createComputeObjects();
-    VkPipeline computePipeline(const char* what, VkShaderModule module, const std::array<std::uint32_t, 7>& spec);
+    // `oneSubgroup`: the local size is the subgroup size and the pass relies on
+    // the workgroup being one subgroup (REQUIRE_FULL_SUBGROUPS where supported).
+    VkPipeline computePipeline(const char* what, VkShaderModule module, const std::array<std::uint32_t, 8>& spec,
+                               bool oneSubgroup);
     VkPipeline depthPipeline(bool reversed);
     VkRenderPass depthRenderPass(bool reversed);
 
     Context ctx_;
     DescriptorSetLayoutHandle setLayout_;
     PipelineLayoutHandle computeLayout_;
-    ShaderModuleHandle boundsShader_, cullShader_, scanShader_, vertShader_;
+    ShaderModuleHandle boundsShader_, binsShader_, cullShader_, scanShader_, vertShader_;
+    double lastCullWallMs_ = -1;
     std::map<std::string, PipelineHandle> computePipelines_;
     PipelineLayoutHandle depthLayout_;
     RenderPassHandle renderPass_[2];
     PipelineHandle depthPipeline_[2];
+    std::unique_ptr<ShadePass> shadePass_;
 };
 
 void VulkanBackend::createComputeObjects() {
@@ -129,24 +255,25 @@ void VulkanBackend::createComputeObjects() {
 
     auto mk = [&](spirv::Code c, const char* n) { return ctx_.createShader(c.words, c.wordCount, n); };
     boundsShader_ = mk(spirv::tileBounds(), "shader.tile_bounds");
+    binsShader_ = mk(spirv::lightBins(), "shader.light_bins");
     cullShader_ = mk(spirv::cullLists(), "shader.cull_lists");
     scanShader_ = mk(spirv::prefixSum(), "shader.prefix_sum");
     vertShader_ = mk(spirv::depthVert(), "shader.depth_vert");
 }
 
-// Specialisation constants, ids as in cull_common.glsl: 0 local size (= the
-// subgroup size), 1 tile size, 2 cells, 3 slicing, 4 algorithm, 5 sphere
-// test, 6 write pass. Pipelines are cached per combination.
+// Specialisation constants, ids as in cull_common.glsl: 0 local size, 1 tile
+// size, 2 cells, 3 slicing, 4 algorithm, 5 sphere test, 6 write pass, and
+// tile_bounds.comp's 7 lanes per tile. Pipelines are cached per combination.
 VkPipeline VulkanBackend::computePipeline(const char* what, VkShaderModule module,
-                                          const std::array<std::uint32_t, 7>& spec) {
+                                          const std::array<std::uint32_t, 8>& spec, bool oneSubgroup) {
     std::string key = what;
     for (auto v : spec) key += "." + std::to_string(v);
     auto it = computePipelines_.find(key);
     if (it != computePipelines_.end()) return it->second;
-    std::array<VkSpecializationMapEntry, 7> entries{};
-    for (std::uint32_t i = 0; i < 7; ++i) entries[i] = {i, i * 4u, 4u};
+    std::array<VkSpecializationMapEntry, 8> entries{};
+    for (std::uint32_t i = 0; i < 8; ++i) entries[i] = {i, i * 4u, 4u};
     VkSpecializationInfo si{};
-    si.mapEntryCount = 7;
+    si.mapEntryCount = 8;
     si.pMapEntries = entries.data();
     si.dataSize = sizeof(spec);
     si.pData = spec.data();
@@ -157,7 +284,8 @@ VkPipeline VulkanBackend::computePipeline(const char* what, VkShaderModule modul
     ci.stage.pName = "main";
     ci.stage.pSpecializationInfo = &si;
     // Full subgroups: a workgroup of subgroupSize invocations is one subgroup.
-    if (ctx_.fullSubgroupsSupported()) ci.stage.flags = VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT;
+    if (oneSubgroup && ctx_.fullSubgroupsSupported())
+        ci.stage.flags = VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT;
     ci.layout = computeLayout_;
     VkPipeline p;
     LC_VK(vkCreateComputePipelines(ctx_.device(), VK_NULL_HANDLE, 1, &ci, nullptr, &p));
@@ -310,18 +438,22 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
         vertexFloats += m.vertexCount() * 3;
         indexCount += m.triangleCount() * 3;
     }
-    Buffer vbuf = ctx_.createBuffer(vertexFloats * 4, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "depth.vertices");
-    Buffer ibuf = ctx_.createBuffer(indexCount * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "depth.indices");
+    // Device-local vertex and index buffers (staged on a discrete GPU).
+    Buffer vbuf = ctx_.createDeviceBuffer(vertexFloats * 4, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "depth.vertices");
+    Buffer ibuf = ctx_.createDeviceBuffer(indexCount * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "depth.indices");
+    Staging staging(ctx_);
     {
-        float* v = vbuf.as<float>();
-        std::uint32_t* ix = ibuf.as<std::uint32_t>();
+        std::vector<float> v;
+        std::vector<std::uint32_t> ix;
+        v.reserve(vertexFloats);
+        ix.reserve(indexCount);
         for (const Mesh& m : scene.meshes) {
             if (m.triangleCount() == 0) continue;
-            std::memcpy(v, m.positions.data(), m.vertexCount() * 12);
-            v += m.vertexCount() * 3;
-            std::memcpy(ix, m.indices.data(), m.triangleCount() * 12);
-            ix += m.triangleCount() * 3;
+            v.insert(v.end(), m.positions.data(), m.positions.data() + m.vertexCount() * 3);
+            ix.insert(ix.end(), m.indices.data(), m.indices.data() + m.triangleCount() * 3);
         }
+        staging.upload(vbuf, v.data(), v.size() * 4);
+        staging.upload(ibuf, ix.data(), ix.size() * 4);
     }
     Image img = ctx_.createDepthImage(W, H, VK_FORMAT_D32_SFLOAT, "depth.image");
     Buffer readback = ctx_.createBuffer(VkDeviceSize(W) * H * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "depth.readback");
@@ -340,8 +472,14 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
     FramebufferHandle fb(dev, fbRaw);
     ctx_.name(VK_OBJECT_TYPE_FRAMEBUFFER, fbRaw, "depth.framebuffer");
 
-    lastDepthMs_ = ctx_.submitAndWait(
+    const bool gpuClock = useGpuTimestamps();
+    TimestampPool stamps = gpuClock ? TimestampPool(ctx_, 1, "depth.timestamps") : TimestampPool();
+    const double wallMs = ctx_.submitAndWait(
         [&](VkCommandBuffer cmd) {
+            if (gpuClock) stamps.reset(cmd);
+            staging.recordUploads(cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT,
+                                  VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_INDEX_READ_BIT);
+            if (gpuClock) stamps.begin(cmd, 0);
             VkClearValue clear{};
             clear.depthStencil.depth = clearDepth;
             VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
@@ -368,6 +506,7 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
                 }
             }
             vkCmdEndRenderPass(cmd);
+            if (gpuClock) stamps.end(cmd, 0);
             VkBufferImageCopy region{};
             region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
             region.imageExtent = {W, H, 1};
@@ -380,6 +519,9 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
                                  nullptr, 0, nullptr);
         },
         "depth.commands");
+    // GPU: the render pass alone; CPU device: the whole submission (the
+    // readback copy included).
+    lastDepthMs_ = gpuClock ? stamps.milliseconds(0) : wallMs;
 
     DepthImage out;
     out.width = W;
@@ -418,6 +560,11 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     if (listTotal64 >= std::numeric_limits<std::uint32_t>::max())
         throw SettingsError("tile", "more than 2^32 light lists");
     const std::uint32_t listTotal = std::uint32_t(listTotal64);
+    // Light bins: one bit per light per tile column and per tile row.
+    const std::uint32_t binWords = (n + 31) / 32;
+    const std::uint64_t binTotal64 = std::uint64_t(binWords) * (grid.tilesX + grid.tilesY);
+    if (binTotal64 * 4 > lim.maxStorageBufferRange)
+        throw SettingsError("lights", "too many lights for the light bins of this device");
 
     // The depth ranges of naive and clustered, exactly as the CPU reference.
     double lightFar = 0.0;
@@ -430,21 +577,9 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         res.clusterFar = farInfinite ? std::max(lightFar, 2.0 * camNear) : proj.farPlane();
     }
 
-    // Buffers (sizes from the inputs; the index array comes after the count).
-    Buffer params = ctx_.createBuffer(sizeof(GpuCullParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.params");
-    Buffer depthBuf = ctx_.createBuffer(depth.depth.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.depth");
-    Buffer tileBuf = ctx_.createBuffer(std::size_t(tiles) * sizeof(GpuTileBounds), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                       "cull.tiles");
-    Buffer lightBuf = ctx_.createBuffer(std::size_t(n) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.lights");
-    Buffer countBuf = ctx_.createBuffer(std::size_t(listTotal) * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.counts");
-    Buffer offsetBuf =
-        ctx_.createBuffer((std::size_t(listTotal) + 1) * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.offsets");
-    Buffer statusBuf = ctx_.createBuffer(4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.status");
-    Buffer placeholder = ctx_.createBuffer(4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.indices.placeholder");
-
+    // Inputs, prepared on the host.
+    GpuCullParams p{};
     {
-        GpuCullParams& p = *params.as<GpuCullParams>();
-        p = GpuCullParams{};
         std::uint32_t flags = 0;
         if (proj.orthographic()) flags |= LC_FLAG_ORTHO;
         if (isReversed(proj.kind())) flags |= LC_FLAG_REVERSED;
@@ -459,16 +594,34 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         const glm::dvec3 corner = proj.viewPositionAt({double(proj.width()), 0.0}, 1.0);
         p.lens = glm::vec4(float(corner.x), float(corner.y), float(camNear), float(naiveFar));
         p.cluster = glm::vec4(float(res.clusterNear), float(res.clusterFar), kRelEps, kAbsEps);
-        std::memcpy(depthBuf.mapped, depth.depth.data(), depth.depth.size() * 4);
-        float* L = lightBuf.as<float>();
-        for (std::uint32_t l = 0; l < n; ++l) {
-            L[4 * l + 0] = float(lights.centers[l].x);
-            L[4 * l + 1] = float(lights.centers[l].y);
-            L[4 * l + 2] = float(lights.centers[l].z);
-            L[4 * l + 3] = float(lights.radii[l]);
-        }
-        *statusBuf.as<std::uint32_t>() = 0;
+        p.bins = glm::uvec4(binWords, binWords * grid.tilesX, 0, 0);
     }
+    std::vector<GpuLight> gpuLights(n);
+    for (std::uint32_t l = 0; l < n; ++l)
+        gpuLights[l].centerRadius = glm::vec4(glm::vec3(lights.centers[l]), float(lights.radii[l]));
+    const std::uint32_t statusZero = 0;
+
+    // Device buffers (sizes from the inputs; the index array comes after the count).
+    const VkBufferUsageFlags ssbo = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    Buffer params = ctx_.createDeviceBuffer(sizeof(GpuCullParams), ssbo, "cull.params");
+    Buffer depthBuf = ctx_.createDeviceBuffer(depth.depth.size() * 4, ssbo, "cull.depth");
+    Buffer tileBuf = ctx_.createDeviceBuffer(std::size_t(tiles) * sizeof(GpuTileBounds), ssbo, "cull.tiles");
+    Buffer lightBuf = ctx_.createDeviceBuffer(std::size_t(n) * sizeof(GpuLight), ssbo, "cull.lights");
+    Buffer binBuf = ctx_.createDeviceBuffer(binTotal64 * 4, ssbo, "cull.bins");
+    Buffer countBuf = ctx_.createDeviceBuffer(std::size_t(listTotal) * 4, ssbo, "cull.counts");
+    Buffer offsetBuf = ctx_.createDeviceBuffer((std::size_t(listTotal) + 1) * 4, ssbo, "cull.offsets");
+    Buffer statusBuf = ctx_.createDeviceBuffer(4, ssbo, "cull.status");
+    Buffer placeholder = ctx_.createDeviceBuffer(4, ssbo, "cull.indices.placeholder");
+
+    Staging staging(ctx_);
+    staging.upload(params, &p, sizeof p);
+    staging.upload(depthBuf, depth.depth.data(), depth.depth.size() * 4);
+    staging.upload(lightBuf, gpuLights.data(), gpuLights.size() * sizeof(GpuLight));
+    staging.upload(statusBuf, &statusZero, 4);
+    const auto* counts = static_cast<const std::uint32_t*>(staging.download(countBuf, std::size_t(listTotal) * 4));
+    const auto* offs = static_cast<const std::uint32_t*>(staging.download(offsetBuf, (std::size_t(listTotal) + 1) * 4));
+    const auto* tb = static_cast<const GpuTileBounds*>(staging.download(tileBuf, std::size_t(tiles) * sizeof(GpuTileBounds)));
+    const auto* status = static_cast<const std::uint32_t*>(staging.download(statusBuf, 4));
 
     // Descriptor sets: one for passes 1-3, one with the sized index array for pass 4.
     VkDevice dev = ctx_.device();
@@ -490,8 +643,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         VkDescriptorSet set;
         LC_VK(vkAllocateDescriptorSets(dev, &ai, &set));
         ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_SET, set, nm);
-        const Buffer* bufs[kBindings] = {&params, &depthBuf, &tileBuf, &lightBuf, &countBuf, &offsetBuf, &indices,
-                                         &statusBuf};
+        const Buffer* bufs[kBindings] = {&params,    &depthBuf, &tileBuf,   &lightBuf, &countBuf,
+                                         &offsetBuf, &indices,  &statusBuf, &binBuf};
         std::array<VkDescriptorBufferInfo, kBindings> infos{};
         std::array<VkWriteDescriptorSet, kBindings> writes{};
         for (std::uint32_t i = 0; i < kBindings; ++i) {
@@ -511,72 +664,99 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const std::uint32_t sg = ctx_.subgroupSize();
     const std::uint32_t algoId = std::uint32_t(algo), testId = std::uint32_t(settings.test),
                         slicingId = std::uint32_t(settings.slicing);
-    auto spec = [&](std::uint32_t write) {
-        return std::array<std::uint32_t, 7>{sg, grid.tileSize, cells, slicingId, algoId, testId, write};
+    auto spec = [&](std::uint32_t local, std::uint32_t write, std::uint32_t lanesPerTile = 1) {
+        return std::array<std::uint32_t, 8>{local, grid.tileSize, cells, slicingId, algoId, testId, write,
+                                            lanesPerTile};
     };
-    VkPipeline boundsPipe = computePipeline("tile_bounds", boundsShader_, spec(0));
-    VkPipeline countPipe = computePipeline("cull_lists.count", cullShader_, spec(0));
-    VkPipeline scanPipe = computePipeline("prefix_sum", scanShader_, spec(0));
-    VkPipeline writePipe = computePipeline("cull_lists.write", cullShader_, spec(1));
-    const std::uint32_t gx = std::min<std::uint32_t>(listTotal, lim.maxComputeWorkGroupCount[0]);
-    const std::uint32_t gy = (listTotal + gx - 1) / gx;
-    if (gy > lim.maxComputeWorkGroupCount[1]) throw SettingsError("tile", "too many light lists for one dispatch");
+    // Subgroup passes: workgroup = one subgroup. Per-invocation passes: kLocal.
+    // Tile bounds: a subgroup per tile on a GPU, an invocation per tile on a
+    // CPU device (see tile_bounds.comp).
+    const bool tilePerLane = ctx_.isCpuDevice();
+    VkPipeline boundsPipe = tilePerLane ? computePipeline("tile_bounds", boundsShader_, spec(kLocal, 0, 1), false)
+                                        : computePipeline("tile_bounds", boundsShader_, spec(kLocal, 0, sg), true);
+    const std::uint32_t tilesPerGroup = tilePerLane ? kLocal : kLocal / sg;
+    const Grid boundsGroups = Grid{(grid.tilesX + tilesPerGroup - 1) / tilesPerGroup, grid.tilesY};
+    VkPipeline binsPipe = computePipeline("light_bins", binsShader_, spec(kLocal, 0), false);
+    VkPipeline countPipe = computePipeline("cull_lists.count", cullShader_, spec(kLocal, 0), false);
+    VkPipeline scanPipe = computePipeline("prefix_sum", scanShader_, spec(sg, 0), true);
+    VkPipeline writePipe = computePipeline("cull_lists.write", cullShader_, spec(kLocal, 1), false);
+    const bool all = algo == Algorithm::All;
+    const Grid binGroups = groupsFor(binTotal64, lim);
+    const Grid countGroups = groupsFor(all ? 1 : listTotal, lim);
+    const Grid writeGroups = groupsFor(all ? n : listTotal, lim);
 
-    double ms = ctx_.submitAndWait(
+    const bool gpuClock = useGpuTimestamps();
+    TimestampPool stamps = gpuClock ? TimestampPool(ctx_, 2, "cull.timestamps") : TimestampPool();
+    double wallMs = ctx_.submitAndWait(
         [&](VkCommandBuffer cmd) {
+            if (gpuClock) stamps.reset(cmd);
+            staging.recordUploads(cmd);
+            if (gpuClock) stamps.begin(cmd, 0);
             vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, computeLayout_, 0, 1, &set1, 0, nullptr);
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, boundsPipe);
-            vkCmdDispatch(cmd, grid.tilesX, grid.tilesY, 1);
-            // The count pass reads the tile bounds (and ORs status) the bounds pass wrote.
+            vkCmdDispatch(cmd, boundsGroups.x, boundsGroups.y, 1);
+            if (!all && n > 0) {
+                // No barrier before: the bins pass reads only params and lights and
+                // writes only the bins, which the bounds pass never touches.
+                vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, binsPipe);
+                vkCmdDispatch(cmd, binGroups.x, binGroups.y, 1);
+            }
+            // The count pass reads the tile bounds and bins the two passes above wrote
+            // (and ORs status after the bounds pass did).
             computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
                            VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, countPipe);
-            vkCmdDispatch(cmd, gx, gy, 1);
+            vkCmdDispatch(cmd, countGroups.x, countGroups.y, 1);
             // The scan reads the counts the count pass wrote.
             computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
                            VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scanPipe);
             vkCmdDispatch(cmd, 1, 1, 1);
-            // The host reads the total, counts, bounds and status after this submit.
-            computeBarrier(cmd, VK_ACCESS_HOST_READ_BIT, VK_PIPELINE_STAGE_HOST_BIT);
+            if (gpuClock) stamps.end(cmd, 0);
+            staging.recordDownloads(cmd);
         },
         "cull.commands.count");
+    double gpuMs = gpuClock ? stamps.milliseconds(0) : 0.0;
 
-    const std::uint32_t status = *statusBuf.as<std::uint32_t>();
-    if (status & 1u)
+    if (*status & 1u)
         throw DeviceError("Vulkan device '" + ctx_.deviceName() +
                           "' split a subgroup-sized workgroup into several subgroups; the culling passes need one");
-    const std::uint32_t* counts = countBuf.as<std::uint32_t>();
     std::uint64_t total64 = 0;
     for (std::uint32_t l = 0; l < listTotal; ++l) total64 += counts[l];
-    const std::uint32_t total = offsetBuf.as<std::uint32_t>()[listTotal];
+    const std::uint32_t total = offs[listTotal];
     if (total64 != total || total64 * 4 > lim.maxStorageBufferRange)
         throw DeviceError("culling produced " + std::to_string(total64) +
                           " list entries, more than one storage buffer of this device holds (" +
                           std::to_string(lim.maxStorageBufferRange / 4) + ")");
 
-    Buffer indexBuf = ctx_.createBuffer(std::size_t(total) * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "cull.indices");
+    Buffer indexBuf = ctx_.createDeviceBuffer(std::size_t(total) * 4, ssbo, "cull.indices");
+    const std::uint32_t* idx = nullptr;
     if (total > 0) {
         VkDescriptorSet set2 = makeSet(indexBuf, "cull.set.write");
-        ms += ctx_.submitAndWait(
+        Staging back(ctx_);
+        idx = static_cast<const std::uint32_t*>(back.download(indexBuf, std::size_t(total) * 4));
+        const auto* status2 = static_cast<const std::uint32_t*>(back.download(statusBuf, 4));
+        wallMs += ctx_.submitAndWait(
             [&](VkCommandBuffer cmd) {
                 // The write pass reads counts/offsets/bounds written by the previous submission.
                 computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
                                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+                if (gpuClock) stamps.begin(cmd, 1);
                 vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, computeLayout_, 0, 1, &set2, 0,
                                         nullptr);
                 vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, writePipe);
-                vkCmdDispatch(cmd, gx, gy, 1);
-                // The host reads the indices and status after this submit.
-                computeBarrier(cmd, VK_ACCESS_HOST_READ_BIT, VK_PIPELINE_STAGE_HOST_BIT);
+                vkCmdDispatch(cmd, writeGroups.x, writeGroups.y, 1);
+                if (gpuClock) stamps.end(cmd, 1);
+                back.recordDownloads(cmd);
             },
             "cull.commands.write");
-        if (*statusBuf.as<std::uint32_t>() & 2u)
+        if (gpuClock) gpuMs += stamps.milliseconds(1);
+        if (*status2 & 2u)
             throw DeviceError("Vulkan write pass found a different entry count than the count pass");
+        res.lightIndices.assign(idx, idx + total);
     }
 
-    // Results out of the mapped buffers.
-    const GpuTileBounds* tb = tileBuf.as<GpuTileBounds>();
+    // Results out of the mapped (or staged) buffers.
     res.tileDepthMin.resize(tiles);
     res.tileDepthMax.resize(tiles);
     if (algo == Algorithm::HalfZ) res.halfzSplit.resize(tiles);
@@ -589,16 +769,14 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         if (!res.cellMask.empty()) res.cellMask[t] = tb[t].cellMask;
     }
     res.listCount.assign(counts, counts + listTotal);
-    const std::uint32_t* offs = offsetBuf.as<std::uint32_t>();
     res.listOffset.assign(offs, offs + listTotal);
-    const std::uint32_t* idx = indexBuf.as<std::uint32_t>();
-    res.lightIndices.assign(idx, idx + total);
 
     res.backend = name();
     res.device = deviceName();
     res.timingMethod = timingMethod();
-    res.timings.cullMs = ms;
+    res.timings.cullMs = gpuClock ? gpuMs : wallMs;
     res.timings.depthMs = lastDepthMs_;
+    lastCullWallMs_ = wallMs;
     return res;
 }
 
