@@ -99,6 +99,7 @@ struct SceneFlags {
     std::string sceneFile, builtin, backendName, device;
     long long lightCount = -1;
     unsigned long long seed = 1;
+    double spotFraction = 0.0;
     std::map<std::string, std::string> paramValues;
     std::vector<std::pair<std::string, CLI::Option*>> paramOptions;
     CLI::Option* optLights = nullptr;
@@ -122,6 +123,11 @@ struct SceneFlags {
         cmd->add_option("--seed", seed, "Seed of the light generator used by --lights (default: 1)")
             ->type_name("S")
             ->needs(optLights);
+        cmd->add_option("--spot-fraction", spotFraction,
+                        "Fraction of the --lights that are spot lights (0..1, default 0; outer angles 15..45 "
+                        "degrees, random directions)")
+            ->type_name("F")
+            ->needs(optLights);
         std::string backendHelp = "Backend running depth and culling: ";
         for (const std::string& b : lc::availableBackends()) backendHelp += b + " ";
         backendHelp += "(default: vulkan where available, else cpu)";
@@ -142,7 +148,9 @@ struct SceneFlags {
     void replaceLights(lc::Scene& scene, long long count) const {
         if (count < 0 || count > 1000000)
             throw lc::SettingsError("lights", "must be in 0..1000000, got " + std::to_string(count));
-        scene.lights = lc::generateLights(lc::defaultLightGen(scene, std::uint32_t(count), seed));
+        lc::LightGenSettings gen = lc::defaultLightGen(scene, std::uint32_t(count), seed);
+        gen.spotFraction = spotFraction; // generateLights refuses values outside [0, 1]
+        scene.lights = lc::generateLights(gen);
     }
 
     void applyParams(lc::CullSettings& settings, lc::Camera& camera) const {
