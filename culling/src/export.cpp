@@ -157,7 +157,11 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     j["cells"] = settings.cells;
     j["slicing"] = toString(settings.slicing);
     j["skip_empty"] = settings.skipEmpty;
+    j["spot_test"] = toString(settings.spotTest);
     j["lights"] = run.lights.size();
+    std::size_t spots = 0;
+    for (std::size_t i = 0; i < run.lights.size(); ++i) spots += run.lights.isSpot(i);
+    j["spot_lights"] = spots;
     j["timings_ms"] = {{"depth", msOrNull(r.timings.depthMs)},
                        {"cull", msOrNull(r.timings.cullMs)},
                        {"ground_truth", msOrNull(r.timings.groundTruthMs)},
