@@ -4,6 +4,7 @@
 #include "depth_vert.spv.h"
 #include "light_bins_comp.spv.h"
 #include "prefix_sum_comp.spv.h"
+#include "shade_comp.spv.h"
 #include "tile_bounds_comp.spv.h"
 
 namespace lc::spirv {
@@ -14,5 +15,6 @@ LC_SPV(tileBounds, lc_spv_tile_bounds_comp)
 LC_SPV(lightBins, lc_spv_light_bins_comp)
 LC_SPV(cullLists, lc_spv_cull_lists_comp)
 LC_SPV(prefixSum, lc_spv_prefix_sum_comp)
+LC_SPV(shade, lc_spv_shade_comp)
 #undef LC_SPV
 } // namespace lc::spirv

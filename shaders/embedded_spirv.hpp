@@ -17,5 +17,6 @@ Code tileBounds();  // per-tile depth bounds, halfz split, cell / slice masks
 Code lightBins();  // per tile column / row bitmask of the lights not outside its side planes
 Code cullLists();   // per-list light tests: count pass and write pass
 Code prefixSum();   // exclusive scan of the list counts into offsets
+Code shade();       // Lambert shading pass, one invocation per pixel
 
 } // namespace lc::spirv

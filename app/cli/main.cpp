@@ -16,6 +16,7 @@
 #include "culling/params.hpp"
 #include "culling/pipeline.hpp"
 #include "culling/scene_io.hpp"
+#include "report.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -88,8 +89,9 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
     else
         std::cout << "image error: not computed (--no-image-error)\n";
     std::cout << "times: depth " << ms(r.timings.depthMs) << ", cull " << ms(r.timings.cullMs)
-              << ", ground truth " << ms(r.timings.groundTruthMs) << " (" << r.timingMethod << ")\n"
-              << "wrote " << out << "/summary.json, tiles.csv, heatmap.png\n";
+              << ", shade " << ms(r.timings.shadeMs) << ", ground truth " << ms(r.timings.groundTruthMs) << " (" << r.timingMethod << ")\n"
+              << "wrote " << out << "/summary.json, tiles.csv, heatmap.png"
+              << (run.shadedAll.empty() ? "" : ", shaded_culled.png, shaded_all.png, shaded_diff.png") << "\n";
 }
 
 
@@ -350,7 +352,10 @@ int main(int argc, char** argv) {
     std::string outDir;
     bool noImageError = false;
     run->add_flag("--no-image-error", noImageError,
-                  "Skip the Lambert image error (it costs pixels x lights); JSON gets null");
+                  "Skip the shading pass and the Lambert image error (it costs pixels x lights); JSON gets null");
+    bool shadedImages = false;
+    run->add_flag("--shaded-images", shadedImages,
+                  "Also write shaded_culled.png, shaded_all.png and shaded_diff.png (the backend's shading pass)");
     run->add_option("--out", outDir, "Folder to write the diagnostics into (written atomically; its parent must exist)")
         ->type_name("DIR")
         ->required();
@@ -363,10 +368,13 @@ int main(int argc, char** argv) {
     BenchOptions benchOptions;
     addBenchOptions(bench, benchOptions);
 
+    lcli::ReportCommand report;
+    report.add(app);
+
     // CLI11 reports a missing subcommand before an unknown word; name the word.
     if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "scenes" && std::string(argv[1]) != "run" &&
-        std::string(argv[1]) != "bench")
-        return fail(2, std::string("unknown command '") + argv[1] + "' (commands: scenes, run, bench; see --help)");
+        std::string(argv[1]) != "bench" && std::string(argv[1]) != "report")
+        return fail(2, std::string("unknown command '") + argv[1] + "' (commands: scenes, run, bench, report; see --help)");
 
     try {
         app.parse(argc, argv);
@@ -390,6 +398,8 @@ int main(int argc, char** argv) {
             return runBench(benchFlags, benchOptions);
         }
 
+        if (report.chosen()) return report.run();
+
         if (!runFlags.hasScene()) return fail(2, "run: give --scene FILE.json or --builtin NAME");
         {
             // Fail before the (possibly long) run when the output cannot be written.
@@ -410,6 +420,8 @@ int main(int argc, char** argv) {
 
         lc::RunOptions options;
         options.truthOptions.imageError = !noImageError;
+        options.keepShadedImages = shadedImages;
+        if (shadedImages && noImageError) return fail(2, "--shaded-images needs the shading pass: drop --no-image-error");
         const lc::RunOutput result = lc::runPipeline(scene, settings, *backend, options);
         lc::exportDiagnostics(scene, settings, result, outDir);
         printSummary(scene, settings, result, outDir);

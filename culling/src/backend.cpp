@@ -2,7 +2,10 @@
 #include "culling/backend.hpp"
 
 #include "culling/errors.hpp"
+#include "culling/shade.hpp"
 #include "vk/vulkan_backend.hpp"
+
+#include <chrono>
 
 namespace lc {
 
@@ -30,6 +33,13 @@ ViewLights makeViewLights(const Scene& scene) {
         }
     }
     return out;
+}
+
+std::vector<float> CullBackend::shade(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled) {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<float> rgb = shadeCpu(in, lights, culled);
+    lastShadeMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return rgb;
 }
 
 std::vector<std::string> availableBackends() {

@@ -13,6 +13,7 @@
 #include "culling/ground_truth.hpp"
 
 #include "culling/errors.hpp"
+#include "culling/shade.hpp"
 #include "light_grid.hpp"
 
 #include <algorithm>
@@ -111,190 +112,7 @@ bool geometryBounds(const DepthImage& depth, const Projection& proj, unsigned wo
     return bmin.x <= bmax.x;
 }
 
-// ---- Lambert shading -------------------------------------------------------
-
-// Light data for the shading kernel, float SoA.
-struct LightSoA {
-    std::vector<float> x, y, z, r, g, b;
-    explicit LightSoA(const ViewLights& l) {
-        const std::size_t n = l.size();
-        x.resize(n), y.resize(n), z.resize(n), r.resize(n), g.resize(n), b.resize(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            x[i] = float(l.centers[i].x), y[i] = float(l.centers[i].y), z[i] = float(l.centers[i].z);
-            r[i] = float(l.power[i].x), g[i] = float(l.power[i].y), b[i] = float(l.power[i].z);
-        }
-    }
-};
-
-// A group of pixels shaded by the same light list, float SoA.
-struct PixelGroup {
-    std::vector<float> px, py, pz, nx, ny, nz, ar, ag, ab;
-    void resize(std::size_t n) {
-        for (auto* v : {&px, &py, &pz, &nx, &ny, &nz}) v->resize(n);
-        for (auto* v : {&ar, &ag, &ab}) v->assign(n, 0.0f);
-    }
-};
-
-// The one Lambert kernel, used for both the culled and the all-lights image so
-// that the same light list gives bitwise the same sum: per pixel, lights are
-// accumulated in the order given, with the same float operations. The inner
-// loop runs over pixels and vectorises; light data are loop invariants.
-//   contribution = power * max(0, n.l) / max(d^2, 1e-4),  l = (c - P) / |c - P|
-// x86-64 always has SSE2: the pixel loop runs 4 pixels per instruction with
-// explicit intrinsics (GCC will not vectorise std::sqrt without
-// -fno-math-errno). SSE's add/mul/div/sqrt are IEEE-exact like the scalar
-// tail's, so every pixel gets bitwise the value the scalar loop would give.
-void shadeGroup(PixelGroup& g, std::size_t begin, std::size_t end, const LightSoA& L,
-                const std::uint32_t* lightIndex, std::size_t lightCount) {
-    float* __restrict ar = g.ar.data();
-    float* __restrict ag = g.ag.data();
-    float* __restrict ab = g.ab.data();
-    const float* __restrict px = g.px.data();
-    const float* __restrict py = g.py.data();
-    const float* __restrict pz = g.pz.data();
-    const float* __restrict nx = g.nx.data();
-    const float* __restrict ny = g.ny.data();
-    const float* __restrict nz = g.nz.data();
-    for (std::size_t k = 0; k < lightCount; ++k) {
-        const std::size_t i = lightIndex ? lightIndex[k] : k;
-        const float lx = L.x[i], ly = L.y[i], lz = L.z[i];
-        const float cr = L.r[i], cg = L.g[i], cb = L.b[i];
-        std::size_t p = begin;
-#if defined(__SSE2__)
-        const __m128 vlx = _mm_set1_ps(lx), vly = _mm_set1_ps(ly), vlz = _mm_set1_ps(lz);
-        const __m128 vcr = _mm_set1_ps(cr), vcg = _mm_set1_ps(cg), vcb = _mm_set1_ps(cb);
-        const __m128 tiny = _mm_set1_ps(1e-30f), floor2 = _mm_set1_ps(1e-4f), zero = _mm_setzero_ps();
-        for (; p + 4 <= end; p += 4) {
-            const __m128 dx = _mm_sub_ps(vlx, _mm_loadu_ps(px + p));
-            const __m128 dy = _mm_sub_ps(vly, _mm_loadu_ps(py + p));
-            const __m128 dz = _mm_sub_ps(vlz, _mm_loadu_ps(pz + p));
-            const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
-            const __m128 len = _mm_sqrt_ps(_mm_max_ps(d2, tiny));
-            const __m128 dot = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(nx + p), dx),
-                                                     _mm_mul_ps(_mm_loadu_ps(ny + p), dy)),
-                                          _mm_mul_ps(_mm_loadu_ps(nz + p), dz));
-            const __m128 ndl = _mm_div_ps(dot, len);
-            const __m128 f = _mm_div_ps(_mm_max_ps(ndl, zero), _mm_max_ps(d2, floor2));
-            _mm_storeu_ps(ar + p, _mm_add_ps(_mm_loadu_ps(ar + p), _mm_mul_ps(vcr, f)));
-            _mm_storeu_ps(ag + p, _mm_add_ps(_mm_loadu_ps(ag + p), _mm_mul_ps(vcg, f)));
-            _mm_storeu_ps(ab + p, _mm_add_ps(_mm_loadu_ps(ab + p), _mm_mul_ps(vcb, f)));
-        }
-#endif
-        for (; p < end; ++p) {
-            const float dx = lx - px[p], dy = ly - py[p], dz = lz - pz[p];
-            const float d2 = (dx * dx + dy * dy) + dz * dz;
-            // A light exactly at the pixel has no direction: clamp the length.
-            const float len = std::sqrt(d2 > 1e-30f ? d2 : 1e-30f);
-            const float ndl = ((nx[p] * dx + ny[p] * dy) + nz[p] * dz) / len;
-            const float f = (ndl > 0.0f ? ndl : 0.0f) / (d2 > 1e-4f ? d2 : 1e-4f);
-            ar[p] += cr * f;
-            ag[p] += cg * f;
-            ab[p] += cb * f;
-        }
-    }
-}
-
-// Shading normal at a geometry pixel, from the reconstructed view positions of
-// its neighbours. In each of x and y the shorter of the forward and backward
-// differences is used, so that a pixel on a silhouette takes its slope from the
-// surface it belongs to. Without a valid neighbour in x or in y the normal is
-// the direction to the camera. The normal faces the camera.
-glm::dvec3 shadingNormal(const DepthImage& depth, const Projection& proj, std::uint32_t x,
-                         std::uint32_t y, const glm::dvec3& p) {
-    auto pick = [&](bool hasB, std::uint32_t bx, std::uint32_t by, bool hasF, std::uint32_t fx,
-                    std::uint32_t fy, glm::dvec3& out) {
-        bool ok = false;
-        double best = std::numeric_limits<double>::infinity();
-        if (hasF && depth.hasGeometry(fx, fy)) {
-            const glm::dvec3 d = proj.viewPositionFromDepth(fx, fy, depth.at(fx, fy)) - p;
-            best = glm::dot(d, d), out = d, ok = true;
-        }
-        if (hasB && depth.hasGeometry(bx, by)) {
-            const glm::dvec3 d = p - proj.viewPositionFromDepth(bx, by, depth.at(bx, by));
-            if (glm::dot(d, d) < best) out = d, ok = true;
-        }
-        return ok;
-    };
-    const glm::dvec3 toCamera =
-        proj.orthographic() ? glm::dvec3(0, 0, 1) : (glm::dot(p, p) > 0 ? glm::normalize(-p) : glm::dvec3(0, 0, 1));
-    glm::dvec3 dx, dy;
-    const bool okX = pick(x > 0, x - 1, y, x + 1 < depth.width, x + 1, y, dx);
-    const bool okY = pick(y > 0, x, y - 1, y + 1 < depth.height, x, y + 1, dy);
-    if (!okX || !okY) return toCamera;
-    glm::dvec3 n = glm::cross(dx, dy);
-    const double len = glm::length(n);
-    if (!(len > 0) || !std::isfinite(len)) return toCamera;
-    n /= len;
-    return glm::dot(n, toCamera) < 0 ? -n : n;
-}
-
 } // namespace
-
-std::vector<float> shadeLambertCpu(const DepthImage& depth, const Projection& proj,
-                                   const ViewLights& lights, const CullResult* culled) {
-    checkInputs(depth, proj);
-    const std::uint32_t W = depth.width;
-    std::vector<float> rgb(std::size_t(W) * depth.height * 3, 0.0f);
-    if (culled && (culled->grid.width != W || culled->grid.height != depth.height))
-        throw Error("shading: cull result grid is " + std::to_string(culled->grid.width) + "x" +
-                    std::to_string(culled->grid.height) + ", depth image " + std::to_string(W) +
-                    "x" + std::to_string(depth.height));
-    const LightSoA L(lights);
-    // Band height: a tile row, so that pixels sharing a tile list form groups
-    // of a whole tile (long vectorisable inner loops).
-    const std::uint32_t band = culled ? std::max(culled->grid.tileSize, 4u) : 16u;
-    const unsigned workers = workerCount();
-    forEachRowBand(depth.height, band, workers, nullptr, [&](unsigned, std::uint32_t y0, std::uint32_t y1) {
-        // (list, pixel) pairs of this band, sorted by list: each run of equal
-        // lists is shaded light-outer, pixel-inner.
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> order;
-        order.reserve(std::size_t(W) * (y1 - y0));
-        for (std::uint32_t y = y0; y < y1; ++y)
-            for (std::uint32_t x = 0; x < W; ++x) {
-                if (!depth.hasGeometry(x, y)) continue;
-                std::uint32_t list = 0;
-                if (culled)
-                    list = culled->listOfPixel(x, y, proj.viewDepthFromWindowDepth(depth.at(x, y)));
-                order.emplace_back(list, y * W + x);
-            }
-        if (culled) std::sort(order.begin(), order.end());
-        PixelGroup g;
-        g.resize(order.size());
-        for (std::size_t k = 0; k < order.size(); ++k) {
-            const std::uint32_t x = order[k].second % W, y = order[k].second / W;
-            const glm::dvec3 p = proj.viewPositionFromDepth(x, y, depth.at(x, y));
-            const glm::dvec3 n = shadingNormal(depth, proj, x, y, p);
-            g.px[k] = float(p.x), g.py[k] = float(p.y), g.pz[k] = float(p.z);
-            g.nx[k] = float(n.x), g.ny[k] = float(n.y), g.nz[k] = float(n.z);
-        }
-        for (std::size_t begin = 0; begin < order.size();) {
-            std::size_t end = begin + 1;
-            while (end < order.size() && order[end].first == order[begin].first) ++end;
-            if (culled) {
-                const std::uint32_t l = order[begin].first;
-                if (l >= culled->listCount.size())
-                    throw Error("shading: list " + std::to_string(l) + " out of range");
-                const std::uint32_t off = culled->listOffset[l], cnt = culled->listCount[l];
-                if (std::size_t(off) + cnt > culled->lightIndices.size())
-                    throw Error("shading: list " + std::to_string(l) + " overruns the index array");
-                for (std::uint32_t k = 0; k < cnt; ++k)
-                    if (culled->lightIndices[off + k] >= lights.size())
-                        throw Error("shading: list " + std::to_string(l) + " names light " +
-                                    std::to_string(culled->lightIndices[off + k]) + " of " +
-                                    std::to_string(lights.size()));
-                shadeGroup(g, begin, end, L, culled->lightIndices.data() + off, cnt);
-            } else {
-                shadeGroup(g, begin, end, L, nullptr, lights.size());
-            }
-            begin = end;
-        }
-        for (std::size_t k = 0; k < order.size(); ++k) {
-            float* out = &rgb[std::size_t(order[k].second) * 3];
-            out[0] = g.ar[k], out[1] = g.ag[k], out[2] = g.ab[k];
-        }
-    });
-    return rgb;
-}
 
 GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
                                const ViewLights& lights, const CullResult& result,
@@ -398,19 +216,9 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
         const std::vector<float> cul =
             identity ? ref : shadeLambertCpu(depth, proj, lights, &result);
         if (isCancelled(cancel)) throw Cancelled();
-        double sum2 = 0, maxErr = 0;
-        for (std::uint32_t y = 0; y < depth.height; ++y)
-            for (std::uint32_t x = 0; x < depth.width; ++x) {
-                if (!depth.hasGeometry(x, y)) continue;
-                const std::size_t i = (std::size_t(y) * depth.width + x) * 3;
-                for (int c = 0; c < 3; ++c) {
-                    const double e = double(cul[i + c]) - double(ref[i + c]);
-                    sum2 += e * e;
-                    maxErr = std::max(maxErr, std::abs(e));
-                }
-            }
-        m.imageRmse = m.geometryPixels ? std::sqrt(sum2 / (3.0 * double(m.geometryPixels))) : 0.0;
-        m.imageMaxError = maxErr;
+        const ImageError e = compareShadedImages(depth, cul, ref);
+        m.imageRmse = e.rmse;
+        m.imageMaxError = e.maxAbs;
         m.imageErrorComputed = true;
     }
     return gt;

@@ -5,6 +5,7 @@
 #include "culling/pipeline.hpp"
 
 #include "culling/errors.hpp"
+#include "culling/shade.hpp"
 
 #include <chrono>
 
@@ -26,6 +27,38 @@ void throwIfCancelled(const CancelToken* cancel) {
 }
 
 } // namespace
+
+void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
+                     const CancelToken* cancel) {
+    const ShadeInputs culledIn = makeShadeInputs(out.depth, proj, &out.result);
+    std::vector<float> culled = backend.shade(culledIn, out.lights, &out.result);
+    out.result.timings.shadeMs = backend.lastShadeMs();
+    throwIfCancelled(cancel);
+    // `all` with one list of every light in order shades exactly the reference.
+    const CullResult& r = out.result;
+    bool identity = r.listCount.size() == 1 && r.listCount[0] == out.lights.size();
+    for (std::size_t i = 0; identity && i < out.lights.size(); ++i)
+        identity = r.lightIndices[r.listOffset[0] + i] == i;
+    std::vector<float> all;
+    if (identity) {
+        all = culled;
+    } else {
+        ShadeInputs allIn = culledIn;
+        for (std::uint32_t& l : allIn.list)
+            if (l != ShadeInputs::kNoList) l = 0;
+        all = backend.shade(allIn, out.lights, nullptr);
+        throwIfCancelled(cancel);
+    }
+    const ImageError e = compareShadedImages(out.depth, culled, all);
+    Metrics& m = out.truth.metrics;
+    m.imageRmse = e.rmse;
+    m.imageMaxError = e.maxAbs;
+    m.imageErrorComputed = true;
+    if (keepImages) {
+        out.shadedCulled = std::move(culled);
+        out.shadedAll = std::move(all);
+    }
+}
 
 RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBackend& backend,
                       const RunOptions& options, const CancelToken* cancel) {
@@ -64,10 +97,16 @@ RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBack
     throwIfCancelled(cancel);
 
     if (options.groundTruth) {
+        GroundTruthOptions truthOptions = options.truthOptions;
+        truthOptions.imageError = false; // from the backend's shading pass below
         const auto t2 = Clock::now();
-        out.truth = computeGroundTruth(out.depth, proj, out.lights, out.result, options.truthOptions, cancel);
+        out.truth = computeGroundTruth(out.depth, proj, out.lights, out.result, truthOptions, cancel);
         out.result.timings.groundTruthMs =
             std::chrono::duration<double, std::milli>(Clock::now() - t2).count();
+    }
+    if (options.truthOptions.imageError) {
+        throwIfCancelled(cancel);
+        shadeAndCompare(backend, out, proj, options.keepShadedImages, cancel);
     }
     return out;
 }

@@ -13,6 +13,8 @@
 
 namespace lc {
 
+struct ShadeInputs; // culling/shade.hpp
+
 // Lights transformed to view space with their radii, the input of every pass.
 // centers/radii are each light's range sphere (a spot light's apex sphere).
 struct ViewLights {
@@ -51,6 +53,13 @@ public:
                             const ViewLights& lights, const CullSettings& settings) = 0;
     double lastDepthMs() const { return lastDepthMs_; }
     virtual std::string timingMethod() const = 0;
+    // Lambert shading pass (culling/shade.hpp) over a G-buffer built by
+    // makeShadeInputs: each geometry pixel shaded from the lights of its list
+    // in `culled` (null: every light in index order). Returns RGB, 3 floats per
+    // pixel, background 0. Sets lastShadeMs(), timed like cull(). The default
+    // is the CPU reference (shadeCpu) timed by steady_clock.
+    virtual std::vector<float> shade(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled);
+    double lastShadeMs() const { return lastShadeMs_; }
     // CPU wall-clock milliseconds of the last cull() around its submissions
     // (equal to its cullMs where that is the timing method; -1: not run).
     virtual double lastCullWallMs() const { return -1; }
@@ -61,6 +70,7 @@ public:
 
 protected:
     double lastDepthMs_ = -1;
+    double lastShadeMs_ = -1;
 };
 
 std::unique_ptr<CullBackend> makeCpuBackend();

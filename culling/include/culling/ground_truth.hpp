@@ -5,6 +5,7 @@
 // compared with the list the shading pass would loop over there.
 
 #include "culling/backend.hpp"
+#include "culling/shade.hpp"
 
 #include <cstdint>
 #include <vector>
@@ -33,7 +34,9 @@ struct GroundTruth {
 };
 
 struct GroundTruthOptions {
-    bool imageError = true; // Lambert image error costs pixels x lights
+    // Lambert image error on the CPU (costs pixels x lights). runPipeline turns
+    // this off and takes the error from the backend's shading pass instead.
+    bool imageError = true;
 };
 
 GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
@@ -46,11 +49,6 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>>
 pixelsNeedingLights(const DepthImage& depth, const Projection& proj, const ViewLights& lights,
                     const TileGrid& grid, std::uint32_t tile);
 
-// Lambert shading used for the image error: per pixel RGB, from the listed
-// lights (culled) or all lights. Normals from the depth buffer's neighbours.
-// Layout: 3 floats per pixel, row-major; background pixels are 0.
-std::vector<float> shadeLambertCpu(const DepthImage& depth, const Projection& proj,
-                                   const ViewLights& lights,
-                                   const CullResult* culled /* null: all lights */);
+// The Lambert shading and image error live in culling/shade.hpp.
 
 } // namespace lc

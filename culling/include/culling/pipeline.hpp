@@ -13,16 +13,29 @@ struct RunOutput {
     CullResult result;
     GroundTruth truth;
     ViewLights lights;
+    // The shaded images (RGB, 3 floats per pixel) when RunOptions::keepShadedImages.
+    std::vector<float> shadedCulled, shadedAll;
 };
 
 struct RunOptions {
     bool groundTruth = true;
+    // truthOptions.imageError: the backend's shading pass shades the culled
+    // and the all-lights image (timings.shadeMs = the culled one) and the
+    // image error compares them; off, nothing is shaded.
     GroundTruthOptions truthOptions;
+    bool keepShadedImages = false; // keep both images in RunOutput (for export)
 };
 
 // Validates the scene and settings (typed errors), runs every phase on
-// `backend`, and fills result.timings (depth, cull, ground truth).
+// `backend`, and fills result.timings (depth, cull, ground truth, shade).
 RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBackend& backend,
                       const RunOptions& options = {}, const CancelToken* cancel = nullptr);
+
+// The shading phase of runPipeline on its own: shades `out.result`'s lists and
+// every light on `backend` over out.depth, sets timings.shadeMs (the culled
+// image) and the image error in out.truth.metrics; keeps the images in `out`
+// when asked.
+void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
+                     const CancelToken* cancel = nullptr);
 
 } // namespace lc

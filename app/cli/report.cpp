@@ -1,0 +1,150 @@
+// lightcull report (--builtin NAME | --scene FILE) [--lights N [--seed S]]
+//                  [--backend NAME]... [--repeat N] [culling flags] --out DIR
+#include "report.hpp"
+
+#include "culling/errors.hpp"
+#include "culling/report.hpp"
+#include "culling/scene_io.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+namespace lcli {
+
+namespace {
+
+int usage(const std::string& message) {
+    std::cerr << "lightcull: error: " << message << "\n";
+    return 2;
+}
+
+std::vector<std::string> splitCommas(const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream in(s);
+    for (std::string v; std::getline(in, v, ',');) out.push_back(v);
+    return out;
+}
+
+} // namespace
+
+void ReportCommand::add(CLI::App& app) {
+    cmd_ = app.add_subcommand(
+        "report", "Sweep algorithm x tile size x cells x slicing x sphere test (every culling parameter that "
+                  "applies) on every backend; write report.csv, report.md and pareto.png into --out DIR");
+    CLI::Option* optScene = cmd_->add_option("--scene", sceneFile_, "Scene JSON file to load")->type_name("FILE.json");
+    CLI::Option* optBuiltin =
+        cmd_->add_option("--builtin", builtin_, "Built-in scene to use (see `lightcull scenes`)")->type_name("NAME");
+    optScene->excludes(optBuiltin);
+    optLights_ = cmd_->add_option("--lights", lights_,
+                                  "Replace the scene's lights with N generated ones (deterministic)")
+                     ->type_name("N");
+    cmd_->add_option("--seed", seed_, "Seed of the light generator used by --lights (default: 1)")
+        ->type_name("S")
+        ->needs(optLights_);
+    std::string backendHelp = "Backend to sweep on (repeatable; default: every available one:";
+    for (const std::string& b : lc::availableBackends()) backendHelp += " " + b;
+    cmd_->add_option("--backend", backends_, backendHelp + ")")->type_name("NAME");
+    cmd_->add_option("--device", device_, "Vulkan device: index or name substring")->type_name("D");
+    cmd_->add_option("--repeat", repeat_, "Timed culls and shades per configuration; medians reported (default: 3)")
+        ->type_name("N")
+        ->check(CLI::Range(1, 1000));
+    cmd_->add_option("--warmup", warmup_, "Untimed culls and shades before those (default: 1)")
+        ->type_name("N")
+        ->check(CLI::Range(0, 1000));
+    // One flag per culling parameter: it holds that parameter at one value
+    // instead of sweeping it (tile and cells take a comma-separated list).
+    for (const lc::ParamSpec& p : lc::cullParams()) {
+        std::string help = p.name == "width" || p.name == "height"
+                               ? "Camera " + p.name + " in pixels (default: the scene's)"
+                               : "Hold " + p.name + " at this value instead of sweeping it";
+        if (p.name == "tile") help = "Tile sizes to sweep, comma-separated (default: 8,16,32)";
+        if (p.name == "cells") help = "Cell counts to sweep, comma-separated (default: 1,2,4,8,16,32)";
+        CLI::Option* o = cmd_->add_option("--" + p.name, paramValues_[p.name], help);
+        o->type_name(p.name == "tile" || p.name == "cells" ? "N[,N...]" : "VALUE");
+        paramOptions_.emplace_back(p.name, o);
+    }
+    cmd_->add_option("--out", outDir_, "Folder to write into (written atomically; its parent must exist)")
+        ->type_name("DIR")
+        ->required();
+}
+
+int ReportCommand::run() {
+    if (sceneFile_.empty() && builtin_.empty()) return usage("report: give --scene FILE.json or --builtin NAME");
+    {
+        namespace fs = std::filesystem;
+        fs::path target = fs::path(outDir_).lexically_normal();
+        if (!target.has_filename()) target = target.parent_path();
+        fs::path parent = target.parent_path();
+        if (parent.empty()) parent = ".";
+        std::error_code ec;
+        if (!fs::is_directory(parent, ec))
+            return usage("--out: parent folder " + parent.string() + " of " + outDir_ + " does not exist");
+    }
+
+    lc::Scene scene = sceneFile_.empty() ? lc::makeBuiltinScene(builtin_) : lc::loadSceneFile(sceneFile_);
+    if (optLights_->count()) {
+        if (lights_ < 0 || lights_ > 1000000)
+            throw lc::SettingsError("lights", "must be in 0..1000000, got " + std::to_string(lights_));
+        scene.lights = lc::generateLights(lc::defaultLightGen(scene, std::uint32_t(lights_), seed_));
+    }
+
+    lc::ReportOptions options;
+    options.device = device_;
+    options.repeat = repeat_;
+    options.warmup = warmup_;
+    for (const std::string& b : backends_)
+        for (const std::string& name : splitCommas(b)) options.backends.push_back(name);
+    lc::CullSettings scratch;
+    for (const auto& [name, opt] : paramOptions_) {
+        if (!opt->count()) continue;
+        const std::string& value = paramValues_.at(name);
+        if (name == "width" || name == "height") {
+            lc::setParam(scratch, scene.camera, name, value);
+        } else if (name == "tile" || name == "cells") {
+            std::vector<std::uint32_t>& list = name == "tile" ? options.tileSizes : options.cellCounts;
+            list.clear();
+            for (const std::string& v : splitCommas(value)) {
+                lc::Camera c;
+                lc::setParam(scratch, c, name, v); // validates against the table's range
+                list.push_back(std::uint32_t(std::stoul(v)));
+            }
+            if (list.empty()) throw lc::SettingsError(name, "give at least one value");
+        } else {
+            options.fixed[name] = value;
+        }
+    }
+
+    const bool tty = ::isatty(STDERR_FILENO);
+    const lc::Report report = lc::runReport(scene, options, [&](std::size_t done, std::size_t total,
+                                                                const std::string& label) {
+        if (tty) std::cerr << "\r[" << done << "/" << total << "] " << label << "\033[K" << std::flush;
+    });
+    if (tty) std::cerr << "\r\033[K";
+    lc::writeReport(report, outDir_);
+
+    std::cout << "report " << report.sceneName << ": " << report.width << "x" << report.height << ", "
+              << report.lights << " lights, " << report.rows.size() << " configurations\n";
+    for (const auto& [backend, device] : report.backendDevices) std::cout << "backend " << backend << ": " << device << "\n";
+    for (const std::string& n : report.notes) std::cout << "note: " << n << "\n";
+    std::uint64_t fnRows = 0;
+    for (const lc::ReportRow& r : report.rows) fnRows += r.falseNegatives > 0;
+    if (!report.rows.empty()) {
+        const lc::ReportRow& fastest = *std::min_element(
+            report.rows.begin(), report.rows.end(), [](const auto& a, const auto& b) { return a.totalMs < b.totalMs; });
+        char buf[256];
+        std::snprintf(buf, sizeof buf, "fastest: %s %s, total %.3f ms (cull %.3f + shade %.3f), efficiency %.4f\n",
+                      fastest.config.backend.c_str(), fastest.config.label().c_str(), fastest.totalMs, fastest.cullMs,
+                      fastest.shadeMs, fastest.efficiency);
+        std::cout << buf;
+    }
+    std::cout << "configurations with false negatives: " << fnRows << "\n"
+              << "wrote " << outDir_ << "/report.csv, report.md, pareto.png\n";
+    return 0;
+}
+
+} // namespace lcli

@@ -1,0 +1,184 @@
+// The Vulkan shading pass: one dispatch of shaders/shade.comp over the image,
+// 8x8 pixels per workgroup, every buffer host-visible (as the culling passes;
+// docs/VULKAN.md).
+#include "vk/shade_pass.hpp"
+
+#include "culling/errors.hpp"
+#include "culling/gpu_shade.h"
+#include "embedded_spirv.hpp"
+
+#include <cstring>
+
+// Vulkan create-info structs are value-initialised as {VK_STRUCTURE_TYPE_...}:
+// the remaining members are zero on purpose.
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+
+namespace lc::vk {
+
+namespace {
+constexpr std::uint32_t kBindings = 8; // shade.comp bindings 0..7
+constexpr std::uint32_t kGroup = 8;    // shade.comp local size, x and y
+} // namespace
+
+ShadePass::ShadePass(Context& ctx) : ctx_(ctx) {
+    VkDevice dev = ctx_.device();
+    std::array<VkDescriptorSetLayoutBinding, kBindings> b{};
+    for (std::uint32_t i = 0; i < kBindings; ++i) {
+        b[i].binding = i;
+        b[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        b[i].descriptorCount = 1;
+        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    }
+    VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    lci.bindingCount = kBindings;
+    lci.pBindings = b.data();
+    VkDescriptorSetLayout sl;
+    LC_VK(vkCreateDescriptorSetLayout(dev, &lci, nullptr, &sl));
+    setLayout_ = DescriptorSetLayoutHandle(dev, sl);
+    ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, sl, "shade.setLayout");
+    VkPipelineLayoutCreateInfo pci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    pci.setLayoutCount = 1;
+    pci.pSetLayouts = &sl;
+    VkPipelineLayout pl;
+    LC_VK(vkCreatePipelineLayout(dev, &pci, nullptr, &pl));
+    layout_ = PipelineLayoutHandle(dev, pl);
+    ctx_.name(VK_OBJECT_TYPE_PIPELINE_LAYOUT, pl, "shade.pipelineLayout");
+    const spirv::Code code = spirv::shade();
+    shader_ = ctx_.createShader(code.words, code.wordCount, "shader.shade");
+}
+
+VkPipeline ShadePass::pipeline(bool allLights) {
+    PipelineHandle& pipe = pipelines_[allLights ? 1 : 0];
+    if (pipe) return pipe;
+    const std::uint32_t all = allLights ? 1u : 0u;
+    VkSpecializationMapEntry entry{0, 0, 4};
+    VkSpecializationInfo si{};
+    si.mapEntryCount = 1;
+    si.pMapEntries = &entry;
+    si.dataSize = 4;
+    si.pData = &all;
+    VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    ci.stage.module = shader_;
+    ci.stage.pName = "main";
+    ci.stage.pSpecializationInfo = &si;
+    ci.layout = layout_;
+    VkPipeline p;
+    LC_VK(vkCreateComputePipelines(ctx_.device(), VK_NULL_HANDLE, 1, &ci, nullptr, &p));
+    ctx_.name(VK_OBJECT_TYPE_PIPELINE, p, allLights ? "pipeline.shade.all" : "pipeline.shade.lists");
+    pipe = PipelineHandle(ctx_.device(), p);
+    return pipe;
+}
+
+std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled,
+                                  double& ms) {
+    const std::size_t pixels = std::size_t(in.width) * in.height;
+    if (in.position.size() != 3 * pixels || in.normal.size() != 3 * pixels || in.list.size() != pixels)
+        throw Error("shading: inconsistent shading inputs");
+    const std::size_t lightCount = lights.size();
+    const std::size_t listTotal = culled ? culled->listCount.size() : 1;
+    // The shader trusts its indices: check every one here (typed errors, never
+    // an out-of-bounds read on the device).
+    if (culled) {
+        if (culled->listOffset.size() != listTotal) throw Error("shading: cull result offsets and counts differ");
+        for (std::size_t l = 0; l < listTotal; ++l)
+            if (std::size_t(culled->listOffset[l]) + culled->listCount[l] > culled->lightIndices.size())
+                throw Error("shading: list " + std::to_string(l) + " overruns the index array");
+        for (std::uint32_t i : culled->lightIndices)
+            if (i >= lightCount)
+                throw Error("shading: a list names light " + std::to_string(i) + " of " + std::to_string(lightCount));
+    }
+    for (std::size_t i = 0; i < pixels; ++i)
+        if (in.list[i] != ShadeInputs::kNoList && in.list[i] >= listTotal)
+            throw Error("shading: pixel " + std::to_string(i) + " uses list " + std::to_string(in.list[i]) + " of " +
+                        std::to_string(listTotal));
+    const auto& lim = ctx_.properties().limits;
+    if (pixels * sizeof(GpuShadePixel) > lim.maxStorageBufferRange)
+        throw DeviceError("shading: a " + std::to_string(in.width) + "x" + std::to_string(in.height) +
+                          " G-buffer exceeds this device's storage buffer range");
+    const std::uint32_t gx = (in.width + kGroup - 1) / kGroup, gy = (in.height + kGroup - 1) / kGroup;
+    if (gx > lim.maxComputeWorkGroupCount[0] || gy > lim.maxComputeWorkGroupCount[1])
+        throw DeviceError("shading: too many workgroups for one dispatch on this device");
+
+    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    Buffer params = ctx_.createBuffer(sizeof(GpuShadeParams), usage, "shade.params");
+    Buffer pixelBuf = ctx_.createBuffer(pixels * sizeof(GpuShadePixel), usage, "shade.pixels");
+    Buffer listBuf = ctx_.createBuffer(pixels * 4, usage, "shade.pixelLists");
+    Buffer lightBuf = ctx_.createBuffer(lightCount * sizeof(GpuShadeLight), usage, "shade.lights");
+    Buffer offsetBuf = ctx_.createBuffer(culled ? listTotal * 4 : 4, usage, "shade.listOffsets");
+    Buffer countBuf = ctx_.createBuffer(culled ? listTotal * 4 : 4, usage, "shade.listCounts");
+    Buffer indexBuf = ctx_.createBuffer(culled ? culled->lightIndices.size() * 4 : 4, usage, "shade.lightIndices");
+    Buffer outBuf = ctx_.createBuffer(pixels * 3 * 4, usage, "shade.rgb");
+
+    params.as<GpuShadeParams>()->size =
+        glm::uvec4(in.width, in.height, std::uint32_t(lightCount), std::uint32_t(listTotal));
+    GpuShadePixel* px = pixelBuf.as<GpuShadePixel>();
+    for (std::size_t i = 0; i < pixels; ++i) {
+        px[i].position = glm::vec4(in.position[3 * i], in.position[3 * i + 1], in.position[3 * i + 2], 0.0f);
+        px[i].normal = glm::vec4(in.normal[3 * i], in.normal[3 * i + 1], in.normal[3 * i + 2], 0.0f);
+    }
+    std::memcpy(listBuf.mapped, in.list.data(), pixels * 4);
+    GpuShadeLight* L = lightBuf.as<GpuShadeLight>();
+    for (std::size_t i = 0; i < lightCount; ++i) {
+        L[i].position = glm::vec4(glm::vec3(lights.centers[i]), 0.0f);
+        L[i].power = glm::vec4(glm::vec3(lights.power[i]), 0.0f);
+    }
+    if (culled) {
+        std::memcpy(offsetBuf.mapped, culled->listOffset.data(), listTotal * 4);
+        std::memcpy(countBuf.mapped, culled->listCount.data(), listTotal * 4);
+        if (!culled->lightIndices.empty())
+            std::memcpy(indexBuf.mapped, culled->lightIndices.data(), culled->lightIndices.size() * 4);
+    }
+
+    VkDevice dev = ctx_.device();
+    VkDescriptorPoolSize ps{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings};
+    VkDescriptorPoolCreateInfo dpci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    dpci.maxSets = 1;
+    dpci.poolSizeCount = 1;
+    dpci.pPoolSizes = &ps;
+    VkDescriptorPool poolRaw;
+    LC_VK(vkCreateDescriptorPool(dev, &dpci, nullptr, &poolRaw));
+    DescriptorPoolHandle pool(dev, poolRaw);
+    ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_POOL, poolRaw, "shade.descriptorPool");
+    VkDescriptorSetLayout sl = setLayout_;
+    VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    ai.descriptorPool = pool;
+    ai.descriptorSetCount = 1;
+    ai.pSetLayouts = &sl;
+    VkDescriptorSet set;
+    LC_VK(vkAllocateDescriptorSets(dev, &ai, &set));
+    ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_SET, set, "shade.set");
+    const Buffer* bufs[kBindings] = {&params, &pixelBuf, &listBuf, &lightBuf, &offsetBuf, &countBuf, &indexBuf, &outBuf};
+    std::array<VkDescriptorBufferInfo, kBindings> infos{};
+    std::array<VkWriteDescriptorSet, kBindings> writes{};
+    for (std::uint32_t i = 0; i < kBindings; ++i) {
+        infos[i] = {bufs[i]->buffer, 0, VK_WHOLE_SIZE};
+        writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+        writes[i].dstSet = set;
+        writes[i].dstBinding = i;
+        writes[i].descriptorCount = 1;
+        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        writes[i].pBufferInfo = &infos[i];
+    }
+    vkUpdateDescriptorSets(dev, kBindings, writes.data(), 0, nullptr);
+
+    VkPipeline pipe = pipeline(culled == nullptr);
+    ms = ctx_.submitAndWait(
+        [&](VkCommandBuffer cmd) {
+            vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set, 0, nullptr);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
+            vkCmdDispatch(cmd, gx, gy, 1);
+            // The host reads the shaded image the dispatch wrote.
+            VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+            mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+            mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0,
+                                 nullptr, 0, nullptr);
+        },
+        "shade.commands");
+    const float* out = outBuf.as<float>();
+    return std::vector<float>(out, out + pixels * 3);
+}
+
+} // namespace lc::vk

@@ -1,0 +1,30 @@
+#pragma once
+// Internal: the Vulkan Lambert shading pass (shaders/shade.comp) on a backend's
+// context. Inputs are the CPU-built G-buffer (lc::ShadeInputs) so that both
+// backends shade the same positions, normals and per-pixel lists.
+#include "culling/shade.hpp"
+#include "vk/vk_context.hpp"
+
+#include <array>
+
+namespace lc::vk {
+
+class ShadePass {
+public:
+    explicit ShadePass(Context& ctx);
+    // RGB, 3 floats per pixel. `ms`: CPU wall-clock around submit + fence
+    // wait of the shading dispatch (the backend's cull timing method); the
+    // uploads into host-visible buffers and the readback are not included.
+    std::vector<float> run(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled, double& ms);
+
+private:
+    VkPipeline pipeline(bool allLights);
+
+    Context& ctx_;
+    DescriptorSetLayoutHandle setLayout_;
+    PipelineLayoutHandle layout_;
+    ShaderModuleHandle shader_;
+    std::array<PipelineHandle, 2> pipelines_;
+};
+
+} // namespace lc::vk

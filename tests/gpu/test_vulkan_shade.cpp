@@ -1,0 +1,127 @@
+// The Vulkan shading pass (shaders/shade.comp) against the CPU reference
+// (culling/shade.cpp) on the SAME G-buffer and lists: per pixel within float
+// rounding of the device's sqrt and division; background pixels exactly 0;
+// the image error of the pipeline within rounding of the CPU backend's; bad
+// lists are typed errors before anything reaches the device. Validation is on.
+#include "gpu_test_env.hpp"
+
+#include "culling/errors.hpp"
+#include "culling/pipeline.hpp"
+#include "culling/scene_io.hpp"
+#include "culling/shade.hpp"
+
+#include <cmath>
+
+using namespace lc;
+using lc::gputest::GpuTest;
+
+namespace {
+
+Scene smallScene(const std::string& builtin, std::uint32_t w, std::uint32_t h, std::uint32_t lights) {
+    Scene s = makeBuiltinScene(builtin);
+    s.camera.width = w;
+    s.camera.height = h;
+    s.camera.tileSize = 16;
+    s.lights = generateLights(defaultLightGen(s, lights, 3));
+    return s;
+}
+
+// Largest per-channel difference relative to the pixel's value (floored so
+// that near-zero pixels compare absolutely), and whether backgrounds are 0.
+void expectSameImage(const std::vector<float>& gpu, const std::vector<float>& cpu, const ShadeInputs& in,
+                     const std::string& what) {
+    ASSERT_EQ(gpu.size(), cpu.size()) << what;
+    float peak = 0;
+    for (float v : cpu) peak = std::max(peak, v);
+    ASSERT_GT(peak, 0.0f) << what << ": nothing lit, the comparison would prove nothing";
+    std::size_t bad = 0;
+    double worst = 0;
+    for (std::size_t i = 0; i < in.list.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            const float g = gpu[3 * i + c], r = cpu[3 * i + c];
+            if (in.list[i] == ShadeInputs::kNoList) {
+                bad += g != 0.0f;
+                continue;
+            }
+            // Float sums of up to a few hundred terms with 1-3 ulp sqrt/div
+            // differences per term: 1e-4 relative, 1e-6 of the image peak.
+            const double err = std::abs(double(g) - double(r)) / (std::abs(double(r)) + 1e-2 * peak);
+            worst = std::max(worst, err);
+            bad += !(err <= 1e-4);
+        }
+    EXPECT_EQ(bad, 0u) << what << ": worst relative difference " << worst;
+}
+
+} // namespace
+
+class VulkanShade : public GpuTest {};
+
+TEST_F(VulkanShade, MatchesTheCpuReferenceForEveryAlgorithmAndAllLights) {
+    CullBackend& gpu = gputest::vulkan();
+    auto cpu = makeCpuBackend();
+    const Scene scene = smallScene("mountain", 120, 68, 40);
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(120, 68, 16);
+    const ViewLights lights = makeViewLights(scene);
+    const DepthImage depth = cpu->renderDepth(scene, proj);
+    {
+        const ShadeInputs in = makeShadeInputs(depth, proj, nullptr);
+        expectSameImage(gpu.shade(in, lights, nullptr), shadeCpu(in, lights, nullptr), in, "all lights");
+        EXPECT_GE(gpu.lastShadeMs(), 0.0);
+    }
+    for (Algorithm algo : {Algorithm::All, Algorithm::Naive, Algorithm::MinMax, Algorithm::HalfZ,
+                           Algorithm::TwoPointFiveD, Algorithm::Clustered}) {
+        CullSettings settings;
+        settings.algorithm = algo;
+        settings.cells = 8;
+        // Lists from the GPU cull (what the pipeline shades), inputs shared.
+        const CullResult result = gpu.cull(depth, proj, grid, lights, settings);
+        const ShadeInputs in = makeShadeInputs(depth, proj, &result);
+        expectSameImage(gpu.shade(in, lights, &result), shadeCpu(in, lights, &result), in, toString(algo));
+    }
+}
+
+TEST_F(VulkanShade, PipelineImageErrorAgreesWithTheCpuBackendOnTheSameDepth) {
+    CullBackend& gpu = gputest::vulkan();
+    const Scene scene = smallScene("forest", 96, 54, 48);
+    CullSettings settings;
+    settings.algorithm = Algorithm::HalfZ;
+    RunOptions opt;
+    opt.keepShadedImages = true;
+    const RunOutput run = runPipeline(scene, settings, gpu, opt);
+    ASSERT_TRUE(run.truth.metrics.imageErrorComputed);
+    EXPECT_GE(run.result.timings.shadeMs, 0.0);
+    const Projection proj(scene.camera);
+    // The CPU reference on the GPU run's own depth and lists.
+    const std::vector<float> all = shadeLambertCpu(run.depth, proj, run.lights, nullptr);
+    const std::vector<float> cul = shadeLambertCpu(run.depth, proj, run.lights, &run.result);
+    const ImageError ref = compareShadedImages(run.depth, cul, all);
+    EXPECT_GT(ref.rmse, 0.0);
+    EXPECT_NEAR(run.truth.metrics.imageRmse, ref.rmse, 1e-3 * ref.rmse);
+    EXPECT_NEAR(run.truth.metrics.imageMaxError, ref.maxAbs, 1e-3 * ref.maxAbs);
+}
+
+TEST_F(VulkanShade, BadListsAreTypedErrorsAndZeroLightsShadeBlack) {
+    CullBackend& gpu = gputest::vulkan();
+    auto cpu = makeCpuBackend();
+    const Scene scene = smallScene("wall", 32, 32, 8);
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(32, 32, 16);
+    const ViewLights lights = makeViewLights(scene);
+    const DepthImage depth = cpu->renderDepth(scene, proj);
+    CullSettings settings;
+    settings.algorithm = Algorithm::MinMax;
+    const CullResult result = cpu->cull(depth, proj, grid, lights, settings);
+    const ShadeInputs in = makeShadeInputs(depth, proj, &result);
+    CullResult bad = result;
+    ASSERT_FALSE(bad.lightIndices.empty());
+    bad.lightIndices.back() = 1000;
+    EXPECT_THROW(gpu.shade(in, lights, &bad), Error);
+    ShadeInputs badIn = in;
+    badIn.list[5] = 77;
+    EXPECT_THROW(gpu.shade(badIn, lights, &result), Error);
+
+    const ViewLights none;
+    const ShadeInputs allIn = makeShadeInputs(depth, proj, nullptr);
+    for (float v : gpu.shade(allIn, none, nullptr)) ASSERT_EQ(v, 0.0f);
+}

@@ -1,0 +1,257 @@
+// The report's sweep (culling/report.hpp): which configurations it builds from
+// the parameter table and which it skips, a real run on a tiny scene (rows,
+// timings, metrics, progress, cancel), the Pareto flags against their
+// definition, and the written folder (csv shape, atomic refusal).
+#include "culling/errors.hpp"
+#include "culling/report.hpp"
+#include "culling/scene_io.hpp"
+
+#include <gtest/gtest.h>
+
+#include <png.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+using namespace lc;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::size_t countIf(const std::vector<ReportConfig>& cfgs, Algorithm a) {
+    return std::size_t(std::count_if(cfgs.begin(), cfgs.end(),
+                                     [&](const ReportConfig& c) { return c.settings.algorithm == a; }));
+}
+
+Scene tinyScene() {
+    Scene s = makeBuiltinScene("atrium");
+    s.camera.width = 64;
+    s.camera.height = 40;
+    s.lights = generateLights(defaultLightGen(s, 24, 5));
+    return s;
+}
+
+std::vector<std::string> splitCsvLine(const std::string& line) {
+    std::vector<std::string> out;
+    std::string cur;
+    bool quoted = false;
+    for (char c : line) {
+        if (c == '"') quoted = !quoted;
+        else if (c == ',' && !quoted) out.push_back(cur), cur.clear();
+        else cur += c;
+    }
+    out.push_back(cur);
+    return out;
+}
+
+struct TempDir {
+    fs::path path;
+    TempDir() {
+        std::string t = (fs::temp_directory_path() / "lc_report_XXXXXX").string();
+        path = ::mkdtemp(t.data());
+    }
+    ~TempDir() { fs::remove_all(path); }
+};
+
+} // namespace
+
+// Default sweep: all x1; naive/minmax/halfz x tile 3 x test 3; 2.5d x tile 3 x
+// test 3 x (cells 1 + cells {2..32} x slicing 2); clustered as 2.5d x
+// skip-empty 2. Parameters that do not apply have empty values.
+TEST(Report, DefaultSweepFollowsTheParameterTableAndSkipsWhatDoesNotApply) {
+    const std::vector<ReportConfig> cfgs = reportConfigs(ReportOptions{}, "cpu");
+    EXPECT_EQ(countIf(cfgs, Algorithm::All), 1u);
+    EXPECT_EQ(countIf(cfgs, Algorithm::Naive), 9u);
+    EXPECT_EQ(countIf(cfgs, Algorithm::MinMax), 9u);
+    EXPECT_EQ(countIf(cfgs, Algorithm::HalfZ), 9u);
+    EXPECT_EQ(countIf(cfgs, Algorithm::TwoPointFiveD), 3u * 3u * (1u + 5u * 2u));
+    EXPECT_EQ(countIf(cfgs, Algorithm::Clustered), 3u * 3u * (1u + 5u * 2u) * 2u);
+    std::set<std::string> labels;
+    for (const ReportConfig& c : cfgs) {
+        EXPECT_TRUE(labels.insert(c.label()).second) << "duplicate " << c.label();
+        EXPECT_TRUE(c.settings.validate().empty()) << c.label();
+        // Every table parameter but the camera's size is a column.
+        for (const ParamSpec& p : cullParams()) {
+            const bool camera = p.name == "width" || p.name == "height";
+            EXPECT_EQ(c.params.count(p.name), camera ? 0u : 1u) << p.name;
+            if (!camera && c.params.count(p.name))
+                EXPECT_EQ(c.params.at(p.name).empty(),
+                          !paramAppliesTo(p.name, c.settings.algorithm, c.settings.cells, false))
+                    << c.label() << " " << p.name;
+        }
+        if (c.settings.algorithm == Algorithm::All) EXPECT_EQ(c.label(), "all");
+        if (c.settings.algorithm == Algorithm::TwoPointFiveD && c.settings.cells == 1)
+            EXPECT_EQ(c.params.at("slicing"), "");
+        if (!c.params.at("tile").empty()) EXPECT_EQ(std::to_string(c.tileSize), c.params.at("tile"));
+    }
+}
+
+// A parameter added to the table later is swept where it applies: spot-test
+// multiplies every culling algorithm's rows by its choices, but only for a
+// scene with spot lights.
+TEST(Report, SpotTestIsSweptOnlyForScenesWithSpotLights) {
+    const ParamSpec& spot = cullParam("spot-test");
+    ReportOptions o;
+    o.fixed["algorithm"] = "minmax";
+    EXPECT_EQ(reportConfigs(o, "cpu", false).size(), 9u);
+    const std::vector<ReportConfig> withSpots = reportConfigs(o, "cpu", true);
+    EXPECT_EQ(withSpots.size(), 9u * spot.choices.size());
+    for (const ReportConfig& c : withSpots) EXPECT_FALSE(c.params.at("spot-test").empty());
+    o.fixed = {{"algorithm", "all"}};
+    EXPECT_EQ(reportConfigs(o, "cpu", true).size(), 1u);
+}
+
+TEST(Report, FixedParametersAndListsNarrowTheSweep) {
+    ReportOptions o;
+    o.fixed["algorithm"] = "halfz";
+    o.fixed["test"] = "exact";
+    o.tileSizes = {8, 32};
+    const std::vector<ReportConfig> cfgs = reportConfigs(o, "cpu");
+    ASSERT_EQ(cfgs.size(), 2u);
+    EXPECT_EQ(cfgs[0].label(), "halfz test=exact tile=8");
+    EXPECT_EQ(cfgs[1].label(), "halfz test=exact tile=32");
+
+    ReportOptions bad;
+    bad.fixed["no-such-parameter"] = "1";
+    EXPECT_THROW(reportConfigs(bad, "cpu"), SettingsError);
+    bad.fixed = {{"algorithm", "fastest"}};
+    EXPECT_THROW(reportConfigs(bad, "cpu"), SettingsError);
+    bad.fixed = {{"width", "64"}};
+    EXPECT_THROW(reportConfigs(bad, "cpu"), SettingsError);
+}
+
+TEST(Report, RunsOnATinySceneWithProgressAndParetoFlags) {
+    ReportOptions o;
+    o.backends = {"cpu"};
+    o.fixed["algorithm"] = "2.5d";
+    o.tileSizes = {16};
+    o.cellCounts = {1, 8};
+    o.repeat = 1;
+    o.warmup = 0;
+    std::vector<std::size_t> seen;
+    const Report rep = runReport(tinyScene(), o, [&](std::size_t done, std::size_t total, const std::string&) {
+        EXPECT_EQ(total, 9u);
+        seen.push_back(done);
+    });
+    ASSERT_EQ(rep.rows.size(), 9u); // 3 tests x (cells 1 + cells 8 x 2 slicings)
+    EXPECT_EQ(seen, (std::vector<std::size_t>{1, 2, 3, 4, 5, 6, 7, 8, 9}));
+    ASSERT_EQ(rep.backendDevices.size(), 1u);
+    std::size_t onFront = 0;
+    for (const ReportRow& r : rep.rows) {
+        EXPECT_EQ(r.falseNegatives, 0u) << r.config.label();
+        EXPECT_GE(r.cullMs, 0.0);
+        EXPECT_GE(r.shadeMs, 0.0);
+        EXPECT_DOUBLE_EQ(r.totalMs, r.cullMs + r.shadeMs);
+        EXPECT_GT(r.efficiency, 0.0);
+        EXPECT_LE(r.efficiency, 1.0);
+        EXPECT_GT(r.resultBytes, 0u);
+        EXPECT_GE(r.imageRmse, 0.0);
+        onFront += r.paretoEfficiency;
+        // The flag is exactly "no row dominates it".
+        bool dominated = false;
+        for (const ReportRow& o2 : rep.rows)
+            dominated |= o2.totalMs <= r.totalMs && o2.efficiency >= r.efficiency &&
+                         (o2.totalMs < r.totalMs || o2.efficiency > r.efficiency);
+        EXPECT_EQ(r.paretoEfficiency, !dominated) << r.config.label();
+    }
+    EXPECT_GE(onFront, 1u);
+    // One cell and eight: more cells never lose efficiency on the same tile/test.
+    for (const ReportRow& a : rep.rows)
+        for (const ReportRow& b : rep.rows)
+            if (a.config.settings.cells == 1 && b.config.settings.cells == 8 &&
+                a.config.settings.test == b.config.settings.test)
+                EXPECT_GE(b.efficiency, a.efficiency - 1e-12) << b.config.label();
+
+    // `all` shades every light: its image error is exactly 0.
+    ReportOptions all = o;
+    all.fixed = {{"algorithm", "all"}};
+    const Report allRep = runReport(tinyScene(), all);
+    ASSERT_EQ(allRep.rows.size(), 1u);
+    EXPECT_EQ(allRep.rows[0].imageRmse, 0.0);
+    EXPECT_EQ(allRep.rows[0].efficiency, allRep.rows[0].efficiency); // not NaN
+}
+
+TEST(Report, CancelStopsTheSweep) {
+    ReportOptions o;
+    o.backends = {"cpu"};
+    o.fixed["algorithm"] = "minmax";
+    o.repeat = 1;
+    CancelToken cancel;
+    std::size_t calls = 0;
+    EXPECT_THROW(runReport(tinyScene(), o,
+                           [&](std::size_t, std::size_t, const std::string&) {
+                               ++calls;
+                               cancel.cancelled = true;
+                           },
+                           &cancel),
+                 Cancelled);
+    EXPECT_EQ(calls, 1u);
+}
+
+TEST(Report, MarkParetoOnHandMadeRows) {
+    auto row = [](const char* backend, double ms, double eff, double rmse, std::uint64_t fn = 0) {
+        ReportRow r;
+        r.config.backend = backend;
+        r.totalMs = ms, r.efficiency = eff, r.imageRmse = rmse, r.falseNegatives = fn;
+        return r;
+    };
+    std::vector<ReportRow> rows{row("cpu", 1, 0.2, 0.5), row("cpu", 2, 0.5, 0.1), row("cpu", 3, 0.4, 0.05),
+                                row("cpu", 0.5, 0.9, 0.0, 3), row("vulkan", 9, 0.1, 0.9)};
+    markPareto(rows);
+    EXPECT_TRUE(rows[0].paretoEfficiency);
+    EXPECT_TRUE(rows[1].paretoEfficiency);
+    EXPECT_FALSE(rows[2].paretoEfficiency); // slower and less efficient than row 1
+    EXPECT_TRUE(rows[2].paretoError);       // but the lowest error
+    EXPECT_FALSE(rows[3].paretoEfficiency); // false negatives: never on a front
+    EXPECT_FALSE(rows[3].paretoError);
+    EXPECT_TRUE(rows[4].paretoEfficiency);  // fronts are per backend
+}
+
+TEST(Report, WritesCsvMarkdownAndPngAtomically) {
+    ReportOptions o;
+    o.backends = {"cpu"};
+    o.fixed["algorithm"] = "halfz";
+    o.tileSizes = {16, 32};
+    o.repeat = 1;
+    const Report rep = runReport(tinyScene(), o);
+    TempDir tmp;
+    const fs::path out = tmp.path / "rep";
+    writeReport(rep, out.string());
+    std::ifstream csv(out / "report.csv");
+    std::string header, line;
+    std::getline(csv, header);
+    const std::vector<std::string> cols = splitCsvLine(header);
+    EXPECT_EQ(cols.front(), "backend");
+    EXPECT_NE(std::find(cols.begin(), cols.end(), "image_rmse"), cols.end());
+    EXPECT_NE(std::find(cols.begin(), cols.end(), "skip_empty"), cols.end());
+    std::size_t rows = 0;
+    while (std::getline(csv, line)) {
+        ++rows;
+        EXPECT_EQ(splitCsvLine(line).size(), cols.size()) << line;
+    }
+    EXPECT_EQ(rows, rep.rows.size());
+    EXPECT_EQ(rows, 6u);
+    std::ifstream md(out / "report.md");
+    std::stringstream mds;
+    mds << md.rdbuf();
+    EXPECT_NE(mds.str().find("fastest configuration"), std::string::npos);
+    EXPECT_NE(mds.str().find("Pareto front"), std::string::npos);
+    png_image img{};
+    img.version = PNG_IMAGE_VERSION;
+    ASSERT_TRUE(png_image_begin_read_from_file(&img, (out / "pareto.png").c_str())) << img.message;
+    EXPECT_EQ(img.width, 1120u);
+    png_image_free(&img);
+
+    // Rewriting replaces the folder; a folder holding anything else is refused
+    // and left untouched.
+    writeReport(rep, out.string());
+    std::ofstream(out / "notes.txt") << "mine";
+    EXPECT_THROW(writeReport(rep, out.string()), Error);
+    EXPECT_TRUE(fs::exists(out / "notes.txt"));
+    EXPECT_THROW(writeReport(rep, (tmp.path / "missing" / "rep").string()), Error);
+    for (const auto& e : fs::directory_iterator(tmp.path))
+        EXPECT_EQ(e.path().filename().string().rfind(".rep", 0), std::string::npos) << "staging left behind";
+}

@@ -1,0 +1,180 @@
+// The shading pass's CPU reference (culling/shade.hpp) on real scenes: every
+// pixel against a brute-force double-precision sum over the lights of the list
+// CullResult::listOfPixel names; the pipeline's image error against the
+// ground truth's own CPU path; zero error when every list holds every light.
+#include "culling/errors.hpp"
+#include "culling/pipeline.hpp"
+#include "culling/scene_io.hpp"
+#include "culling/shade.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace lc;
+
+namespace {
+
+Scene smallScene(const std::string& builtin, std::uint32_t w, std::uint32_t h, std::uint32_t tile,
+                 std::uint32_t lights) {
+    Scene s = makeBuiltinScene(builtin);
+    s.camera.width = w;
+    s.camera.height = h;
+    s.camera.tileSize = tile;
+    s.lights = generateLights(defaultLightGen(s, lights, 7));
+    return s;
+}
+
+RunOutput cpuRun(const Scene& scene, Algorithm algo, std::uint32_t cells = 8) {
+    CullSettings settings;
+    settings.algorithm = algo;
+    settings.cells = cells;
+    auto cpu = makeCpuBackend();
+    RunOptions opt;
+    opt.truthOptions.imageError = false;
+    return runPipeline(scene, settings, *cpu, opt);
+}
+
+} // namespace
+
+// Every geometry pixel: the sum over exactly the lights of its list (the rule
+// of listOfPixel at the pixel's view depth), evaluated in double from the
+// pixel's reconstructed position; background pixels stay 0.
+TEST(Shade, CpuShadingIsTheBruteForceSumOverEachPixelsList) {
+    const Scene scene = smallScene("mountain", 96, 64, 16, 48);
+    const Projection proj(scene.camera);
+    for (Algorithm algo : {Algorithm::HalfZ, Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Naive}) {
+        const RunOutput run = cpuRun(scene, algo);
+        const ShadeInputs in = makeShadeInputs(run.depth, proj, &run.result);
+        const std::vector<float> rgb = shadeCpu(in, run.lights, &run.result);
+        std::size_t geometry = 0, lit = 0;
+        for (std::uint32_t y = 0; y < run.depth.height; ++y)
+            for (std::uint32_t x = 0; x < run.depth.width; ++x) {
+                const std::size_t i = std::size_t(y) * run.depth.width + x;
+                if (!run.depth.hasGeometry(x, y)) {
+                    EXPECT_EQ(in.list[i], ShadeInputs::kNoList);
+                    for (int c = 0; c < 3; ++c) ASSERT_EQ(rgb[3 * i + c], 0.0f) << "background " << x << "," << y;
+                    continue;
+                }
+                ++geometry;
+                const double d = run.depth.at(x, y);
+                const glm::dvec3 p = proj.viewPositionFromDepth(x, y, d);
+                const glm::dvec3 n(in.normal[3 * i], in.normal[3 * i + 1], in.normal[3 * i + 2]);
+                EXPECT_NEAR(glm::length(n), 1.0, 1e-5);
+                const std::uint32_t list = run.result.listOfPixel(x, y, proj.viewDepthFromWindowDepth(d));
+                ASSERT_EQ(in.list[i], list);
+                glm::dvec3 sum(0.0), magnitude(0.0);
+                for (std::uint32_t k = 0; k < run.result.listCount[list]; ++k) {
+                    const std::uint32_t li = run.result.lightIndices[run.result.listOffset[list] + k];
+                    const glm::dvec3 to = run.lights.centers[li] - p;
+                    const double d2 = glm::dot(to, to);
+                    const double ndl = glm::dot(n, to) / std::sqrt(std::max(d2, 1e-30));
+                    const glm::dvec3 term = run.lights.power[li] * (std::max(ndl, 0.0) / std::max(d2, 1e-4));
+                    sum += term;
+                    magnitude += glm::abs(term);
+                }
+                lit += sum.x > 0;
+                for (int c = 0; c < 3; ++c)
+                    ASSERT_NEAR(rgb[3 * i + c], sum[c], 1e-3 * magnitude[c] + 1e-12)
+                        << toString(algo) << " pixel " << x << "," << y << " channel " << c;
+            }
+        EXPECT_GT(geometry, 1000u);
+        EXPECT_GT(lit, 0u) << toString(algo) << ": no lit pixel, the comparison would prove nothing";
+    }
+}
+
+// runPipeline takes the image error from the backend's shading pass; on the
+// CPU backend it must equal the ground truth's own CPU path bitwise.
+TEST(Shade, PipelineImageErrorEqualsTheGroundTruthsCpuPath) {
+    const Scene scene = smallScene("forest", 128, 72, 16, 64);
+    auto cpu = makeCpuBackend();
+    for (Algorithm algo : {Algorithm::MinMax, Algorithm::Clustered}) {
+        CullSettings settings;
+        settings.algorithm = algo;
+        RunOptions opt;
+        opt.keepShadedImages = true;
+        const RunOutput run = runPipeline(scene, settings, *cpu, opt);
+        ASSERT_TRUE(run.truth.metrics.imageErrorComputed);
+        EXPECT_GE(run.result.timings.shadeMs, 0.0);
+        const Projection proj(scene.camera);
+        const Metrics m = computeGroundTruth(run.depth, proj, run.lights, run.result).metrics;
+        EXPECT_EQ(run.truth.metrics.imageRmse, m.imageRmse) << toString(algo);
+        EXPECT_EQ(run.truth.metrics.imageMaxError, m.imageMaxError) << toString(algo);
+        EXPECT_GT(m.imageRmse, 0.0) << "lights cut off by their spheres leave some error";
+        ASSERT_EQ(run.shadedCulled.size(), std::size_t(128) * 72 * 3);
+        EXPECT_EQ(run.shadedAll, shadeLambertCpu(run.depth, proj, run.lights, nullptr));
+        EXPECT_EQ(run.shadedCulled, shadeLambertCpu(run.depth, proj, run.lights, &run.result));
+    }
+}
+
+// Lists that hold every light (through the per-list path, not `all`) shade
+// bitwise like the all-lights image: the error is exactly 0. Emptying the
+// lists makes the error the all-lights image itself.
+TEST(Shade, ErrorIsZeroWhenEveryListHoldsEveryLightAndFullWhenListsAreEmpty) {
+    const Scene scene = smallScene("atrium", 80, 48, 16, 24);
+    RunOutput run = cpuRun(scene, Algorithm::TwoPointFiveD);
+    const Projection proj(scene.camera);
+    CullResult every = run.result;
+    const std::uint32_t n = std::uint32_t(run.lights.size());
+    every.lightIndices.clear();
+    for (std::size_t l = 0; l < every.listCount.size(); ++l) {
+        every.listOffset[l] = std::uint32_t(every.lightIndices.size());
+        every.listCount[l] = n;
+        for (std::uint32_t i = 0; i < n; ++i) every.lightIndices.push_back(i);
+    }
+    const std::vector<float> all = shadeLambertCpu(run.depth, proj, run.lights, nullptr);
+    const ImageError zero = compareShadedImages(run.depth, shadeLambertCpu(run.depth, proj, run.lights, &every), all);
+    EXPECT_EQ(zero.rmse, 0.0);
+    EXPECT_EQ(zero.maxAbs, 0.0);
+    EXPECT_EQ(zero.pixels, run.depth.geometryPixelCount());
+
+    CullResult none = run.result;
+    std::fill(none.listCount.begin(), none.listCount.end(), 0u);
+    std::fill(none.listOffset.begin(), none.listOffset.end(), 0u);
+    none.lightIndices.clear();
+    const ImageError full = compareShadedImages(run.depth, shadeLambertCpu(run.depth, proj, run.lights, &none), all);
+    double sum2 = 0, mx = 0;
+    for (float v : all) sum2 += double(v) * v, mx = std::max(mx, double(v));
+    EXPECT_GT(mx, 0.0);
+    EXPECT_NEAR(full.rmse, std::sqrt(sum2 / (3.0 * double(full.pixels))), 1e-9 * mx);
+    EXPECT_EQ(full.maxAbs, mx);
+}
+
+TEST(Shade, BadListsAndSizesAreTypedErrors) {
+    const Scene scene = smallScene("wall", 32, 32, 16, 8);
+    RunOutput run = cpuRun(scene, Algorithm::MinMax);
+    const Projection proj(scene.camera);
+    ShadeInputs in = makeShadeInputs(run.depth, proj, &run.result);
+    CullResult bad = run.result;
+    ASSERT_FALSE(bad.lightIndices.empty());
+    bad.lightIndices[0] = 999;
+    EXPECT_THROW(shadeCpu(in, run.lights, &bad), Error);
+    bad = run.result;
+    bad.listCount[0] = std::uint32_t(bad.lightIndices.size()) + 1;
+    EXPECT_THROW(shadeCpu(in, run.lights, &bad), Error);
+    ShadeInputs wrongList = in;
+    wrongList.list[0] = std::uint32_t(run.result.listCount.size());
+    EXPECT_THROW(shadeCpu(wrongList, run.lights, &run.result), Error);
+    ShadeInputs truncated = in;
+    truncated.normal.pop_back();
+    EXPECT_THROW(shadeCpu(truncated, run.lights, &run.result), Error);
+    CullResult otherGrid = run.result;
+    otherGrid.grid = TileGrid::make(16, 16, 16);
+    EXPECT_THROW(makeShadeInputs(run.depth, proj, &otherGrid), Error);
+    EXPECT_THROW(compareShadedImages(run.depth, std::vector<float>(3), std::vector<float>(3)), Error);
+}
+
+TEST(Shade, PicturesMapExposureAndDifference) {
+    // Two pixels: 0.5 and 1.0 (reference) against 0.5 and 0.25 (culled).
+    const std::vector<float> ref{0.5f, 0.5f, 0.5f, 1.0f, 1.0f, 1.0f};
+    const std::vector<float> cul{0.5f, 0.5f, 0.5f, 0.25f, 0.25f, 0.25f};
+    const std::vector<std::uint8_t> a = shadedPicture(ref, 1.0);
+    EXPECT_EQ(a[3], 255); // 1.0 -> white
+    EXPECT_EQ(a[0], 188); // sRGB(0.5) = 0.7354 -> 188
+    const std::vector<std::uint8_t> d = differencePicture(cul, ref, 0.75);
+    EXPECT_EQ(d[0], 0);   // no difference: black
+    EXPECT_EQ(d[3], 255); // the largest difference: white
+    DepthImage depth;
+    depth.width = 2, depth.height = 1, depth.clearDepth = 1.0f, depth.depth = {0.5f, 0.5f};
+    EXPECT_NEAR(exposureFor(depth, ref), 0.9, 1e-12); // 99th percentile of {0.5, 1} is 1
+}
