@@ -1,6 +1,7 @@
 // lightcull-studio: the Qt + VTK scene editor.
 //
-//   lightcull-studio [--scene FILE | --builtin NAME] [--run] [--screenshot FILE.png] [--quit]
+//   lightcull-studio [--scene FILE | --builtin NAME] [--lights N [--seed S]] [--run]
+//                    [--screenshot FILE.png] [--quit] [--measure-live-drag SECONDS]
 //
 // With no arguments it opens the built-in default scene and runs culling once.
 // --screenshot grabs the whole main window once the run's result has arrived
@@ -9,6 +10,7 @@
 
 #include "cull_worker.hpp"
 #include "document.hpp"
+#include "live_drag_probe.hpp"
 #include "main_window.hpp"
 
 #include "culling/scene_io.hpp"
@@ -64,16 +66,48 @@ int main(int argc, char** argv) {
     QCommandLineOption runOpt("run", "Run culling once the scene is open.");
     QCommandLineOption shotOpt("screenshot", "Save a PNG of the window after the run and render.", "FILE.png");
     QCommandLineOption quitOpt("quit", "Quit after the run / screenshot.");
-    parser.addOptions({sceneOpt, builtinOpt, runOpt, shotOpt, quitOpt});
+    QCommandLineOption lightsOpt("lights", "Replace the scene's lights with N generated ones (as the CLI's --lights).",
+                                 "N");
+    QCommandLineOption seedOpt("seed", "Seed of --lights (default 1).", "S", "1");
+    QCommandLineOption dragOpt("measure-live-drag",
+                               "Benchmark: drag one light with Live on for SECONDS, print the rate of results "
+                               "shown and their latency, then quit.",
+                               "SECONDS");
+    parser.addOptions({sceneOpt, builtinOpt, lightsOpt, seedOpt, runOpt, shotOpt, quitOpt, dragOpt});
     parser.process(app);
     if (parser.isSet(sceneOpt) && parser.isSet(builtinOpt)) {
         std::fprintf(stderr, "lightcull-studio: --scene and --builtin are exclusive\n");
         return 2;
     }
 
+    long long lightCount = -1;
+    unsigned long long seed = 1;
+    double dragSeconds = 0;
+    {
+        bool ok1 = true, ok2 = true, ok3 = true;
+        if (parser.isSet(lightsOpt)) lightCount = parser.value(lightsOpt).toLongLong(&ok1);
+        seed = parser.value(seedOpt).toULongLong(&ok2);
+        if (parser.isSet(dragOpt)) dragSeconds = parser.value(dragOpt).toDouble(&ok3);
+        if (!ok1 || lightCount == 0 || lightCount > 1000000 || lightCount < -1) {
+            std::fprintf(stderr, "lightcull-studio: --lights: expected a count in [1, 1000000], got '%s'\n",
+                         qPrintable(parser.value(lightsOpt)));
+            return 2;
+        }
+        if (!ok2) {
+            std::fprintf(stderr, "lightcull-studio: --seed: expected a whole number, got '%s'\n",
+                         qPrintable(parser.value(seedOpt)));
+            return 2;
+        }
+        if (!ok3 || (parser.isSet(dragOpt) && !(dragSeconds > 0 && dragSeconds <= 600))) {
+            std::fprintf(stderr, "lightcull-studio: --measure-live-drag: expected seconds in (0, 600], got '%s'\n",
+                         qPrintable(parser.value(dragOpt)));
+            return 2;
+        }
+    }
+
     lcui::MainWindow window;
     // A script has nobody to answer dialogs: errors go to stderr instead.
-    const bool scripted = parser.isSet(quitOpt);
+    const bool scripted = parser.isSet(quitOpt) || dragSeconds > 0;
     if (scripted)
         window.prompts.showError = [](QWidget*, const QString& title, const QString& text) {
             std::fprintf(stderr, "lightcull-studio: %s: %s\n", qPrintable(title), qPrintable(text));
@@ -86,9 +120,44 @@ int main(int argc, char** argv) {
     else ok = window.openBuiltin(parser.isSet(builtinOpt) ? parser.value(builtinOpt)
                                                           : QString(lc::kDefaultBuiltin));
     if (!ok && scripted) return 1;
+    if (ok && lightCount > 0) {
+        // Same generator and defaults as the CLI, so both see the same lights.
+        lc::Scene scene = window.document()->scene();
+        try {
+            scene.lights = lc::generateLights(lc::defaultLightGen(scene, std::uint32_t(lightCount), seed));
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "lightcull-studio: --lights: %s\n", e.what());
+            return 2;
+        }
+        window.document()->resetScene(std::move(scene), window.document()->filePath());
+        window.runCulling();
+    }
     const quint64 generation = window.cullService()->lastGeneration();
     const bool wantRun = generation > 0 || parser.isSet(runOpt);
     if (wantRun && generation == 0) window.runCulling();
+
+    if (dragSeconds > 0) {
+        auto* probe = new LiveDragProbe(&window, dragSeconds);
+        QObject::connect(probe, &LiveDragProbe::done, &app, [&window, &app](const LiveDragReport& r) {
+            std::fprintf(stdout,
+                         "live drag: %d edits, %d results shown in %.2f s: %.1f Hz; latency edit->shown "
+                         "median %.1f ms, max %.1f ms; per run median depth %.1f ms, cull %.1f ms, "
+                         "ground truth %.1f ms\n",
+                         r.edits, r.shown, r.seconds, r.rateHz(), r.medianLatencyMs, r.maxLatencyMs,
+                         r.medianDepthMs, r.medianCullMs, r.medianTruthMs);
+            window.document()->undoStack()->setClean();
+            app.exit(r.shown > 0 ? 0 : 1);
+        });
+        const quint64 target = window.cullService()->lastGeneration();
+        QObject::connect(&window, &lcui::MainWindow::runFinished, probe, [probe, target](quint64 g) {
+            static bool started = false;
+            if (g >= target && !started) {
+                started = true;
+                QTimer::singleShot(500, probe, &LiveDragProbe::start); // let both views settle
+            }
+        });
+        return app.exec();
+    }
 
     const QString shot = parser.value(shotOpt);
     auto finish = [&window, &app, shot, scripted](bool runOk) {
