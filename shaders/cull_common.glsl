@@ -14,8 +14,9 @@
 // workgroup = one subgroup (local size = the device's subgroup size) and reduce
 // with subgroup operations only: no shared memory and no barrier() (each costs
 // tens of ms on lavapipe); a device that splits such a workgroup is reported
-// through status bit 1. light_bins and cull_lists use one invocation per mask
-// word / per list and no subgroup operations, so any local size works.
+// through status bit 1. light_bins uses one invocation per mask word; with
+// LANES > 1, tile_bounds and cull_lists give each tile / list one subgroup
+// (gl_SubgroupID within a workgroup of several subgroups).
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint TILE_SIZE = 16u;
 layout(constant_id = 2) const uint CELLS = 32u;
@@ -23,6 +24,9 @@ layout(constant_id = 3) const uint SLICING = 0u;      // LC_SLICING_*
 layout(constant_id = 4) const uint ALGORITHM = 0u;    // LC_ALG_*
 layout(constant_id = 5) const uint SPHERE_TEST = 0u;  // LC_TEST_*
 layout(constant_id = 6) const uint WRITE_PASS = 0u;   // cull_lists: 0 count, 1 write
+// Lanes sharing one tile (tile_bounds) or one list (cull_lists): 1 (an
+// invocation each: CPU devices), or the subgroup size (a subgroup each: GPUs).
+layout(constant_id = 7) const uint LANES = 1u;
 
 layout(std430, binding = 0) readonly buffer Params { GpuCullParams params; };
 // A private copy of the parameters, filled by loadParams() at the top of every
@@ -37,7 +41,9 @@ layout(std430, binding = 3) readonly buffer LightBuf { GpuLight lights[]; };
 layout(std430, binding = 4) buffer CountBuf { uint listCount[]; };
 layout(std430, binding = 5) buffer OffsetBuf { uint listOffset[]; };    // listCount + 1 (total)
 layout(std430, binding = 6) buffer IndexBuf { uint lightIndices[]; };
-layout(std430, binding = 7) buffer StatusBuf { uint status; };
+// status: STATUS_* bits; candidateTests: light-versus-volume tests the count
+// pass performed (the write pass repeats them), for the benchmarks.
+layout(std430, binding = 7) buffer StatusBuf { uint status; uint candidateTests; };
 // Light bins (light_bins.comp): one bit per light. Column tx's word w is
 // binMask[w * tilesX + tx], row ty's word w is binMask[P.bins.y + w * tilesY + ty].
 // A set bit means the light's sphere is not outside either side plane of that
@@ -46,6 +52,11 @@ layout(std430, binding = 8) buffer BinBuf { uint binMask[]; };
 
 const uint STATUS_SPLIT_WORKGROUP = 1u; // more than one subgroup per workgroup
 const uint STATUS_COUNT_MISMATCH = 2u;  // write pass found a different count
+const uint STATUS_TESTS_OVERFLOW = 4u;  // candidateTests wrapped around 2^32
+// A loop ended before its condition did: lavapipe (gallivm) stops every loop
+// of a shader invocation after 65,535 iterations in all, silently. The host
+// sizes the work per invocation below that and turns this bit into an error.
+const uint STATUS_LOOP_LIMIT = 8u;
 
 bool isOrtho() { return (P.counts.w & LC_FLAG_ORTHO) != 0u; }
 
@@ -96,6 +107,7 @@ vec3 viewAt(float u, float v, float z) {
 struct Chunk {
     vec4 planes[6];
     vec3 corners[8];
+    vec3 boxLo, boxHi; // the corners' bounding box (SPHERE_TEST planes+aabb)
 };
 
 // NDC of a tile column's left/right edges (x) or a tile row's top/bottom
@@ -153,6 +165,12 @@ Chunk makeChunk(uint tileIndex, float zlo, float zhi) {
     c.corners[5] = viewAt(ur, vt, zhi);
     c.corners[6] = viewAt(ur, vb, zhi);
     c.corners[7] = viewAt(ul, vb, zhi);
+    // Once per chunk, not per light (a per-light loop over the corner array
+    // cost lavapipe ~25x the whole planes test).
+    c.boxLo = min(min(min(c.corners[0], c.corners[1]), min(c.corners[2], c.corners[3])),
+                  min(min(c.corners[4], c.corners[5]), min(c.corners[6], c.corners[7])));
+    c.boxHi = max(max(max(c.corners[0], c.corners[1]), max(c.corners[2], c.corners[3])),
+                  max(max(c.corners[4], c.corners[5]), max(c.corners[6], c.corners[7])));
     return c;
 }
 
@@ -194,12 +212,7 @@ bool sphereHitsChunk(Chunk c, vec3 s, float r) {
     }
     if (SPHERE_TEST == LC_TEST_PLANES || inside) return true;
     if (SPHERE_TEST == LC_TEST_PLANES_AABB) {
-        vec3 lo = c.corners[0], hi = c.corners[0];
-        for (int i = 1; i < 8; ++i) {
-            lo = min(lo, c.corners[i]);
-            hi = max(hi, c.corners[i]);
-        }
-        vec3 d = max(max(lo - s, s - hi), vec3(0.0));
+        vec3 d = max(max(c.boxLo - s, s - c.boxHi), vec3(0.0));
         return dot(d, d) <= r * r;
     }
     // Exact: faces in plane order left, right, top, bottom, near, far.

@@ -1,13 +1,18 @@
 #version 450
-// Passes 2 and 4 of the culling: one INVOCATION per list. It walks the mask
-// words of its tile's column and row bins (light_bins.comp) and tests only
-// the lights set in both against the list's volume, lowest bit first, so each
-// list comes out ascending and deterministic, without a sort, without
-// subgroup operations and without barriers. WRITE_PASS == 0 stores the count;
-// WRITE_PASS == 1 writes the indices at the scanned offset and checks that
-// the count matches. `all` has one list of every light: its count pass is one
-// invocation, its write pass one invocation per light.
+// Passes 2 and 4 of the culling: LANES invocations per list (1 on CPU
+// devices, a subgroup on GPUs). They walk the mask words of the tile's column
+// and row bins (light_bins.comp), lane i taking words i, i + LANES, ..., and
+// test only the lights set in both against the list's volume. Each lane keeps
+// the lights that pass as a 32-bit mask of its word; a subgroup exclusive add
+// of the masks' bit counts places them, so the words go out in order and each
+// list comes out ascending and deterministic, without a sort and without
+// barriers. WRITE_PASS == 0 stores the count; WRITE_PASS == 1 writes the
+// indices at the scanned offset and checks that the count matches. `all` has
+// one list of every light: its count pass is one invocation, its write pass
+// one invocation per light.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
 #include "cull_common.glsl"
 
 float sliceBoundary(float lo, float hi, uint i) {
@@ -29,7 +34,13 @@ void main() {
         }
         return;
     }
-    uint list = id;
+    uint list = id, lane = 0u;
+    if (LANES != 1u) {
+        if (gl_SubgroupSize != LANES) atomicOr(status, STATUS_SPLIT_WORKGROUP);
+        list = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_NumSubgroups + gl_SubgroupID;
+        lane = gl_SubgroupInvocationID;
+    }
+    // Uniform per list (so per subgroup): the early exits keep subgroups whole.
     if (list >= P.counts.z) return;
     if (WRITE_PASS != 0u && listCount[list] == 0u) return;
 
@@ -59,35 +70,55 @@ void main() {
         zlo = sliceBoundary(P.cluster.x, P.cluster.y, sub);
         zhi = sliceBoundary(P.cluster.x, P.cluster.y, sub + 1u);
     }
-    uint n = 0u;
+    uint n = 0u, tested = 0u;
     if (listLive) {
         Chunk ch = makeChunk(tile, max(widenDown(zlo), isOrtho() ? -3.4e38 : 0.0), widenUp(zhi));
         uint base = (WRITE_PASS != 0u) ? listOffset[list] : 0u;
         uint tilesX = P.size.z, tilesY = P.size.w, words = P.bins.x;
         uint tx = tile % tilesX, ty = tile / tilesX;
         uint rowBase = P.bins.y + ty;
-        for (uint w = 0u; w < words; ++w) {
-            uint m = binMask[w * tilesX + tx] & binMask[rowBase + w * tilesY];
+        uint w0 = 0u;
+        bool cut = false;
+        for (; w0 < words; w0 += LANES) {
+            uint w = w0 + lane;
+            uint m = w < words ? binMask[w * tilesX + tx] & binMask[rowBase + w * tilesY] : 0u;
+            uint passMask = 0u;
+            tested += uint(bitCount(m));
             while (m != 0u) {
                 uint bit = uint(findLSB(m));
                 m &= m - 1u;
-                uint i = w * 32u + bit;
-                vec4 L = lights[i].centerRadius;
+                vec4 L = lights[w * 32u + bit].centerRadius;
                 float r = widenedRadius(L);
                 bool pass = sphereHitsChunk(ch, L.xyz, r);
                 if (pass && ALGORITHM == LC_ALG_25D) {
                     float depth = -L.z;
                     pass = (sliceRangeMask(maskLo, maskHi, widenDown(depth - r), widenUp(depth + r)) & geomMask) != 0u;
                 }
-                if (pass) {
-                    if (WRITE_PASS != 0u) lightIndices[base + n] = i;
-                    ++n;
-                }
+                if (pass) passMask |= 1u << bit;
             }
+            cut = cut || m != 0u;
+            uint cnt = uint(bitCount(passMask));
+            uint at = n + ((LANES != 1u) ? subgroupExclusiveAdd(cnt) : 0u);
+            if (WRITE_PASS != 0u) {
+                while (passMask != 0u) {
+                    uint bit = uint(findLSB(passMask));
+                    passMask &= passMask - 1u;
+                    lightIndices[base + at] = w * 32u + bit;
+                    ++at;
+                }
+                cut = cut || passMask != 0u;
+            }
+            n += (LANES != 1u) ? subgroupAdd(cnt) : cnt;
         }
+        if (cut || w0 < words) atomicOr(status, STATUS_LOOP_LIMIT);
     }
     if (WRITE_PASS == 0u) {
-        listCount[list] = n;
+        if (LANES != 1u) tested = subgroupAdd(tested);
+        if (lane == 0u) {
+            listCount[list] = n;
+            if (tested != 0u && atomicAdd(candidateTests, tested) + tested < tested)
+                atomicOr(status, STATUS_TESTS_OVERFLOW);
+        }
     } else if (n != listCount[list]) {
         atomicOr(status, STATUS_COUNT_MISMATCH);
     }

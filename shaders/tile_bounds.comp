@@ -3,24 +3,23 @@
 // geometry (clear-valued pixels skipped), the halfz split, and the occupancy
 // mask of the 2.5d cells / clustered slices.
 //
-// LANES_PER_TILE lanes share a tile. On a GPU: a whole subgroup (workgroup =
-// one subgroup), several pixels per lane, reductions by subgroup operations;
-// the lanes cover min(lanes, TILE_SIZE) columns x the rest rows at a time, so
-// no pixel address needs an integer division, and the column loop has a
-// constant trip count (unrolled; x < tw masks partial edge tiles). On a CPU device (lavapipe):
-// one invocation per tile walks all its pixels, so SIMD lanes are tiles and a
-// workgroup holds many tiles (per-workgroup cost dominated otherwise).
+// LANES lanes share a tile. On a GPU: a subgroup per tile (several tiles per
+// workgroup, by gl_SubgroupID), several pixels per lane, reductions by
+// subgroup operations; the lanes cover min(lanes, TILE_SIZE) columns x the
+// rest rows at a time, so no pixel address needs an integer division. On a
+// CPU device (lavapipe): one invocation per tile walks all its pixels, so the
+// SIMD lanes are tiles and a workgroup holds many tiles (measured: 8 lanes
+// per tile cost more, a workgroup per tile far more). Either way the column
+// loop has a constant trip count (unrolled; x < tw masks partial edge tiles).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #include "cull_common.glsl"
 
-layout(constant_id = 7) const uint LANES_PER_TILE = 1u;
-
 void main() {
     loadParams();
     uint tx, ty, lane, stride;
-    if (LANES_PER_TILE == 1u) {
+    if (LANES == 1u) {
         tx = gl_GlobalInvocationID.x;
         ty = gl_WorkGroupID.y;
         lane = 0u;
@@ -28,11 +27,11 @@ void main() {
         if (tx >= P.size.z) return;
     } else {
         // A subgroup per tile, gl_NumSubgroups tiles per workgroup along x.
-        if (gl_SubgroupSize != LANES_PER_TILE) atomicOr(status, STATUS_SPLIT_WORKGROUP);
+        if (gl_SubgroupSize != LANES) atomicOr(status, STATUS_SPLIT_WORKGROUP);
         tx = gl_WorkGroupID.x * gl_NumSubgroups + gl_SubgroupID;
         ty = gl_WorkGroupID.y;
         lane = gl_SubgroupInvocationID;
-        stride = LANES_PER_TILE; // = the subgroup size
+        stride = LANES; // = the subgroup size
         if (tx >= P.size.z) return;
     }
     uint W = P.size.x;
@@ -55,7 +54,7 @@ void main() {
             }
         }
     }
-    if (LANES_PER_TILE != 1u) {
+    if (LANES != 1u) {
         wLo = subgroupMin(wLo);
         wHi = subgroupMax(wHi);
     }
@@ -117,9 +116,9 @@ void main() {
                     }
                 }
             }
-            if (LANES_PER_TILE != 1u) mask = subgroupOr(mask);
+            if (LANES != 1u) mask = subgroupOr(mask);
             tb.cellMask = mask;
         }
     }
-    if (LANES_PER_TILE == 1u || subgroupElect()) tiles[ty * P.size.z + tx] = tb;
+    if (LANES == 1u || subgroupElect()) tiles[ty * P.size.z + tx] = tb;
 }

@@ -285,22 +285,30 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
         const lc::Projection proj(scene.camera);
         const lc::TileGrid grid = lc::TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
         const lc::ViewLights lights = lc::makeViewLights(scene);
-        std::vector<double> depthMs, cullMs;
+        std::vector<double> depthMs, cullMs, cullWallMs;
+        std::size_t peakDeviceBytes = 0;
         lc::CullResult last;
         for (int i = 0; i < opt.warmup + opt.repeat; ++i) {
             const lc::DepthImage depth = backend->renderDepth(scene, proj);
             const double d = backend->lastDepthMs();
+            // Peak device memory of the culling pass alone (its buffers, the
+            // staging copies included; the depth image is the input).
+            backend->resetPeakDeviceBytes();
             last = backend->cull(depth, proj, grid, lights, settings);
+            peakDeviceBytes = std::max(peakDeviceBytes, backend->peakDeviceBytes());
             if (i >= opt.warmup) {
                 depthMs.push_back(d);
                 cullMs.push_back(last.timings.cullMs);
+                cullWallMs.push_back(backend->lastCullWallMs());
             }
         }
-        const Stats ds = stats(depthMs), cs = stats(cullMs);
+        const Stats ds = stats(depthMs), cs = stats(cullMs), ws = stats(cullWallMs);
         std::cout << label << ": depth " << fmt("%.3f", ds.median) << " [" << fmt("%.3f", ds.min) << ".."
                   << fmt("%.3f", ds.max) << "], cull " << fmt("%.3f", cs.median) << " [" << fmt("%.3f", cs.min)
-                  << ".." << fmt("%.3f", cs.max) << "], " << last.entries() << " entries, "
-                  << last.listCountTotal() << " lists, " << last.bytes() << " bytes\n";
+                  << ".." << fmt("%.3f", cs.max) << "] (wall " << fmt("%.3f", ws.median) << "), "
+                  << last.entries() << " entries, " << last.listCountTotal() << " lists, " << last.bytes()
+                  << " bytes (+" << last.diagnosticBytes() << " diagnostic), " << last.volumeTests
+                  << " volume tests, peak device " << peakDeviceBytes << " bytes\n";
         configs.push_back({{"params", params},
                            {"algorithm", lc::toString(settings.algorithm)},
                            {"test", lc::toString(settings.test)},
@@ -312,9 +320,14 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
                            {"lights", lights.size()},
                            {"depth_ms", statsJson(ds)},
                            {"cull_ms", statsJson(cs)},
+                           {"cull_wall_ms", statsJson(ws)},
                            {"list_entries", last.entries()},
                            {"lists", last.listCountTotal()},
-                           {"result_bytes", last.bytes()}});
+                           {"result_bytes", last.bytes()},
+                           {"diagnostic_bytes", last.diagnosticBytes()},
+                           {"volume_tests", last.volumeTests},
+                           {"depth_bytes", std::uint64_t(scene.camera.width) * scene.camera.height * 4},
+                           {"peak_device_bytes", peakDeviceBytes}});
 
         std::size_t k = 0;
         while (k < sweeps.size() && ++index[k] == sweeps[k].values.size()) index[k++] = 0;

@@ -3,14 +3,17 @@
 
 namespace lc {
 
-// 4 bytes per index, offset + count per list (8), per-tile min/max as float (8),
-// 4 per cell mask, and for halfz the split as float (4 per tile).
+// See cull_result.hpp: the lists as a renderer stores them. halfz's far list
+// starts where its near list ends (both backends lay lists out in list
+// order), so its offset is implied and the 4 bytes go to the split.
 std::uint64_t CullResult::bytes() const {
-    const std::uint64_t tiles = grid.tileCount();
-    std::uint64_t b = 4 * entries() + 8 * std::uint64_t(listCount.size()) + 8 * tiles +
-                      4 * std::uint64_t(cellMask.size());
-    if (algorithm == Algorithm::HalfZ) b += 4 * tiles;
+    std::uint64_t b = 4 * entries() + 8 * std::uint64_t(listCount.size());
+    if (algorithm == Algorithm::Clustered) b += 8; // clusterNear, clusterFar as float
     return b;
+}
+
+std::uint64_t CullResult::diagnosticBytes() const {
+    return 8 * std::uint64_t(tileDepthMin.size()) + 4 * std::uint64_t(cellMask.size());
 }
 
 // The lookup every shading pass (and the ground truth) uses: the pixel's tile,

@@ -57,10 +57,10 @@ struct CaseReport {
 // issue asks; returns the extras for the caller's summary.
 CaseReport checkCase(const std::string& label, const DepthImage& depth, const Projection& proj,
                      const TileGrid& grid, const ViewLights& lights, const CullSettings& settings,
-                     CullBackend& cpuBackend) {
+                     CullBackend& cpuBackend, CullBackend& gpuBackend = gputest::vulkan()) {
     SCOPED_TRACE(label);
     const CullResult cpu = cpuBackend.cull(depth, proj, grid, lights, settings);
-    const CullResult gpu = gputest::vulkan().cull(depth, proj, grid, lights, settings);
+    const CullResult gpu = gpuBackend.cull(depth, proj, grid, lights, settings);
     EXPECT_EQ(gpu.validate(lights.size()), "");
     EXPECT_EQ(gpu.backend, "vulkan");
     EXPECT_FALSE(gpu.timingMethod.empty());
@@ -362,6 +362,116 @@ TEST_F(GpuTest, ResultsAreDeterministic) {
     EXPECT_EQ(a.listCount, b.listCount);
     EXPECT_EQ(a.lightIndices, b.lightIndices);
     EXPECT_EQ(a.cellMask, b.cellMask);
+}
+
+// The GPU work layout (a subgroup per tile and per list, wide scan,
+// device-local buffers behind staging copies, timestamps), forced onto
+// lavapipe by LIGHTCULL_VK_EMULATE_GPU=1 so that CI runs the code a real GPU
+// runs: the same lists as the CPU layout, bit for bit (same float tests, exact
+// min/max/or reductions), hence the same superset of the CPU reference.
+TEST_F(GpuTest, GpuWorkLayoutEmulatedOnLavapipe) {
+    setenv("LIGHTCULL_VK_EMULATE_GPU", "1", 1);
+    std::unique_ptr<CullBackend> emulated = makeVulkanBackend("");
+    unsetenv("LIGHTCULL_VK_EMULATE_GPU");
+    EXPECT_NE(emulated->timingMethod(), gputest::vulkan().timingMethod());
+    EXPECT_NE(emulated->timingMethod().find("gpu-timestamps"), std::string::npos);
+    auto cpuBackend = makeCpuBackend();
+    // 333x187: partial edge tiles both ways; 500 lights: 16 mask words, so
+    // lanes hold several words (8 lanes on lavapipe).
+    for (const char* name : {"forest", "atrium"}) {
+        Scene scene = sized(name, 333, 187);
+        scene.lights = generateLights(defaultLightGen(scene, 500, 5));
+        const Projection proj(scene.camera);
+        const TileGrid grid = TileGrid::make(333, 187, 16);
+        const ViewLights lights = makeViewLights(scene);
+        const DepthImage depth = emulated->renderDepth(scene, proj);
+        EXPECT_GE(emulated->lastDepthMs(), 0.0);
+        const DepthImage cpuLayoutDepth = gputest::vulkan().renderDepth(scene, proj);
+        EXPECT_EQ(depth.depth, cpuLayoutDepth.depth) << "staged vertex upload changed the depth";
+        for (Algorithm a : kAlgorithms) {
+            for (SphereTest t : {SphereTest::Planes, SphereTest::Exact}) {
+                if (t == SphereTest::Exact && a != Algorithm::TwoPointFiveD && a != Algorithm::Clustered) continue;
+                CullSettings st;
+                st.algorithm = a;
+                st.test = t;
+                st.cells = 16;
+                const std::string label = std::string("emulated gpu ") + name + " " + toString(a) + " " + toString(t);
+                checkCase(label, depth, proj, grid, lights, st, *cpuBackend, *emulated);
+                const CullResult g = emulated->cull(depth, proj, grid, lights, st);
+                const CullResult c = gputest::vulkan().cull(depth, proj, grid, lights, st);
+                EXPECT_EQ(g.listCount, c.listCount) << label;
+                EXPECT_EQ(g.listOffset, c.listOffset) << label;
+                EXPECT_EQ(g.lightIndices, c.lightIndices) << label;
+                EXPECT_EQ(g.cellMask, c.cellMask) << label;
+                EXPECT_EQ(g.tileDepthMin, c.tileDepthMin) << label;
+                EXPECT_EQ(g.tileDepthMax, c.tileDepthMax) << label;
+                EXPECT_EQ(g.volumeTests, c.volumeTests) << label;
+                EXPECT_GE(g.timings.cullMs, 0.0) << label;
+            }
+        }
+    }
+}
+
+// Result bytes follow the entries: bytes() <= 4 x entries + 8 x lists + 4 KiB
+// on real scenes for every algorithm and both backends, and the halfz packing
+// bytes() assumes (a tile's far list starts where its near list ends) holds.
+TEST_F(GpuTest, ResultBytesFollowTheEntries) {
+    auto cpuBackend = makeCpuBackend();
+    for (const char* name : {"forest", "atrium"}) {
+        Scene scene = sized(name, 640, 360);
+        scene.lights = generateLights(defaultLightGen(scene, 2048, 3));
+        const Projection proj(scene.camera);
+        const TileGrid grid = TileGrid::make(640, 360, 16);
+        const ViewLights lights = makeViewLights(scene);
+        const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+        for (Algorithm a : kAlgorithms) {
+            CullSettings st;
+            st.algorithm = a;
+            for (CullBackend* b : {static_cast<CullBackend*>(cpuBackend.get()), &gputest::vulkan()}) {
+                const CullResult r = b->cull(depth, proj, grid, lights, st);
+                const std::string label = std::string(name) + " " + toString(a) + " " + r.backend;
+                const std::uint64_t lists = r.listCountTotal();
+                EXPECT_LE(r.bytes(), 4 * r.entries() + 8 * lists + 4096) << label;
+                EXPECT_GE(r.bytes(), 4 * r.entries() + 8 * lists) << label;
+                EXPECT_EQ(r.diagnosticBytes(), 8 * std::uint64_t(grid.tileCount()) + 4 * r.cellMask.size()) << label;
+                if (a == Algorithm::HalfZ)
+                    for (std::uint32_t t = 0; t < grid.tileCount(); ++t)
+                        ASSERT_EQ(r.listOffset[2 * t + 1], r.listOffset[2 * t] + r.listCount[2 * t]) << label;
+            }
+        }
+    }
+}
+
+// Device memory accounting: the peak of a cull covers the buffers it must
+// hold (depth, light bins, counts, offsets, indices), and every byte is given
+// back afterwards (live memory before == after). Nothing per tile x light:
+// at 65,536 lights the peak stays far below tiles x lights x 4 bytes.
+TEST_F(GpuTest, DeviceMemoryPeakAndNoLeak) {
+    CullBackend& vk = gputest::vulkan();
+    for (std::uint32_t n : {64u, 65536u}) {
+        Scene scene = sized("forest", 480, 270);
+        scene.lights = generateLights(defaultLightGen(scene, n, 9));
+        const Projection proj(scene.camera);
+        const TileGrid grid = TileGrid::make(480, 270, 16);
+        const ViewLights lights = makeViewLights(scene);
+        const DepthImage depth = vk.renderDepth(scene, proj);
+        CullSettings st;
+        st.algorithm = Algorithm::TwoPointFiveD;
+        vk.resetPeakDeviceBytes();
+        const std::size_t liveBefore = vk.peakDeviceBytes(); // after a reset: what is alive now
+        const CullResult r = vk.cull(depth, proj, grid, lights, st);
+        const std::size_t peak = vk.peakDeviceBytes();
+        vk.resetPeakDeviceBytes();
+        EXPECT_EQ(vk.peakDeviceBytes(), liveBefore) << "device memory leaked by cull()";
+        const std::uint64_t words = (n + 31) / 32;
+        const std::uint64_t needed = 480ull * 270 * 4 + 4 * words * (grid.tilesX + grid.tilesY) +
+                                     8ull * r.listCountTotal() + 4 * r.entries();
+        EXPECT_GE(peak - liveBefore, needed) << n << " lights";
+        EXPECT_LT(peak - liveBefore, 4 * needed + (1u << 20)) << n << " lights";
+        if (n == 65536u) EXPECT_LT(peak - liveBefore, std::uint64_t(grid.tileCount()) * n * 4 / 8);
+        EXPECT_GT(r.volumeTests, 0u);
+        EXPECT_GE(r.volumeTests, r.entries());
+    }
 }
 
 } // namespace

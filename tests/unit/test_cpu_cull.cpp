@@ -377,7 +377,8 @@ TEST(CullResult, BytesListOfPixelAndValidate) {
     CullRun r = runCpu(syntheticScene(ProjectionKind::Perspective, 64, 48, 8, 40, 6), st);
     const CullResult& res = r.result;
     const std::uint64_t tiles = 8 * 6;
-    EXPECT_EQ(res.bytes(), 4 * res.entries() + 8 * (2 * tiles) + 8 * tiles + 4 * tiles);
+    EXPECT_EQ(res.bytes(), 4 * res.entries() + 8 * (2 * tiles));
+    EXPECT_EQ(res.diagnosticBytes(), 8 * tiles);
     // halfz: the split decides between the two lists.
     const std::uint32_t t = res.grid.tileOfPixel(20, 20);
     ASSERT_TRUE(std::isfinite(res.halfzSplit[t]));
@@ -387,7 +388,8 @@ TEST(CullResult, BytesListOfPixelAndValidate) {
     st.algorithm = Algorithm::Clustered;
     st.cells = 8;
     const CullRun c = runCpu(syntheticScene(ProjectionKind::Perspective, 64, 48, 8, 40, 6), st);
-    EXPECT_EQ(c.result.bytes(), 4 * c.result.entries() + 8 * (8 * tiles) + 8 * tiles + 4 * tiles);
+    EXPECT_EQ(c.result.bytes(), 4 * c.result.entries() + 8 * (8 * tiles) + 8);
+    EXPECT_EQ(c.result.diagnosticBytes(), 8 * tiles + 4 * tiles);
     EXPECT_EQ(c.result.listOfPixel(63, 47, 0.5), (tiles - 1) * 8);
     EXPECT_EQ(c.result.listOfPixel(63, 47, 60.0), (tiles - 1) * 8 + 7);
 

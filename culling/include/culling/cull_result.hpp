@@ -41,6 +41,10 @@ struct CullResult {
 
     std::vector<std::uint32_t> listOffset, listCount, lightIndices;
 
+    // Light-versus-volume tests one pass over the lists performed (Vulkan: the
+    // candidates left by the light bins); 0 when the backend does not count.
+    std::uint64_t volumeTests = 0;
+
     std::string backend;      // "cpu" or "vulkan"
     std::string device;       // physical device name, or the CPU's
     std::string timingMethod; // how cullMs/depthMs were taken
@@ -48,9 +52,17 @@ struct CullResult {
 
     std::uint32_t listCountTotal() const { return std::uint32_t(listCount.size()); }
     std::uint64_t entries() const { return lightIndices.size(); }
-    // Bytes of the result a renderer would upload: indices, offsets, counts,
-    // per-tile depth bounds (as float) and masks.
+    // Bytes of the light lists in the form a renderer uploads and reads while
+    // shading: 4 per index and 8 per list (offset + count). halfz packs a
+    // tile's two adjacent lists as offset, near count, far count and split (16
+    // bytes per tile = 8 per list); clustered adds its depth range (8 bytes).
+    // So bytes() <= 4 * entries + 8 * lists + 8. The per-tile depth bounds and
+    // masks the culling computes on the way are in diagnosticBytes().
     std::uint64_t bytes() const;
+    // Bytes of the per-tile intermediates kept for diagnostics and overlays,
+    // at the GPU's float precision: depth min/max (8 per tile) and cell/slice
+    // masks (4 per tile where the algorithm has them).
+    std::uint64_t diagnosticBytes() const;
     // The list a shading pass loops over at pixel (px, py) whose geometry lies
     // at view depth viewDepth. Follows exactly the rule the passes use.
     std::uint32_t listOfPixel(std::uint32_t px, std::uint32_t py, double viewDepth) const;

@@ -220,6 +220,7 @@ std::vector<std::string> physicalDeviceNames() {
 }
 
 Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
+    if (const char* e = std::getenv("LIGHTCULL_VK_EMULATE_GPU")) emulateGpu_ = std::string(e) == "1";
     bool validation = false;
     instance_ = createInstance(debugUtils_, validation);
     try {
@@ -407,12 +408,14 @@ Buffer Context::allocateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, cons
     vkGetBufferMemoryRequirements(device_, buf, &req);
     const VkMemoryPropertyFlags hostFlags = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
     VkMemoryPropertyFlags want = hostFlags;
+    bool map = true;
     if (deviceLocal) {
         // A CPU device's memory is the host's: keep it mapped. A GPU's
-        // device-local memory is mapped only where the host sees it anyway.
+        // device-local memory is never mapped (see createDeviceBuffer).
         const VkMemoryPropertyFlags both = hostFlags | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-        want = isCpuDevice() && hasMemoryType(req.memoryTypeBits, both) ? both
-                                                                      : VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+        map = isCpuDevice();
+        if (!map) want = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+        else if (hasMemoryType(req.memoryTypeBits, both)) want = both;
     }
     VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     ai.allocationSize = req.size;
@@ -424,7 +427,7 @@ Buffer Context::allocateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, cons
     name(VK_OBJECT_TYPE_DEVICE_MEMORY, mem, n + ".memory");
     LC_VK(vkBindBufferMemory(device_, buf, mem, 0));
     const VkMemoryPropertyFlags got = memProps_.memoryTypes[ai.memoryTypeIndex].propertyFlags;
-    if ((got & hostFlags) == hostFlags) LC_VK(vkMapMemory(device_, mem, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+    if (map && (got & hostFlags) == hostFlags) LC_VK(vkMapMemory(device_, mem, 0, VK_WHOLE_SIZE, 0, &b.mapped));
     return b;
 }
 

@@ -166,7 +166,11 @@ public:
     // A CPU implementation (lavapipe): device memory is host memory, so
     // buffers stay host-visible and mapped, and compute timestamps are not
     // trusted (DESIGN.md). Elsewhere: device-local buffers, GPU timestamps.
-    bool isCpuDevice() const { return props_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+    // LIGHTCULL_VK_EMULATE_GPU=1 makes a CPU device take the GPU paths
+    // (device-local buffers behind staging copies, subgroup work layout, GPU
+    // timestamps) so that tests exercise them on lavapipe.
+    bool isCpuDevice() const { return props_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU && !emulateGpu_; }
+    bool emulatesGpu() const { return emulateGpu_; }
     // The queue writes timestamps in compute and graphics (and the device
     // reports a tick period): GPU timing is possible.
     bool timestampsSupported() const { return timestamps_; }
@@ -182,10 +186,11 @@ public:
 
     // Host-visible, coherent, persistently mapped buffer (size 0 -> 4 bytes).
     Buffer createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name) const;
-    // Buffer for work on the device: device-local memory; mapped when that
-    // memory is also host-visible and coherent (lavapipe, resizable BAR),
-    // else `mapped` is null and data moves through staging copies (usage
-    // gets TRANSFER_SRC | TRANSFER_DST for that).
+    // Buffer for work on the device: device-local memory. On a CPU device
+    // (lavapipe: device memory is host memory) it is mapped and used in
+    // place; on a GPU `mapped` is null and data moves through staging copies
+    // (usage gets TRANSFER_SRC | TRANSFER_DST for that): host reads of mapped
+    // video memory (resizable BAR) are uncached and slow.
     Buffer createDeviceBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name) const;
     Image createDepthImage(std::uint32_t w, std::uint32_t h, VkFormat format, const std::string& name) const;
     ShaderModuleHandle createShader(const std::uint32_t* words, std::size_t wordCount,
@@ -213,6 +218,7 @@ private:
     std::uint32_t subgroupSize_ = 1;
     bool fullSubgroups_ = false;
     bool timestamps_ = false;
+    bool emulateGpu_ = false;
     std::uint32_t timestampValidBits_ = 0;
     std::shared_ptr<MemoryStats> memory_ = std::make_shared<MemoryStats>();
     bool debugUtils_ = false;

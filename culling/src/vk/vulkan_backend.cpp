@@ -52,6 +52,9 @@ enum Binding : std::uint32_t { bParams, bDepth, bTiles, bLights, bCounts, bOffse
 // a multiple of every subgroup size in practice (8 on lavapipe, 32 on NVIDIA,
 // 64 on AMD), so no partial subgroups.
 constexpr std::uint32_t kLocal = 64;
+// lavapipe (gallivm) ends every loop of a shader invocation after this many
+// iterations in all, without an error; work per invocation is sized below it.
+constexpr std::uint64_t kLoopLimit = 65535;
 
 // Workgroup counts (x, y) for `invocations` invocations of kLocal each,
 // folded into y when x would exceed the device's limit.
@@ -543,6 +546,13 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     if (grid.width != proj.width() || grid.height != proj.height())
         throw Error("tile grid does not match the camera's resolution");
     if (lights.centers.size() != lights.size()) throw Error("view lights: centres and radii differ in count");
+    // Spot lights: the sphere tests need only the chosen sphere (below); the
+    // cone refinements are not in the cull shader yet (docs/SPOT_LIGHTS.md).
+    if (!lights.spotAngles.empty() &&
+        (settings.spotTest == SpotTest::ConeSphere || settings.spotTest == SpotTest::ConePlanes))
+        throw SettingsError("spot-test", std::string(toString(settings.spotTest)) +
+                                             " is not implemented on the vulkan backend yet (use the cpu "
+                                             "backend, or apex-sphere / tight-sphere)");
 
     const Algorithm algo = settings.algorithm;
     const std::uint32_t tiles = grid.tileCount(), cells = settings.cells;
@@ -568,7 +578,11 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
 
     // The depth ranges of naive and clustered, exactly as the CPU reference.
     double lightFar = 0.0;
-    for (std::size_t l = 0; l < n; ++l) lightFar = std::max(lightFar, -lights.centers[l].z + lights.radii[l]);
+    std::vector<BoundingSphere> cullSpheres(n); // range spheres, or each spot test's sphere
+    for (std::size_t l = 0; l < n; ++l) {
+        cullSpheres[l] = lights.cullSphere(l, settings.spotTest);
+        lightFar = std::max(lightFar, -cullSpheres[l].center.z + cullSpheres[l].radius);
+    }
     const double camNear = proj.nearPlane();
     const bool farInfinite = !std::isfinite(proj.farPlane());
     const double naiveFar = farInfinite ? std::max(lightFar, camNear) : proj.farPlane();
@@ -598,8 +612,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     }
     std::vector<GpuLight> gpuLights(n);
     for (std::uint32_t l = 0; l < n; ++l)
-        gpuLights[l].centerRadius = glm::vec4(glm::vec3(lights.centers[l]), float(lights.radii[l]));
-    const std::uint32_t statusZero = 0;
+        gpuLights[l].centerRadius = glm::vec4(glm::vec3(cullSpheres[l].center), float(cullSpheres[l].radius));
+    const std::uint32_t statusZero[2] = {0, 0};
 
     // Device buffers (sizes from the inputs; the index array comes after the count).
     const VkBufferUsageFlags ssbo = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
@@ -610,18 +624,18 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     Buffer binBuf = ctx_.createDeviceBuffer(binTotal64 * 4, ssbo, "cull.bins");
     Buffer countBuf = ctx_.createDeviceBuffer(std::size_t(listTotal) * 4, ssbo, "cull.counts");
     Buffer offsetBuf = ctx_.createDeviceBuffer((std::size_t(listTotal) + 1) * 4, ssbo, "cull.offsets");
-    Buffer statusBuf = ctx_.createDeviceBuffer(4, ssbo, "cull.status");
+    Buffer statusBuf = ctx_.createDeviceBuffer(8, ssbo, "cull.status"); // status bits, candidate tests
     Buffer placeholder = ctx_.createDeviceBuffer(4, ssbo, "cull.indices.placeholder");
 
     Staging staging(ctx_);
     staging.upload(params, &p, sizeof p);
     staging.upload(depthBuf, depth.depth.data(), depth.depth.size() * 4);
     staging.upload(lightBuf, gpuLights.data(), gpuLights.size() * sizeof(GpuLight));
-    staging.upload(statusBuf, &statusZero, 4);
+    staging.upload(statusBuf, statusZero, 8);
     const auto* counts = static_cast<const std::uint32_t*>(staging.download(countBuf, std::size_t(listTotal) * 4));
     const auto* offs = static_cast<const std::uint32_t*>(staging.download(offsetBuf, (std::size_t(listTotal) + 1) * 4));
     const auto* tb = static_cast<const GpuTileBounds*>(staging.download(tileBuf, std::size_t(tiles) * sizeof(GpuTileBounds)));
-    const auto* status = static_cast<const std::uint32_t*>(staging.download(statusBuf, 4));
+    const auto* status = static_cast<const std::uint32_t*>(staging.download(statusBuf, 8));
 
     // Descriptor sets: one for passes 1-3, one with the sized index array for pass 4.
     VkDevice dev = ctx_.device();
@@ -668,22 +682,43 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         return std::array<std::uint32_t, 8>{local, grid.tileSize, cells, slicingId, algoId, testId, write,
                                             lanesPerTile};
     };
-    // Subgroup passes: workgroup = one subgroup. Per-invocation passes: kLocal.
-    // Tile bounds: a subgroup per tile on a GPU, an invocation per tile on a
-    // CPU device (see tile_bounds.comp).
-    const bool tilePerLane = ctx_.isCpuDevice();
-    VkPipeline boundsPipe = tilePerLane ? computePipeline("tile_bounds", boundsShader_, spec(kLocal, 0, 1), false)
-                                        : computePipeline("tile_bounds", boundsShader_, spec(kLocal, 0, sg), true);
-    const std::uint32_t tilesPerGroup = tilePerLane ? kLocal : kLocal / sg;
-    const Grid boundsGroups = Grid{(grid.tilesX + tilesPerGroup - 1) / tilesPerGroup, grid.tilesY};
+    // Work layout per device kind (the LANES constant): on a CPU device
+    // (lavapipe) an invocation per tile and per list, so SIMD lanes are tiles /
+    // lists and workgroups hold many of them, and a one-subgroup scan without
+    // barriers; on a GPU a subgroup per tile and per list (coalesced pixel
+    // reads, words of the bins spread over the lanes) and a wide scan.
+    //
+    // lavapipe stops all loops of one invocation after 65,535 iterations in
+    // all (silently; the shaders flag it). A list costs at most 65 loop
+    // iterations per mask word (the word, up to 32 tests, up to 32 writes), so
+    // a CPU device takes an invocation per list only while words * 65 fits,
+    // else spreads the words over a subgroup; beyond that it refuses.
+    const std::uint64_t itersPerList = std::uint64_t(binWords) * 65 + 64;
+    std::uint32_t lanes = sg;
+    if (kLocal % sg != 0) lanes = 1;
+    else if (ctx_.isCpuDevice()) lanes = itersPerList <= kLoopLimit ? 1 : sg;
+    if (ctx_.isCpuDevice() && itersPerList / lanes > kLoopLimit)
+        throw SettingsError("lights", std::to_string(n) + " lights is more than the culling passes can take on '" +
+                                          ctx_.deviceName() + "' (at most " +
+                                          std::to_string((kLoopLimit - 64) / 65 * lanes * 32) +
+                                          ": the driver caps a shader invocation at 65,535 loop iterations)");
+    const bool subgroupLanes = lanes > 1;
+    const std::uint32_t itemsPerGroup = kLocal / lanes;
+    VkPipeline boundsPipe = computePipeline("tile_bounds", boundsShader_, spec(kLocal, 0, lanes), subgroupLanes);
+    const Grid boundsGroups = Grid{(grid.tilesX + itemsPerGroup - 1) / itemsPerGroup, grid.tilesY};
     VkPipeline binsPipe = computePipeline("light_bins", binsShader_, spec(kLocal, 0), false);
-    VkPipeline countPipe = computePipeline("cull_lists.count", cullShader_, spec(kLocal, 0), false);
-    VkPipeline scanPipe = computePipeline("prefix_sum", scanShader_, spec(sg, 0), true);
-    VkPipeline writePipe = computePipeline("cull_lists.write", cullShader_, spec(kLocal, 1), false);
+    VkPipeline countPipe = computePipeline("cull_lists.count", cullShader_, spec(kLocal, 0, lanes), subgroupLanes);
+    VkPipeline writePipe = computePipeline("cull_lists.write", cullShader_, spec(kLocal, 1, lanes), subgroupLanes);
+    // Scan: one subgroup on a CPU device while each lane's run (read and
+    // write: 2 loop iterations per list) fits the loop cap, else wide.
+    const bool wideScan = !ctx_.isCpuDevice() || 2 * (std::uint64_t(listTotal) / sg + 1) > kLoopLimit / 2;
+    const std::uint32_t scanLocal =
+        wideScan ? std::min({1024u, lim.maxComputeWorkGroupInvocations, lim.maxComputeWorkGroupSize[0], 128 * sg}) : sg;
+    VkPipeline scanPipe = computePipeline("prefix_sum", scanShader_, spec(scanLocal, 0, wideScan ? sg : 1), true);
     const bool all = algo == Algorithm::All;
     const Grid binGroups = groupsFor(binTotal64, lim);
-    const Grid countGroups = groupsFor(all ? 1 : listTotal, lim);
-    const Grid writeGroups = groupsFor(all ? n : listTotal, lim);
+    const Grid countGroups = groupsFor(all ? 1 : std::uint64_t(listTotal) * lanes, lim);
+    const Grid writeGroups = groupsFor(all ? n : std::uint64_t(listTotal) * lanes, lim);
 
     const bool gpuClock = useGpuTimestamps();
     TimestampPool stamps = gpuClock ? TimestampPool(ctx_, 2, "cull.timestamps") : TimestampPool();
@@ -721,6 +756,10 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     if (*status & 1u)
         throw DeviceError("Vulkan device '" + ctx_.deviceName() +
                           "' split a subgroup-sized workgroup into several subgroups; the culling passes need one");
+    const std::string loopLimitError = "Vulkan device '" + ctx_.deviceName() +
+                                       "' ended a culling shader loop early (a driver loop cap); result discarded";
+    if (*status & 8u) throw DeviceError(loopLimitError);
+    res.volumeTests = (status[0] & 4u) ? 0 : status[1]; // wrapped: not counted
     std::uint64_t total64 = 0;
     for (std::uint32_t l = 0; l < listTotal; ++l) total64 += counts[l];
     const std::uint32_t total = offs[listTotal];
@@ -751,6 +790,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
             },
             "cull.commands.write");
         if (gpuClock) gpuMs += stamps.milliseconds(1);
+        if (*status2 & 8u) throw DeviceError(loopLimitError);
         if (*status2 & 2u)
             throw DeviceError("Vulkan write pass found a different entry count than the count pass");
         res.lightIndices.assign(idx, idx + total);
