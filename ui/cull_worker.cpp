@@ -6,6 +6,18 @@
 
 namespace lcui {
 
+namespace {
+// Same meshes and camera: the depth image of one scene is the depth of the other.
+bool sameGeometry(const lc::Scene& a, const lc::Scene& b) {
+    if (!(a.camera == b.camera) || a.meshes.size() != b.meshes.size()) return false;
+    for (std::size_t i = 0; i < a.meshes.size(); ++i) {
+        const lc::Mesh &x = a.meshes[i], &y = b.meshes[i];
+        if (x.transform != y.transform || x.positions != y.positions || x.indices != y.indices) return false;
+    }
+    return true;
+}
+} // namespace
+
 void CullWorker::post(CullRequest request) {
     bool schedule = false;
     {
@@ -47,6 +59,8 @@ void CullWorker::drain() {
             if (!backend_ || req.backend != backendName_ || req.device != deviceSelector_) {
                 backend_.reset(); // release the old device before opening a new one
                 backendName_.clear();
+                depthScene_.reset();
+                depth_.reset();
                 backend_ = lc::makeBackend(req.backend, req.device);
                 backendName_ = req.backend;
                 deviceSelector_ = req.device;
@@ -57,8 +71,14 @@ void CullWorker::drain() {
             // The studio shows false negatives and efficiency; the Lambert image
             // error (pixels x lights) is left to the CLI and exports.
             options.truthOptions.imageError = false;
+            if (depth_ && depthScene_ && sameGeometry(*depthScene_, *req.scene))
+                options.reuseDepth = depth_.get();
             auto out = std::make_shared<lc::RunOutput>(
                 lc::runPipeline(*req.scene, req.settings, *backend_, options, cancel.get()));
+            if (!out->depthReused) {
+                depth_ = std::make_shared<const lc::DepthImage>(out->depth);
+                depthScene_ = req.scene;
+            }
             emit finished(req.generation, std::shared_ptr<const lc::RunOutput>(std::move(out)));
         } catch (const lc::Cancelled&) {
             emit failed(req.generation, tr("culling cancelled"));

@@ -58,6 +58,10 @@ private:
     // Touched only on the worker thread:
     std::unique_ptr<lc::CullBackend> backend_;
     std::string backendName_, deviceSelector_;
+    // The last run's scene and depth: a request that changes only lights (a
+    // Live drag) reuses the depth image instead of re-rendering it.
+    std::shared_ptr<const lc::Scene> depthScene_;
+    std::shared_ptr<const lc::DepthImage> depth_;
 };
 
 // The UI-side handle: starts the thread, numbers the requests.

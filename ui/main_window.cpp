@@ -467,9 +467,10 @@ void MainWindow::updateStatus() {
         return;
     }
     const auto& m = run->truth.metrics;
-    statusTimes_->setText(tr("depth %1 ms | cull %2 ms")
-                              .arg(run->result.timings.depthMs, 0, 'f', 2)
-                              .arg(run->result.timings.cullMs, 0, 'f', 2));
+    // A run that only moved lights reuses the previous depth image (cull_worker).
+    const QString depth = run->depthReused ? tr("depth reused")
+                                           : tr("depth %1 ms").arg(run->result.timings.depthMs, 0, 'f', 2);
+    statusTimes_->setText(tr("%1 | cull %2 ms").arg(depth).arg(run->result.timings.cullMs, 0, 'f', 2));
     statusFn_->setText(tr("FN %1").arg(m.falseNegatives));
     statusFn_->setStyleSheet(m.falseNegatives > 0 ? "color: white; background: #c0392b; padding: 0 4px"
                                                   : "color: #2e7d32");

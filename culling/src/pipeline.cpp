@@ -74,13 +74,22 @@ RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBack
     throwIfCancelled(cancel);
 
     const auto t0 = Clock::now();
-    out.depth = backend.renderDepth(scene, proj);
+    if (options.reuseDepth) {
+        out.depth = *options.reuseDepth;
+        out.depthReused = true;
+    } else {
+        out.depth = backend.renderDepth(scene, proj);
+    }
     const double depthWallMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     if (out.depth.width != grid.width || out.depth.height != grid.height ||
-        out.depth.depth.size() != std::size_t(grid.width) * grid.height)
-        throw Error("backend '" + backend.name() + "' returned a " + std::to_string(out.depth.width) +
-                    "x" + std::to_string(out.depth.height) + " depth image for a " +
-                    std::to_string(grid.width) + "x" + std::to_string(grid.height) + " camera");
+        out.depth.depth.size() != std::size_t(grid.width) * grid.height) {
+        const std::string size = std::to_string(out.depth.width) + "x" + std::to_string(out.depth.height);
+        const std::string cam = std::to_string(grid.width) + "x" + std::to_string(grid.height);
+        if (out.depthReused)
+            throw Error("the reused depth image is " + size + " but the camera is " + cam);
+        throw Error("backend '" + backend.name() + "' returned a " + size + " depth image for a " + cam +
+                    " camera");
+    }
     throwIfCancelled(cancel);
 
     const auto t1 = Clock::now();
@@ -89,7 +98,9 @@ RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBack
     if (const std::string bad = out.result.validate(out.lights.size()); !bad.empty())
         throw Error("backend '" + backend.name() + "' produced an inconsistent result: " + bad);
     // A backend that did not time a phase gets the wall time around the call.
-    out.result.timings.depthMs = backend.lastDepthMs() >= 0 ? backend.lastDepthMs() : depthWallMs;
+    out.result.timings.depthMs = out.depthReused           ? 0.0
+                                 : backend.lastDepthMs() >= 0 ? backend.lastDepthMs()
+                                                              : depthWallMs;
     if (out.result.timings.cullMs < 0) out.result.timings.cullMs = cullWallMs;
     if (out.result.backend.empty()) out.result.backend = backend.name();
     if (out.result.device.empty()) out.result.device = backend.deviceName();

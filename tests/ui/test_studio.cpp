@@ -27,6 +27,7 @@
 #include <QProcess>
 #include <QProcessEnvironment>
 #include <QSet>
+#include <QStatusBar>
 #include <QImage>
 #include <QPushButton>
 #include <QRegularExpression>
@@ -521,6 +522,33 @@ private slots:
         doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(0, 0.5, 0), doc()->newDragId());
         QVERIFY(waitRun(g2 + 1));
         QCOMPARE(doc()->runOutput()->lights.centers.size(), doc()->scene().lights.size());
+        w_->setLive(false);
+    }
+
+    // A light move re-culls over the previous depth image (the pre-pass is
+    // skipped and the status bar says so); a camera edit renders depth again.
+    void liveLightMoveReusesDepthCameraEditDoesNot() {
+        openSmall();
+        const quint64 gen = doc()->runGeneration();
+        QVERIFY(!doc()->runOutput()->depthReused);
+        w_->setLive(true);
+        QVERIFY(waitRun(gen + 1));
+        const std::vector<float> depth = doc()->runOutput()->depth.depth;
+        doc()->moveLight(1, doc()->scene().lights[1].position + glm::dvec3(0.5, 0, 0), doc()->newDragId());
+        QVERIFY(waitRun(gen + 2));
+        QVERIFY(doc()->runOutput()->depthReused);
+        QVERIFY(doc()->runOutput()->depth.depth == depth);
+        bool saysReused = false;
+        for (QLabel* l : w_->statusBar()->findChildren<QLabel*>())
+            saysReused = saysReused || l->text().startsWith("depth reused");
+        QVERIFY(saysReused);
+
+        lc::Camera c = doc()->scene().camera;
+        c.position += glm::dvec3(0.0, 0.5, 0.0);
+        doc()->setCamera(c);
+        QVERIFY(waitRun(gen + 3));
+        QVERIFY(!doc()->runOutput()->depthReused);
+        QVERIFY(doc()->runOutput()->depth.depth != depth);
         w_->setLive(false);
     }
 

@@ -15,6 +15,9 @@ struct RunOutput {
     ViewLights lights;
     // The shaded images (RGB, 3 floats per pixel) when RunOptions::keepShadedImages.
     std::vector<float> shadedCulled, shadedAll;
+    // True when the depth pre-pass was skipped for RunOptions::reuseDepth
+    // (timings.depthMs is then 0).
+    bool depthReused = false;
 };
 
 struct RunOptions {
@@ -24,6 +27,10 @@ struct RunOptions {
     // image error compares them; off, nothing is shaded.
     GroundTruthOptions truthOptions;
     bool keepShadedImages = false; // keep both images in RunOutput (for export)
+    // A depth image of an earlier run with the same meshes and camera (an edit
+    // that moved only lights, as Live drags do): the pre-pass is skipped and
+    // this image used. Its size must match the camera (checked).
+    const DepthImage* reuseDepth = nullptr;
 };
 
 // Validates the scene and settings (typed errors), runs every phase on

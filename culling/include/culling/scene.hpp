@@ -97,6 +97,7 @@ struct Camera {
 
     glm::dmat4 viewFromWorld() const;
     double aspect() const { return double(width) / double(height); }
+    bool operator==(const Camera&) const = default;
     // Empty when valid; otherwise names the bad field ("camera.near: ...").
     std::string validate() const;
 };
