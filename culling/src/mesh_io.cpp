@@ -115,10 +115,15 @@ public:
     void set_status(OM::FaceHandle, const OM::Attributes::StatusInfo&) override {}
     void add_texture_information(int, std::string) override {}
 
+    // The counts come from the file's header, unchecked: a 31-byte OFF file
+    // can announce billions of elements. Every vertex and face takes at least
+    // 4 bytes of the file (binary or ASCII), so reservations stop there.
+    std::uint64_t fileSize = 0;
     void reserve(unsigned nV, unsigned, unsigned nF) override {
-        positions.reserve(std::size_t(nV) * 3);
-        polyStart.reserve(nF);
-        polyIndices.reserve(std::size_t(nF) * 3);
+        const std::uint64_t most = fileSize / 4 + 1;
+        positions.reserve(std::size_t(std::min<std::uint64_t>(nV, most)) * 3);
+        polyStart.reserve(std::size_t(std::min<std::uint64_t>(nF, most)));
+        polyIndices.reserve(std::size_t(std::min<std::uint64_t>(nF, most)) * 3);
         expectedFaces = nF;
     }
     std::size_t n_vertices() const override { return positions.size() / 3; }
@@ -318,10 +323,27 @@ void scanAsciiForNonFinite(const std::string& path, const std::string& ext, std:
     }
 }
 
+// OpenMesh 9.0's PLY reader loops forever on a header that never reaches
+// "end_header" (found by fuzzing): require that line before handing it over.
+void checkPlyHeaderEnds(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    int n = 0;
+    while (std::getline(in, line)) {
+        ++n;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (n == 1 && line != "ply") throw InputError(path, "", 1, "a PLY file starts with the line \"ply\"");
+        if (line == "end_header") return;
+    }
+    throw InputError(path, "", n, "PLY header has no \"end_header\" line");
+}
+
 // PLY, OFF, STL and OM through OpenMesh's readers into the flat importer.
 void readWithOpenMesh(const std::string& path, const std::string& ext, std::uint64_t size,
                       FlatImporter& imp, const CancelToken* cancel, const Progress& progress) {
+    if (ext == "ply") checkPlyHeaderEnds(path);
     scanAsciiForNonFinite(path, ext, size);
+    imp.fileSize = size;
     imp.cancel = cancel;
     imp.progress = &progress;
     bool ok = false;
