@@ -641,7 +641,7 @@ bool MainWindow::generateLights(const lc::LightGenSettings& g) {
     try {
         lights = runWithProgressResult<std::vector<lc::PointLight>>(
             this, tr("Generating %1 lights...").arg(g.count),
-            [g](const lc::CancelToken&, const lc::Progress&) { return lc::generateLights(g); });
+            [g](const lc::CancelToken& c, const lc::Progress& p) { return lc::generateLights(g, &c, p); });
     } catch (const lc::Cancelled&) {
         log(tr("light generation cancelled"));
         return false;

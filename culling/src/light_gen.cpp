@@ -35,7 +35,8 @@ void checkRange(const char* field, double lo, double hi) {
 
 } // namespace
 
-std::vector<PointLight> generateLights(const LightGenSettings& s) {
+std::vector<PointLight> generateLights(const LightGenSettings& s, const CancelToken* cancel,
+                                       const Progress& progress) {
     for (int k = 0; k < 3; ++k) {
         checkRange("lights.box", s.boxMin[k], s.boxMax[k]);
         checkRange("lights.color", s.colorMin[k], s.colorMax[k]);
@@ -57,6 +58,10 @@ std::vector<PointLight> generateLights(const LightGenSettings& s) {
     std::vector<PointLight> out;
     out.reserve(s.count);
     for (std::uint32_t i = 0; i < s.count; ++i) {
+        if (i % 4096 == 0) {
+            if (cancel) cancel->throwIfCancelled();
+            if (progress) progress(double(i) / double(s.count));
+        }
         PointLight l;
         l.name = "light_" + std::to_string(i);
         // Fixed draw order (x, y, z, r, g, b, intensity) keeps lights stable
@@ -80,6 +85,7 @@ std::vector<PointLight> generateLights(const LightGenSettings& s) {
         }
         out.push_back(std::move(l));
     }
+    if (progress) progress(1.0);
     return out;
 }
 

@@ -69,7 +69,10 @@ struct LightGenSettings {
     double spotFraction = 0.0;                          // [0, 1]
     double spotAngleMinDeg = 15, spotAngleMaxDeg = 45;  // within (0, 90]
 };
-std::vector<PointLight> generateLights(const LightGenSettings& s);
+// Deterministic in `s` (seed included). `progress` is told how far it got
+// every few thousand lights; a set `cancel` stops it with lc::Cancelled.
+std::vector<PointLight> generateLights(const LightGenSettings& s, const CancelToken* cancel = nullptr,
+                                       const Progress& progress = {});
 // A placement volume suited to a scene: its mesh bounds, slightly grown.
 LightGenSettings defaultLightGen(const Scene& scene, std::uint32_t count, std::uint64_t seed);
 
