@@ -40,6 +40,10 @@ void main() {
             precise float len = sqrt(max(d2, 1e-30));
             precise float ndl = ((n.x * d.x + n.y * d.y) + n.z * d.z) / len;
             precise float f = max(ndl, 0.0) / max(d2, 1e-4);
+            // Spot cone (shade.cpp): inside when -(axis.d) >= len cos a.
+            vec4 s = lights[li].spot;
+            precise float axial = 0.0 - ((s.x * d.x + s.y * d.y) + s.z * d.z);
+            if (!(axial >= len * s.w)) f = 0.0;
             acc += lights[li].power.xyz * f;
         }
     }

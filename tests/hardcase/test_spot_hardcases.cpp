@@ -7,6 +7,7 @@
 
 #include "culling/errors.hpp"
 #include "culling/ground_truth.hpp"
+#include "culling/shade.hpp"
 #include "culling/pipeline.hpp"
 
 #include <algorithm>
@@ -191,6 +192,33 @@ TEST_F(SpotVulkan, ConeTestsSayTheyAreNotThereYet) {
             EXPECT_NE(std::string(e.what()).find(toString(t)), std::string::npos) << e.what();
         }
     }
+}
+
+TEST_F(SpotVulkan, ShadingMatchesTheCpuReferenceWithTheCone) {
+    // Vulkan's shading pass against the CPU reference on a spot scene: the
+    // same pixels lit, within float rounding of the device's sqrt/division,
+    // and exactly 0 outside the cone (apex in the view, 25-degree cone).
+    const SpotCase c = cases()[3];
+    const Projection proj(c.scene.camera);
+    auto cpu = makeCpuBackend();
+    const DepthImage depth = cpu->renderDepth(c.scene, proj);
+    const ViewLights lights = makeViewLights(c.scene);
+    const ShadeInputs in = makeShadeInputs(depth, proj, nullptr);
+    const std::vector<float> ref = cpu->shade(in, lights, nullptr);
+    const std::vector<float> gpu = gputest::vulkan().shade(in, lights, nullptr);
+    ASSERT_EQ(gpu.size(), ref.size());
+    std::size_t lit = 0, dark = 0;
+    for (std::size_t i = 0; i < ref.size(); ++i) {
+        if (ref[i] == 0.0f) {
+            ++dark;
+            EXPECT_EQ(gpu[i], 0.0f) << "value " << i;
+        } else {
+            ++lit;
+            EXPECT_NEAR(gpu[i], ref[i], 1e-5f * ref[i]) << "value " << i;
+        }
+    }
+    EXPECT_GT(lit, 100u);  // the cone's disc on the wall
+    EXPECT_GT(dark, lit);  // and most of the picture outside it
 }
 
 INSTANTIATE_TEST_SUITE_P(Spot, SpotHardCase, ::testing::Range(0, 4), [](const auto& info) {

@@ -7,6 +7,7 @@
 #include "culling/ground_truth.hpp"
 #include "culling/params.hpp"
 #include "culling/scene_io.hpp"
+#include "culling/shade.hpp"
 #include "culling/spot_tests.hpp"
 #include "light_grid.hpp"
 
@@ -496,6 +497,54 @@ TEST(SpotCull, GroundTruthNeedsTheExactCone) {
     const GroundTruth gt = computeGroundTruth(d, proj, L, all, o);
     EXPECT_EQ(gt.metrics.exactWork, inCone);
     EXPECT_EQ(gt.metrics.shadingWork, 32u * 32u);
+}
+
+TEST(SpotShading, ZeroOutsideTheConeAndAPointLightInside) {
+    // A wall at depth 10 through a perspective camera; one light 4 in front of
+    // it. As a spot (20 degrees, pointing at the wall) it must give exactly
+    // the point light's value inside its cone and 0 outside.
+    Scene s;
+    s.camera.position = {0, 0, 0};
+    s.camera.target = {0, 0, -1};
+    s.camera.width = 96;
+    s.camera.height = 64;
+    s.camera.tileSize = 16;
+    Mesh wall;
+    wall.positions = {-20, -20, -10, 20, -20, -10, 20, 20, -10, -20, 20, -10};
+    wall.indices = {0, 1, 2, 0, 2, 3};
+    s.meshes.push_back(wall);
+    PointLight l;
+    l.position = {0.5, 0.25, -6};
+    l.intensity = 20;
+    s.lights.push_back(l);
+    const Projection proj(s.camera);
+    auto cpu = makeCpuBackend();
+    const DepthImage depth = cpu->renderDepth(s, proj);
+    const std::vector<float> asPoint = shadeLambertCpu(depth, proj, makeViewLights(s), nullptr);
+    s.lights[0].kind = LightKind::Spot;
+    s.lights[0].direction = {0, 0, -1};
+    s.lights[0].outerAngleDeg = 20;
+    const ViewLights spotLights = makeViewLights(s);
+    const std::vector<float> asSpot = shadeLambertCpu(depth, proj, spotLights, nullptr);
+    int inside = 0, outside = 0;
+    for (std::uint32_t y = 0; y < depth.height; ++y)
+        for (std::uint32_t x = 0; x < depth.width; ++x) {
+            if (!depth.hasGeometry(x, y)) continue;
+            const glm::dvec3 p = proj.viewPositionFromDepth(x, y, depth.at(x, y));
+            const glm::dvec3 d = p - spotLights.centers[0];
+            const double angle = std::acos(glm::dot(glm::normalize(d), spotLights.spotAxes[0]));
+            const std::size_t i = 3 * (std::size_t(y) * depth.width + x);
+            if (angle < rad(19.9)) {
+                ++inside;
+                EXPECT_EQ(asSpot[i], asPoint[i]) << x << "," << y;
+                EXPECT_GT(asSpot[i], 0.0f);
+            } else if (angle > rad(20.1)) {
+                ++outside;
+                EXPECT_EQ(asSpot[i], 0.0f) << x << "," << y;
+            }
+        }
+    EXPECT_GT(inside, 20);
+    EXPECT_GT(outside, 1000);
 }
 
 TEST(SpotCull, EveryTestHasNoFalseNegativesAndTheExpectedOrder) {

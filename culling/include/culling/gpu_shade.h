@@ -22,10 +22,12 @@ struct GpuShadeParams {
     uvec4 size; // width, height, light count, list count
 };
 
-// One light (binding 3): view-space centre and colour * intensity.
+// One light (binding 3): view-space centre, colour * intensity and cone.
 struct GpuShadeLight {
     vec4 position; // xyz view space, w unused
     vec4 power;    // rgb linear, w unused
+    vec4 spot;     // xyz: a spot light's unit axis (view space), w: cos(outer angle);
+                   // a point light: (0, 0, 0, -2), which every pixel passes
 };
 
 // One pixel of the G-buffer (binding 1): view position and shading normal
@@ -37,7 +39,8 @@ struct GpuShadePixel {
 
 #ifdef __cplusplus
 static_assert(sizeof(GpuShadeParams) == 16, "GpuShadeParams must match std430");
-static_assert(sizeof(GpuShadeLight) == 32, "GpuShadeLight must match std430");
+static_assert(sizeof(GpuShadeLight) == 48, "GpuShadeLight must match std430");
+static_assert(offsetof(GpuShadeLight, spot) == 32, "GpuShadeLight.spot offset");
 static_assert(offsetof(GpuShadeLight, power) == 16, "GpuShadeLight.power offset");
 static_assert(sizeof(GpuShadePixel) == 32, "GpuShadePixel must match std430");
 static_assert(offsetof(GpuShadePixel, normal) == 16, "GpuShadePixel.normal offset");

@@ -7,6 +7,7 @@
 #include "culling/gpu_shade.h"
 #include "embedded_spirv.hpp"
 
+#include <cmath>
 #include <cstring>
 
 // Vulkan create-info structs are value-initialised as {VK_STRUCTURE_TYPE_...}:
@@ -123,6 +124,8 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     for (std::size_t i = 0; i < lightCount; ++i) {
         L[i].position = glm::vec4(glm::vec3(lights.centers[i]), 0.0f);
         L[i].power = glm::vec4(glm::vec3(lights.power[i]), 0.0f);
+        L[i].spot = lights.isSpot(i) ? glm::vec4(glm::vec3(lights.spotAxes[i]), float(std::cos(lights.spotAngles[i])))
+                                     : glm::vec4(0.0f, 0.0f, 0.0f, -2.0f);
     }
     if (culled) {
         std::memcpy(offsetBuf.mapped, culled->listOffset.data(), listTotal * 4);
