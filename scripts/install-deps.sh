@@ -16,6 +16,9 @@ PACKAGES=(
   qtbase5-dev libvtk9-dev libvtk9-qt-dev
   # tests and benchmarks: GoogleTest, Google Benchmark, a virtual X server
   libgtest-dev libbenchmark-dev xvfb xauth x11-utils imagemagick
+  # hostile-input runs: clang with libFuzzer and the sanitizer runtimes
+  # (scripts/fuzz.sh), llvm-symbolizer for readable sanitizer stacks
+  clang-14 libclang-rt-14-dev llvm-14
 )
 
 missing=()
