@@ -29,4 +29,6 @@ function(lc_add_studio_tests dir label timeout)
 endfunction()
 
 lc_add_studio_tests(ui ui 300)
+# The overlays test reads overlays.vtm back with VTK's own XML reader.
+target_link_libraries(ui_test_overlays PRIVATE VTK::IOXML)
 lc_add_studio_tests(render render 300)

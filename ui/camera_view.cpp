@@ -3,6 +3,8 @@
 #include "document.hpp"
 #include "vtk_adapters.hpp"
 
+#include "culling/overlays.hpp"
+
 #include <vtkActor.h>
 #include <vtkActor2D.h>
 #include <vtkCamera.h>
@@ -73,8 +75,12 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
     selActor_->SetMapper(normalizedMapper(selData_));
     selActor_->GetProperty()->SetColor(1, 1, 0);
     selActor_->GetProperty()->SetLineWidth(3);
+    reverseActor_->SetMapper(normalizedMapper(reverseData_));
+    reverseActor_->GetProperty()->SetColor(1.0, 0.3, 1.0);
+    reverseActor_->GetProperty()->SetLineWidth(2);
     scene_->AddActor2D(heatActor_);
     scene_->AddActor2D(gridActor_);
+    scene_->AddActor2D(reverseActor_);
     scene_->AddActor2D(selActor_);
 
     legend_->SetLookupTable(lut_);
@@ -120,6 +126,11 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
     connect(doc_, &Document::runOutputChanged, this, &CameraView::updateOverlay);
     connect(doc_, &Document::tileSelectionChanged, this, [this] {
         updateSelectedTile();
+        renderNow();
+    });
+    connect(doc_, &Document::overlaysChanged, this, &CameraView::updateOverlay);
+    connect(doc_, &Document::selectionChanged, this, [this] {
+        updateReverseLookup();
         renderNow();
     });
     rebuildMeshes();
@@ -246,15 +257,18 @@ void CameraView::updateOverlay() {
         for (std::uint32_t i = 0; i <= g.tilesX; ++i) pts->InsertNextPoint(nx(cornerX(i)), ny(cornerY(j)), 0);
     auto pid = [&](std::uint32_t i, std::uint32_t j) { return vtkIdType(j * (g.tilesX + 1) + i); };
 
-    const std::vector<int> heat = tileHeatValues(*run);
+    // Heat per tile in the chosen mode. List length and false positives run
+    // blue (low) to red (high); efficiency red (0, all wasted) to blue (1).
+    const lc::HeatMode mode = doc_->overlays().heat;
+    shownHeat_ = lc::tileHeat(*run, mode);
     vtkNew<vtkCellArray> quads;
     vtkNew<vtkDoubleArray> values;
-    values->SetName("list_length");
-    int maxHeat = 0;
+    values->SetName(lc::toString(mode));
+    double maxHeat = 0;
     for (std::uint32_t ty = 0; ty < g.tilesY; ++ty)
         for (std::uint32_t tx = 0; tx < g.tilesX; ++tx) {
-            const int v = heat[g.tileIndex(tx, ty)];
-            if (v < 0) continue; // no geometry: nothing drawn over the background
+            const double v = shownHeat_[g.tileIndex(tx, ty)];
+            if (std::isnan(v)) continue; // no geometry (or no per-tile figure): nothing drawn
             const vtkIdType q[4] = {pid(tx, ty), pid(tx + 1, ty), pid(tx + 1, ty + 1), pid(tx, ty + 1)};
             quads->InsertNextCell(4, q);
             values->InsertNextValue(v);
@@ -263,7 +277,18 @@ void CameraView::updateOverlay() {
     heatData_->SetPoints(pts);
     heatData_->SetPolys(quads);
     heatData_->GetCellData()->SetScalars(values);
-    lut_->SetTableRange(0, std::max(1, maxHeat));
+    if (mode == lc::HeatMode::Efficiency) {
+        lut_->SetHueRange(0.0, 0.667);
+        lut_->SetTableRange(0, 1);
+        legend_->SetTitle("efficiency\nper tile");
+        legend_->SetLabelFormat("%.2f");
+    } else {
+        lut_->SetHueRange(0.667, 0.0);
+        lut_->SetTableRange(0, std::max(1.0, maxHeat));
+        legend_->SetTitle(mode == lc::HeatMode::ListLength ? "lights\nper tile" : "false\npositives");
+        legend_->SetLabelFormat("%.0f");
+    }
+    lut_->Build();
 
     vtkNew<vtkCellArray> lines;
     for (std::uint32_t i = 0; i <= g.tilesX; ++i) {
@@ -287,7 +312,35 @@ void CameraView::updateOverlay() {
                                 " tiles of " + std::to_string(g.tileSize) + " px";
     caption_->SetInput(caption.c_str());
     updateSelectedTile();
+    updateReverseLookup();
     renderNow();
+}
+
+void CameraView::updateReverseLookup() {
+    reverseData_->Initialize();
+    reverseTiles_.clear();
+    const auto run = doc_->runOutput();
+    const int light = doc_->currentLight();
+    if (!run || !doc_->overlays().reverseLookup || light < 0 || std::size_t(light) >= run->lights.size()) return;
+    const lc::TileGrid& g = run->result.grid;
+    for (std::uint32_t t : lc::tilesHoldingLight(run->result, std::uint32_t(light))) reverseTiles_.push_back(int(t));
+    // One closed outline per tile, inset by a tenth of a tile so that
+    // neighbouring outlines stay apart.
+    vtkNew<vtkPoints> pts;
+    vtkNew<vtkCellArray> loops;
+    const double inset = 0.1 * g.tileSize;
+    for (int t : reverseTiles_) {
+        const auto rect = g.tileRect(std::uint32_t(t) % g.tilesX, std::uint32_t(t) / g.tilesX);
+        const double x0 = rect.x0 + inset, x1 = rect.x1 - inset, y0 = rect.y0 + inset, y1 = rect.y1 - inset;
+        const vtkIdType a = pts->InsertNextPoint(x0 / g.width, 1 - y0 / g.height, 0);
+        pts->InsertNextPoint(x1 / g.width, 1 - y0 / g.height, 0);
+        pts->InsertNextPoint(x1 / g.width, 1 - y1 / g.height, 0);
+        pts->InsertNextPoint(x0 / g.width, 1 - y1 / g.height, 0);
+        const vtkIdType ids[5] = {a, a + 1, a + 2, a + 3, a};
+        loops->InsertNextCell(5, ids);
+    }
+    reverseData_->SetPoints(pts);
+    reverseData_->SetLines(loops);
 }
 
 void CameraView::updateSelectedTile() {

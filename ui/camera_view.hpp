@@ -42,6 +42,13 @@ public:
     // longest loop a pixel of the tile can run). Tiles without geometry: -1.
     static std::vector<int> tileHeatValues(const lc::RunOutput& run);
 
+    // Tiles outlined by the reverse look-up: those whose lists hold the
+    // current light (ascending; empty when no light or the toggle is off).
+    const std::vector<int>& highlightedTiles() const { return reverseTiles_; }
+    // The values the heat map shows per tile in the document's heat mode
+    // (lc::tileHeat; NaN = no geometry, not drawn).
+    const std::vector<double>& shownHeat() const { return shownHeat_; }
+
     vtkRenderer* sceneRenderer() const;
     vtkScalarBarActor* legend() const;
     // Re-renders now (tests, screenshots).
@@ -58,6 +65,7 @@ private:
     void updateCamera();
     void updateOverlay();
     void updateSelectedTile();
+    void updateReverseLookup();
     void updateViewport();
     void onLeftPress();
 
@@ -65,8 +73,10 @@ private:
     vtkNew<vtkRenderer> background_; // full window: legend and captions
     vtkNew<vtkRenderer> scene_;      // letterboxed: culling camera image + overlay
     std::vector<vtkSmartPointer<vtkActor>> meshActors_;
-    vtkNew<vtkPolyData> heatData_, gridData_, selData_;
-    vtkNew<vtkActor2D> heatActor_, gridActor_, selActor_;
+    vtkNew<vtkPolyData> heatData_, gridData_, selData_, reverseData_;
+    vtkNew<vtkActor2D> heatActor_, gridActor_, selActor_, reverseActor_;
+    std::vector<int> reverseTiles_;
+    std::vector<double> shownHeat_;
     vtkNew<vtkLookupTable> lut_;
     vtkNew<vtkScalarBarActor> legend_;
     vtkNew<vtkTextActor> caption_;

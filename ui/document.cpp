@@ -19,6 +19,7 @@ void Document::resetScene(lc::Scene scene, const QString& path) {
     selectedLights_.clear();
     cameraSelected_ = false;
     selectedTile_ = -1;
+    selectedCell_ = -1;
     run_.reset();
     emit sceneReset();
     emit selectionChanged();
@@ -65,7 +66,20 @@ void Document::selectCamera() {
 void Document::setSelectedTile(int tile) {
     if (tile == selectedTile_) return;
     selectedTile_ = tile;
+    selectedCell_ = -1;
     emit tileSelectionChanged(tile);
+}
+
+void Document::setSelectedCell(int cell) {
+    if (cell == selectedCell_) return;
+    selectedCell_ = cell;
+    emit tileSelectionChanged(selectedTile_);
+}
+
+void Document::setOverlays(const OverlayOptions& o) {
+    if (o == overlays_) return;
+    overlays_ = o;
+    emit overlaysChanged();
 }
 
 void Document::moveLight(int index, const glm::dvec3& position, int dragId) {
@@ -175,6 +189,7 @@ void Document::applyRemoveLights(const std::vector<int>& indices) {
 void Document::applyCamera(const lc::Camera& c) {
     scene_.camera = c;
     selectedTile_ = -1;
+    selectedCell_ = -1;
     emit cameraChanged();
     emit tileSelectionChanged(-1);
     emit sceneEdited();

@@ -4,6 +4,7 @@
 // Panels and views observe it through signals; every edit of the scene goes
 // through its QUndoStack (the public edit functions below push commands).
 
+#include "culling/overlays.hpp"
 #include "culling/params.hpp"
 #include "culling/pipeline.hpp"
 #include "culling/scene.hpp"
@@ -52,6 +53,25 @@ public:
     int selectedTile() const { return selectedTile_; }
     void setSelectedTile(int tile);
 
+    // Depth cell of the selected tile (tileCells order, -1: the whole tile).
+    // Emits tileSelectionChanged; selecting another tile clears it.
+    int selectedCell() const { return selectedCell_; }
+    void setSelectedCell(int cell);
+
+    // --- inspection overlays (view state: not part of the scene, not undoable)
+    struct OverlayOptions {
+        bool tileFrustum = true;      // the selected tile's frustum, translucent + outline
+        bool allTileFrustums = false; // every tile's frustum, one wireframe by list length
+        bool cells = true;            // 2.5d cells, halfz split, clustered froxels
+        bool lightCellRange = true;   // cells the current light's sphere spans
+        bool listHighlight = true;    // listed lights highlighted, others dimmed, missing red
+        bool reverseLookup = true;    // tiles whose lists hold the current light
+        lc::HeatMode heat = lc::HeatMode::ListLength;
+        bool operator==(const OverlayOptions&) const = default;
+    };
+    const OverlayOptions& overlays() const { return overlays_; }
+    void setOverlays(const OverlayOptions& o);
+
     // --- edits: each pushes one undo command ----------------------------------
     // A light drag: every call with the same `dragId` for the same light merges
     // into one undo step (the handle widget starts a new id per drag).
@@ -95,7 +115,8 @@ signals:
     void cameraChanged();
     void meshesChanged();
     void selectionChanged();
-    void tileSelectionChanged(int tile);
+    void tileSelectionChanged(int tile); // also when the selected cell changes
+    void overlaysChanged();
     void settingsChanged();
     void sceneEdited();             // any scene edit (for Live re-runs)
     void runOutputChanged();
@@ -110,6 +131,8 @@ private:
     std::vector<int> selectedLights_;
     bool cameraSelected_ = false;
     int selectedTile_ = -1;
+    int selectedCell_ = -1;
+    OverlayOptions overlays_;
     int dragCounter_ = 0;
     std::shared_ptr<const lc::RunOutput> run_;
     quint64 runGeneration_ = 0;

@@ -1,6 +1,7 @@
 #include "inspector_view.hpp"
 
 #include "document.hpp"
+#include "overlay_actors.hpp"
 #include "vtk_adapters.hpp"
 
 #include "culling/projection.hpp"
@@ -94,6 +95,15 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     frustumActor_->PickableOff();
     renderer_->AddActor(frustumActor_);
 
+    // Inspection overlays; translucent volumes over translucent spheres stay
+    // readable with depth peeling (order-independent).
+    overlays_ = std::make_unique<InspectorOverlays>(renderer_, sphere_);
+    rw->SetAlphaBitPlanes(1);
+    rw->SetMultiSamples(0);
+    renderer_->SetUseDepthPeeling(1);
+    renderer_->SetMaximumNumberOfPeels(6);
+    renderer_->SetOcclusionRatio(0.05);
+
     vtkNew<vtkInteractorStyleTrackballCamera> style;
     interactor()->SetInteractorStyle(style);
 
@@ -159,16 +169,34 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     });
     connect(doc_, &Document::cameraChanged, this, [this] {
         updateFrustum();
+        updateOverlays();
+        renderNow();
+    });
+    for (auto sig : {&Document::runOutputChanged, &Document::overlaysChanged, &Document::selectionChanged,
+                     &Document::lightsChanged})
+        connect(doc_, sig, this, [this] {
+            updateOverlays();
+            renderNow();
+        });
+    connect(doc_, &Document::tileSelectionChanged, this, [this] {
+        updateOverlays();
         renderNow();
     });
     rebuildMeshes();
     rebuildLights();
     updateFrustum();
     updateSelection();
+    updateOverlays();
     resetCamera();
 }
 
 InspectorView::~InspectorView() = default;
+
+void InspectorView::updateOverlays() {
+    overlays_->update(*doc_);
+    // Dim the other lights while a tile's listed lights are highlighted.
+    lightActor_->GetProperty()->SetOpacity(overlays_->dimLights() ? 0.06 : 0.22);
+}
 
 vtkRenderer* InspectorView::renderer() const { return renderer_.Get(); }
 vtkHandleWidget* InspectorView::handleWidget() const { return handle_.Get(); }

@@ -15,6 +15,7 @@
 #include <vtkNew.h>
 #include <vtkSmartPointer.h>
 
+#include <memory>
 #include <vector>
 
 class vtkActor;
@@ -29,6 +30,7 @@ class vtkSphereSource;
 namespace lcui {
 
 class Document;
+class InspectorOverlays;
 
 class InspectorView : public QVTKOpenGLNativeWidget {
     Q_OBJECT
@@ -55,6 +57,8 @@ public:
     vtkPointHandleRepresentation3D* radiusHandleRepresentation() const;
     // The glyph actor showing every light's sphere.
     vtkActor* lightActor() const;
+    // Tile frustums, cells, reverse look-up and list highlights (overlay_actors.hpp).
+    InspectorOverlays* overlays() const { return overlays_.get(); }
     void renderNow();
 
 private:
@@ -63,6 +67,7 @@ private:
     void updateLight(int index);
     void updateSelection();
     void updateFrustum();
+    void updateOverlays();
     void onHandleStart();
     void onHandleMove();
     void onHandleEnd();
@@ -96,6 +101,7 @@ private:
     bool handleActive_ = false;
     int pressX_ = 0, pressY_ = 0;
     bool cameraFramed_ = false;
+    std::unique_ptr<InspectorOverlays> overlays_;
 };
 
 } // namespace lcui

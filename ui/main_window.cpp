@@ -246,6 +246,7 @@ void MainWindow::buildMenus() {
     file->addAction(action("actionSave"));
     file->addAction(action("actionSaveAs"));
     file->addSeparator();
+    QMenu* overlayFileMenu = file; // File > Export diagnostics... (main_window_overlays.cpp)
     file->addAction(action("actionQuit"));
     rebuildRecentMenu();
 
@@ -265,6 +266,7 @@ void MainWindow::buildMenus() {
     view->addAction(action("actionResetView"));
     view->addSeparator();
     for (auto* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());
+    buildOverlayMenus(overlayFileMenu, view);
 
     QMenu* cull = menuBar()->addMenu(tr("&Culling"));
     cull->addAction(action("actionRun"));

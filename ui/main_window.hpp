@@ -98,6 +98,12 @@ public:
     bool generateLights(const lc::LightGenSettings& settings);
     void setCullingCameraFromInspector();
 
+    // Export diagnostics (File menu): summary.json, tiles.csv, heatmap.png,
+    // overlays.vtm and PNG screenshots of both views, through the CLI's
+    // lc::exportDiagnostics, atomically into `dir`. False (logged, shown) on
+    // failure or when there is no run to export.
+    bool exportDiagnostics(const QString& dir);
+
     // Whole-window image with both views' GL content.
     QImage grabWindow();
     void log(const QString& message, bool error = false);
@@ -117,6 +123,7 @@ private:
     void buildToolbar();
     void buildDocks();
     void buildStatusBar();
+    void buildOverlayMenus(QMenu* file, QMenu* view); // main_window_overlays.cpp
     void syncParamWidgets();
     void onParamEdited(const std::string& name, const QString& value);
     void onRunFinished(quint64 generation, std::shared_ptr<const lc::RunOutput> out);

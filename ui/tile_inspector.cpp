@@ -2,57 +2,126 @@
 
 #include "document.hpp"
 
+#include <QBrush>
+#include <QColor>
 #include <QHeaderView>
+#include <QLabel>
+#include <QTableView>
+#include <QVBoxLayout>
 
 namespace lcui {
 
-TileInspector::TileInspector(Document* doc, QWidget* parent) : QTableWidget(parent), doc_(doc) {
-    setColumnCount(4);
-    setHorizontalHeaderLabels({tr("list"), tr("light"), tr("name"), tr("radius")});
-    horizontalHeader()->setStretchLastSection(true);
-    verticalHeader()->hide();
-    setEditTriggers(QAbstractItemView::NoEditTriggers);
-    setSelectionBehavior(QAbstractItemView::SelectRows);
+TileLightsModel::TileLightsModel(Document* doc, QObject* parent) : QAbstractTableModel(parent), doc_(doc) {}
+
+int TileLightsModel::rowCount(const QModelIndex& parent) const { return parent.isValid() ? 0 : int(rows_.size()); }
+int TileLightsModel::columnCount(const QModelIndex& parent) const { return parent.isValid() ? 0 : ColumnCount; }
+
+QVariant TileLightsModel::headerData(int section, Qt::Orientation o, int role) const {
+    if (o != Qt::Horizontal || role != Qt::DisplayRole) return {};
+    static const char* kNames[ColumnCount] = {"list", "light", "name", "position", "radius", "pixels", "verdict"};
+    return section >= 0 && section < ColumnCount ? tr(kNames[section]) : QVariant();
+}
+
+void TileLightsModel::setRows(std::vector<lc::TileLightRow> rows, std::shared_ptr<const lc::RunOutput> run) {
+    beginResetModel();
+    rows_ = std::move(rows);
+    run_ = std::move(run);
+    endResetModel();
+}
+
+QVariant TileLightsModel::data(const QModelIndex& index, int role) const {
+    if (!index.isValid() || index.row() >= int(rows_.size())) return {};
+    const lc::TileLightRow& r = rows_[std::size_t(index.row())];
+    const auto& lights = doc_->scene().lights;
+    if (role == Qt::BackgroundRole && r.verdict == lc::Verdict::Missing) return QBrush(QColor(200, 40, 40));
+    if (role == Qt::ForegroundRole) {
+        if (r.verdict == lc::Verdict::Missing) return QBrush(Qt::white);
+        if (r.verdict == lc::Verdict::FalsePositive) return QBrush(QColor(130, 130, 130));
+    }
+    if (role == Qt::TextAlignmentRole && index.column() != ColName && index.column() != ColVerdict)
+        return int(Qt::AlignRight | Qt::AlignVCenter);
+    if (role != Qt::DisplayRole && role != Qt::EditRole) return {};
+    // The run may be older than the scene: a removed light has no name.
+    const bool inScene = r.light < lights.size();
+    switch (index.column()) {
+    case ColList: return int(r.list);
+    case ColLight: return int(r.light);
+    case ColName: return inScene ? QString::fromStdString(lights[r.light].name) : QString();
+    case ColPosition: {
+        if (!inScene) return QString();
+        const auto& p = lights[r.light].position;
+        return QString("%1, %2, %3").arg(p.x, 0, 'g', 4).arg(p.y, 0, 'g', 4).arg(p.z, 0, 'g', 4);
+    }
+    case ColRadius:
+        return run_ && r.light < run_->lights.size() ? QVariant(run_->lights.radii[r.light]) : QVariant();
+    case ColPixels: return int(r.pixelsNeeding);
+    case ColVerdict: return QString(lc::toString(r.verdict));
+    }
+    return {};
+}
+
+TileInspector::TileInspector(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
+    model_ = new TileLightsModel(doc_, this);
+    table_ = new QTableView;
+    table_->setObjectName("tileLightsTable");
+    table_->setModel(model_);
+    table_->horizontalHeader()->setStretchLastSection(true);
+    table_->verticalHeader()->hide();
+    table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+    table_->setSelectionBehavior(QAbstractItemView::SelectRows);
+    summary_ = new QLabel;
+    summary_->setObjectName("tileSummary");
+    summary_->setWordWrap(true);
+    auto* l = new QVBoxLayout(this);
+    l->setContentsMargins(2, 2, 2, 2);
+    l->addWidget(summary_);
+    l->addWidget(table_, 1);
     connect(doc_, &Document::tileSelectionChanged, this, &TileInspector::refresh);
     connect(doc_, &Document::runOutputChanged, this, &TileInspector::refresh);
-    connect(this, &QTableWidget::cellDoubleClicked, this, [this](int row, int) {
-        doc_->setSelectedLights({item(row, 1)->text().toInt()});
+    connect(table_, &QTableView::doubleClicked, this, [this](const QModelIndex& i) {
+        if (i.row() < int(model_->rows().size())) doc_->setSelectedLights({int(model_->rows()[std::size_t(i.row())].light)});
     });
+    refresh();
 }
 
 std::vector<int> TileInspector::listedLights() const {
     std::vector<int> out;
-    for (int r = 0; r < rowCount(); ++r) out.push_back(item(r, 1)->text().toInt());
+    for (const auto& r : model_->rows())
+        if (r.verdict != lc::Verdict::Missing) out.push_back(int(r.light));
     return out;
 }
 
+QString TileInspector::summaryText() const { return summary_->text(); }
+
 void TileInspector::refresh() {
-    setRowCount(0);
     const auto run = doc_->runOutput();
     const int tile = doc_->selectedTile();
-    if (!run || tile < 0 || std::uint32_t(tile) >= run->result.grid.tileCount()) return;
-    const lc::CullResult& r = run->result;
-    const auto& lights = doc_->scene().lights;
-    // `all` has one list for every tile; otherwise the tile's listsPerTile lists.
-    const std::uint32_t first = r.algorithm == lc::Algorithm::All ? 0 : std::uint32_t(tile) * r.listsPerTile;
-    const std::uint32_t n = r.algorithm == lc::Algorithm::All ? 1 : r.listsPerTile;
-    for (std::uint32_t s = 0; s < n; ++s) {
-        const std::uint32_t list = first + s;
-        if (list >= r.listCount.size()) break;
-        for (std::uint32_t k = 0; k < r.listCount[list]; ++k) {
-            const std::uint32_t li = r.lightIndices[r.listOffset[list] + k];
-            const int row = rowCount();
-            insertRow(row);
-            setItem(row, 0, new QTableWidgetItem(QString::number(s)));
-            setItem(row, 1, new QTableWidgetItem(QString::number(li)));
-            // The run may be older than the scene: a removed light has no name.
-            const bool known = li < run->lights.size();
-            setItem(row, 2, new QTableWidgetItem(li < lights.size() ? QString::fromStdString(lights[li].name)
-                                                                    : QString()));
-            setItem(row, 3, new QTableWidgetItem(known ? QString::number(run->lights.radii[li], 'g', 5)
-                                                       : QString()));
-        }
+    const lc::Camera& cam = doc_->scene().camera;
+    if (!run || tile < 0 || std::uint32_t(tile) >= run->result.grid.tileCount()) {
+        model_->setRows({}, run);
+        summary_->setText(run ? tr("Click a tile in the camera view.") : tr("No culling run yet (F5)."));
+        return;
     }
+    if (run->result.grid.width != cam.width || run->result.grid.height != cam.height || !cam.validate().empty()) {
+        model_->setRows({}, run);
+        summary_->setText(tr("The camera changed since the last run: run culling again."));
+        return;
+    }
+    const lc::Projection proj(cam);
+    const int cell = doc_->selectedCell();
+    model_->setRows(lc::tileLightRows(*run, proj, std::uint32_t(tile), cell), run);
+    int needed = 0, fp = 0, missing = 0;
+    for (const auto& r : model_->rows())
+        (r.verdict == lc::Verdict::Needed ? needed : r.verdict == lc::Verdict::FalsePositive ? fp : missing)++;
+    const lc::TileGrid& g = run->result.grid;
+    QString where = tr("Tile %1, %2").arg(tile % int(g.tilesX)).arg(tile / int(g.tilesX));
+    if (cell >= 0) where += tr(", cell %1").arg(cell);
+    summary_->setText(tr("%1: %2 needed, %3 false positive, %4 missing")
+                          .arg(where)
+                          .arg(needed)
+                          .arg(fp)
+                          .arg(missing));
+    summary_->setStyleSheet(missing ? "color: rgb(230,60,60); font-weight: bold" : "");
 }
 
 } // namespace lcui

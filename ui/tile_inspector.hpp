@@ -1,24 +1,61 @@
 #pragma once
-// The tile inspector dock: the selected tile's light lists (index, name,
-// radius, which of the tile's lists holds it). A placeholder for the overlays
-// issue, which adds per-pixel need counts and ground-truth verdicts here.
+// The tile inspector dock: the selected tile's (or cell's) lights, one row per
+// (list, light): index, name, position, radius, how many of the list's pixels
+// need it, and the ground-truth verdict (needed / false positive / MISSING).
+// Rows come from lc::tileLightRows; a double click selects the light.
 
-#include <QTableWidget>
+#include "culling/overlays.hpp"
+
+#include <QAbstractTableModel>
+#include <QWidget>
+
+#include <memory>
+#include <vector>
+
+class QLabel;
+class QTableView;
 
 namespace lcui {
 
 class Document;
 
-class TileInspector : public QTableWidget {
+class TileLightsModel : public QAbstractTableModel {
+    Q_OBJECT
+public:
+    enum Column { ColList, ColLight, ColName, ColPosition, ColRadius, ColPixels, ColVerdict, ColumnCount };
+    explicit TileLightsModel(Document* doc, QObject* parent = nullptr);
+    int rowCount(const QModelIndex& parent = {}) const override;
+    int columnCount(const QModelIndex& parent = {}) const override;
+    QVariant data(const QModelIndex& index, int role) const override;
+    QVariant headerData(int section, Qt::Orientation o, int role) const override;
+
+    void setRows(std::vector<lc::TileLightRow> rows, std::shared_ptr<const lc::RunOutput> run);
+    const std::vector<lc::TileLightRow>& rows() const { return rows_; }
+
+private:
+    Document* doc_;
+    std::vector<lc::TileLightRow> rows_;
+    std::shared_ptr<const lc::RunOutput> run_;
+};
+
+class TileInspector : public QWidget {
     Q_OBJECT
 public:
     explicit TileInspector(Document* doc, QWidget* parent = nullptr);
-    // Light indices currently listed, in table order.
+    // Light indices listed for the selection (verdict needed or false
+    // positive), in table order; missing lights are not listed.
     std::vector<int> listedLights() const;
+    const std::vector<lc::TileLightRow>& rows() const { return model_->rows(); }
+    TileLightsModel* model() const { return model_; }
+    QTableView* table() const { return table_; }
+    QString summaryText() const;
 
 private:
     void refresh();
     Document* doc_;
+    TileLightsModel* model_;
+    QTableView* table_;
+    QLabel* summary_;
 };
 
 } // namespace lcui

@@ -1,0 +1,112 @@
+// MainWindow: the overlay toggles (View > Overlays), the heat-map mode and
+// File > Export diagnostics. Kept apart from main_window.cpp so that the
+// overlays stay one small hook there.
+#include "main_window.hpp"
+
+#include "camera_view.hpp"
+#include "document.hpp"
+#include "inspector_view.hpp"
+
+#include "culling/errors.hpp"
+#include "culling/export.hpp"
+
+#include <QAction>
+#include <QActionGroup>
+#include <QImage>
+#include <QMenu>
+
+namespace lcui {
+
+namespace {
+
+lc::RgbImage toRgb(const QImage& image) {
+    const QImage img = image.convertToFormat(QImage::Format_RGB888);
+    lc::RgbImage out;
+    out.width = std::uint32_t(img.width());
+    out.height = std::uint32_t(img.height());
+    out.rgb.resize(std::size_t(out.width) * out.height * 3);
+    for (int y = 0; y < img.height(); ++y)
+        std::copy_n(img.constScanLine(y), std::size_t(out.width) * 3, out.rgb.begin() + std::ptrdiff_t(y) * out.width * 3);
+    return out;
+}
+
+} // namespace
+
+void MainWindow::buildOverlayMenus(QMenu* file, QMenu* view) {
+    QAction* exportAction = new QAction(tr("E&xport diagnostics..."), this);
+    exportAction->setObjectName("actionExportDiagnostics");
+    exportAction->setShortcut(QKeySequence(tr("Ctrl+E")));
+    connect(exportAction, &QAction::triggered, this, [this] {
+        const QString dir = prompts.savePath(this, tr("Export diagnostics into a new folder"), tr("Folder (*)"));
+        if (!dir.isEmpty()) exportDiagnostics(dir);
+    });
+    QAction* quit = action("actionQuit");
+    file->insertAction(quit, exportAction);
+    file->insertSeparator(quit);
+
+    using Options = Document::OverlayOptions;
+    QMenu* overlays = view->addMenu(tr("&Overlays"));
+    auto toggle = [&](const QString& text, const char* name, bool Options::*field) {
+        QAction* a = overlays->addAction(text);
+        a->setObjectName(name);
+        a->setCheckable(true);
+        a->setChecked(doc_->overlays().*field);
+        connect(a, &QAction::toggled, this, [this, field](bool on) {
+            Options o = doc_->overlays();
+            o.*field = on;
+            doc_->setOverlays(o);
+        });
+    };
+    toggle(tr("Selected tile frustum"), "actionOverlayTileFrustum", &Options::tileFrustum);
+    toggle(tr("All tile frustums"), "actionOverlayAllTiles", &Options::allTileFrustums);
+    toggle(tr("Depth cells / split / froxels"), "actionOverlayCells", &Options::cells);
+    toggle(tr("Light's cell range"), "actionOverlayLightRange", &Options::lightCellRange);
+    toggle(tr("Highlight listed lights"), "actionOverlayListHighlight", &Options::listHighlight);
+    toggle(tr("Tiles holding the selected light"), "actionOverlayReverse", &Options::reverseLookup);
+
+    QMenu* heat = view->addMenu(tr("&Heat map"));
+    auto* group = new QActionGroup(this);
+    const std::pair<QString, lc::HeatMode> modes[] = {{tr("List length"), lc::HeatMode::ListLength},
+                                                      {tr("False positives"), lc::HeatMode::FalsePositives},
+                                                      {tr("Efficiency"), lc::HeatMode::Efficiency}};
+    for (const auto& [text, mode] : modes) {
+        QAction* a = heat->addAction(text);
+        a->setObjectName(QString("actionHeat_%1").arg(lc::toString(mode)));
+        a->setCheckable(true);
+        a->setChecked(doc_->overlays().heat == mode);
+        group->addAction(a);
+        const lc::HeatMode m = mode;
+        connect(a, &QAction::triggered, this, [this, m] {
+            Options o = doc_->overlays();
+            o.heat = m;
+            doc_->setOverlays(o);
+        });
+    }
+}
+
+bool MainWindow::exportDiagnostics(const QString& dir) {
+    const auto run = doc_->runOutput();
+    if (!run) {
+        log(tr("export diagnostics: no culling run yet (F5)"), true);
+        prompts.showError(this, tr("Export diagnostics"), tr("There is no culling run to export yet: press F5."));
+        return false;
+    }
+    try {
+        cameraView_->renderNow();
+        inspectorView_->renderNow();
+        std::vector<lc::NamedImage> views;
+        views.push_back({"camera_view.png", toRgb(cameraView_->grabFramebuffer())});
+        views.push_back({"inspector_view.png", toRgb(inspectorView_->grabFramebuffer())});
+        // The settings the run used (the toolbar may have changed since).
+        lc::exportDiagnostics(doc_->scene(), run->result.settings, *run, dir.toStdString(), views);
+    } catch (const std::exception& e) {
+        const QString msg = QString::fromStdString(e.what());
+        log(tr("export diagnostics: %1").arg(msg), true);
+        prompts.showError(this, tr("Export diagnostics"), msg);
+        return false;
+    }
+    log(tr("exported diagnostics to %1").arg(dir));
+    return true;
+}
+
+} // namespace lcui

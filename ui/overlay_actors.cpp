@@ -1,0 +1,336 @@
+#include "overlay_actors.hpp"
+
+#include "document.hpp"
+#include "vtk_adapters.hpp"
+
+#include <vtkActor.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDoubleArray.h>
+#include <vtkGlyph3D.h>
+#include <vtkLookupTable.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderer.h>
+#include <vtkSphereSource.h>
+
+#include <algorithm>
+
+namespace lcui {
+
+namespace {
+
+// Accumulates world-space chunk geometry into one poly data.
+struct ChunkGeometry {
+    vtkNew<vtkPoints> points;
+    vtkNew<vtkCellArray> lines, polys;
+    glm::dmat4 worldFromView{1.0};
+
+    vtkIdType corner(const glm::dvec3& v) {
+        const glm::dvec4 w = worldFromView * glm::dvec4(v, 1.0);
+        return points->InsertNextPoint(w.x, w.y, w.z);
+    }
+    // corners: near tl,tr,br,bl; far tl,tr,br,bl
+    void faces(const lc::FrustumChunk& c) {
+        vtkIdType id[8];
+        for (int i = 0; i < 8; ++i) id[i] = corner(c.corners[i]);
+        const int f[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 3, 7, 4}, {1, 5, 6, 2}, {0, 4, 5, 1}, {3, 2, 6, 7}};
+        for (const auto& q : f) {
+            const vtkIdType ids[4] = {id[q[0]], id[q[1]], id[q[2]], id[q[3]]};
+            polys->InsertNextCell(4, ids);
+        }
+    }
+    void edges(const lc::FrustumChunk& c) {
+        vtkIdType id[8];
+        for (int i = 0; i < 8; ++i) id[i] = corner(c.corners[i]);
+        static constexpr int e[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
+                                         {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+        for (const auto& k : e) {
+            const vtkIdType ids[2] = {id[k[0]], id[k[1]]};
+            lines->InsertNextCell(2, ids);
+        }
+    }
+    // The near face of a chunk only (the halfz split of the far half).
+    void nearFace(const lc::FrustumChunk& c) {
+        vtkIdType id[4];
+        for (int i = 0; i < 4; ++i) id[i] = corner(c.corners[i]);
+        polys->InsertNextCell(4, id);
+    }
+    void into(vtkPolyData* pd) {
+        pd->Initialize();
+        pd->SetPoints(points);
+        if (lines->GetNumberOfCells()) pd->SetLines(lines);
+        if (polys->GetNumberOfCells()) pd->SetPolys(polys);
+    }
+};
+
+vtkSmartPointer<vtkActor> makeActor(vtkPolyData* pd, double r, double g, double b, double opacity,
+                                    double lineWidth = 1.0) {
+    vtkNew<vtkPolyDataMapper> m;
+    m->SetInputData(pd);
+    m->ScalarVisibilityOff();
+    auto a = vtkSmartPointer<vtkActor>::New();
+    a->SetMapper(m);
+    a->GetProperty()->SetColor(r, g, b);
+    a->GetProperty()->SetOpacity(opacity);
+    a->GetProperty()->SetLineWidth(lineWidth);
+    a->GetProperty()->SetLighting(false);
+    a->PickableOff();
+    return a;
+}
+
+} // namespace
+
+struct InspectorOverlays::Impl {
+    vtkRenderer* renderer;
+    vtkNew<vtkPolyData> tileSolid, tileOutline, cellFill, cellOutline, cellSelected, splitQuad, lightRange,
+        allTiles, reverse;
+    vtkSmartPointer<vtkActor> tileSolidA, tileOutlineA, cellFillA, cellOutlineA, cellSelectedA, splitA, rangeA,
+        allTilesA, reverseA;
+    vtkNew<vtkLookupTable> lut;
+    vtkSmartPointer<vtkPolyData> listedData, missingData;
+    vtkNew<vtkGlyph3D> listedGlyph, missingGlyph;
+    vtkNew<vtkActor> listedA, missingA;
+};
+
+InspectorOverlays::InspectorOverlays(vtkRenderer* renderer, vtkSphereSource* sphere) : d_(new Impl) {
+    d_->renderer = renderer;
+    d_->tileSolidA = makeActor(d_->tileSolid, 0.35, 0.8, 1.0, 0.12);
+    d_->tileOutlineA = makeActor(d_->tileOutline, 0.35, 0.85, 1.0, 1.0, 2.5);
+    d_->cellFillA = makeActor(d_->cellFill, 1.0, 0.55, 0.15, 0.3);
+    d_->cellOutlineA = makeActor(d_->cellOutline, 0.85, 0.85, 0.85, 0.45);
+    d_->cellSelectedA = makeActor(d_->cellSelected, 1.0, 0.95, 0.2, 0.45, 3.0);
+    d_->splitA = makeActor(d_->splitQuad, 1.0, 0.3, 0.9, 0.4);
+    d_->rangeA = makeActor(d_->lightRange, 0.3, 1.0, 0.35, 1.0, 3.0);
+    d_->reverseA = makeActor(d_->reverse, 1.0, 0.3, 1.0, 0.8, 1.5);
+
+    // All tiles: one wireframe actor, lines coloured by the tile's list length.
+    d_->lut->SetHueRange(0.667, 0.0);
+    d_->lut->SetNumberOfTableValues(256);
+    d_->lut->Build();
+    vtkNew<vtkPolyDataMapper> allMapper;
+    allMapper->SetInputData(d_->allTiles);
+    allMapper->SetScalarModeToUseCellData();
+    allMapper->SetLookupTable(d_->lut);
+    allMapper->UseLookupTableScalarRangeOn();
+    d_->allTilesA = vtkSmartPointer<vtkActor>::New();
+    d_->allTilesA->SetMapper(allMapper);
+    d_->allTilesA->GetProperty()->SetLighting(false);
+    // Opaque: 12 lines x ~8,000 tiles stay out of the depth-peeling passes.
+    d_->allTilesA->GetProperty()->SetOpacity(1.0);
+    d_->allTilesA->PickableOff();
+
+    // Listed lights: their spheres, brighter than the dimmed glyph actor;
+    // missing lights: red.
+    auto glyphActor = [&](vtkGlyph3D* g, vtkSmartPointer<vtkPolyData>& data, vtkActor* a, bool colored) {
+        data = lightsToPolyData({});
+        g->SetSourceConnection(sphere->GetOutputPort());
+        g->SetInputData(data);
+        g->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "radius");
+        g->SetInputArrayToProcess(3, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "color");
+        g->SetScaleModeToScaleByScalar();
+        g->ClampingOff();
+        g->OrientOff();
+        g->SetColorModeToColorByScalar();
+        vtkNew<vtkPolyDataMapper> m;
+        m->SetInputConnection(g->GetOutputPort());
+        if (colored) {
+            m->SetScalarModeToUsePointFieldData();
+            m->SelectColorArray("color");
+            m->SetColorModeToDirectScalars();
+            m->ScalarVisibilityOn();
+        } else {
+            m->ScalarVisibilityOff();
+        }
+        a->SetMapper(m);
+        a->GetProperty()->BackfaceCullingOn();
+        a->PickableOff();
+    };
+    glyphActor(d_->listedGlyph, d_->listedData, d_->listedA, true);
+    d_->listedA->GetProperty()->SetOpacity(0.45);
+    glyphActor(d_->missingGlyph, d_->missingData, d_->missingA, false);
+    d_->missingA->GetProperty()->SetColor(1.0, 0.1, 0.1);
+    d_->missingA->GetProperty()->SetOpacity(0.7);
+
+    for (vtkActor* a : {d_->allTilesA.Get(), d_->tileSolidA.Get(), d_->tileOutlineA.Get(), d_->cellFillA.Get(),
+                        d_->cellOutlineA.Get(), d_->cellSelectedA.Get(), d_->splitA.Get(), d_->rangeA.Get(),
+                        d_->reverseA.Get(), static_cast<vtkActor*>(d_->listedA.Get()),
+                        static_cast<vtkActor*>(d_->missingA.Get())}) {
+        a->SetVisibility(false);
+        renderer->AddActor(a);
+    }
+}
+
+InspectorOverlays::~InspectorOverlays() = default;
+
+vtkPolyData* InspectorOverlays::tileSolid() const { return d_->tileSolid; }
+vtkPolyData* InspectorOverlays::cellFill() const { return d_->cellFill; }
+vtkPolyData* InspectorOverlays::cellOutline() const { return d_->cellOutline; }
+vtkPolyData* InspectorOverlays::splitQuad() const { return d_->splitQuad; }
+vtkPolyData* InspectorOverlays::lightRange() const { return d_->lightRange; }
+vtkPolyData* InspectorOverlays::allTiles() const { return d_->allTiles; }
+vtkPolyData* InspectorOverlays::reverse() const { return d_->reverse; }
+vtkActor* InspectorOverlays::allTilesActor() const { return d_->allTilesA; }
+
+void InspectorOverlays::update(const Document& doc) {
+    for (vtkPolyData* pd : {d_->tileSolid.Get(), d_->tileOutline.Get(), d_->cellFill.Get(), d_->cellOutline.Get(),
+                            d_->cellSelected.Get(), d_->splitQuad.Get(), d_->lightRange.Get(), d_->reverse.Get()})
+        pd->Initialize();
+    listed_.clear();
+    missing_.clear();
+    reverseLists_.clear();
+    dim_ = false;
+
+    const auto run = doc.runOutput();
+    const lc::Camera& cam = doc.scene().camera;
+    const auto& opt = doc.overlays();
+    const bool usable = run && run->result.grid.width == cam.width && run->result.grid.height == cam.height &&
+                        run->result.grid.tileSize == cam.tileSize && cam.validate().empty();
+    auto show = [](vtkActor* a, bool on) { a->SetVisibility(on); };
+    if (!usable) {
+        for (vtkActor* a : {d_->allTilesA.Get(), d_->tileSolidA.Get(), d_->tileOutlineA.Get(), d_->cellFillA.Get(),
+                            d_->cellOutlineA.Get(), d_->cellSelectedA.Get(), d_->splitA.Get(), d_->rangeA.Get(),
+                            d_->reverseA.Get(), static_cast<vtkActor*>(d_->listedA.Get()),
+                            static_cast<vtkActor*>(d_->missingA.Get())})
+            show(a, false);
+        d_->allTiles->Initialize();
+        allTilesRun_ = nullptr;
+        return;
+    }
+    const lc::CullResult& r = run->result;
+    const lc::Projection proj(cam);
+    const glm::dmat4 w = lc::worldFromView(cam);
+    const int tile = doc.selectedTile();
+    const bool tileOk = tile >= 0 && std::uint32_t(tile) < r.grid.tileCount();
+
+    // Selected tile frustum.
+    if (tileOk && opt.tileFrustum)
+        if (const auto chunk = lc::tileFrustum(r, proj, run->lights, std::uint32_t(tile))) {
+            ChunkGeometry solid, outline;
+            solid.worldFromView = outline.worldFromView = w;
+            solid.faces(*chunk);
+            outline.edges(*chunk);
+            solid.into(d_->tileSolid);
+            outline.into(d_->tileOutline);
+        }
+    show(d_->tileSolidA, d_->tileSolid->GetNumberOfCells() > 0);
+    show(d_->tileOutlineA, d_->tileOutline->GetNumberOfCells() > 0);
+
+    // Depth cells, the halfz split, the selected cell, the light's cell range.
+    const std::vector<lc::DepthCell> cells =
+        tileOk ? lc::tileCells(r, proj, std::uint32_t(tile)) : std::vector<lc::DepthCell>{};
+    if (opt.cells && !cells.empty()) {
+        ChunkGeometry fill, outline, selected, split;
+        fill.worldFromView = outline.worldFromView = selected.worldFromView = split.worldFromView = w;
+        for (const lc::DepthCell& c : cells) {
+            if (c.occupied) fill.faces(c.chunk);
+            outline.edges(c.chunk);
+            if (int(c.cell) == doc.selectedCell()) {
+                selected.faces(c.chunk);
+                selected.edges(c.chunk);
+            }
+        }
+        if (r.algorithm == lc::Algorithm::HalfZ && cells.size() == 2) split.nearFace(cells[1].chunk);
+        fill.into(d_->cellFill);
+        outline.into(d_->cellOutline);
+        selected.into(d_->cellSelected);
+        split.into(d_->splitQuad);
+    }
+    show(d_->cellFillA, d_->cellFill->GetNumberOfCells() > 0);
+    show(d_->cellOutlineA, d_->cellOutline->GetNumberOfCells() > 0);
+    show(d_->cellSelectedA, d_->cellSelected->GetNumberOfCells() > 0);
+    show(d_->splitA, d_->splitQuad->GetNumberOfCells() > 0);
+
+    const int light = doc.currentLight();
+    const bool lightOk = light >= 0 && std::size_t(light) < run->lights.size();
+    if (opt.lightCellRange && lightOk && !cells.empty()) {
+        const std::uint32_t range =
+            lc::lightCellRange(r, std::uint32_t(tile), run->lights.centers[std::size_t(light)],
+                               run->lights.radii[std::size_t(light)]);
+        ChunkGeometry g;
+        g.worldFromView = w;
+        for (const lc::DepthCell& c : cells)
+            if ((range >> c.cell) & 1u) g.edges(c.chunk);
+        g.into(d_->lightRange);
+    }
+    show(d_->rangeA, d_->lightRange->GetNumberOfCells() > 0);
+
+    // Reverse look-up: the volumes whose lists hold the current light.
+    if (opt.reverseLookup && lightOk) {
+        reverseLists_ = lc::listsHoldingLight(r, std::uint32_t(light));
+        ChunkGeometry g;
+        g.worldFromView = w;
+        const bool perCell = r.algorithm == lc::Algorithm::HalfZ || r.algorithm == lc::Algorithm::Clustered;
+        if (r.algorithm != lc::Algorithm::All) {
+            const std::uint32_t per = std::max(r.listsPerTile, 1u);
+            std::uint32_t lastTile = ~0u;
+            std::vector<lc::DepthCell> tileCellsCache;
+            for (std::uint32_t l : reverseLists_) {
+                const std::uint32_t t = l / per;
+                if (perCell) {
+                    if (t != lastTile) tileCellsCache = lc::tileCells(r, proj, t);
+                    for (const auto& c : tileCellsCache)
+                        if (c.list == l) g.edges(c.chunk);
+                } else if (const auto chunk = lc::tileFrustum(r, proj, run->lights, t)) {
+                    g.edges(*chunk);
+                }
+                lastTile = t;
+            }
+        }
+        g.into(d_->reverse);
+    }
+    show(d_->reverseA, d_->reverse->GetNumberOfCells() > 0);
+
+    // Listed lights of the selected tile (or cell) highlighted, missing in red.
+    const auto& lights = doc.scene().lights;
+    if (opt.listHighlight && tileOk) {
+        const auto rows = lc::tileLightRows(*run, proj, std::uint32_t(tile), doc.selectedCell());
+        std::vector<lc::PointLight> listedL, missingL;
+        for (const auto& row : rows) {
+            if (row.light >= lights.size()) continue;
+            auto& ids = row.verdict == lc::Verdict::Missing ? missing_ : listed_;
+            if (std::find(ids.begin(), ids.end(), int(row.light)) != ids.end()) continue;
+            ids.push_back(int(row.light));
+            (row.verdict == lc::Verdict::Missing ? missingL : listedL).push_back(lights[row.light]);
+        }
+        d_->listedData = lightsToPolyData(listedL);
+        d_->missingData = lightsToPolyData(missingL);
+        d_->listedGlyph->SetInputData(d_->listedData);
+        d_->missingGlyph->SetInputData(d_->missingData);
+        dim_ = true;
+    }
+    show(d_->listedA, !listed_.empty());
+    show(d_->missingA, !missing_.empty());
+
+    // Every tile's frustum: rebuilt only for a new run (or when turned on).
+    if (opt.allTileFrustums) {
+        if (allTilesRun_ != run.get()) {
+            ChunkGeometry g;
+            g.worldFromView = w;
+            vtkNew<vtkDoubleArray> len;
+            len->SetName("list_length");
+            const auto heat = lc::tileHeat(*run, lc::HeatMode::ListLength);
+            double maxLen = 1;
+            for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t) {
+                const auto chunk = lc::tileFrustum(r, proj, run->lights, t);
+                if (!chunk) continue;
+                g.edges(*chunk);
+                const double v = std::isnan(heat[t]) ? 0.0 : heat[t];
+                for (int e = 0; e < 12; ++e) len->InsertNextValue(v);
+                maxLen = std::max(maxLen, v);
+            }
+            g.into(d_->allTiles);
+            d_->allTiles->GetCellData()->SetScalars(len);
+            d_->lut->SetTableRange(0, maxLen);
+            allTilesRun_ = run.get();
+        }
+    } else {
+        d_->allTiles->Initialize();
+        allTilesRun_ = nullptr;
+    }
+    show(d_->allTilesA, d_->allTiles->GetNumberOfCells() > 0);
+}
+
+} // namespace lcui

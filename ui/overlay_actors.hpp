@@ -1,0 +1,68 @@
+#pragma once
+// The inspector view's inspection overlays, built from the document's latest
+// run with the culling library's overlay geometry (culling/overlays.hpp):
+// - the selected tile's frustum (translucent solid + outline);
+// - its depth cells: occupied cells filled, empty ones outlined, the selected
+//   cell highlighted; the halfz split as a filled quad; clustered froxels;
+// - the cells the current light's sphere spans in that tile (green outline);
+// - every tile's frustum as ONE wireframe poly-data actor coloured by list
+//   length (interactive at ~8,000 tiles: 12 lines per tile, one draw);
+// - reverse look-up: the frustums (halfz/clustered: the cells) whose lists
+//   hold the current light, magenta;
+// - the selected tile's listed lights highlighted (the light glyph actor is
+//   dimmed meanwhile), missing lights in red.
+// Each part follows its Document::OverlayOptions toggle. Translucent parts
+// rely on the renderer's depth peeling (set up by InspectorView).
+
+#include "culling/overlays.hpp"
+
+#include <vtkNew.h>
+#include <vtkSmartPointer.h>
+
+#include <memory>
+#include <vector>
+
+class vtkActor;
+class vtkGlyph3D;
+class vtkLookupTable;
+class vtkPolyData;
+class vtkRenderer;
+class vtkSphereSource;
+
+namespace lcui {
+
+class Document;
+
+class InspectorOverlays {
+public:
+    InspectorOverlays(vtkRenderer* renderer, vtkSphereSource* sphere);
+    ~InspectorOverlays();
+
+    // Rebuilds everything that depends on the document's state.
+    void update(const Document& doc);
+    // Whether the light glyphs should be dimmed (a tile's lists are highlighted).
+    bool dimLights() const { return dim_; }
+
+    // --- for tests and screenshots ---------------------------------------------
+    vtkPolyData* tileSolid() const;
+    vtkPolyData* cellFill() const;    // occupied cells (6 quads each)
+    vtkPolyData* cellOutline() const; // every cell (12 lines each)
+    vtkPolyData* splitQuad() const;   // halfz split
+    vtkPolyData* lightRange() const;  // cells the current light spans
+    vtkPolyData* allTiles() const;    // every tile frustum, "list_length" cell data
+    vtkPolyData* reverse() const;     // volumes whose list holds the current light
+    vtkActor* allTilesActor() const;
+    const std::vector<int>& listedLights() const { return listed_; }   // highlighted
+    const std::vector<int>& missingLights() const { return missing_; } // red
+    const std::vector<std::uint32_t>& reverseLists() const { return reverseLists_; }
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> d_;
+    bool dim_ = false;
+    std::vector<int> listed_, missing_;
+    std::vector<std::uint32_t> reverseLists_;
+    const void* allTilesRun_ = nullptr; // run the all-tiles wireframe was built for
+};
+
+} // namespace lcui
