@@ -19,14 +19,19 @@
 #include "camera_view.hpp"
 #include "document.hpp"
 #include "inspector_view.hpp"
+#include "overlay_actors.hpp"
 
 #include "culling/backend.hpp"
+#include "culling/overlays.hpp"
 #include "culling/pipeline.hpp"
 
 #include <QDir>
 #include <QImage>
 
+#include <vtkCamera.h>
+#include <vtkPolyData.h>
 #include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
 
 #include <cmath>
 #include <memory>
@@ -180,6 +185,65 @@ private slots:
         const QImage shot = view.grabFramebuffer();
         QVERIFY(!shot.isNull());
         const Comparison c = compareWithBaseline(shot, "inspector_view");
+        QVERIFY2(c.ok, qPrintable(c.message));
+        qInfo("%s", qPrintable(c.message));
+    }
+
+    // Overlays of a selected tile: its frustum, its 2.5d cells (occupied
+    // filled, empty outlined), the current light's cell range, the tile's
+    // listed lights highlighted and the rest dimmed, and the tiles holding
+    // the current light outlined in the camera view (efficiency heat map).
+    void tileOverlays() {
+        Document doc;
+        doc.resetScene(fixedScene(), {});
+        lc::CullSettings s = doc.settings();
+        s.algorithm = lc::Algorithm::TwoPointFiveD;
+        s.cells = 8;
+        doc.setSettings(s);
+        auto backend = lc::makeBackend("cpu");
+        lc::RunOptions opt;
+        opt.truthOptions.imageError = false;
+        auto run = std::make_shared<lc::RunOutput>(lc::runPipeline(doc.scene(), doc.settings(), *backend, opt));
+        QVERIFY(doc.setRunOutput(run, 1));
+        // The tile with the longest list (a fixed choice: the scene is fixed).
+        std::uint32_t tile = 0;
+        for (std::uint32_t t = 0; t < run->result.grid.tileCount(); ++t)
+            if (run->result.listCount[t] > run->result.listCount[tile]) tile = t;
+        const std::uint32_t first = lc::tileLists(run->result, tile).first;
+        QVERIFY(run->result.listCount[first] >= 2); // the picture shows listed lights and dimmed others
+        doc.setSelectedTile(int(tile));
+        doc.setSelectedLights({int(run->result.lightIndices[run->result.listOffset[first]])});
+        auto o = doc.overlays();
+        o.heat = lc::HeatMode::Efficiency;
+        doc.setOverlays(o);
+
+        InspectorView iv(&doc);
+        iv.resize(640, 480);
+        iv.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&iv));
+        iv.resetCamera();
+        // Close up on the tile's frustum, from the inspector's default direction.
+        double b[6];
+        iv.overlays()->tileSolid()->GetBounds(b);
+        QVERIFY(b[1] > b[0]);
+        iv.renderer()->ResetCamera(b);
+        iv.renderer()->GetActiveCamera()->Zoom(1.3);
+        iv.renderer()->ResetCameraClippingRange();
+        iv.renderNow();
+        QTest::qWait(50);
+        iv.renderNow();
+        Comparison c = compareWithBaseline(iv.grabFramebuffer(), "inspector_tile_overlays");
+        QVERIFY2(c.ok, qPrintable(c.message));
+        qInfo("%s", qPrintable(c.message));
+
+        CameraView cv(&doc);
+        cv.resize(720, 360);
+        cv.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&cv));
+        cv.renderNow();
+        QTest::qWait(50);
+        cv.renderNow();
+        c = compareWithBaseline(cv.grabFramebuffer(), "camera_efficiency_reverse");
         QVERIFY2(c.ok, qPrintable(c.message));
         qInfo("%s", qPrintable(c.message));
     }
