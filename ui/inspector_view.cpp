@@ -3,6 +3,7 @@
 #include "document.hpp"
 #include "overlay_actors.hpp"
 #include "vtk_adapters.hpp"
+#include "spot_actor.hpp"
 
 #include "culling/projection.hpp"
 
@@ -94,6 +95,7 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     frustumActor_->GetProperty()->SetLighting(false);
     frustumActor_->PickableOff();
     renderer_->AddActor(frustumActor_);
+    spotCones_ = std::make_unique<SpotConesActor>(renderer_);
 
     // Inspection overlays; translucent volumes over translucent spheres stay
     // readable with depth peeling (order-independent).
@@ -268,6 +270,7 @@ void InspectorView::rebuildMeshes() {
 void InspectorView::rebuildLights() {
     lightData_ = lightsToPolyData(doc_->scene().lights);
     glyph_->SetInputData(lightData_);
+    spotCones_->update(doc_->scene().lights);
 }
 
 void InspectorView::updateLight(int index) {
@@ -287,6 +290,7 @@ void InspectorView::updateLight(int index) {
     for (int c = 0; c < 3; ++c) color->SetComponent(index, c, rgb[c]);
     color->Modified();
     lightData_->Modified();
+    spotCones_->update(lights);
 }
 
 void InspectorView::updateSelection() {

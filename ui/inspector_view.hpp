@@ -32,6 +32,8 @@ namespace lcui {
 class Document;
 class InspectorOverlays;
 
+class SpotConesActor;
+
 class InspectorView : public QVTKOpenGLNativeWidget {
     Q_OBJECT
 public:
@@ -57,6 +59,7 @@ public:
     vtkPointHandleRepresentation3D* radiusHandleRepresentation() const;
     // The glyph actor showing every light's sphere.
     vtkActor* lightActor() const;
+    SpotConesActor* spotCones() const { return spotCones_.get(); }
     // Tile frustums, cells, reverse look-up and list highlights (overlay_actors.hpp).
     InspectorOverlays* overlays() const { return overlays_.get(); }
     void renderNow();
@@ -102,6 +105,7 @@ private:
     int pressX_ = 0, pressY_ = 0;
     bool cameraFramed_ = false;
     std::unique_ptr<InspectorOverlays> overlays_;
+    std::unique_ptr<SpotConesActor> spotCones_; // spot lights' cones (ui/spot_actor.hpp)
 };
 
 } // namespace lcui

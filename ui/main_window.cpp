@@ -201,6 +201,10 @@ void MainWindow::buildActions() {
 
     connect(make(tr("&Add light"), "actionAddLight", QKeySequence(tr("Ctrl+L"))), &QAction::triggered, this,
             [this] { addLightAt(inspectorView_->mapFromGlobal(QCursor::pos())); });
+    connect(make(tr("Add &spot light"), "actionAddSpotLight", QKeySequence(tr("Ctrl+Shift+L"))),
+            &QAction::triggered, this, [this] {
+                addLightAt(inspectorView_->mapFromGlobal(QCursor::pos()), lc::LightKind::Spot);
+            });
     connect(make(tr("&Duplicate"), "actionDuplicate", QKeySequence(tr("Ctrl+D"))), &QAction::triggered, this,
             [this] { doc_->duplicateLights(doc_->selectedLights()); });
     connect(make(tr("De&lete"), "actionDelete", QKeySequence::Delete), &QAction::triggered, this,
@@ -255,6 +259,7 @@ void MainWindow::buildMenus() {
     edit->addAction(action("actionRedo"));
     edit->addSeparator();
     edit->addAction(action("actionAddLight"));
+    edit->addAction(action("actionAddSpotLight"));
     edit->addAction(action("actionDuplicate"));
     edit->addAction(action("actionDelete"));
     edit->addAction(action("actionGenerate"));
@@ -617,24 +622,31 @@ void MainWindow::rebuildRecentMenu() {
 
 int MainWindow::addLightAtCentre() { return addLightAt(QPoint(-1, -1)); }
 
-int MainWindow::addLightAt(const QPoint& pos) {
+int MainWindow::addLightAt(const QPoint& pos, lc::LightKind kind) {
     const lc::Scene& s = doc_->scene();
     const auto [lo, hi] = s.bounds();
     double diag = glm::length(hi - lo);
     if (diag <= 0) diag = std::max(1.0, glm::length(s.camera.target - s.camera.position));
     glm::dvec3 p = diag > 0 && s.triangleCount() > 0 ? 0.5 * (lo + hi) : s.camera.target;
-    glm::dvec3 hit, normal;
-    if (inspectorView_->rect().contains(pos) && inspectorView_->pickSurface(pos, &hit, &normal))
-        p = hit + normal * (0.01 * diag); // just off the surface, on the viewer's side
+    glm::dvec3 hit, normal(0.0, 1.0, 0.0);
+    const bool onSurface = inspectorView_->rect().contains(pos) && inspectorView_->pickSurface(pos, &hit, &normal);
     lc::PointLight l;
-    l.name = QStringLiteral("light %1").arg(s.lights.size()).toStdString();
+    l.kind = kind;
+    // A spot light stands off the surface by a tenth of the scene and points
+    // back at it (no surface: above the centre, pointing down).
+    const double standOff = kind == lc::LightKind::Spot ? 0.1 * diag : 0.01 * diag;
+    if (onSurface) p = hit + normal * standOff; // off the surface, on the viewer's side
+    else if (kind == lc::LightKind::Spot) p += normal * standOff;
+    l.direction = -normal;
+    l.outerAngleDeg = 30;
+    l.name = QStringLiteral("%1 %2").arg(kind == lc::LightKind::Spot ? "spot" : "light").arg(s.lights.size()).toStdString();
     l.position = p;
     l.color = {1, 1, 1};
     l.minIntensity = 0.05;
-    // Radius a tenth of the scene: r^2 = I / I_min.
-    const double r = 0.1 * diag;
+    // Radius a tenth of the scene (a spot's range a fifth): r^2 = I / I_min.
+    const double r = (kind == lc::LightKind::Spot ? 0.2 : 0.1) * diag;
     l.intensity = r * r * l.minIntensity;
-    doc_->addLights({l}, tr("Add light"));
+    doc_->addLights({l}, kind == lc::LightKind::Spot ? tr("Add spot light") : tr("Add light"));
     return int(doc_->scene().lights.size()) - 1;
 }
 

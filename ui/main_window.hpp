@@ -91,8 +91,9 @@ public:
 
     // --- editing ----------------------------------------------------------------
     // Adds a light under the inspector-view position `pos` (logical px) when a
-    // surface is there, else at the scene centre. Returns its index.
-    int addLightAt(const QPoint& inspectorPos);
+    // surface is there, else at the scene centre. Returns its index. A spot
+    // light stands off the surface and points back at it (30 degrees).
+    int addLightAt(const QPoint& inspectorPos, lc::LightKind kind = lc::LightKind::Point);
     int addLightAtCentre();
     // Generates lights as one undo step (progress + cancel for large counts).
     bool generateLights(const lc::LightGenSettings& settings);

@@ -92,11 +92,33 @@ PropertyPanel::PropertyPanel(Document* doc, QWidget* parent) : QWidget(parent), 
     radius_ = new QLabel;
     radius_->setObjectName("lightRadius");
     lf->addRow(tr("Radius"), radius_);
+    kind_ = new QComboBox;
+    kind_->setObjectName("lightKind");
+    kind_->addItem(tr("point"), int(lc::LightKind::Point));
+    kind_->addItem(tr("spot"), int(lc::LightKind::Spot));
+    lf->addRow(tr("Kind"), kind_);
+    const char* dirNames[3] = {"lightDirX", "lightDirY", "lightDirZ"};
+    for (int i = 0; i < 3; ++i) direction_[i] = makeSpin(-1e6, 1e6, 3, dirNames[i]);
+    directionRow_ = row3(direction_);
+    directionRow_->setToolTip(tr("Cone axis, world space (any non-zero length)"));
+    lf->addRow(tr("Direction"), directionRow_);
+    outerAngle_ = makeSpin(0.01, 90, 2, "lightOuterAngle");
+    outerAngle_->setToolTip(tr("Half-angle of the cone in degrees, (0, 90]"));
+    lf->addRow(tr("Outer angle"), outerAngle_);
     stack_->addWidget(lightPage);
+    // Spot rows hide for point lights (Qt 5's QFormLayout has no row visibility).
+    setSpotRowsVisible_ = [lf, this](bool on) {
+        for (QWidget* w : {directionRow_, static_cast<QWidget*>(outerAngle_)}) {
+            w->setVisible(on);
+            if (QWidget* label = lf->labelForField(w)) label->setVisible(on);
+        }
+    };
 
     connect(name_, &QLineEdit::editingFinished, this, &PropertyPanel::commitLight);
-    for (auto* s : {pos_[0], pos_[1], pos_[2], intensity_, minIntensity_, explicitRadius_})
+    for (auto* s : {pos_[0], pos_[1], pos_[2], intensity_, minIntensity_, explicitRadius_, direction_[0],
+                    direction_[1], direction_[2], outerAngle_})
         connect(s, qOverload<double>(&QDoubleSpinBox::valueChanged), this, &PropertyPanel::commitLight);
+    connect(kind_, qOverload<int>(&QComboBox::currentIndexChanged), this, &PropertyPanel::commitLight);
     connect(color_, &QPushButton::clicked, this, [this] {
         const QColor c = pickColor(this, colorValue_);
         if (!c.isValid()) return;
@@ -186,6 +208,10 @@ void PropertyPanel::refresh() {
         intensity_->setValue(l.intensity);
         minIntensity_->setValue(l.minIntensity);
         explicitRadius_->setValue(l.explicitRadius);
+        kind_->setCurrentIndex(kind_->findData(int(l.kind)));
+        for (int i = 0; i < 3; ++i) direction_[i]->setValue(l.direction[i]);
+        outerAngle_->setValue(l.outerAngleDeg);
+        setSpotRowsVisible_(l.isSpot());
         const std::string err = l.validate();
         radius_->setText(err.empty() ? QString::number(l.radius(), 'g', 6)
                                      : tr("invalid: %1").arg(QString::fromStdString(err)));
@@ -228,9 +254,19 @@ void PropertyPanel::commitLight() {
     l.intensity = edited(intensity_, before.intensity);
     l.minIntensity = edited(minIntensity_, before.minIntensity);
     l.explicitRadius = edited(explicitRadius_, before.explicitRadius);
+    l.kind = lc::LightKind(kind_->currentData().toInt());
+    for (int i = 0; i < 3; ++i) l.direction[i] = edited(direction_[i], before.direction[i]);
+    l.outerAngleDeg = edited(outerAngle_, before.outerAngleDeg);
+    // A zero axis has no direction: refuse it and show the previous one again
+    // rather than storing a light that cannot be culled.
+    if (l.direction == glm::dvec3(0.0)) {
+        refresh();
+        return;
+    }
     const bool same = l.name == before.name && l.position == before.position && l.color == before.color &&
                       l.intensity == before.intensity && l.minIntensity == before.minIntensity &&
-                      l.explicitRadius == before.explicitRadius;
+                      l.explicitRadius == before.explicitRadius && l.kind == before.kind &&
+                      l.direction == before.direction && l.outerAngleDeg == before.outerAngleDeg;
     if (!same) doc_->setLight(cur, l);
 }
 

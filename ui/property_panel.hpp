@@ -1,5 +1,6 @@
 #pragma once
-// The properties dock: edits the current light or the culling camera. Every
+// The properties dock: edits the current light (point or spot: kind,
+// direction, outer angle) or the culling camera. Every
 // change becomes one undo command in the document (a value committed in a
 // field, a colour picked, ...).
 
@@ -46,6 +47,12 @@ private:
     QDoubleSpinBox* explicitRadius_;
     QLabel* radius_;
     QColor colorValue_;
+    // spot fields (shown for spot lights only)
+    QComboBox* kind_;
+    QDoubleSpinBox* direction_[3];
+    QWidget* directionRow_;
+    QDoubleSpinBox* outerAngle_;
+    std::function<void(bool)> setSpotRowsVisible_;
     // camera page
     QDoubleSpinBox* camPos_[3];
     QDoubleSpinBox* camTarget_[3];
