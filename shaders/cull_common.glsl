@@ -9,6 +9,7 @@
 // (absolute), so a light the double-precision CPU reference keeps is always
 // kept here too; the GPU lists may only hold MORE entries near a bound.
 #include "culling/gpu_shared.h"
+#include "spot_tests.glsl"
 
 // Local size is a specialisation constant. tile_bounds and prefix_sum run one
 // workgroup = one subgroup (local size = the device's subgroup size) and reduce
@@ -49,6 +50,8 @@ layout(std430, binding = 7) buffer StatusBuf { uint status; uint candidateTests;
 // A set bit means the light's sphere is not outside either side plane of that
 // tile column / row; (tilesX + tilesY) x lightCount bits in all.
 layout(std430, binding = 8) buffer BinBuf { uint binMask[]; };
+// Spot cones (one per light; a 1-element placeholder without cone tests).
+layout(std430, binding = 9) readonly buffer SpotBuf { GpuSpotCone spots[]; };
 
 const uint STATUS_SPLIT_WORKGROUP = 1u; // more than one subgroup per workgroup
 const uint STATUS_COUNT_MISMATCH = 2u;  // write pass found a different count

@@ -21,6 +21,10 @@ float sliceBoundary(float lo, float hi, uint i) {
     return lo + (hi - lo) * t;
 }
 
+bool spotConeOutsideChunkPlane(GpuSpotCone s, vec4 plane, float eps) {
+    return spotConeOutsidePlane(s.apexRange.xyz, s.axisCos.xyz, s.apexRange.w, s.axisCos.w, s.sinAngle.x, plane, eps);
+}
+
 void main() {
     loadParams();
     uint id = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
@@ -73,6 +77,23 @@ void main() {
     uint n = 0u, tested = 0u;
     if (listLive) {
         Chunk ch = makeChunk(tile, max(widenDown(zlo), isOrtho() ? -3.4e38 : 0.0), widenUp(zhi));
+        // Spot cone refinements (spot_tests.glsl), as the CPU reference runs
+        // them after the (tight) sphere test. The chunk's bounding sphere once
+        // per list: centroid of the corners, farthest corner, widened.
+        uint spotMode = P.counts.w & (LC_FLAG_SPOT_CONE_SPHERE | LC_FLAG_SPOT_CONE_PLANES);
+        vec3 cellCentre = vec3(0.0);
+        float cellRadius = 0.0;
+        if (spotMode == LC_FLAG_SPOT_CONE_SPHERE) {
+            // Unrolled: lavapipe caps the loop iterations of an invocation
+            // (vulkan_backend.cpp, kLoopLimit), so no loops per list or light.
+            cellCentre = 0.125 * (((ch.corners[0] + ch.corners[1]) + (ch.corners[2] + ch.corners[3])) +
+                                  ((ch.corners[4] + ch.corners[5]) + (ch.corners[6] + ch.corners[7])));
+            cellRadius = max(max(max(distance(ch.corners[0], cellCentre), distance(ch.corners[1], cellCentre)),
+                                 max(distance(ch.corners[2], cellCentre), distance(ch.corners[3], cellCentre))),
+                             max(max(distance(ch.corners[4], cellCentre), distance(ch.corners[5], cellCentre)),
+                                 max(distance(ch.corners[6], cellCentre), distance(ch.corners[7], cellCentre))));
+            cellRadius += (length(cellCentre) + cellRadius) * P.cluster.z + P.cluster.w;
+        }
         uint base = (WRITE_PASS != 0u) ? listOffset[list] : 0u;
         uint tilesX = P.size.z, tilesY = P.size.w, words = P.bins.x;
         uint tx = tile % tilesX, ty = tile / tilesX;
@@ -90,6 +111,23 @@ void main() {
                 vec4 L = lights[w * 32u + bit].centerRadius;
                 float r = widenedRadius(L);
                 bool pass = sphereHitsChunk(ch, L.xyz, r);
+                if (pass && spotMode != 0u) {
+                    GpuSpotCone s = spots[w * 32u + bit];
+                    if (s.apexRange.w > 0.0) {
+                        float eps = (length(s.apexRange.xyz) + s.apexRange.w) * P.cluster.z + P.cluster.w;
+                        if (spotMode == LC_FLAG_SPOT_CONE_SPHERE) {
+                            pass = spotConeHitsSphere(s.apexRange.xyz, s.axisCos.xyz, s.apexRange.w, s.axisCos.w,
+                                                      s.sinAngle.x, cellCentre, cellRadius, eps);
+                        } else {
+                            pass = !(spotConeOutsideChunkPlane(s, ch.planes[0], eps) ||
+                                     spotConeOutsideChunkPlane(s, ch.planes[1], eps) ||
+                                     spotConeOutsideChunkPlane(s, ch.planes[2], eps) ||
+                                     spotConeOutsideChunkPlane(s, ch.planes[3], eps) ||
+                                     spotConeOutsideChunkPlane(s, ch.planes[4], eps) ||
+                                     spotConeOutsideChunkPlane(s, ch.planes[5], eps));
+                        }
+                    }
+                }
                 if (pass && ALGORITHM == LC_ALG_25D) {
                     float depth = -L.z;
                     pass = (sliceRangeMask(maskLo, maskHi, widenDown(depth - r), widenUp(depth + r)) & geomMask) != 0u;

@@ -54,6 +54,8 @@ const uint LC_FLAG_ORTHO = 1u;         // orthographic projection
 const uint LC_FLAG_REVERSED = 2u;      // reversed-Z (nearer = larger window depth)
 const uint LC_FLAG_FAR_INFINITE = 4u;  // camera far plane at +infinity: no far plane
 const uint LC_FLAG_SKIP_EMPTY = 8u;    // clustered: clusters without geometry get no lights
+const uint LC_FLAG_SPOT_CONE_SPHERE = 16u; // spot lights: cone vs the chunk's bounding sphere
+const uint LC_FLAG_SPOT_CONE_PLANES = 32u; // spot lights: cone vs each of the chunk's planes
 
 // Per-dispatch parameters of the culling passes (one read-only storage buffer,
 // std430). Sizes and modes that shape the code (tile size, cells, slicing,
@@ -89,6 +91,15 @@ struct GpuLight {
     vec4 centerRadius; // xyz: view-space centre, w: bounding-sphere radius
 };
 
+// A spot light's cone for the cone refinements (binding 9, one per light, read
+// only under LC_FLAG_SPOT_CONE_*; docs/SPOT_LIGHTS.md). A separate buffer so
+// that GpuLight, which every pass streams, stays 16 bytes.
+struct GpuSpotCone {
+    vec4 apexRange; // xyz: view-space apex, w: range; w = 0 marks a point light (no cone)
+    vec4 axisCos;   // xyz: unit axis (view space), w: cos(outer angle)
+    vec4 sinAngle;  // x: sin(outer angle), yzw unused
+};
+
 // Per-tile output of the bounds pass (std430, 16 bytes). View depths of the
 // tile's geometry pixels (float): depthMin > depthMax marks an empty tile.
 struct GpuTileBounds {
@@ -106,6 +117,9 @@ static_assert(offsetof(GpuCullParams, lens) == 48, "GpuCullParams.lens offset");
 static_assert(offsetof(GpuCullParams, cluster) == 64, "GpuCullParams.cluster offset");
 static_assert(offsetof(GpuCullParams, bins) == 80, "GpuCullParams.bins offset");
 static_assert(sizeof(GpuLight) == 16, "GpuLight must match std430");
+static_assert(sizeof(GpuSpotCone) == 48, "GpuSpotCone must match std430");
+static_assert(offsetof(GpuSpotCone, axisCos) == 16, "GpuSpotCone.axisCos offset");
+static_assert(offsetof(GpuSpotCone, sinAngle) == 32, "GpuSpotCone.sinAngle offset");
 static_assert(sizeof(GpuTileBounds) == 16, "GpuTileBounds must match std430");
 static_assert(offsetof(GpuTileBounds, cellMask) == 12, "GpuTileBounds.cellMask offset");
 #endif

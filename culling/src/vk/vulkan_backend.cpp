@@ -46,7 +46,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr float kRelEps = 2e-5f;
 constexpr float kAbsEps = 1e-6f;
 
-constexpr std::uint32_t kBindings = 9; // cull_common.glsl bindings 0..8
+constexpr std::uint32_t kBindings = 10; // cull_common.glsl bindings 0..9
 enum Binding : std::uint32_t { bParams, bDepth, bTiles, bLights, bCounts, bOffsets, bIndices, bStatus, bBins };
 // Local size of the one-invocation-per-item passes (light_bins, cull_lists):
 // a multiple of every subgroup size in practice (8 on lavapipe, 32 on NVIDIA,
@@ -547,12 +547,9 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         throw Error("tile grid does not match the camera's resolution");
     if (lights.centers.size() != lights.size()) throw Error("view lights: centres and radii differ in count");
     // Spot lights: the sphere tests need only the chosen sphere (below); the
-    // cone refinements are not in the cull shader yet (docs/SPOT_LIGHTS.md).
-    if (!lights.spotAngles.empty() &&
-        (settings.spotTest == SpotTest::ConeSphere || settings.spotTest == SpotTest::ConePlanes))
-        throw SettingsError("spot-test", std::string(toString(settings.spotTest)) +
-                                             " is not implemented on the vulkan backend yet (use the cpu "
-                                             "backend, or apex-sphere / tight-sphere)");
+    // cone tests also upload each spot's cone (binding 9).
+    const bool spotCones = !lights.spotAngles.empty() &&
+                           (settings.spotTest == SpotTest::ConeSphere || settings.spotTest == SpotTest::ConePlanes);
 
     const Algorithm algo = settings.algorithm;
     const std::uint32_t tiles = grid.tileCount(), cells = settings.cells;
@@ -599,6 +596,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         if (isReversed(proj.kind())) flags |= LC_FLAG_REVERSED;
         if (farInfinite) flags |= LC_FLAG_FAR_INFINITE;
         if (settings.skipEmpty) flags |= LC_FLAG_SKIP_EMPTY;
+        if (spotCones)
+            flags |= settings.spotTest == SpotTest::ConeSphere ? LC_FLAG_SPOT_CONE_SPHERE : LC_FLAG_SPOT_CONE_PLANES;
         p.size = glm::uvec4(grid.width, grid.height, grid.tilesX, grid.tilesY);
         p.counts = glm::uvec4(n, res.listsPerTile, listTotal, flags);
         double a, b;
@@ -613,6 +612,17 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     std::vector<GpuLight> gpuLights(n);
     for (std::uint32_t l = 0; l < n; ++l)
         gpuLights[l].centerRadius = glm::vec4(glm::vec3(cullSpheres[l].center), float(cullSpheres[l].radius));
+    // One cone per light under a cone test (range 0: a point light), else a
+    // single unused element.
+    std::vector<GpuSpotCone> gpuSpots(spotCones ? n : 1, GpuSpotCone{});
+    if (spotCones)
+        for (std::uint32_t l = 0; l < n; ++l) {
+            if (!lights.isSpot(l)) continue;
+            const SpotCone c = lights.spotCone(l);
+            gpuSpots[l].apexRange = glm::vec4(glm::vec3(c.apex), float(c.range));
+            gpuSpots[l].axisCos = glm::vec4(glm::vec3(c.axis), float(c.cosAngle));
+            gpuSpots[l].sinAngle = glm::vec4(float(c.sinAngle), 0.0f, 0.0f, 0.0f);
+        }
     const std::uint32_t statusZero[2] = {0, 0};
 
     // Device buffers (sizes from the inputs; the index array comes after the count).
@@ -626,11 +636,13 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     Buffer offsetBuf = ctx_.createDeviceBuffer((std::size_t(listTotal) + 1) * 4, ssbo, "cull.offsets");
     Buffer statusBuf = ctx_.createDeviceBuffer(8, ssbo, "cull.status"); // status bits, candidate tests
     Buffer placeholder = ctx_.createDeviceBuffer(4, ssbo, "cull.indices.placeholder");
+    Buffer spotBuf = ctx_.createDeviceBuffer(gpuSpots.size() * sizeof(GpuSpotCone), ssbo, "cull.spots");
 
     Staging staging(ctx_);
     staging.upload(params, &p, sizeof p);
     staging.upload(depthBuf, depth.depth.data(), depth.depth.size() * 4);
     staging.upload(lightBuf, gpuLights.data(), gpuLights.size() * sizeof(GpuLight));
+    staging.upload(spotBuf, gpuSpots.data(), gpuSpots.size() * sizeof(GpuSpotCone));
     staging.upload(statusBuf, statusZero, 8);
     const auto* counts = static_cast<const std::uint32_t*>(staging.download(countBuf, std::size_t(listTotal) * 4));
     const auto* offs = static_cast<const std::uint32_t*>(staging.download(offsetBuf, (std::size_t(listTotal) + 1) * 4));
@@ -658,7 +670,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         LC_VK(vkAllocateDescriptorSets(dev, &ai, &set));
         ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_SET, set, nm);
         const Buffer* bufs[kBindings] = {&params,    &depthBuf, &tileBuf,   &lightBuf, &countBuf,
-                                         &offsetBuf, &indices,  &statusBuf, &binBuf};
+                                         &offsetBuf, &indices,  &statusBuf, &binBuf,  &spotBuf};
         std::array<VkDescriptorBufferInfo, kBindings> infos{};
         std::array<VkWriteDescriptorSet, kBindings> writes{};
         for (std::uint32_t i = 0; i < kBindings; ++i) {
