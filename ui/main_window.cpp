@@ -9,6 +9,7 @@
 #include "property_panel.hpp"
 #include "scene_tree.hpp"
 #include "tile_inspector.hpp"
+#include "report_dock.hpp"
 
 #include "culling/errors.hpp"
 #include "culling/scene_io.hpp"
@@ -165,6 +166,8 @@ void MainWindow::buildDocks() {
     dock(tr("Properties"), "propertiesDock", properties_, Qt::LeftDockWidgetArea);
     dock(tr("Tile inspector"), "tileDock", tileInspector_, Qt::RightDockWidgetArea);
     dock(tr("Message log"), "logDock", log_, Qt::BottomDockWidgetArea);
+    tabifyDockWidget(findChild<QDockWidget*>("logDock"),
+                     dock(tr("Report"), "reportDock", new ReportDock(doc_), Qt::BottomDockWidgetArea));
 }
 
 void MainWindow::buildActions() {
