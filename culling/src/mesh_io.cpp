@@ -323,25 +323,100 @@ void scanAsciiForNonFinite(const std::string& path, const std::string& ext, std:
     }
 }
 
-// OpenMesh 9.0's PLY reader loops forever on a header that never reaches
-// "end_header" (found by fuzzing): require that line before handing it over.
-void checkPlyHeaderEnds(const std::string& path) {
+// OpenMesh 9.0's PLY and OFF readers loop forever on some malformed headers
+// (found by fuzzing: a PLY header without "end_header" or with an element
+// line lacking its count; an OFF file whose count line is not three numbers).
+// The headers are therefore checked against their grammar first, and element
+// counts against what the file can hold (every vertex and face takes at least
+// 2 bytes), so OpenMesh only ever sees a well-formed header.
+void checkPlyHeader(const std::string& path, std::uint64_t size) {
     std::ifstream in(path, std::ios::binary);
     std::string line;
     int n = 0;
+    auto fail = [&](const std::string& what) { throw InputError(path, "", n, "PLY header: " + what); };
     while (std::getline(in, line)) {
         ++n;
         if (!line.empty() && line.back() == '\r') line.pop_back();
-        if (n == 1 && line != "ply") throw InputError(path, "", 1, "a PLY file starts with the line \"ply\"");
-        if (line == "end_header") return;
+        std::istringstream words(line);
+        std::string key, a, b, extra;
+        words >> key;
+        if (n == 1) {
+            if (line != "ply") fail("the first line must be \"ply\"");
+            continue;
+        }
+        if (key == "end_header") return;
+        if (key == "comment" || key == "obj_info" || key.empty()) continue;
+        if (key == "format") {
+            words >> a >> b;
+            if ((a != "ascii" && a != "binary_little_endian" && a != "binary_big_endian") || b.empty())
+                fail("bad format line '" + line + "'");
+        } else if (key == "element") {
+            words >> a;
+            unsigned long long count = 0;
+            if (a.empty() || !(words >> count) || (words >> extra))
+                fail("an element line is \"element <name> <count>\", not '" + line + "'");
+            if (count > size / 2 + 1)
+                fail("element '" + a + "' announces " + std::to_string(count) + " items, more than the " +
+                     std::to_string(size) + "-byte file can hold");
+        } else if (key == "property") {
+            // "property <type> <name>" or "property list <count type> <type> <name>".
+            std::vector<std::string> t;
+            for (std::string w; words >> w;) t.push_back(w);
+            if (t.size() != (!t.empty() && t[0] == "list" ? 4u : 2u)) fail("bad property line '" + line + "'");
+        } else {
+            fail("unknown header line '" + line + "'");
+        }
     }
     throw InputError(path, "", n, "PLY header has no \"end_header\" line");
+}
+
+void checkOffHeader(const std::string& path, std::uint64_t size) {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    int n = 0;
+    bool sawKeyword = false;
+    while (std::getline(in, line)) {
+        ++n;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        const auto hash = line.find('#');
+        if (hash != std::string::npos) line.erase(hash);
+        std::istringstream words(line);
+        std::string first;
+        if (!(words >> first)) continue; // blank or comment
+        if (!sawKeyword) {
+            sawKeyword = true;
+            // [ST][C][N][4][n]OFF, possibly followed by BINARY (then counts are binary).
+            if (first.size() < 3 || first.compare(first.size() - 3, 3, "OFF") != 0)
+                throw InputError(path, "", n, "OFF file: the first line must name the OFF format, not '" + line + "'");
+            std::string rest;
+            if (words >> rest) {
+                if (rest == "BINARY") return;
+                // The counts may follow the keyword on the same line.
+                line = rest + line.substr(line.find(rest) + rest.size());
+            } else {
+                continue;
+            }
+        }
+        std::istringstream counts(line);
+        unsigned long long nv = 0, nf = 0;
+        std::string ne, extra;
+        if (!(counts >> nv >> nf >> ne) || (counts >> extra) ||
+            ne.find_first_not_of("0123456789") != std::string::npos)
+            throw InputError(path, "", n, "OFF file: the counts line is \"<vertices> <faces> <edges>\", not '" + line + "'");
+        if (nv > size / 2 + 1 || nf > size / 2 + 1)
+            throw InputError(path, "", n, "OFF file announces " + std::to_string(nv) + " vertices and " +
+                                              std::to_string(nf) + " faces, more than the " + std::to_string(size) +
+                                              "-byte file can hold");
+        return;
+    }
+    throw InputError(path, "", n, "OFF file: no counts line");
 }
 
 // PLY, OFF, STL and OM through OpenMesh's readers into the flat importer.
 void readWithOpenMesh(const std::string& path, const std::string& ext, std::uint64_t size,
                       FlatImporter& imp, const CancelToken* cancel, const Progress& progress) {
-    if (ext == "ply") checkPlyHeaderEnds(path);
+    if (ext == "ply") checkPlyHeader(path, size);
+    if (ext == "off") checkOffHeader(path, size);
     scanAsciiForNonFinite(path, ext, size);
     imp.fileSize = size;
     imp.cancel = cancel;

@@ -7,7 +7,9 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <future>
 #include <new>
 #include <thread>
@@ -53,29 +55,68 @@ std::string loadError(const std::string& path, std::chrono::seconds limit) {
     return result.get();
 }
 
-// fuzz_mesh_ply: OpenMesh's PLY reader looped forever on a header without
-// "end_header" (a hang in the studio and the CLI). The file has 12 lines; the
-// error names the last one read.
-TEST(MeshHostile, PlyHeaderWithoutEndHeaderIsAClearError) {
+// OpenMesh 9.0's PLY reader looped forever on these headers (a hang in the
+// studio and the CLI); loadMesh now checks the header grammar first.
+// fuzz_mesh_ply found: a mangled property line and no "end_header".
+TEST(MeshHostile, PlyUnknownHeaderLineIsAClearError) {
     const std::string path = kData + "/fuzz_ply_no_end_header.ply";
+    const std::string error = loadError(path, std::chrono::seconds(20));
+    EXPECT_EQ(error.rfind(path + ":5: PLY header: unknown header line 'prope", 0), 0u) << error;
+}
+
+// fuzz_mesh_ply found: "element fdices" (no count) on line 8.
+TEST(MeshHostile, PlyElementWithoutCountIsAClearError) {
+    const std::string path = kData + "/fuzz_ply_element_without_count.ply";
     EXPECT_EQ(loadError(path, std::chrono::seconds(20)),
-              path + ":12: PLY header has no \"end_header\" line");
+              path + ":8: PLY header: an element line is \"element <name> <count>\", not 'element fdices'");
+}
+
+// Hand-written: six valid header lines and nothing else (the last one named).
+TEST(MeshHostile, PlyWithoutEndHeaderIsAClearError) {
+    const std::string path = kData + "/ply_without_end_header.ply";
+    EXPECT_EQ(loadError(path, std::chrono::seconds(20)), path + ":6: PLY header has no \"end_header\" line");
 }
 
 TEST(MeshHostile, PlyWithoutPlyFirstLineIsAClearError) {
     const std::string path = kData + "/garbage.ply";
-    EXPECT_EQ(loadError(path, std::chrono::seconds(20)), path + ":1: a PLY file starts with the line \"ply\"");
+    EXPECT_EQ(loadError(path, std::chrono::seconds(20)), path + ":1: PLY header: the first line must be \"ply\"");
 }
 
-// fuzz_mesh_off: a 31-byte OFF file announcing ~1.1e9 vertices made the
-// importer reserve 13.7 GB before reading a single vertex.
+// fuzz_mesh_off found: "OF4\0 4 2 0" as the counts line made OpenMesh's OFF
+// reader spin.
+TEST(MeshHostile, OffCountsLineThatIsNotNumbersIsAClearError) {
+    const std::string path = kData + "/fuzz_off_bad_counts_line.off";
+    const std::string error = loadError(path, std::chrono::seconds(20));
+    EXPECT_EQ(error.rfind(path + ":2: OFF file: the counts line is \"<vertices> <faces> <edges>\"", 0), 0u) << error;
+}
+
+// fuzz_mesh_off found: a 31-byte OFF file whose header made the importer
+// reserve 13.7 GB before reading a single vertex.
 TEST(MeshHostile, OffHeaderCountsDoNotDriveAllocations) {
     const std::string path = kData + "/fuzz_off_huge_counts.off";
     gLargestAllocation = 0;
     const std::string error = loadError(path, std::chrono::seconds(20));
-    EXPECT_EQ(error.rfind(path + ": ", 0), 0u) << error;
+    EXPECT_EQ(error.rfind(path + ":2: OFF file: ", 0), 0u) << error;
     EXPECT_LT(gLargestAllocation.load(), std::size_t(1) << 20) << "an allocation of " << gLargestAllocation.load()
                                                               << " bytes for a 31-byte file";
+}
+
+// Well-formed headers announcing more elements than the file can hold.
+TEST(MeshHostile, AnnouncedCountsBeyondTheFileSizeAreAClearError) {
+    const std::string off = ::testing::TempDir() + "/lc_huge_counts.off";
+    const std::string ply = ::testing::TempDir() + "/lc_huge_counts.ply";
+    {
+        std::ofstream(off) << "OFF\n2000000000 1 0\n0 0 0\n";
+        std::ofstream(ply) << "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nend_header\n0\n";
+    }
+    gLargestAllocation = 0;
+    EXPECT_EQ(loadError(off, std::chrono::seconds(20)),
+              off + ":2: OFF file announces 2000000000 vertices and 1 faces, more than the 25-byte file can hold");
+    EXPECT_EQ(loadError(ply, std::chrono::seconds(20)),
+              ply + ":3: PLY header: element 'vertex' announces 4000000000 items, more than the 77-byte file can hold");
+    EXPECT_LT(gLargestAllocation.load(), std::size_t(1) << 20);
+    std::remove(off.c_str());
+    std::remove(ply.c_str());
 }
 
 } // namespace
