@@ -37,6 +37,9 @@ class SpotConesActor;
 class InspectorView : public QVTKOpenGLNativeWidget {
     Q_OBJECT
 public:
+    // Depth peeling (order-independent translucency) is used up to this many
+    // lights; beyond it every frame would redraw all spheres once per peel.
+    static constexpr std::size_t kMaxPeeledLights = 256;
     explicit InspectorView(Document* doc, QWidget* parent = nullptr);
     ~InspectorView() override;
 
