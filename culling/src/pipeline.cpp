@@ -112,6 +112,7 @@ RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBack
         truthOptions.imageError = false; // from the backend's shading pass below
         const auto t2 = Clock::now();
         out.truth = computeGroundTruth(out.depth, proj, out.lights, out.result, truthOptions, cancel);
+        out.truthComputed = true;
         out.result.timings.groundTruthMs =
             std::chrono::duration<double, std::milli>(Clock::now() - t2).count();
     }

@@ -18,6 +18,8 @@ struct RunOutput {
     // True when the depth pre-pass was skipped for RunOptions::reuseDepth
     // (timings.depthMs is then 0).
     bool depthReused = false;
+    // False when RunOptions::groundTruth was off: `truth` is then empty.
+    bool truthComputed = false;
 };
 
 struct RunOptions {
