@@ -1,13 +1,59 @@
 #!/usr/bin/env bash
-# Sets up what is missing, builds, and runs the WHOLE test suite (every CTest
-# label: unit, gpu, hardcase, render, ui). GUI tests need an X server: when no
-# DISPLAY is set the suite runs under Xvfb. Extra arguments go to ctest.
+# The README's test command and CI (.ci/run). Three stages, each timed:
+#   1. build (preset default) and run the WHOLE test suite (every CTest label:
+#      unit, gpu, hardcase, render, ui); GUI tests need an X server, so without
+#      DISPLAY the suite runs under Xvfb. Extra arguments go to this ctest.
+#   2. ASan+UBSan build (preset asan, build-asan/) and its `unit` and
+#      `hardcase` tests, with third-party (Mesa/LLVM/validation layer) leak
+#      reports suppressed by scripts/lsan.supp and nothing else.
+#   3. the bounded libFuzzer runs (scripts/fuzz.sh, build-fuzz/).
+# LIGHTCULL_TEST_STAGES selects stages; the default is "1 2 3", or only "1"
+# when ctest arguments are given (`scripts/test.sh -L unit` runs a subset).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/build.sh
-ctest_cmd=(ctest --preset default --timeout 900 "$@")
-if [ -z "${DISPLAY:-}" ]; then
-  exec xvfb-run -a -s "-screen 0 1920x1080x24" "${ctest_cmd[@]}"
-else
-  exec "${ctest_cmd[@]}"
+if [ $# -gt 0 ]; then default_stages="1"; else default_stages="1 2 3"; fi
+stages="${LIGHTCULL_TEST_STAGES:-$default_stages}"
+jobs="$(nproc)"
+
+stage_time() { # name start
+  echo "test.sh: $1 took $(( $(date +%s) - $2 )) s"
+}
+with_display() {
+  if [ -z "${DISPLAY:-}" ]; then
+    xvfb-run -a -s "-screen 0 1920x1080x24" "$@"
+  else
+    "$@"
+  fi
+}
+
+if [[ " $stages " == *" 1 "* ]]; then
+  t0=$(date +%s)
+  scripts/build.sh
+  stage_time "stage 1 build" "$t0"
+  t1=$(date +%s)
+  with_display ctest --preset default --timeout 900 "$@"
+  stage_time "stage 1 tests (whole suite)" "$t1"
+fi
+
+if [[ " $stages " == *" 2 "* ]]; then
+  t0=$(date +%s)
+  scripts/install-deps.sh
+  cmake --preset asan >/dev/null
+  cmake --build --preset asan -j"$jobs"
+  stage_time "stage 2 ASan+UBSan build" "$t0"
+  t1=$(date +%s)
+  # halt_on_error: the first report fails the test. The suppressions name
+  # only third-party libraries (see the file).
+  ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" \
+  LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0" \
+  UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
+    ctest --test-dir build-asan -L '^(unit|hardcase)$' --output-on-failure -j "$jobs" --timeout 900 \
+      --no-tests=error
+  stage_time "stage 2 ASan+UBSan unit+hardcase tests" "$t1"
+fi
+
+if [[ " $stages " == *" 3 "* ]]; then
+  t0=$(date +%s)
+  scripts/fuzz.sh
+  stage_time "stage 3 fuzzing (build + runs)" "$t0"
 fi

@@ -417,7 +417,7 @@ inline const std::vector<HardCase>& hardCases() {
                  return s;
              },
              SphereTest::Exact, 32, Slicing::Log, "", 0, checkSomeEmptyTiles});
-        add({"lights_touching_bounds", "lights whose spheres exactly touch a tile's side plane or its depth bound",
+        add({"lights_touching_bounds", "a wall whose stored depth is exact in float (orthographic, 0.5): lights exactly touching a tile side plane or its near/far depth bound",
              [] {
                  Scene s = makeBuiltinScene("wall");
                  s.camera.width = 96;
