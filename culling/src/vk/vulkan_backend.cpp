@@ -19,6 +19,7 @@
 #include "vk/vk_context.hpp"
 #include "vk/shade_pass.hpp"
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
@@ -431,13 +432,31 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
         std::int32_t vertexOffset;
     };
     std::vector<Draw> draws;
+    std::vector<glm::dvec3> centres; // per drawn mesh, model space
     std::size_t vertexFloats = 0, indexCount = 0;
     const glm::dmat4 clipFromWorld = proj.clipFromView() * scene.camera.viewFromWorld();
     for (const Mesh& m : scene.meshes) {
         if (m.triangleCount() == 0) continue;
+        // A mesh that sits farther from its model origin than its own size
+        // goes up relative to the centre of its bounding box (subtracted in
+        // double) and the matrix takes the centre back: float then only holds
+        // small coordinates and a camera-relative matrix, so a scene far from
+        // the origin (1e5) keeps its depth precision instead of cancelling two
+        // large float terms in the shader. Other meshes go up unchanged (the
+        // shift would only move their rounding).
+        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+        for (std::size_t i = 0; i < m.vertexCount(); ++i) {
+            const glm::dvec3 p(m.positions[3 * i], m.positions[3 * i + 1], m.positions[3 * i + 2]);
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+        glm::dvec3 c = m.vertexCount() ? 0.5 * (lo + hi) : glm::dvec3(0.0);
+        if (!(glm::length(c) > glm::length(hi - lo))) c = glm::dvec3(0.0);
+        centres.push_back(c);
         // Composed in double, rounded once to float.
-        draws.push_back({glm::mat4(clipFromWorld * m.transform), std::uint32_t(indexCount),
-                         std::uint32_t(m.triangleCount() * 3), std::int32_t(vertexFloats / 3)});
+        draws.push_back({glm::mat4(clipFromWorld * m.transform * glm::translate(glm::dmat4(1.0), c)),
+                         std::uint32_t(indexCount), std::uint32_t(m.triangleCount() * 3),
+                         std::int32_t(vertexFloats / 3)});
         vertexFloats += m.vertexCount() * 3;
         indexCount += m.triangleCount() * 3;
     }
@@ -450,9 +469,12 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
         std::vector<std::uint32_t> ix;
         v.reserve(vertexFloats);
         ix.reserve(indexCount);
+        std::size_t drawn = 0;
         for (const Mesh& m : scene.meshes) {
             if (m.triangleCount() == 0) continue;
-            v.insert(v.end(), m.positions.data(), m.positions.data() + m.vertexCount() * 3);
+            const glm::dvec3 c = centres[drawn++];
+            for (std::size_t i = 0; i < m.vertexCount() * 3; ++i)
+                v.push_back(float(double(m.positions[i]) - c[int(i % 3)]));
             ix.insert(ix.end(), m.indices.data(), m.indices.data() + m.triangleCount() * 3);
         }
         staging.upload(vbuf, v.data(), v.size() * 4);
