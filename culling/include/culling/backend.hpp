@@ -53,13 +53,6 @@ public:
                             const ViewLights& lights, const CullSettings& settings) = 0;
     double lastDepthMs() const { return lastDepthMs_; }
     virtual std::string timingMethod() const = 0;
-    // Lambert shading pass (culling/shade.hpp) over a G-buffer built by
-    // makeShadeInputs: each geometry pixel shaded from the lights of its list
-    // in `culled` (null: every light in index order). Returns RGB, 3 floats per
-    // pixel, background 0. Sets lastShadeMs(), timed like cull(). The default
-    // is the CPU reference (shadeCpu) timed by steady_clock.
-    virtual std::vector<float> shade(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled);
-    double lastShadeMs() const { return lastShadeMs_; }
     // CPU wall-clock milliseconds of the last cull() around its submissions
     // (equal to its cullMs where that is the timing method; -1: not run).
     virtual double lastCullWallMs() const { return -1; }
@@ -67,6 +60,13 @@ public:
     // since the last resetPeakDeviceBytes(); 0 for backends without a device.
     virtual std::size_t peakDeviceBytes() const { return 0; }
     virtual void resetPeakDeviceBytes() {}
+    // Lambert shading pass (culling/shade.hpp) over a G-buffer built by
+    // makeShadeInputs: each geometry pixel shaded from the lights of its list
+    // in `culled` (null: every light in index order). Returns RGB, 3 floats per
+    // pixel, background 0. Sets lastShadeMs(), timed like cull(). The default
+    // is the CPU reference (shadeCpu) timed by steady_clock.
+    virtual std::vector<float> shade(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled);
+    double lastShadeMs() const { return lastShadeMs_; }
 
 protected:
     double lastDepthMs_ = -1;
