@@ -1,6 +1,9 @@
 #include "cull_worker.hpp"
 
 #include "culling/errors.hpp"
+#include "culling/projection.hpp"
+
+#include <chrono>
 
 #include <QMetaObject>
 
@@ -24,6 +27,7 @@ void CullWorker::post(CullRequest request) {
         std::lock_guard lock(mutex_);
         if (pending_) ++dropped_;
         pending_ = std::move(request);
+        if (truthCancel_) truthCancel_->cancelled = true;
         if (!scheduled_) scheduled_ = schedule = true;
     }
     if (schedule) QMetaObject::invokeMethod(this, "drain", Qt::QueuedConnection);
@@ -33,11 +37,37 @@ void CullWorker::cancelCurrent() {
     std::lock_guard lock(mutex_);
     pending_.reset();
     if (cancel_) cancel_->cancelled = true;
+    if (truthCancel_) truthCancel_->cancelled = true;
 }
 
 quint64 CullWorker::droppedRequests() const {
     std::lock_guard lock(mutex_);
     return dropped_;
+}
+
+void CullWorker::addDeferredTruth(const CullRequest& req, const lc::RunOutput& partial) {
+    auto truthCancel = std::make_shared<lc::CancelToken>();
+    {
+        std::lock_guard lock(mutex_);
+        if (pending_) return; // the newer request will bring its own
+        truthCancel_ = truthCancel;
+    }
+    try {
+        auto full = std::make_shared<lc::RunOutput>(partial);
+        lc::GroundTruthOptions truthOptions;
+        truthOptions.imageError = false;
+        const auto t0 = std::chrono::steady_clock::now();
+        full->truth = lc::computeGroundTruth(full->depth, lc::Projection(req.scene->camera), full->lights,
+                                             full->result, truthOptions, truthCancel.get());
+        full->result.timings.groundTruthMs =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        full->truthComputed = true;
+        emit finished(req.generation, std::shared_ptr<const lc::RunOutput>(std::move(full)));
+    } catch (const lc::Cancelled&) {
+        // A newer request arrived: its run supersedes this truth.
+    }
+    std::lock_guard lock(mutex_);
+    if (truthCancel_ == truthCancel) truthCancel_.reset();
 }
 
 void CullWorker::drain() {
@@ -73,13 +103,15 @@ void CullWorker::drain() {
             options.truthOptions.imageError = false;
             if (depth_ && depthScene_ && sameGeometry(*depthScene_, *req.scene))
                 options.reuseDepth = depth_.get();
+            options.groundTruth = !req.deferTruth;
             auto out = std::make_shared<lc::RunOutput>(
                 lc::runPipeline(*req.scene, req.settings, *backend_, options, cancel.get()));
             if (!out->depthReused) {
                 depth_ = std::make_shared<const lc::DepthImage>(out->depth);
                 depthScene_ = req.scene;
             }
-            emit finished(req.generation, std::shared_ptr<const lc::RunOutput>(std::move(out)));
+            emit finished(req.generation, std::shared_ptr<const lc::RunOutput>(out));
+            if (req.deferTruth) addDeferredTruth(req, *out);
         } catch (const lc::Cancelled&) {
             emit failed(req.generation, tr("culling cancelled"));
         } catch (const std::exception& e) {
@@ -108,13 +140,14 @@ CullService::~CullService() {
 }
 
 quint64 CullService::request(const lc::Scene& scene, const lc::CullSettings& settings,
-                             const QString& backend, const QString& device) {
+                             const QString& backend, const QString& device, bool deferTruth) {
     CullRequest r;
     r.generation = ++generation_;
     r.scene = std::make_shared<const lc::Scene>(scene);
     r.settings = settings;
     r.backend = backend.toStdString();
     r.device = device.toStdString();
+    r.deferTruth = deferTruth;
     worker_->post(std::move(r));
     return generation_;
 }

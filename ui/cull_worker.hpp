@@ -27,6 +27,11 @@ struct CullRequest {
     lc::CullSettings settings;
     std::string backend; // "cpu", "vulkan"
     std::string device;  // selector for makeBackend (empty: default)
+    // A Live edit: the result is sent as soon as the lists exist, and ground
+    // truth follows as a second result of the same generation unless a newer
+    // request arrives first (ground truth costs more than culling, so a drag
+    // would otherwise be paced by it).
+    bool deferTruth = false;
 };
 
 class CullWorker : public QObject {
@@ -50,11 +55,16 @@ private slots:
     void drain();
 
 private:
+    // Second phase of a deferTruth request (worker thread).
+    void addDeferredTruth(const CullRequest& req, const lc::RunOutput& partial);
+
+private:
     mutable std::mutex mutex_;
     std::optional<CullRequest> pending_;
     bool scheduled_ = false;
     quint64 dropped_ = 0;
     std::shared_ptr<lc::CancelToken> cancel_;
+    std::shared_ptr<lc::CancelToken> truthCancel_; // set by post(): a newer request stops deferred truth
     // Touched only on the worker thread:
     std::unique_ptr<lc::CullBackend> backend_;
     std::string backendName_, deviceSelector_;
@@ -73,7 +83,7 @@ public:
 
     // Copies the scene and posts it; returns the request's generation.
     quint64 request(const lc::Scene& scene, const lc::CullSettings& settings,
-                    const QString& backend, const QString& device);
+                    const QString& backend, const QString& device, bool deferTruth = false);
     quint64 lastGeneration() const { return generation_; }
     CullWorker* worker() { return worker_; }
     // "vulkan" when this build and machine have it, else "cpu".

@@ -115,7 +115,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
         updateStatus();
     });
     connect(doc_, &Document::sceneEdited, this, [this] {
-        if (isLive()) runCulling();
+        if (isLive()) runCulling(/*liveEdit=*/true);
     });
     connect(doc_, &Document::settingsChanged, this, [this] {
         syncParamWidgets();
@@ -431,9 +431,9 @@ void MainWindow::setBackend(const QString& backend, const QString& device) {
 
 // --- culling -------------------------------------------------------------------------
 
-quint64 MainWindow::runCulling() {
+quint64 MainWindow::runCulling(bool liveEdit) {
     const quint64 gen = service_->request(doc_->scene(), doc_->settings(), backendCombo_->currentText(),
-                                          deviceEdit_->text());
+                                          deviceEdit_->text(), liveEdit);
     statusBar()->showMessage(tr("culling (run %1)...").arg(gen));
     return gen;
 }
@@ -444,7 +444,8 @@ bool MainWindow::isLive() const { return action("actionLive")->isChecked(); }
 void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::RunOutput> out) {
     if (!doc_->setRunOutput(out, generation)) return; // an older run finished late
     const auto& m = out->truth.metrics;
-    log(tr("run %1: %2, %3 lights, depth %4 ms, cull %5 ms, false negatives %6, efficiency %7")
+    // A Live edit's lists arrive before its ground truth: log once, with it.
+    if (out->truthComputed) log(tr("run %1: %2, %3 lights, depth %4 ms, cull %5 ms, false negatives %6, efficiency %7")
             .arg(generation)
             .arg(lc::toString(out->result.algorithm))
             .arg(out->lights.size())
@@ -481,6 +482,22 @@ void MainWindow::updateStatus() {
     const QString depth = run->depthReused ? tr("depth reused")
                                            : tr("depth %1 ms").arg(run->result.timings.depthMs, 0, 'f', 2);
     statusTimes_->setText(tr("%1 | cull %2 ms").arg(depth).arg(run->result.timings.cullMs, 0, 'f', 2));
+    if (!run->truthComputed) {
+        // Live edit: ground truth is still being computed (or was superseded).
+        const auto& counts = run->result.listCount;
+        std::uint64_t sum = 0, mx = 0;
+        for (std::uint32_t c : counts) {
+            sum += c;
+            mx = std::max<std::uint64_t>(mx, c);
+        }
+        statusFn_->setText(tr("FN ..."));
+        statusFn_->setStyleSheet("color: gray");
+        statusEfficiency_->setText(tr("efficiency ..."));
+        statusLists_->setText(tr("mean/max list %1 / %2")
+                                  .arg(counts.empty() ? 0.0 : double(sum) / double(counts.size()), 0, 'f', 2)
+                                  .arg(mx));
+        return;
+    }
     statusFn_->setText(tr("FN %1").arg(m.falseNegatives));
     statusFn_->setStyleSheet(m.falseNegatives > 0 ? "color: white; background: #c0392b; padding: 0 4px"
                                                   : "color: #2e7d32");

@@ -81,7 +81,9 @@ public:
 
     // --- culling ----------------------------------------------------------------
     // Posts a run of the current scene and settings; returns its generation.
-    quint64 runCulling();
+    // `liveEdit`: a Live re-run after a scene edit; its lists are shown first
+    // and ground truth follows (CullRequest::deferTruth).
+    quint64 runCulling(bool liveEdit = false);
     void setLive(bool live);
     bool isLive() const;
     // The backend and device selector the next run uses.

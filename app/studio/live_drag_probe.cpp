@@ -64,15 +64,17 @@ void LiveDragProbe::step() {
 
 void LiveDragProbe::onFinished(quint64 generation) {
     if (firstEditMs_ < 0) return; // a run from before the drag
+    if (const auto run = window_->document()->runOutput(); run && run->truthComputed)
+        truth_.push_back(run->result.timings.groundTruthMs);
     const auto it = editAtMs_.find(generation);
     if (it == editAtMs_.end()) return;
     const double now = clock_.nsecsElapsed() * 1e-6;
     latencies_.push_back(now - it->second);
     lastShownMs_ = now;
+    editAtMs_.erase(it); // the same generation's ground truth may follow: count it once
     if (const auto run = window_->document()->runOutput()) {
         cull_.push_back(run->result.timings.cullMs);
         depth_.push_back(run->result.timings.depthMs);
-        truth_.push_back(run->result.timings.groundTruthMs);
     }
 }
 
@@ -90,5 +92,6 @@ void LiveDragProbe::finish() {
     r.medianCullMs = median(cull_);
     r.medianDepthMs = median(depth_);
     r.medianTruthMs = median(truth_);
+    r.truths = int(truth_.size());
     emit done(r);
 }

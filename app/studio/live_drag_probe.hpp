@@ -22,7 +22,9 @@ struct LiveDragReport {
     int shown = 0;           // runs whose result reached the views
     double seconds = 0;      // from the first edit to the last result
     double medianLatencyMs = 0, maxLatencyMs = 0;
-    double medianCullMs = 0, medianDepthMs = 0, medianTruthMs = 0;
+    double medianCullMs = 0, medianDepthMs = 0;
+    double medianTruthMs = 0; // of the ground truths that completed (a newer edit cancels one)
+    int truths = 0;
     double rateHz() const { return seconds > 0 ? shown / seconds : 0; }
 };
 

@@ -142,9 +142,9 @@ int main(int argc, char** argv) {
             std::fprintf(stdout,
                          "live drag: %d edits, %d results shown in %.2f s: %.1f Hz; latency edit->shown "
                          "median %.1f ms, max %.1f ms; per run median depth %.1f ms, cull %.1f ms, "
-                         "ground truth %.1f ms\n",
+                         "ground truth %.1f ms (%d completed)\n",
                          r.edits, r.shown, r.seconds, r.rateHz(), r.medianLatencyMs, r.maxLatencyMs,
-                         r.medianDepthMs, r.medianCullMs, r.medianTruthMs);
+                         r.medianDepthMs, r.medianCullMs, r.medianTruthMs, r.truths);
             window.document()->undoStack()->setClean();
             app.exit(r.shown > 0 ? 0 : 1);
         });

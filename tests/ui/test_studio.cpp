@@ -13,6 +13,8 @@
 #include "scene_tree.hpp"
 #include "tile_inspector.hpp"
 
+#include "culling/ground_truth.hpp"
+#include "culling/pipeline.hpp"
 #include "culling/projection.hpp"
 #include "culling/scene_io.hpp"
 
@@ -549,6 +551,33 @@ private slots:
         QVERIFY(waitRun(gen + 3));
         QVERIFY(!doc()->runOutput()->depthReused);
         QVERIFY(doc()->runOutput()->depth.depth != depth);
+        w_->setLive(false);
+    }
+
+    // A Live edit shows its lists first, then the same generation again with
+    // ground truth; the truth equals one computed directly on that run.
+    void liveEditShowsListsThenGroundTruth() {
+        openSmall();
+        w_->setLive(true);
+        QVERIFY(waitRun(doc()->runGeneration() + 1));
+        QSignalSpy finished(w_->cullService(), &CullService::finished);
+        doc()->moveLight(2, doc()->scene().lights[2].position + glm::dvec3(0, 0.4, 0), doc()->newDragId());
+        const quint64 g = w_->cullService()->lastGeneration();
+        QTRY_VERIFY_WITH_TIMEOUT(doc()->runGeneration() == g && doc()->runOutput()->truthComputed, 60000);
+        std::vector<std::shared_ptr<const lc::RunOutput>> ofG;
+        for (const auto& args : finished)
+            if (args.at(0).value<quint64>() == g)
+                ofG.push_back(args.at(1).value<std::shared_ptr<const lc::RunOutput>>());
+        QCOMPARE(int(ofG.size()), 2);
+        QVERIFY(!ofG[0]->truthComputed);
+        QVERIFY(ofG[1]->truthComputed);
+        QVERIFY(ofG[0]->result.lightIndices == ofG[1]->result.lightIndices);
+        const lc::GroundTruth direct = lc::computeGroundTruth(
+            ofG[1]->depth, lc::Projection(doc()->scene().camera), ofG[1]->lights, ofG[1]->result, {false});
+        QCOMPARE(ofG[1]->truth.metrics.falseNegatives, direct.metrics.falseNegatives);
+        QCOMPARE(ofG[1]->truth.metrics.exactWork, direct.metrics.exactWork);
+        QCOMPARE(ofG[1]->truth.metrics.shadingWork, direct.metrics.shadingWork);
+        QVERIFY(direct.metrics.exactWork > 0);
         w_->setLive(false);
     }
 
