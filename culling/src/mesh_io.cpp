@@ -323,9 +323,10 @@ void scanAsciiForNonFinite(const std::string& path, const std::string& ext, std:
     }
 }
 
-// OpenMesh 9.0's PLY and OFF readers loop forever on some malformed headers
-// (found by fuzzing: a PLY header without "end_header" or with an element
-// line lacking its count; an OFF file whose count line is not three numbers).
+// OpenMesh 9.0's PLY and OFF readers loop forever or crash on some malformed
+// headers (found by fuzzing: a PLY header without "end_header", with an
+// element line lacking its count or a property before any element; an OFF
+// file whose count line is not three numbers or announces no vertices).
 // The headers are therefore checked against their grammar first, and element
 // counts against what the file can hold (every vertex and face takes at least
 // 2 bytes), so OpenMesh only ever sees a well-formed header.
@@ -334,6 +335,7 @@ void checkPlyHeader(const std::string& path, std::uint64_t size) {
     std::string line;
     int n = 0;
     auto fail = [&](const std::string& what) { throw InputError(path, "", n, "PLY header: " + what); };
+    bool sawElement = false;
     while (std::getline(in, line)) {
         ++n;
         if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -348,7 +350,8 @@ void checkPlyHeader(const std::string& path, std::uint64_t size) {
         if (key == "comment" || key == "obj_info" || key.empty()) continue;
         if (key == "format") {
             words >> a >> b;
-            if ((a != "ascii" && a != "binary_little_endian" && a != "binary_big_endian") || b.empty())
+            if ((a != "ascii" && a != "binary_little_endian" && a != "binary_big_endian") || b != "1.0" ||
+                (words >> extra))
                 fail("bad format line '" + line + "'");
         } else if (key == "element") {
             words >> a;
@@ -358,7 +361,10 @@ void checkPlyHeader(const std::string& path, std::uint64_t size) {
             if (count > size / 2 + 1)
                 fail("element '" + a + "' announces " + std::to_string(count) + " items, more than the " +
                      std::to_string(size) + "-byte file can hold");
+            sawElement = true;
         } else if (key == "property") {
+            // (OpenMesh crashes on a property declared before any element.)
+            if (!sawElement) fail("property before any element: '" + line + "'");
             // "property <type> <name>" or "property list <count type> <type> <name>".
             std::vector<std::string> t;
             for (std::string w; words >> w;) t.push_back(w);
@@ -403,6 +409,10 @@ void checkOffHeader(const std::string& path, std::uint64_t size) {
         if (!(counts >> nv >> nf >> ne) || (counts >> extra) ||
             ne.find_first_not_of("0123456789") != std::string::npos)
             throw InputError(path, "", n, "OFF file: the counts line is \"<vertices> <faces> <edges>\", not '" + line + "'");
+        // (OpenMesh's reader spins on a file announcing no vertices.)
+        if (nv == 0 || nf == 0)
+            throw InputError(path, "", n, "OFF file announces " + std::to_string(nv) + " vertices and " +
+                                              std::to_string(nf) + " faces: no triangles");
         if (nv > size / 2 + 1 || nf > size / 2 + 1)
             throw InputError(path, "", n, "OFF file announces " + std::to_string(nv) + " vertices and " +
                                               std::to_string(nf) + " faces, more than the " + std::to_string(size) +

@@ -71,6 +71,29 @@ TEST(MeshHostile, PlyElementWithoutCountIsAClearError) {
               path + ":8: PLY header: an element line is \"element <name> <count>\", not 'element fdices'");
 }
 
+// fuzz_mesh_ply found (a crash in OpenMesh): the format line "format ascii
+// 1oat y" (line 2), after which "property float z" (line 3) has no element.
+TEST(MeshHostile, PlyBadFormatLineIsAClearError) {
+    const std::string path = kData + "/fuzz_ply_property_before_element.ply";
+    EXPECT_EQ(loadError(path, std::chrono::seconds(20)), path + ":2: PLY header: bad format line 'format ascii 1oat y'");
+}
+
+TEST(MeshHostile, PlyPropertyBeforeAnyElementIsAClearError) {
+    const std::string path = ::testing::TempDir() + "/lc_property_first.ply";
+    std::ofstream(path) << "ply\nformat ascii 1.0\nproperty float z\nelement vertex 1\nend_header\n0\n";
+    EXPECT_EQ(loadError(path, std::chrono::seconds(20)),
+              path + ":3: PLY header: property before any element: 'property float z'");
+    std::remove(path.c_str());
+}
+
+// fuzz_mesh_off found: "0 0 1" as the counts (after a comment line) made
+// OpenMesh's OFF reader spin.
+TEST(MeshHostile, OffAnnouncingNoVerticesIsAClearError) {
+    const std::string path = kData + "/fuzz_off_zero_counts.off";
+    EXPECT_EQ(loadError(path, std::chrono::seconds(20)),
+              path + ":3: OFF file announces 0 vertices and 0 faces: no triangles");
+}
+
 // Hand-written: six valid header lines and nothing else (the last one named).
 TEST(MeshHostile, PlyWithoutEndHeaderIsAClearError) {
     const std::string path = kData + "/ply_without_end_header.ply";
