@@ -5,6 +5,7 @@
 
 #include "culling/overlays.hpp"
 
+#include <QTimer>
 #include <vtkActor.h>
 #include <vtkActor2D.h>
 #include <vtkCamera.h>
@@ -117,7 +118,7 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
     });
     connect(doc_, &Document::meshesChanged, this, [this] {
         rebuildMeshes();
-        renderNow();
+        scheduleRender();
     });
     connect(doc_, &Document::cameraChanged, this, [this] {
         updateCamera();
@@ -126,12 +127,12 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
     connect(doc_, &Document::runOutputChanged, this, &CameraView::updateOverlay);
     connect(doc_, &Document::tileSelectionChanged, this, [this] {
         updateSelectedTile();
-        renderNow();
+        scheduleRender();
     });
     connect(doc_, &Document::overlaysChanged, this, &CameraView::updateOverlay);
     connect(doc_, &Document::selectionChanged, this, [this] {
         updateReverseLookup();
-        renderNow();
+        scheduleRender();
     });
     rebuildMeshes();
     updateCamera();
@@ -142,6 +143,15 @@ CameraView::~CameraView() = default;
 
 vtkRenderer* CameraView::sceneRenderer() const { return scene_.Get(); }
 vtkScalarBarActor* CameraView::legend() const { return legend_.Get(); }
+
+void CameraView::scheduleRender() {
+    if (renderPending_) return;
+    renderPending_ = true;
+    QTimer::singleShot(0, this, [this] {
+        renderPending_ = false;
+        renderNow();
+    });
+}
 
 void CameraView::renderNow() {
     if (renderWindow()) renderWindow()->Render();
@@ -241,7 +251,7 @@ void CameraView::updateOverlay() {
         legend_->SetVisibility(false);
         caption_->SetInput("no culling run yet (F5)");
         updateSelectedTile();
-        renderNow();
+        scheduleRender();
         return;
     }
     const lc::TileGrid& g = run->result.grid;
@@ -313,7 +323,7 @@ void CameraView::updateOverlay() {
     caption_->SetInput(caption.c_str());
     updateSelectedTile();
     updateReverseLookup();
-    renderNow();
+    scheduleRender();
 }
 
 void CameraView::updateReverseLookup() {

@@ -53,6 +53,9 @@ public:
     vtkScalarBarActor* legend() const;
     // Re-renders now (tests, screenshots).
     void renderNow();
+    // Renders once when control returns to the event loop, however many
+    // document signals asked for it (a Live result fires several).
+    void scheduleRender();
 
 signals:
     void tileClicked(int tile);
@@ -61,6 +64,7 @@ protected:
     void resizeEvent(QResizeEvent* e) override;
 
 private:
+    bool renderPending_ = false;
     void rebuildMeshes();
     void updateCamera();
     void updateOverlay();

@@ -7,6 +7,7 @@
 
 #include "culling/projection.hpp"
 
+#include <QTimer>
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
@@ -157,36 +158,36 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     });
     connect(doc_, &Document::meshesChanged, this, [this] {
         rebuildMeshes();
-        renderNow();
+        scheduleRender();
     });
     connect(doc_, &Document::lightsChanged, this, [this] {
         rebuildLights();
         updateSelection();
-        renderNow();
+        scheduleRender();
     });
     connect(doc_, &Document::lightChanged, this, [this](int i) {
         updateLight(i);
         updateSelection();
-        renderNow();
+        scheduleRender();
     });
     connect(doc_, &Document::selectionChanged, this, [this] {
         updateSelection();
-        renderNow();
+        scheduleRender();
     });
     connect(doc_, &Document::cameraChanged, this, [this] {
         updateFrustum();
         updateOverlays();
-        renderNow();
+        scheduleRender();
     });
     for (auto sig : {&Document::runOutputChanged, &Document::overlaysChanged, &Document::selectionChanged,
                      &Document::lightsChanged})
         connect(doc_, sig, this, [this] {
             updateOverlays();
-            renderNow();
+            scheduleRender();
         });
     connect(doc_, &Document::tileSelectionChanged, this, [this] {
         updateOverlays();
-        renderNow();
+        scheduleRender();
     });
     rebuildMeshes();
     rebuildLights();
@@ -210,6 +211,15 @@ vtkPointHandleRepresentation3D* InspectorView::handleRepresentation() const { re
 vtkHandleWidget* InspectorView::radiusHandleWidget() const { return radiusHandle_.Get(); }
 vtkPointHandleRepresentation3D* InspectorView::radiusHandleRepresentation() const { return radiusRep_.Get(); }
 vtkActor* InspectorView::lightActor() const { return lightActor_.Get(); }
+
+void InspectorView::scheduleRender() {
+    if (renderPending_) return;
+    renderPending_ = true;
+    QTimer::singleShot(0, this, [this] {
+        renderPending_ = false;
+        renderNow();
+    });
+}
 
 void InspectorView::renderNow() {
     if (renderWindow()) renderWindow()->Render();

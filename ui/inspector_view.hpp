@@ -66,8 +66,12 @@ public:
     // Tile frustums, cells, reverse look-up and list highlights (overlay_actors.hpp).
     InspectorOverlays* overlays() const { return overlays_.get(); }
     void renderNow();
+    // Renders once when control returns to the event loop, however many
+    // document signals asked for it (a Live result fires several).
+    void scheduleRender();
 
 private:
+    bool renderPending_ = false;
     void rebuildMeshes();
     void rebuildLights();
     void updateLight(int index);

@@ -68,14 +68,19 @@ void LiveDragProbe::onFinished(quint64 generation) {
         truth_.push_back(run->result.timings.groundTruthMs);
     const auto it = editAtMs_.find(generation);
     if (it == editAtMs_.end()) return;
-    const double now = clock_.nsecsElapsed() * 1e-6;
-    latencies_.push_back(now - it->second);
-    lastShownMs_ = now;
+    const double editAt = it->second;
     editAtMs_.erase(it); // the same generation's ground truth may follow: count it once
     if (const auto run = window_->document()->runOutput()) {
         cull_.push_back(run->result.timings.cullMs);
         depth_.push_back(run->result.timings.depthMs);
     }
+    // The views render on the event loop's next turn (scheduleRender): their
+    // timers were queued before this one, so this fires after the redraw.
+    QTimer::singleShot(0, this, [this, editAt] {
+        const double now = clock_.nsecsElapsed() * 1e-6;
+        latencies_.push_back(now - editAt);
+        lastShownMs_ = now;
+    });
 }
 
 void LiveDragProbe::finish() {
