@@ -369,6 +369,15 @@ void checkPlyHeader(const std::string& path, std::uint64_t size) {
             std::vector<std::string> t;
             for (std::string w; words >> w;) t.push_back(w);
             if (t.size() != (!t.empty() && t[0] == "list" ? 4u : 2u)) fail("bad property line '" + line + "'");
+            // (OpenMesh reads garbage counts, and allocates GBs, past an unknown type.)
+            static const char* kTypes[] = {"char",  "uchar",  "short",  "ushort", "int",    "uint",
+                                           "float", "double", "int8",   "uint8",  "int16",  "uint16",
+                                           "int32", "uint32", "float32", "float64"};
+            auto known = [](const std::string& w) {
+                return std::find(std::begin(kTypes), std::end(kTypes), w) != std::end(kTypes);
+            };
+            if (t[0] == "list" ? !(known(t[1]) && known(t[2])) : !known(t[0]))
+                fail("unknown property type in '" + line + "'");
         } else {
             fail("unknown header line '" + line + "'");
         }

@@ -78,6 +78,14 @@ TEST(MeshHostile, PlyBadFormatLineIsAClearError) {
     EXPECT_EQ(loadError(path, std::chrono::seconds(20)), path + ":2: PLY header: bad format line 'format ascii 1oat y'");
 }
 
+// fuzz_mesh_ply found: "property list uchar i\xba...nt vertex_indices" (line
+// 8) made OpenMesh read garbage list counts and allocate 2 GB.
+TEST(MeshHostile, PlyUnknownPropertyTypeIsAClearError) {
+    const std::string path = kData + "/fuzz_ply_unknown_list_type.ply";
+    const std::string error = loadError(path, std::chrono::seconds(20));
+    EXPECT_EQ(error.rfind(path + ":8: PLY header: unknown property type in 'property list uchar i", 0), 0u) << error;
+}
+
 TEST(MeshHostile, PlyPropertyBeforeAnyElementIsAClearError) {
     const std::string path = ::testing::TempDir() + "/lc_property_first.ply";
     std::ofstream(path) << "ply\nformat ascii 1.0\nproperty float z\nelement vertex 1\nend_header\n0\n";
