@@ -385,8 +385,43 @@ void checkPlyHeader(const std::string& path, std::uint64_t size) {
     throw InputError(path, "", n, "PLY header has no \"end_header\" line");
 }
 
+// OpenMesh's ASCII OFF reader reads each vertex as 3 numbers (6 with
+// normals) plus the rest of its line, and each face as a count, that many
+// indices and the rest of the line, with no check of the stream: a count of
+// "-3" becomes 4294967293 and it pushes that many handles (found by
+// fuzz_mesh_off). Walk the body the same way first and refuse a face count
+// that is not a plain whole number the file could hold.
+void checkOffBody(std::istream& in, const std::string& path, int countsLine, std::uint64_t nv,
+                  std::uint64_t nf, bool normals, std::uint64_t size) {
+    std::string tok, rest;
+    const int perVertex = normals ? 6 : 3;
+    for (std::uint64_t v = 0; v < nv; ++v) {
+        for (int k = 0; k < perVertex; ++k)
+            if (!(in >> tok))
+                throw InputError(path, "", countsLine, "OFF file ends inside vertex " + std::to_string(v) + " of " +
+                                                           std::to_string(nv));
+        std::getline(in, rest);
+    }
+    for (std::uint64_t f = 0; f < nf; ++f) {
+        if (!(in >> tok))
+            throw InputError(path, "", countsLine, "OFF file ends before face " + std::to_string(f) + " of " +
+                                                       std::to_string(nf));
+        const bool digits = !tok.empty() && tok.size() <= 7 && tok.find_first_not_of("0123456789") == std::string::npos;
+        const std::uint64_t k = digits ? std::stoull(tok) : 0;
+        if (!digits || k > size / 2 + 1)
+            throw InputError(path, "", countsLine, "OFF file: face " + std::to_string(f) + " gives '" + tok +
+                                                       "' as its vertex count; expected a whole number the file can hold");
+        for (std::uint64_t j = 0; j < k; ++j)
+            if (!(in >> tok))
+                throw InputError(path, "", countsLine, "OFF file ends inside face " + std::to_string(f) + " of " +
+                                                           std::to_string(nf));
+        std::getline(in, rest);
+    }
+}
+
 void checkOffHeader(const std::string& path, std::uint64_t size) {
     std::ifstream in(path, std::ios::binary);
+    bool normals = false;
     std::string line;
     int n = 0;
     bool sawKeyword = false;
@@ -403,6 +438,7 @@ void checkOffHeader(const std::string& path, std::uint64_t size) {
             // [ST][C][N][4][n]OFF, possibly followed by BINARY (then counts are binary).
             if (first.size() < 3 || first.compare(first.size() - 3, 3, "OFF") != 0)
                 throw InputError(path, "", n, "OFF file: the first line must name the OFF format, not '" + line + "'");
+            normals = first.find('N') != std::string::npos;
             std::string rest;
             if (words >> rest) {
                 if (rest == "BINARY") return;
@@ -426,6 +462,7 @@ void checkOffHeader(const std::string& path, std::uint64_t size) {
             throw InputError(path, "", n, "OFF file announces " + std::to_string(nv) + " vertices and " +
                                               std::to_string(nf) + " faces, more than the " + std::to_string(size) +
                                               "-byte file can hold");
+        checkOffBody(in, path, n, nv, nf, normals, size);
         return;
     }
     throw InputError(path, "", n, "OFF file: no counts line");
