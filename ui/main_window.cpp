@@ -166,8 +166,11 @@ void MainWindow::buildDocks() {
     dock(tr("Properties"), "propertiesDock", properties_, Qt::LeftDockWidgetArea);
     dock(tr("Tile inspector"), "tileDock", tileInspector_, Qt::RightDockWidgetArea);
     dock(tr("Message log"), "logDock", log_, Qt::BottomDockWidgetArea);
-    tabifyDockWidget(findChild<QDockWidget*>("logDock"),
-                     dock(tr("Report"), "reportDock", new ReportDock(doc_), Qt::BottomDockWidgetArea));
+    auto* logDock = findChild<QDockWidget*>("logDock");
+    tabifyDockWidget(logDock, dock(tr("Report"), "reportDock", new ReportDock(doc_), Qt::BottomDockWidgetArea));
+    // A first start shows the log; the Report tab is one click away (a saved
+    // layout wins).
+    logDock->raise();
 }
 
 void MainWindow::buildActions() {
