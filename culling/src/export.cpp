@@ -99,14 +99,6 @@ std::string fixed2(double v) {
 
 // ---- files ------------------------------------------------------------------
 
-void fsyncPath(const fs::path& p, bool directory) {
-    const int fd = ::open(p.c_str(), directory ? (O_RDONLY | O_DIRECTORY) : O_RDONLY);
-    if (fd < 0) throw Error("cannot open " + p.string() + " to sync it: " + std::strerror(errno));
-    const int rc = ::fsync(fd);
-    const int err = errno;
-    ::close(fd);
-    if (rc != 0) throw Error("cannot sync " + p.string() + ": " + std::strerror(err));
-}
 
 // libpng reports errors by longjmp; this function holds no C++ object with a
 // destructor between setjmp and the libpng calls, so the jump is safe. Returns
@@ -367,76 +359,24 @@ void writeShadedImages(const RunOutput& run, const std::string& dir) {
 
 void exportDiagnostics(const Scene& scene, const CullSettings& settings, const RunOutput& run,
                        const std::string& dir, const std::vector<NamedImage>& viewImages) {
-    fs::path target = fs::path(dir).lexically_normal();
-    if (!target.has_filename()) target = target.parent_path();
-    const std::string name = target.filename().string();
-    if (dir.empty() || name.empty() || name == "." || name == "..")
-        throw Error("cannot export diagnostics into '" + dir + "': give a folder name");
-    fs::path parent = target.parent_path();
-    if (parent.empty()) parent = ".";
-    std::error_code ec;
-    if (!fs::is_directory(parent, ec))
-        throw Error("cannot export diagnostics into " + target.string() + ": parent folder " +
-                    parent.string() + " does not exist");
-    // Replacing a folder removes it: only allow it when it holds nothing but
-    // a previous export (so that `--out ~` cannot wipe a home folder).
+    for (const NamedImage& v : viewImages)
+        if (std::find(std::begin(kExportViewImages), std::end(kExportViewImages), v.fileName) ==
+            std::end(kExportViewImages))
+            throw Error("cannot export diagnostics image '" + v.fileName + "': not a view image name");
     static const std::set<std::string> kOutputs = {"summary.json", "tiles.csv", "heatmap.png",
                                                    "overlays.vtm", "overlays", kExportViewImages[0],
                                                    kExportViewImages[1],
                                                    // writeShadedImages
                                                    "shaded_culled.png", "shaded_all.png", "shaded_diff.png"};
-    for (const NamedImage& v : viewImages)
-        if (std::find(std::begin(kExportViewImages), std::end(kExportViewImages), v.fileName) ==
-            std::end(kExportViewImages))
-            throw Error("cannot export diagnostics image '" + v.fileName + "': not a view image name");
-    const bool exists = fs::exists(fs::symlink_status(target, ec));
-    if (exists) {
-        if (!fs::is_directory(fs::symlink_status(target, ec)))
-            throw Error("cannot export diagnostics into " + target.string() + ": it exists and is not a folder");
-        for (const auto& e : fs::directory_iterator(target, ec))
-            if (!kOutputs.count(e.path().filename().string()))
-                throw Error("refusing to replace " + target.string() + ": it holds " +
-                            e.path().filename().string() + ", which is not a diagnostics output");
-        if (ec) throw Error("cannot read " + target.string() + ": " + ec.message());
-    }
-
-    std::string tmpl = (parent / ("." + name + ".tmp-XXXXXX")).string();
-    if (!::mkdtemp(tmpl.data()))
-        throw Error("cannot create a temporary folder beside " + target.string() + ": " + std::strerror(errno));
-    const fs::path tmp = tmpl;
-    fs::path aside;
-    try {
+    writeFolderAtomic(dir, kOutputs, "export diagnostics", "diagnostics output", [&](const std::string& out) {
+        const fs::path tmp = out;
         writeFileSynced((tmp / "summary.json").string(), summaryJson(scene, settings, run));
         writeFileSynced((tmp / "tiles.csv").string(), tilesCsv(run));
         writePng(heatmapImage(run), (tmp / "heatmap.png").string());
         if (!run.shadedAll.empty()) writeShadedImages(run, tmp.string());
         writeOverlaysVtm(scene, run, tmp.string());
         for (const NamedImage& v : viewImages) writePng(v.image, (tmp / v.fileName).string());
-        fsyncPath(tmp, true);
-        if (exists) {
-            std::string asideTmpl = (parent / ("." + name + ".old-XXXXXX")).string();
-            if (!::mkdtemp(asideTmpl.data()))
-                throw Error("cannot create a temporary folder beside " + target.string() + ": " + std::strerror(errno));
-            aside = asideTmpl;
-            if (std::rename(target.c_str(), aside.c_str()) != 0) {
-                const int err = errno;
-                fs::remove(aside, ec);
-                aside.clear();
-                throw Error("cannot move " + target.string() + " aside: " + std::strerror(err));
-            }
-        }
-        if (std::rename(tmp.c_str(), target.c_str()) != 0) {
-            const int err = errno;
-            if (!aside.empty()) std::rename(aside.c_str(), target.c_str()); // restore
-            aside.clear();
-            throw Error("cannot rename " + tmp.string() + " to " + target.string() + ": " + std::strerror(err));
-        }
-    } catch (...) {
-        fs::remove_all(tmp, ec);
-        throw;
-    }
-    if (!aside.empty()) fs::remove_all(aside, ec);
-    fsyncPath(parent, true);
+    });
 }
 
 } // namespace lc

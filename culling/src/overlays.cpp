@@ -378,14 +378,6 @@ void addChunk(PolyPiece& p, const FrustumChunk& c, const glm::dmat4& worldFromVi
     p.addQuad(id[3], id[2], id[6], id[7]); // bottom
 }
 
-void fsyncDir(const fs::path& p) {
-    const int fd = ::open(p.c_str(), O_RDONLY | O_DIRECTORY);
-    if (fd < 0) throw Error("cannot open " + p.string() + " to sync it: " + std::strerror(errno));
-    const int rc = ::fsync(fd);
-    const int err = errno;
-    ::close(fd);
-    if (rc != 0) throw Error("cannot sync " + p.string() + ": " + std::strerror(err));
-}
 
 } // namespace
 
@@ -515,7 +507,7 @@ void writeOverlaysVtm(const Scene& scene, const RunOutput& run, const std::strin
                name + ".vtp\"/>\n";
     }
     vtm += "  </vtkMultiBlockDataSet>\n</VTKFile>\n";
-    fsyncDir(sub);
+    syncFolder(sub.string());
     writeFileSynced((root / "overlays.vtm").string(), vtm);
 }
 

@@ -563,74 +563,15 @@ RgbImage paretoImage(const Report& rep) {
 
 // ---- the folder ------------------------------------------------------------------
 
-namespace {
-void fsyncDir(const fs::path& p) {
-    const int fd = ::open(p.c_str(), O_RDONLY | O_DIRECTORY);
-    if (fd < 0) throw Error("cannot open " + p.string() + " to sync it: " + std::strerror(errno));
-    const int rc = ::fsync(fd);
-    const int err = errno;
-    ::close(fd);
-    if (rc != 0) throw Error("cannot sync " + p.string() + ": " + std::strerror(err));
-}
-} // namespace
 
 void writeReport(const Report& rep, const std::string& dir) {
-    fs::path target = fs::path(dir).lexically_normal();
-    if (!target.has_filename()) target = target.parent_path();
-    const std::string name = target.filename().string();
-    if (dir.empty() || name.empty() || name == "." || name == "..")
-        throw Error("cannot write the report into '" + dir + "': give a folder name");
-    fs::path parent = target.parent_path();
-    if (parent.empty()) parent = ".";
-    std::error_code ec;
-    if (!fs::is_directory(parent, ec))
-        throw Error("cannot write the report into " + target.string() + ": parent folder " + parent.string() +
-                    " does not exist");
-    static const std::set<std::string> kOutputs = {"report.csv", "report.md", "pareto.png"};
-    const bool exists = fs::exists(fs::symlink_status(target, ec));
-    if (exists) {
-        if (!fs::is_directory(fs::symlink_status(target, ec)))
-            throw Error("cannot write the report into " + target.string() + ": it exists and is not a folder");
-        for (const auto& e : fs::directory_iterator(target, ec))
-            if (!kOutputs.count(e.path().filename().string()))
-                throw Error("refusing to replace " + target.string() + ": it holds " + e.path().filename().string() +
-                            ", which is not a report output");
-        if (ec) throw Error("cannot read " + target.string() + ": " + ec.message());
-    }
-    std::string tmpl = (parent / ("." + name + ".tmp-XXXXXX")).string();
-    if (!::mkdtemp(tmpl.data()))
-        throw Error("cannot create a temporary folder beside " + target.string() + ": " + std::strerror(errno));
-    const fs::path tmp = tmpl;
-    fs::path aside;
-    try {
-        writeFileSynced((tmp / "report.csv").string(), reportCsv(rep));
-        writeFileSynced((tmp / "report.md").string(), reportMarkdown(rep));
-        writePng(paretoImage(rep), (tmp / "pareto.png").string());
-        fsyncDir(tmp);
-        if (exists) {
-            std::string asideTmpl = (parent / ("." + name + ".old-XXXXXX")).string();
-            if (!::mkdtemp(asideTmpl.data()))
-                throw Error("cannot create a temporary folder beside " + target.string() + ": " + std::strerror(errno));
-            aside = asideTmpl;
-            if (std::rename(target.c_str(), aside.c_str()) != 0) {
-                const int err = errno;
-                fs::remove(aside, ec);
-                aside.clear();
-                throw Error("cannot move " + target.string() + " aside: " + std::strerror(err));
-            }
-        }
-        if (std::rename(tmp.c_str(), target.c_str()) != 0) {
-            const int err = errno;
-            if (!aside.empty()) std::rename(aside.c_str(), target.c_str()); // restore
-            aside.clear();
-            throw Error("cannot rename " + tmp.string() + " to " + target.string() + ": " + std::strerror(err));
-        }
-    } catch (...) {
-        fs::remove_all(tmp, ec);
-        throw;
-    }
-    if (!aside.empty()) fs::remove_all(aside, ec);
-    fsyncDir(parent);
+    writeFolderAtomic(dir, {"report.csv", "report.md", "pareto.png"}, "write the report", "report output",
+                      [&](const std::string& out) {
+                          const fs::path tmp = out;
+                          writeFileSynced((tmp / "report.csv").string(), reportCsv(rep));
+                          writeFileSynced((tmp / "report.md").string(), reportMarkdown(rep));
+                          writePng(paretoImage(rep), (tmp / "pareto.png").string());
+                      });
 }
 
 } // namespace lc

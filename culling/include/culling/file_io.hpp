@@ -1,6 +1,8 @@
 #pragma once
 // Durable file writes shared by the exporters, scene saving and the CLI.
 
+#include <functional>
+#include <set>
 #include <string>
 
 namespace lc {
@@ -14,5 +16,17 @@ void writeFileSynced(const std::string& path, const std::string& text);
 // the new one, never a truncated one. On failure the temporary file is
 // removed and `path` is untouched. Throws Error naming the file.
 void writeFileAtomic(const std::string& path, const std::string& text);
+
+// fsyncs a folder (its entries' names). Throws Error naming it.
+void syncFolder(const std::string& path);
+
+// Atomic folder: `fill` writes the outputs into a new temporary folder beside
+// `dir`, which is synced and renamed onto `dir`; a crash or a throw leaves the
+// old folder (or none), never a half-written one. An existing `dir` is only
+// replaced when it holds nothing but names from `outputs`, so a mistyped
+// `--out ~` cannot wipe a home folder. Messages read "cannot <action> into
+// DIR: ..." and "... which is not a <outputKind>".
+void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outputs, const std::string& action,
+                       const std::string& outputKind, const std::function<void(const std::string& tmp)>& fill);
 
 } // namespace lc
