@@ -22,28 +22,9 @@ constexpr std::uint32_t kGroup = 8;    // shade.comp local size, x and y
 } // namespace
 
 ShadePass::ShadePass(Context& ctx) : ctx_(ctx) {
-    VkDevice dev = ctx_.device();
-    std::array<VkDescriptorSetLayoutBinding, kBindings> b{};
-    for (std::uint32_t i = 0; i < kBindings; ++i) {
-        b[i].binding = i;
-        b[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        b[i].descriptorCount = 1;
-        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-    }
-    VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    lci.bindingCount = kBindings;
-    lci.pBindings = b.data();
-    VkDescriptorSetLayout sl;
-    LC_VK(vkCreateDescriptorSetLayout(dev, &lci, nullptr, &sl));
-    setLayout_ = DescriptorSetLayoutHandle(dev, sl);
-    ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, sl, "shade.setLayout");
-    VkPipelineLayoutCreateInfo pci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    pci.setLayoutCount = 1;
-    pci.pSetLayouts = &sl;
-    VkPipelineLayout pl;
-    LC_VK(vkCreatePipelineLayout(dev, &pci, nullptr, &pl));
-    layout_ = PipelineLayoutHandle(dev, pl);
-    ctx_.name(VK_OBJECT_TYPE_PIPELINE_LAYOUT, pl, "shade.pipelineLayout");
+    auto layouts = ctx_.createStorageLayouts(kBindings, "shade");
+    setLayout_ = std::move(layouts.set);
+    layout_ = std::move(layouts.pipeline);
     const spirv::Code code = spirv::shade();
     shader_ = ctx_.createShader(code.words, code.wordCount, "shader.shade");
 }

@@ -516,6 +516,32 @@ ShaderModuleHandle Context::createShader(const std::uint32_t* words, std::size_t
     return ShaderModuleHandle(device_, m);
 }
 
+Context::StorageLayouts Context::createStorageLayouts(std::uint32_t bindings, const std::string& n) const {
+    std::vector<VkDescriptorSetLayoutBinding> b(bindings);
+    for (std::uint32_t i = 0; i < bindings; ++i) {
+        b[i].binding = i;
+        b[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        b[i].descriptorCount = 1;
+        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    }
+    VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    lci.bindingCount = bindings;
+    lci.pBindings = b.data();
+    VkDescriptorSetLayout sl;
+    LC_VK(vkCreateDescriptorSetLayout(device_, &lci, nullptr, &sl));
+    StorageLayouts out;
+    out.set = DescriptorSetLayoutHandle(device_, sl);
+    name(VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, sl, n + ".setLayout");
+    VkPipelineLayoutCreateInfo pci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    pci.setLayoutCount = 1;
+    pci.pSetLayouts = &sl;
+    VkPipelineLayout pl;
+    LC_VK(vkCreatePipelineLayout(device_, &pci, nullptr, &pl));
+    out.pipeline = PipelineLayoutHandle(device_, pl);
+    name(VK_OBJECT_TYPE_PIPELINE_LAYOUT, pl, n + ".pipelineLayout");
+    return out;
+}
+
 double Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record, const std::string& n) {
     VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     ai.commandPool = commandPool_;

@@ -195,6 +195,14 @@ public:
     Image createDepthImage(std::uint32_t w, std::uint32_t h, VkFormat format, const std::string& name) const;
     ShaderModuleHandle createShader(const std::uint32_t* words, std::size_t wordCount,
                                     const std::string& name) const;
+    // The layouts of a compute pass whose bindings 0..bindings-1 are all
+    // storage buffers: one descriptor set layout and a pipeline layout over it,
+    // named "<name>.setLayout" and "<name>.pipelineLayout".
+    struct StorageLayouts {
+        DescriptorSetLayoutHandle set;
+        PipelineLayoutHandle pipeline;
+    };
+    StorageLayouts createStorageLayouts(std::uint32_t bindings, const std::string& name) const;
 
     // Records a one-time command buffer, submits it, waits. Returns the CPU
     // wall-clock milliseconds from submit to the fence signalling.
