@@ -189,6 +189,25 @@ double ReportDock::yOf(const lc::ReportRow& r) const {
     return yBox_->currentIndex() == 0 ? r.efficiency : r.imageRmse;
 }
 
+vtkPlot* ReportDock::addSeries(int plotType, const std::string& name, const std::vector<std::size_t>& rowIndices) {
+    const auto& rows = report_->rows;
+    vtkNew<vtkTable> table;
+    vtkNew<vtkDoubleArray> xs, ys;
+    xs->SetName("total ms");
+    ys->SetName(name.c_str());
+    table->AddColumn(xs);
+    table->AddColumn(ys);
+    table->SetNumberOfRows(vtkIdType(rowIndices.size()));
+    for (std::size_t k = 0; k < rowIndices.size(); ++k) {
+        table->SetValue(vtkIdType(k), 0, rows[rowIndices[k]].totalMs);
+        table->SetValue(vtkIdType(k), 1, yOf(rows[rowIndices[k]]));
+    }
+    vtkPlot* plot = chart_->AddPlot(plotType);
+    plot->SetInputData(table, 0, 1);
+    plot->SetLabel(name);
+    return plot;
+}
+
 void ReportDock::rebuildChart() {
     chart_->ClearPlots();
     seriesRows_.clear();
@@ -220,20 +239,7 @@ void ReportDock::rebuildChart() {
                     members.push_back(i);
             if (members.empty()) continue;
             const std::string name = algorithms[a] + " (" + backend + ")";
-            vtkNew<vtkTable> table;
-            vtkNew<vtkDoubleArray> xs, ys;
-            xs->SetName("total ms");
-            ys->SetName(name.c_str());
-            table->AddColumn(xs);
-            table->AddColumn(ys);
-            table->SetNumberOfRows(vtkIdType(members.size()));
-            for (std::size_t k = 0; k < members.size(); ++k) {
-                table->SetValue(vtkIdType(k), 0, rows[members[k]].totalMs);
-                table->SetValue(vtkIdType(k), 1, yOf(rows[members[k]]));
-            }
-            vtkPlot* plot = chart_->AddPlot(vtkChart::POINTS);
-            plot->SetInputData(table, 0, 1);
-            plot->SetLabel(name);
+            vtkPlot* plot = addSeries(vtkChart::POINTS, name, members);
             plot->SetColor(kAlgorithmRgb[a][0], kAlgorithmRgb[a][1], kAlgorithmRgb[a][2], 255);
             if (auto* pts = vtkPlotPoints::SafeDownCast(plot)) {
                 pts->SetMarkerStyle(b == 0 ? vtkPlotPoints::SQUARE : vtkPlotPoints::CIRCLE);
@@ -250,20 +256,7 @@ void ReportDock::rebuildChart() {
         std::sort(front.begin(), front.end(), [&](auto x, auto y) { return rows[x].totalMs < rows[y].totalMs; });
         if (front.size() >= 2) {
             const std::string name = "Pareto front (" + backend + ")";
-            vtkNew<vtkTable> table;
-            vtkNew<vtkDoubleArray> xs, ys;
-            xs->SetName("total ms");
-            ys->SetName(name.c_str());
-            table->AddColumn(xs);
-            table->AddColumn(ys);
-            table->SetNumberOfRows(vtkIdType(front.size()));
-            for (std::size_t k = 0; k < front.size(); ++k) {
-                table->SetValue(vtkIdType(k), 0, rows[front[k]].totalMs);
-                table->SetValue(vtkIdType(k), 1, yOf(rows[front[k]]));
-            }
-            vtkPlot* line = chart_->AddPlot(vtkChart::LINE);
-            line->SetInputData(table, 0, 1);
-            line->SetLabel(name);
+            vtkPlot* line = addSeries(vtkChart::LINE, name, front);
             line->SetColor(217, 26, 26, 255);
             line->SetWidth(2.0);
             seriesRows_[name] = std::move(front);

@@ -28,6 +28,7 @@ class QPushButton;
 class QSpinBox;
 class QVTKOpenGLNativeWidget;
 class vtkObject;
+class vtkPlot;
 
 namespace lcui {
 
@@ -68,6 +69,8 @@ private:
     void rebuildChart();
     void onChartClick(vtkObject*, unsigned long, void* callData);
     double yOf(const lc::ReportRow& r) const;
+    // One chart series: total ms against yOf() of the given report rows.
+    vtkPlot* addSeries(int plotType, const std::string& name, const std::vector<std::size_t>& rowIndices);
 
     Document* doc_;
     lc::ReportOptions options_;
