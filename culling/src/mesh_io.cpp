@@ -1,22 +1,24 @@
-// Mesh loading: OpenMesh's readers (OBJ, PLY, OFF, STL, OM) feeding a flat
-// importer. We do not read into an OpenMesh TriMesh/PolyMesh: their halfedge
-// kernel rejects or splits non-manifold faces ("complex edge", duplicated
-// vertices) and silently drops repeated-index faces, which would lose
-// triangles a depth pre-pass must draw. The flat importer keeps every face as
-// written, and we triangulate, validate and drop degenerates ourselves so that
-// every dropped face is counted.
+// Mesh loading: the project's own readers for OBJ (parseObj below), PLY
+// (mesh_ply.cpp) and OFF (mesh_off.cpp), and OpenMesh's readers for STL and
+// OM, all feeding a flat importer. We do not read into an OpenMesh
+// TriMesh/PolyMesh: their halfedge kernel rejects or splits non-manifold faces
+// ("complex edge", duplicated vertices) and silently drops repeated-index
+// faces, which would lose triangles a depth pre-pass must draw. The flat
+// importer keeps every face as written, and we triangulate, validate and drop
+// degenerates ourselves so that every dropped face is counted.
 //
-// Reading goes through a counting stream buffer: it reports progress as the
-// fraction of file bytes consumed and stops feeding the reader when the
-// CancelToken fires (checked once per 1 MiB chunk).
+// OBJ has its own parser: OpenMesh 9's OBJ reader cannot read through a
+// non-seekable stream, parses with iostreams that reject "nan"/"inf" (so a
+// NaN vertex silently shifts every later index instead of being reported),
+// and cannot say which line was bad. The parser below uses std::from_chars,
+// reports the line of every error, and reads buildings.obj (13 MB, 400k
+// faces) in a fraction of a second (see the test's printed timing).
 //
-// OBJ has its own parser here (parseObj): OpenMesh 9's OBJ reader cannot read
-// through our counting stream (it fails on a non-seekable stream), parses with
-// iostreams that reject "nan"/"inf" (so a NaN vertex silently shifts every later
-// index instead of being reported), and cannot say which line was bad. The
-// parser below uses std::from_chars, reports the line of every error, and reads
-// buildings.obj (13 MB, 400k faces) in a fraction of a second (see the test's
-// printed timing). PLY, OFF, STL and OM go through OpenMesh.
+// PLY and OFF have their own readers because OpenMesh 9's loop forever, crash
+// or allocate gigabytes on malformed input (docs/TESTING.md lists the fuzz
+// findings); hand-written checks run before them kept missing cases.
+
+#include "mesh_readers.hpp"
 
 #include "culling/errors.hpp"
 #include "culling/scene_io.hpp"
@@ -44,16 +46,13 @@ namespace OM = OpenMesh;
 // Collects vertices and polygons as written. Everything else a reader offers
 // (normals, colours, texture coordinates) is ignored: depth and culling need
 // positions only.
-class FlatImporter final : public OM::IO::BaseImporter {
+class FlatImporter final : public OM::IO::BaseImporter, public meshio::FlatMesh {
 public:
     // Set for OpenMesh reads: checked every 64k faces. Progress needs the face
-    // count that PLY and OFF announce through reserve(); STL reports none.
+    // count that OM announces through reserve(); STL reports none.
     const CancelToken* cancel = nullptr;
     const Progress* progress = nullptr;
     std::size_t expectedFaces = 0;
-    std::vector<float> positions;
-    std::vector<std::uint32_t> polyStart;   // offsets into polyIndices, one per face
-    std::vector<std::int64_t> polyIndices;  // raw indices as the reader gave them
 
     OM::VertexHandle add_vertex(const OM::Vec3f& p) override {
         positions.insert(positions.end(), {p[0], p[1], p[2]});
@@ -115,8 +114,8 @@ public:
     void set_status(OM::FaceHandle, const OM::Attributes::StatusInfo&) override {}
     void add_texture_information(int, std::string) override {}
 
-    // The counts come from the file's header, unchecked: a 31-byte OFF file
-    // can announce billions of elements. Every vertex and face takes at least
+    // The counts come from the file's header, unchecked: a 31-byte file can
+    // announce billions of elements. Every vertex and face takes at least
     // 4 bytes of the file (binary or ASCII), so reservations stop there.
     std::uint64_t fileSize = 0;
     void reserve(unsigned nV, unsigned, unsigned nF) override {
@@ -281,12 +280,9 @@ double doubleArea(const std::vector<float>& p, std::uint32_t a, std::uint32_t b,
 
 // OpenMesh parses ASCII numbers with iostreams, which reject "nan" and "inf":
 // the stream fails and later values come out shifted or zero, so the damage
-// shows up as a misleading error (or none). ASCII PLY, OFF and STL are
-// therefore scanned first for such tokens, to name the real problem and line.
+// shows up as a misleading error (or none). ASCII STL is therefore scanned
+// first for such tokens, to name the real problem and line.
 bool isAsciiForNonFiniteScan(const std::string& ext, const std::string& head, std::uint64_t size) {
-    if (ext == "ply") return head.find("format ascii") != std::string::npos;
-    if (ext == "off") return head.rfind("OFF", 0) != std::string::npos &&
-                             head.substr(0, head.find('\n')).find("BINARY") == std::string::npos;
     if (ext == "stl") {
         // Binary STL: 80-byte header, uint32 count, 50 bytes per triangle.
         if (head.size() >= 84) {
@@ -323,156 +319,9 @@ void scanAsciiForNonFinite(const std::string& path, const std::string& ext, std:
     }
 }
 
-// OpenMesh 9.0's PLY and OFF readers loop forever or crash on some malformed
-// headers (found by fuzzing: a PLY header without "end_header", with an
-// element line lacking its count or a property before any element; an OFF
-// file whose count line is not three numbers or announces no vertices).
-// The headers are therefore checked against their grammar first, and element
-// counts against what the file can hold (every vertex and face takes at least
-// 2 bytes), so OpenMesh only ever sees a well-formed header.
-void checkPlyHeader(const std::string& path, std::uint64_t size) {
-    std::ifstream in(path, std::ios::binary);
-    std::string line;
-    int n = 0;
-    auto fail = [&](const std::string& what) { throw InputError(path, "", n, "PLY header: " + what); };
-    bool sawElement = false;
-    while (std::getline(in, line)) {
-        ++n;
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        std::istringstream words(line);
-        std::string key, a, b, extra;
-        words >> key;
-        if (n == 1) {
-            if (line != "ply") fail("the first line must be \"ply\"");
-            continue;
-        }
-        if (key == "end_header") return;
-        if (key == "comment" || key == "obj_info" || key.empty()) continue;
-        if (key == "format") {
-            words >> a >> b;
-            if ((a != "ascii" && a != "binary_little_endian" && a != "binary_big_endian") || b != "1.0" ||
-                (words >> extra))
-                fail("bad format line '" + line + "'");
-        } else if (key == "element") {
-            words >> a;
-            unsigned long long count = 0;
-            if (a.empty() || !(words >> count) || (words >> extra))
-                fail("an element line is \"element <name> <count>\", not '" + line + "'");
-            if (count > size / 2 + 1)
-                fail("element '" + a + "' announces " + std::to_string(count) + " items, more than the " +
-                     std::to_string(size) + "-byte file can hold");
-            sawElement = true;
-        } else if (key == "property") {
-            // (OpenMesh crashes on a property declared before any element.)
-            if (!sawElement) fail("property before any element: '" + line + "'");
-            // "property <type> <name>" or "property list <count type> <type> <name>".
-            std::vector<std::string> t;
-            for (std::string w; words >> w;) t.push_back(w);
-            if (t.size() != (!t.empty() && t[0] == "list" ? 4u : 2u)) fail("bad property line '" + line + "'");
-            // (OpenMesh reads garbage counts, and allocates GBs, past an unknown type.)
-            static const char* kTypes[] = {"char",  "uchar",  "short",  "ushort", "int",    "uint",
-                                           "float", "double", "int8",   "uint8",  "int16",  "uint16",
-                                           "int32", "uint32", "float32", "float64"};
-            auto known = [](const std::string& w) {
-                return std::find(std::begin(kTypes), std::end(kTypes), w) != std::end(kTypes);
-            };
-            if (t[0] == "list" ? !(known(t[1]) && known(t[2])) : !known(t[0]))
-                fail("unknown property type in '" + line + "'");
-        } else {
-            fail("unknown header line '" + line + "'");
-        }
-    }
-    throw InputError(path, "", n, "PLY header has no \"end_header\" line");
-}
-
-// OpenMesh's ASCII OFF reader reads each vertex as 3 numbers (6 with
-// normals) plus the rest of its line, and each face as a count, that many
-// indices and the rest of the line, with no check of the stream: a count of
-// "-3" becomes 4294967293 and it pushes that many handles (found by
-// fuzz_mesh_off). Walk the body the same way first and refuse a face count
-// that is not a plain whole number the file could hold.
-void checkOffBody(std::istream& in, const std::string& path, int countsLine, std::uint64_t nv,
-                  std::uint64_t nf, bool normals, std::uint64_t size) {
-    std::string tok, rest;
-    const int perVertex = normals ? 6 : 3;
-    for (std::uint64_t v = 0; v < nv; ++v) {
-        for (int k = 0; k < perVertex; ++k)
-            if (!(in >> tok))
-                throw InputError(path, "", countsLine, "OFF file ends inside vertex " + std::to_string(v) + " of " +
-                                                           std::to_string(nv));
-        std::getline(in, rest);
-    }
-    for (std::uint64_t f = 0; f < nf; ++f) {
-        if (!(in >> tok))
-            throw InputError(path, "", countsLine, "OFF file ends before face " + std::to_string(f) + " of " +
-                                                       std::to_string(nf));
-        const bool digits = !tok.empty() && tok.size() <= 7 && tok.find_first_not_of("0123456789") == std::string::npos;
-        const std::uint64_t k = digits ? std::stoull(tok) : 0;
-        if (!digits || k > size / 2 + 1)
-            throw InputError(path, "", countsLine, "OFF file: face " + std::to_string(f) + " gives '" + tok +
-                                                       "' as its vertex count; expected a whole number the file can hold");
-        for (std::uint64_t j = 0; j < k; ++j)
-            if (!(in >> tok))
-                throw InputError(path, "", countsLine, "OFF file ends inside face " + std::to_string(f) + " of " +
-                                                           std::to_string(nf));
-        std::getline(in, rest);
-    }
-}
-
-void checkOffHeader(const std::string& path, std::uint64_t size) {
-    std::ifstream in(path, std::ios::binary);
-    bool normals = false;
-    std::string line;
-    int n = 0;
-    bool sawKeyword = false;
-    while (std::getline(in, line)) {
-        ++n;
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        const auto hash = line.find('#');
-        if (hash != std::string::npos) line.erase(hash);
-        std::istringstream words(line);
-        std::string first;
-        if (!(words >> first)) continue; // blank or comment
-        if (!sawKeyword) {
-            sawKeyword = true;
-            // [ST][C][N][4][n]OFF, possibly followed by BINARY (then counts are binary).
-            if (first.size() < 3 || first.compare(first.size() - 3, 3, "OFF") != 0)
-                throw InputError(path, "", n, "OFF file: the first line must name the OFF format, not '" + line + "'");
-            normals = first.find('N') != std::string::npos;
-            std::string rest;
-            if (words >> rest) {
-                if (rest == "BINARY") return;
-                // The counts may follow the keyword on the same line.
-                line = rest + line.substr(line.find(rest) + rest.size());
-            } else {
-                continue;
-            }
-        }
-        std::istringstream counts(line);
-        unsigned long long nv = 0, nf = 0;
-        std::string ne, extra;
-        if (!(counts >> nv >> nf >> ne) || (counts >> extra) ||
-            ne.find_first_not_of("0123456789") != std::string::npos)
-            throw InputError(path, "", n, "OFF file: the counts line is \"<vertices> <faces> <edges>\", not '" + line + "'");
-        // (OpenMesh's reader spins on a file announcing no vertices.)
-        if (nv == 0 || nf == 0)
-            throw InputError(path, "", n, "OFF file announces " + std::to_string(nv) + " vertices and " +
-                                              std::to_string(nf) + " faces: no triangles");
-        if (nv > size / 2 + 1 || nf > size / 2 + 1)
-            throw InputError(path, "", n, "OFF file announces " + std::to_string(nv) + " vertices and " +
-                                              std::to_string(nf) + " faces, more than the " + std::to_string(size) +
-                                              "-byte file can hold");
-        checkOffBody(in, path, n, nv, nf, normals, size);
-        return;
-    }
-    throw InputError(path, "", n, "OFF file: no counts line");
-}
-
-// PLY, OFF, STL and OM through OpenMesh's readers into the flat importer.
+// STL and OM through OpenMesh's readers into the flat importer.
 void readWithOpenMesh(const std::string& path, const std::string& ext, std::uint64_t size,
                       FlatImporter& imp, const CancelToken* cancel, const Progress& progress) {
-    if (ext == "ply") checkPlyHeader(path, size);
-    if (ext == "off") checkOffHeader(path, size);
     scanAsciiForNonFinite(path, ext, size);
     imp.fileSize = size;
     imp.cancel = cancel;
@@ -506,6 +355,81 @@ void readWithOpenMesh(const std::string& path, const std::string& ext, std::uint
 
 } // namespace
 
+namespace meshio {
+
+void ReadContext::tick(std::size_t offset, std::size_t size) const {
+    if (cancel) cancel->throwIfCancelled();
+    if (progress && *progress && size > 0) (*progress)(0.9 * double(offset) / double(size));
+}
+
+std::string readFileBytes(const std::string& path, std::uint64_t size, const CancelToken* cancel) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, "", 0, "cannot open file for reading");
+    // One allocation of the file's size (from stat); a file that shrank
+    // since is cut to what was read, one that grew is read to that size.
+    std::string bytes(std::size_t(size), '\0');
+    std::size_t got = 0;
+    while (got < bytes.size() && in) {
+        if (cancel) cancel->throwIfCancelled();
+        const std::size_t want = std::min<std::size_t>(bytes.size() - got, std::size_t(1) << 20);
+        in.read(bytes.data() + got, std::streamsize(want));
+        got += std::size_t(in.gcount());
+    }
+    if (in.bad()) throw InputError(path, "", 0, "read error");
+    bytes.resize(got);
+    return bytes;
+}
+
+namespace {
+std::string_view withoutPlus(std::string_view t) {
+    if (!t.empty() && t[0] == '+') t.remove_prefix(1);  // from_chars rejects a leading '+'
+    return t;
+}
+} // namespace
+
+bool parseNumber(std::string_view token, double& value) {
+    const std::string_view t = withoutPlus(token);
+    if (t.empty()) return false;
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), value);
+    if (r.ptr != t.data() + t.size()) return false;
+    if (r.ec == std::errc::result_out_of_range) {
+        // Underflow (1e-400) reads as the nearest value, as strtod gives it;
+        // overflow comes back as +-HUGE_VAL, which callers refuse as non-finite.
+        value = std::strtod(std::string(t).c_str(), nullptr);
+        return true;
+    }
+    return r.ec == std::errc();
+}
+
+bool parseFloat(std::string_view token, float& value) {
+    const std::string_view t = withoutPlus(token);
+    if (t.empty()) return false;
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), value);
+    if (r.ptr != t.data() + t.size()) return false;
+    if (r.ec == std::errc::result_out_of_range) {
+        const double d = std::strtod(std::string(t).c_str(), nullptr);
+        value = std::abs(d) > double(std::numeric_limits<float>::max()) ? std::copysign(HUGE_VALF, float(d))
+                                                                       : float(d);
+        return true;
+    }
+    return r.ec == std::errc();
+}
+
+bool parseInteger(std::string_view token, std::int64_t& value) {
+    const std::string_view t = withoutPlus(token);
+    if (t.empty()) return false;
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), value);
+    return r.ec == std::errc() && r.ptr == t.data() + t.size();
+}
+
+std::string quoted(std::string_view text) {
+    constexpr std::size_t kMost = 80;
+    if (text.size() <= kMost) return "'" + std::string(text) + "'";
+    return "'" + std::string(text.substr(0, kMost)) + "...'";
+}
+
+} // namespace meshio
+
 Mesh loadMesh(const std::string& path, MeshLoadReport* report, const CancelToken* cancel,
               const Progress& progress) {
     namespace fs = std::filesystem;
@@ -525,6 +449,14 @@ Mesh loadMesh(const std::string& path, MeshLoadReport* report, const CancelToken
     FlatImporter imp;
     if (ext == "obj") {
         parseObj(path, size, imp, cancel, progress);
+    } else if (ext == "ply" || ext == "off") {
+        const std::string bytes = meshio::readFileBytes(path, size, cancel);
+        const meshio::ReadContext ctx{path, cancel, &progress};
+        if (ext == "ply") {
+            meshio::readPly(bytes, ctx, imp);
+        } else {
+            meshio::readOff(bytes, ctx, imp);
+        }
     } else {
         readWithOpenMesh(path, ext, size, imp, cancel, progress);
     }
