@@ -3,6 +3,7 @@
 #include "document.hpp"
 #include "vtk_adapters.hpp"
 
+#include "culling/export.hpp"
 #include "culling/overlays.hpp"
 
 #include <QTimer>
@@ -14,6 +15,9 @@
 #include <vtkCoordinate.h>
 #include <vtkDoubleArray.h>
 #include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkImageActor.h>
+#include <vtkImageData.h>
+#include <vtkImageMapper3D.h>
 #include <vtkInteractorStyleUser.h>
 #include <vtkLookupTable.h>
 #include <vtkPoints.h>
@@ -31,6 +35,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace lcui {
 
@@ -47,15 +52,61 @@ vtkSmartPointer<vtkPolyDataMapper2D> normalizedMapper(vtkPolyData* pd) {
     m->SetTransformCoordinate(coord);
     return m;
 }
+
+// Copies an RGB8 picture (row 0 at the top) into `out` (VTK rows go up).
+void fillImage(vtkImageData* out, const lc::RgbImage& p) {
+    out->SetDimensions(int(p.width), int(p.height), 1);
+    out->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+    auto* dst = static_cast<std::uint8_t*>(out->GetScalarPointer());
+    const std::size_t row = std::size_t(p.width) * 3;
+    for (std::uint32_t y = 0; y < p.height; ++y)
+        std::memcpy(dst + std::size_t(p.height - 1 - y) * row, p.rgb.data() + std::size_t(y) * row, row);
+    out->Modified();
+}
+
+// The sRGB encoding lc::differencePicture applies to |culled - all| / max.
+double srgbEncode(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055; }
 } // namespace
+
+const char* CameraView::toString(ImageMode m) {
+    switch (m) {
+    case ImageMode::Heat: return "heat";
+    case ImageMode::ShadedCulled: return "shaded-culled";
+    case ImageMode::ShadedAll: return "shaded-all";
+    case ImageMode::Difference: return "difference";
+    }
+    return "heat";
+}
+
+bool CameraView::fromString(const QString& s, ImageMode* m) {
+    for (ImageMode c : {ImageMode::Heat, ImageMode::ShadedCulled, ImageMode::ShadedAll, ImageMode::Difference})
+        if (s == toString(c)) {
+            *m = c;
+            return true;
+        }
+    return false;
+}
 
 CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(parent), doc_(doc) {
     vtkNew<vtkGenericOpenGLRenderWindow> rw;
     setRenderWindow(rw);
     background_->SetBackground(0.12, 0.12, 0.14);
     scene_->SetBackground(0.02, 0.02, 0.03);
+    // Layer 0: the window background, then the image renderer clearing the
+    // letterboxed viewport (and drawing a shaded picture in image modes).
+    // Layer 1: scene_, which draws on top without clearing the colour.
+    rw->SetNumberOfLayers(2);
+    image_->SetBackground(0.02, 0.02, 0.03);
+    image_->InteractiveOff();
+    scene_->SetLayer(1);
     rw->AddRenderer(background_);
+    rw->AddRenderer(image_);
     rw->AddRenderer(scene_);
+    imageActor_->InterpolateOff(); // the picture's pixels, not a blur of them
+    imageActor_->SetVisibility(false);
+    image_->AddActor(imageActor_);
+    vtkCamera* ic = image_->GetActiveCamera();
+    ic->ParallelProjectionOn();
 
     // Heat map: per-tile quads, coloured through the LUT (blue = short list,
     // red = the longest list of this run), translucent over the shaded scene.
@@ -101,6 +152,29 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
     legend_->SetVisibility(false);
     background_->AddActor2D(legend_);
 
+    // Difference legend: the grey ramp differencePicture uses (sRGB of
+    // |culled - all| / max), labelled in the shading pass's units.
+    diffLut_->SetNumberOfTableValues(256);
+    for (int i = 0; i < 256; ++i) {
+        const double g = srgbEncode(i / 255.0);
+        diffLut_->SetTableValue(i, g, g, g, 1.0);
+    }
+    diffLegend_->SetLookupTable(diffLut_);
+    diffLegend_->SetTitle("|culled -\nall|");
+    diffLegend_->SetNumberOfLabels(5);
+    diffLegend_->SetLabelFormat("%.3g");
+    diffLegend_->SetMaximumWidthInPixels(kLegendWidthPx - 10);
+    for (vtkTextProperty* tp : {diffLegend_->GetTitleTextProperty(), diffLegend_->GetLabelTextProperty()}) {
+        tp->SetColor(1, 1, 1);
+        tp->ShadowOff();
+        tp->ItalicOff();
+    }
+    diffLegend_->GetTitleTextProperty()->SetFontSize(14);
+    diffLegend_->GetLabelTextProperty()->SetFontSize(13);
+    diffLegend_->UnconstrainedFontSizeOn();
+    diffLegend_->SetVisibility(false);
+    background_->AddActor2D(diffLegend_);
+
     caption_->GetTextProperty()->SetFontSize(13);
     caption_->GetTextProperty()->SetColor(0.9, 0.9, 0.9);
     caption_->SetDisplayPosition(6, 6);
@@ -112,6 +186,7 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
     interactor()->AddObserver(vtkCommand::LeftButtonPressEvent, this, &CameraView::onLeftPress);
 
     connect(doc_, &Document::sceneReset, this, [this] {
+        picturesRun_.reset();
         rebuildMeshes();
         updateCamera();
         updateOverlay();
@@ -175,9 +250,12 @@ void CameraView::updateViewport() {
     }
     const double x0 = (availW - vw) / 2, y0 = (h - vh) / 2;
     scene_->SetViewport(x0 / w, y0 / h, (x0 + vw) / w, (y0 + vh) / h);
-    legend_->SetPosition((availW + 6) / w, 0.08);
-    legend_->SetWidth((kLegendWidthPx - 10) / w);
-    legend_->SetHeight(0.84);
+    image_->SetViewport(scene_->GetViewport());
+    for (vtkScalarBarActor* bar : {legend_.Get(), diffLegend_.Get()}) {
+        bar->SetPosition((availW + 6) / w, 0.08);
+        bar->SetWidth((kLegendWidthPx - 10) / w);
+        bar->SetHeight(0.84);
+    }
 }
 
 void CameraView::rebuildMeshes() {
@@ -191,6 +269,7 @@ void CameraView::rebuildMeshes() {
         actor->GetProperty()->SetColor(0.78, 0.78, 0.74);
         actor->GetProperty()->SetAmbient(0.15);
         actor->GetProperty()->SetDiffuse(0.85);
+        actor->SetVisibility(imageMode_ == ImageMode::Heat);
         scene_->AddActor(actor);
         meshActors_.push_back(actor);
     }
@@ -248,8 +327,9 @@ void CameraView::updateOverlay() {
     heatData_->Initialize();
     gridData_->Initialize();
     if (!run) {
-        legend_->SetVisibility(false);
-        caption_->SetInput("no culling run yet (F5)");
+        heatCaption_ = "no culling run yet (F5)";
+        updateImage();
+        updateLegendAndCaption();
         updateSelectedTile();
         scheduleRender();
         return;
@@ -316,14 +396,104 @@ void CameraView::updateOverlay() {
     const double tilePx = g.tileSize * (vp[2] - vp[0]) * width() / std::max(1u, cam.width);
     gridActor_->SetVisibility(tilePx >= 6.0);
 
-    legend_->SetVisibility(true);
-    const std::string caption = std::string(lc::toString(run->result.algorithm)) + "  " +
-                                std::to_string(g.tilesX) + "x" + std::to_string(g.tilesY) +
-                                " tiles of " + std::to_string(g.tileSize) + " px";
-    caption_->SetInput(caption.c_str());
+    heatCaption_ = std::string(lc::toString(run->result.algorithm)) + "  " + std::to_string(g.tilesX) + "x" +
+                   std::to_string(g.tilesY) + " tiles of " + std::to_string(g.tileSize) + " px";
+    updateImage();
+    updateLegendAndCaption();
     updateSelectedTile();
     updateReverseLookup();
     scheduleRender();
+}
+
+void CameraView::setImageMode(ImageMode mode) {
+    if (mode == imageMode_) return;
+    imageMode_ = mode;
+    updateImage();
+    updateLegendAndCaption();
+    scheduleRender();
+    emit imageModeChanged(mode);
+}
+
+vtkImageData* CameraView::shownImage() const {
+    if (imageMode_ == ImageMode::Heat || !imageActor_->GetVisibility()) return nullptr;
+    return imageActor_->GetInput();
+}
+
+double CameraView::shownImageRmse() const {
+    return picturesRun_ ? picturesRun_->truth.metrics.imageRmse : std::nan("");
+}
+double CameraView::shownImageMaxError() const {
+    return picturesRun_ ? picturesRun_->truth.metrics.imageMaxError : std::nan("");
+}
+
+QString CameraView::captionText() const { return QString::fromUtf8(caption_->GetInput()); }
+
+void CameraView::updateImage() {
+    const bool pictureMode = imageMode_ != ImageMode::Heat;
+    for (auto& a : meshActors_) a->SetVisibility(!pictureMode);
+    heatActor_->SetVisibility(!pictureMode); // the tint would falsify the picture
+    const auto run = doc_->runOutput();
+    if (pictureMode && run && !run->shadedAll.empty() && run != picturesRun_) {
+        try {
+            const lc::ShadedPictures p = lc::shadedPictures(*run);
+            fillImage(culledPicture_, p.culled);
+            fillImage(allPicture_, p.all);
+            fillImage(diffPicture_, p.difference);
+            picturesExposure_ = p.exposure;
+            picturesRun_ = run;
+        } catch (const std::exception&) {
+            picturesRun_.reset(); // images that do not match their depth: nothing to show
+        }
+    }
+    // While a newer run is being shaded the last pictures stay up, if they
+    // still cover the same pixels.
+    const bool show = pictureMode && run && picturesRun_ && picturesRun_->depth.width == run->result.grid.width &&
+                      picturesRun_->depth.height == run->result.grid.height;
+    imageActor_->SetVisibility(show);
+    if (!show) return;
+    vtkImageData* picture = imageMode_ == ImageMode::ShadedCulled ? culledPicture_.Get()
+                            : imageMode_ == ImageMode::ShadedAll  ? allPicture_.Get()
+                                                                  : diffPicture_.Get();
+    imageActor_->SetInputData(picture);
+    // Pixel (i, j) of the picture is centred at (i, j); frame it exactly.
+    const double W = picturesRun_->depth.width, H = picturesRun_->depth.height;
+    vtkCamera* ic = image_->GetActiveCamera();
+    ic->SetFocalPoint((W - 1) / 2, (H - 1) / 2, 0);
+    ic->SetPosition((W - 1) / 2, (H - 1) / 2, 10);
+    ic->SetViewUp(0, 1, 0);
+    ic->SetParallelScale(H / 2);
+    ic->SetClippingRange(1, 20);
+}
+
+void CameraView::updateLegendAndCaption() {
+    const auto run = doc_->runOutput();
+    legend_->SetVisibility(run && imageMode_ == ImageMode::Heat);
+    diffLegend_->SetVisibility(false);
+    if (imageMode_ == ImageMode::Heat || !run) {
+        caption_->SetInput(heatCaption_.c_str());
+        return;
+    }
+    QString text = imageMode_ == ImageMode::ShadedCulled ? tr("shaded, culled lists")
+                   : imageMode_ == ImageMode::ShadedAll  ? tr("shaded, all lights")
+                                                         : tr("|culled - all lights|");
+    if (imageActor_->GetVisibility()) {
+        const auto& m = picturesRun_->truth.metrics;
+        if (imageMode_ == ImageMode::Difference) {
+            text += tr(", white = %1").arg(m.imageMaxError, 0, 'g', 4);
+            diffLut_->SetTableRange(0, m.imageMaxError > 0 ? m.imageMaxError : 1.0);
+            diffLegend_->SetVisibility(true);
+        } else {
+            text += tr(", exposure %1").arg(picturesExposure_, 0, 'g', 4);
+        }
+        text += tr("  |  image RMSE %1, max %2 (%3)")
+                    .arg(m.imageRmse, 0, 'g', 6)
+                    .arg(m.imageMaxError, 0, 'g', 6)
+                    .arg(QString::fromStdString(picturesRun_->result.backend));
+        if (picturesRun_ != run) text += tr("  |  shading the newer run...");
+    } else {
+        text += tr(": shading...");
+    }
+    caption_->SetInput(text.toUtf8().constData());
 }
 
 void CameraView::updateReverseLookup() {

@@ -5,15 +5,25 @@
 // viewport letterboxed to the culling resolution's aspect so that the tile
 // grid and the heat map (2D actors in that viewport's normalised coordinates)
 // line up with the pixels the culling saw. A legend sits to the right.
+//
+// Image modes (setImageMode): the scene with the heat map, or the shading
+// pass's pictures (lc::shadedPictures, the pixels `run --shaded-images`
+// writes) drawn 1:1 in the same letterboxed viewport under the tile grid,
+// the selected tile and the reverse look-up outlines.
 
 #include <QVTKOpenGLNativeWidget.h>
 
 #include <vtkNew.h>
 #include <vtkSmartPointer.h>
 
+#include <QString>
+
+#include <memory>
 #include <vector>
 
 class vtkActor;
+class vtkImageActor;
+class vtkImageData;
 class vtkActor2D;
 class vtkLookupTable;
 class vtkPolyData;
@@ -32,6 +42,16 @@ class Document;
 class CameraView : public QVTKOpenGLNativeWidget {
     Q_OBJECT
 public:
+    enum class ImageMode {
+        Heat,         // the scene shaded by VTK, heat map of the tiles
+        ShadedCulled, // the shading pass with each pixel's list
+        ShadedAll,    // the shading pass with every light
+        Difference,   // |culled - all| per channel, the largest error white
+    };
+    static const char* toString(ImageMode m); // "heat", "shaded-culled", "shaded-all", "difference"
+    static bool fromString(const QString& s, ImageMode* m);
+    static bool needsShading(ImageMode m) { return m != ImageMode::Heat; }
+
     explicit CameraView(Document* doc, QWidget* parent = nullptr);
     ~CameraView() override;
 
@@ -51,6 +71,20 @@ public:
 
     vtkRenderer* sceneRenderer() const;
     vtkScalarBarActor* legend() const;
+
+    ImageMode imageMode() const { return imageMode_; }
+    void setImageMode(ImageMode mode);
+    // The picture an image mode shows (VTK rows: row 0 at the bottom), or null
+    // in Heat mode and while no shaded run has arrived.
+    vtkImageData* shownImage() const;
+    // Generation-independent identity of the run whose pictures are shown
+    // (null: none) and the image error the legend states (its RMSE and max
+    // are the run's truth.metrics, the numbers summary.json writes).
+    const lc::RunOutput* shownImageRun() const { return picturesRun_.get(); }
+    double shownImageRmse() const;
+    double shownImageMaxError() const;
+    // The caption line under the image (mode, exposure, image error).
+    QString captionText() const;
     // Re-renders now (tests, screenshots).
     void renderNow();
     // Renders once when control returns to the event loop, however many
@@ -59,6 +93,7 @@ public:
 
 signals:
     void tileClicked(int tile);
+    void imageModeChanged(ImageMode mode);
 
 protected:
     void resizeEvent(QResizeEvent* e) override;
@@ -72,6 +107,8 @@ private:
     void updateReverseLookup();
     void updateViewport();
     void onLeftPress();
+    void updateImage();
+    void updateLegendAndCaption();
 
     Document* doc_;
     vtkNew<vtkRenderer> background_; // full window: legend and captions
@@ -84,6 +121,18 @@ private:
     vtkNew<vtkLookupTable> lut_;
     vtkNew<vtkScalarBarActor> legend_;
     vtkNew<vtkTextActor> caption_;
+
+    // Image modes: a renderer under scene_ (same viewport, layer 0) with a
+    // parallel camera framing the picture pixel for pixel.
+    ImageMode imageMode_ = ImageMode::Heat;
+    vtkNew<vtkRenderer> image_;
+    vtkNew<vtkImageActor> imageActor_;
+    vtkNew<vtkImageData> culledPicture_, allPicture_, diffPicture_;
+    std::shared_ptr<const lc::RunOutput> picturesRun_; // the run the pictures were made from
+    double picturesExposure_ = 1;
+    vtkNew<vtkLookupTable> diffLut_;
+    vtkNew<vtkScalarBarActor> diffLegend_;
+    std::string heatCaption_;
 };
 
 } // namespace lcui

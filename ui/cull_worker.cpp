@@ -2,8 +2,10 @@
 
 #include "culling/errors.hpp"
 #include "culling/projection.hpp"
+#include "culling/shade.hpp"
 
 #include <chrono>
+#include <utility>
 
 #include <QMetaObject>
 
@@ -28,6 +30,17 @@ void CullWorker::post(CullRequest request) {
         if (pending_) ++dropped_;
         pending_ = std::move(request);
         if (truthCancel_) truthCancel_->cancelled = true;
+        if (shadeCancel_) shadeCancel_->cancelled = true;
+        if (!scheduled_) scheduled_ = schedule = true;
+    }
+    if (schedule) QMetaObject::invokeMethod(this, "drain", Qt::QueuedConnection);
+}
+
+void CullWorker::requestShading(quint64 generation) {
+    bool schedule = false;
+    {
+        std::lock_guard lock(mutex_);
+        shadeWanted_ = generation;
         if (!scheduled_) scheduled_ = schedule = true;
     }
     if (schedule) QMetaObject::invokeMethod(this, "drain", Qt::QueuedConnection);
@@ -38,6 +51,8 @@ void CullWorker::cancelCurrent() {
     pending_.reset();
     if (cancel_) cancel_->cancelled = true;
     if (truthCancel_) truthCancel_->cancelled = true;
+    if (shadeCancel_) shadeCancel_->cancelled = true;
+    shadeWanted_ = 0;
 }
 
 quint64 CullWorker::droppedRequests() const {
@@ -45,11 +60,13 @@ quint64 CullWorker::droppedRequests() const {
     return dropped_;
 }
 
-void CullWorker::addDeferredTruth(const CullRequest& req, const lc::RunOutput& partial) {
+std::shared_ptr<const lc::RunOutput> CullWorker::addDeferredTruth(const CullRequest& req,
+                                                                  const lc::RunOutput& partial) {
     auto truthCancel = std::make_shared<lc::CancelToken>();
+    std::shared_ptr<const lc::RunOutput> done;
     {
         std::lock_guard lock(mutex_);
-        if (pending_) return; // the newer request will bring its own
+        if (pending_) return done; // the newer request will bring its own
         truthCancel_ = truthCancel;
     }
     try {
@@ -62,24 +79,97 @@ void CullWorker::addDeferredTruth(const CullRequest& req, const lc::RunOutput& p
         full->result.timings.groundTruthMs =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         full->truthComputed = true;
-        emit finished(req.generation, std::shared_ptr<const lc::RunOutput>(std::move(full)));
+        done = std::move(full);
+        emit finished(req.generation, done);
     } catch (const lc::Cancelled&) {
         // A newer request arrived: its run supersedes this truth.
     }
     std::lock_guard lock(mutex_);
     if (truthCancel_ == truthCancel) truthCancel_.reset();
+    return done;
+}
+
+bool CullWorker::shadeLast() {
+    const quint64 generation = lastGeneration_;
+    auto cancel = std::make_shared<lc::CancelToken>();
+    {
+        std::lock_guard lock(mutex_);
+        if (shadeWanted_ == generation) shadeWanted_ = 0;
+        if (pending_) {
+            // A newer request runs first and brings its own images if wanted.
+            emit shadingEnded(generation, false);
+            return false;
+        }
+        shadeCancel_ = cancel;
+    }
+    emit shadingStarted(generation);
+    bool shaded = false;
+    try {
+        if (cancel->cancelled) throw lc::Cancelled();
+        auto full = std::make_shared<lc::RunOutput>(*last_);
+        lc::shadeAndCompare(*backend_, *full, lc::Projection(lastScene_->camera), /*keepImages=*/true,
+                            cancel.get());
+        // shadeAndCompare looks at the token between its two images only.
+        if (cancel->cancelled) throw lc::Cancelled();
+        last_ = full;
+        shaded = true;
+        emit finished(generation, last_);
+    } catch (const lc::Cancelled&) {
+        // A newer request supersedes these images.
+    } catch (const std::exception& e) {
+        emit failed(generation, tr("shading: %1").arg(QString::fromStdString(e.what())));
+    }
+    {
+        std::lock_guard lock(mutex_);
+        if (shadeCancel_ == cancel) shadeCancel_.reset();
+    }
+    emit shadingEnded(generation, shaded);
+    return shaded;
 }
 
 void CullWorker::drain() {
     for (;;) {
         CullRequest req;
         std::shared_ptr<lc::CancelToken> cancel = std::make_shared<lc::CancelToken>();
+        bool shadeNow = false;
+        std::shared_ptr<const lc::RunOutput> resend;
+        quint64 unknown = 0;
         {
             std::lock_guard lock(mutex_);
             if (!pending_) {
-                scheduled_ = false;
-                return;
+                const quint64 wanted = std::exchange(shadeWanted_, 0);
+                if (wanted == 0) {
+                    scheduled_ = false;
+                    return;
+                }
+                // requestShading() for a run that is not running any more.
+                if (wanted == lastGeneration_ && last_) {
+                    if (last_->shadedAll.empty()) {
+                        shadeWanted_ = wanted;
+                        shadeNow = true;
+                    } else {
+                        resend = last_;
+                    }
+                } else {
+                    unknown = wanted;
+                }
             }
+        }
+        if (shadeNow) {
+            shadeLast();
+            continue;
+        }
+        if (resend) {
+            emit finished(lastGeneration_, resend);
+            emit shadingEnded(lastGeneration_, true);
+            continue;
+        }
+        if (unknown) {
+            emit shadingEnded(unknown, false);
+            continue;
+        }
+        {
+            std::lock_guard lock(mutex_);
             req = std::move(*pending_);
             pending_.reset();
             cancel_ = cancel;
@@ -98,8 +188,8 @@ void CullWorker::drain() {
                                   QString::fromStdString(backend_->deviceName()));
             }
             lc::RunOptions options;
-            // The studio shows false negatives and efficiency; the Lambert image
-            // error (pixels x lights) is left to the CLI and exports.
+            // The Lambert image error (pixels x lights) is left to the shading
+            // phase below, which runs only when asked (CullRequest::shade).
             options.truthOptions.imageError = false;
             if (depth_ && depthScene_ && sameGeometry(*depthScene_, *req.scene))
                 options.reuseDepth = depth_.get();
@@ -111,7 +201,22 @@ void CullWorker::drain() {
                 depthScene_ = req.scene;
             }
             emit finished(req.generation, std::shared_ptr<const lc::RunOutput>(out));
-            if (req.deferTruth) addDeferredTruth(req, *out);
+            lastGeneration_ = req.generation;
+            lastScene_ = req.scene;
+            last_ = out;
+            if (req.deferTruth) {
+                last_ = addDeferredTruth(req, *out);
+                if (!last_) {
+                    last_ = out;
+                    continue; // superseded: so is its shading
+                }
+            }
+            bool shade = req.shade;
+            {
+                std::lock_guard lock(mutex_);
+                shade = shade || shadeWanted_ == req.generation;
+            }
+            if (shade) shadeLast();
         } catch (const lc::Cancelled&) {
             emit failed(req.generation, tr("culling cancelled"));
         } catch (const std::exception& e) {
@@ -130,6 +235,8 @@ CullService::CullService(QObject* parent) : QObject(parent), worker_(new CullWor
     connect(worker_, &CullWorker::failed, this, &CullService::failed, Qt::QueuedConnection);
     connect(worker_, &CullWorker::backendReady, this, &CullService::backendReady,
             Qt::QueuedConnection);
+    connect(worker_, &CullWorker::shadingStarted, this, &CullService::shadingStarted, Qt::QueuedConnection);
+    connect(worker_, &CullWorker::shadingEnded, this, &CullService::shadingEnded, Qt::QueuedConnection);
     thread_.start();
 }
 
@@ -140,7 +247,7 @@ CullService::~CullService() {
 }
 
 quint64 CullService::request(const lc::Scene& scene, const lc::CullSettings& settings,
-                             const QString& backend, const QString& device, bool deferTruth) {
+                             const QString& backend, const QString& device, bool deferTruth, bool shade) {
     CullRequest r;
     r.generation = ++generation_;
     r.scene = std::make_shared<const lc::Scene>(scene);
@@ -148,6 +255,7 @@ quint64 CullService::request(const lc::Scene& scene, const lc::CullSettings& set
     r.backend = backend.toStdString();
     r.device = device.toStdString();
     r.deferTruth = deferTruth;
+    r.shade = shade;
     worker_->post(std::move(r));
     return generation_;
 }

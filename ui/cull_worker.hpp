@@ -32,6 +32,12 @@ struct CullRequest {
     // request arrives first (ground truth costs more than culling, so a drag
     // would otherwise be paced by it).
     bool deferTruth = false;
+    // Shade the culled and the all-lights image (lc::shadeAndCompare, on the
+    // request's backend, at the camera's resolution) once the lists (and
+    // ground truth) are out: a further result of the same generation that
+    // carries RunOutput::shadedCulled/shadedAll and the image error. A newer
+    // request cancels shading that has not finished.
+    bool shade = false;
 };
 
 class CullWorker : public QObject {
@@ -44,19 +50,32 @@ public:
     void cancelCurrent();
     // Requests that were replaced before they ran (for diagnostics and tests).
     quint64 droppedRequests() const;
+    // Thread-safe: asks for the shaded images of run `generation` (the camera
+    // view switched to a shaded mode, or an export needs them). A run still
+    // queued or running shades when its lists are out; the last finished run
+    // is shaded now (or, already shaded, sent again). Any other generation
+    // ends at once with shadingEnded(generation, false).
+    void requestShading(quint64 generation);
 
 signals:
     void started(quint64 generation);
     void finished(quint64 generation, std::shared_ptr<const lc::RunOutput> output);
     void failed(quint64 generation, QString message);
     void backendReady(QString name, QString device);
+    // The shading pass of `generation` starts / ends (`shaded`: its images
+    // were sent with finished(); false: cancelled, failed or not possible).
+    void shadingStarted(quint64 generation);
+    void shadingEnded(quint64 generation, bool shaded);
 
 private slots:
     void drain();
 
 private:
-    // Second phase of a deferTruth request (worker thread).
-    void addDeferredTruth(const CullRequest& req, const lc::RunOutput& partial);
+    // Second phase of a deferTruth request (worker thread); null when a newer
+    // request superseded it.
+    std::shared_ptr<const lc::RunOutput> addDeferredTruth(const CullRequest& req, const lc::RunOutput& partial);
+    // Last phase: shades last_ (worker thread). False when cancelled or failed.
+    bool shadeLast();
 
 private:
     mutable std::mutex mutex_;
@@ -65,6 +84,8 @@ private:
     quint64 dropped_ = 0;
     std::shared_ptr<lc::CancelToken> cancel_;
     std::shared_ptr<lc::CancelToken> truthCancel_; // set by post(): a newer request stops deferred truth
+    std::shared_ptr<lc::CancelToken> shadeCancel_; // likewise for shading
+    quint64 shadeWanted_ = 0;                      // requestShading()'s generation, 0: none
     // Touched only on the worker thread:
     std::unique_ptr<lc::CullBackend> backend_;
     std::string backendName_, deviceSelector_;
@@ -72,6 +93,11 @@ private:
     // Live drag) reuses the depth image instead of re-rendering it.
     std::shared_ptr<const lc::Scene> depthScene_;
     std::shared_ptr<const lc::DepthImage> depth_;
+    // The last finished run (its most complete output) and its request: what
+    // requestShading() shades.
+    quint64 lastGeneration_ = 0;
+    std::shared_ptr<const lc::Scene> lastScene_;
+    std::shared_ptr<const lc::RunOutput> last_;
 };
 
 // The UI-side handle: starts the thread, numbers the requests.
@@ -83,7 +109,10 @@ public:
 
     // Copies the scene and posts it; returns the request's generation.
     quint64 request(const lc::Scene& scene, const lc::CullSettings& settings,
-                    const QString& backend, const QString& device, bool deferTruth = false);
+                    const QString& backend, const QString& device, bool deferTruth = false,
+                    bool shade = false);
+    // CullWorker::requestShading.
+    void requestShading(quint64 generation) { worker_->requestShading(generation); }
     quint64 lastGeneration() const { return generation_; }
     CullWorker* worker() { return worker_; }
     // "vulkan" when this build and machine have it, else "cpu".
@@ -94,6 +123,8 @@ signals:
     void finished(quint64 generation, std::shared_ptr<const lc::RunOutput> output);
     void failed(quint64 generation, QString message);
     void backendReady(QString name, QString device);
+    void shadingStarted(quint64 generation);
+    void shadingEnded(quint64 generation, bool shaded);
 
 private:
     QThread thread_;

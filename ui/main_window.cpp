@@ -278,6 +278,7 @@ void MainWindow::buildMenus() {
     view->addSeparator();
     for (auto* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());
     buildOverlayMenus(overlayFileMenu, view);
+    buildImageModes(view);
 
     QMenu* cull = menuBar()->addMenu(tr("&Culling"));
     cull->addAction(action("actionRun"));
@@ -436,7 +437,8 @@ void MainWindow::setBackend(const QString& backend, const QString& device) {
 
 quint64 MainWindow::runCulling(bool liveEdit) {
     const quint64 gen = service_->request(doc_->scene(), doc_->settings(), backendCombo_->currentText(),
-                                          deviceEdit_->text(), liveEdit);
+                                          deviceEdit_->text(), liveEdit,
+                                          CameraView::needsShading(cameraView_->imageMode()));
     statusBar()->showMessage(tr("culling (run %1)...").arg(gen));
     return gen;
 }
@@ -447,7 +449,17 @@ bool MainWindow::isLive() const { return action("actionLive")->isChecked(); }
 void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::RunOutput> out) {
     if (!doc_->setRunOutput(out, generation)) return; // an older run finished late
     const auto& m = out->truth.metrics;
-    // A Live edit's lists arrive before its ground truth: log once, with it.
+    // A Live edit's lists arrive before its ground truth: log once, with it;
+    // the shaded images come last, with the image error.
+    if (!out->shadedAll.empty()) {
+        log(tr("run %1: image RMSE %2, max error %3, shading %4 ms")
+                .arg(generation)
+                .arg(m.imageRmse, 0, 'g', 6)
+                .arg(m.imageMaxError, 0, 'g', 6)
+                .arg(out->result.timings.shadeMs, 0, 'f', 2));
+        emit runFinished(generation);
+        return;
+    }
     if (out->truthComputed) log(tr("run %1: %2, %3 lights, depth %4 ms, cull %5 ms, false negatives %6, efficiency %7")
             .arg(generation)
             .arg(lc::toString(out->result.algorithm))

@@ -106,6 +106,10 @@ public:
     // lc::exportDiagnostics, atomically into `dir`. False (logged, shown) on
     // failure or when there is no run to export.
     bool exportDiagnostics(const QString& dir);
+    // The shown run with its shaded images: as it is when it has them, else
+    // shaded on the worker now (waits, "shading..." in the status bar). Null
+    // (logged) when shading failed or a newer run replaced this one.
+    std::shared_ptr<const lc::RunOutput> shadedRunOutput();
 
     // Whole-window image with both views' GL content.
     QImage grabWindow();
@@ -127,6 +131,7 @@ private:
     void buildDocks();
     void buildStatusBar();
     void buildOverlayMenus(QMenu* file, QMenu* view); // main_window_overlays.cpp
+    void buildImageModes(QMenu* view);                // main_window_shading.cpp
     void syncParamWidgets();
     void onParamEdited(const std::string& name, const QString& value);
     void onRunFinished(quint64 generation, std::shared_ptr<const lc::RunOutput> out);
@@ -160,6 +165,7 @@ private:
     QLabel* statusFn_;
     QLabel* statusEfficiency_;
     QLabel* statusLists_;
+    QLabel* statusShading_ = nullptr; // "shading..." while the worker shades
     QString lastBackendName_, lastDeviceName_;
     quint64 pendingRuns_ = 0;
 };

@@ -85,10 +85,16 @@ void MainWindow::buildOverlayMenus(QMenu* file, QMenu* view) {
 }
 
 bool MainWindow::exportDiagnostics(const QString& dir) {
-    const auto run = doc_->runOutput();
-    if (!run) {
+    if (!doc_->runOutput()) {
         log(tr("export diagnostics: no culling run yet (F5)"), true);
         prompts.showError(this, tr("Export diagnostics"), tr("There is no culling run to export yet: press F5."));
+        return false;
+    }
+    // shaded_culled.png, shaded_all.png and shaded_diff.png come with it:
+    // shaded on the worker now if the run was not shaded yet.
+    const auto run = shadedRunOutput();
+    if (!run) {
+        prompts.showError(this, tr("Export diagnostics"), tr("The shading pass did not finish; nothing was exported."));
         return false;
     }
     try {

@@ -340,7 +340,7 @@ void writePng(const RgbImage& img, const std::string& path) {
     }
 }
 
-void writeShadedImages(const RunOutput& run, const std::string& dir) {
+ShadedPictures shadedPictures(const RunOutput& run) {
     const DepthImage& d = run.depth;
     const std::size_t n = std::size_t(d.width) * d.height * 3;
     if (run.shadedCulled.size() != n || run.shadedAll.size() != n)
@@ -348,13 +348,21 @@ void writeShadedImages(const RunOutput& run, const std::string& dir) {
                     std::to_string(d.height) + " depth image");
     // One exposure for both shaded images so they compare by eye; the
     // difference is scaled so that the largest error is white.
-    const double exposure = exposureFor(d, run.shadedAll);
-    const ImageError e = compareShadedImages(d, run.shadedCulled, run.shadedAll);
+    ShadedPictures p;
+    p.exposure = exposureFor(d, run.shadedAll);
+    p.error = compareShadedImages(d, run.shadedCulled, run.shadedAll);
+    p.culled = {d.width, d.height, shadedPicture(run.shadedCulled, p.exposure)};
+    p.all = {d.width, d.height, shadedPicture(run.shadedAll, p.exposure)};
+    p.difference = {d.width, d.height, differencePicture(run.shadedCulled, run.shadedAll, p.error.maxAbs)};
+    return p;
+}
+
+void writeShadedImages(const RunOutput& run, const std::string& dir) {
+    const ShadedPictures p = shadedPictures(run);
     const fs::path base(dir);
-    writePng({d.width, d.height, shadedPicture(run.shadedCulled, exposure)}, (base / "shaded_culled.png").string());
-    writePng({d.width, d.height, shadedPicture(run.shadedAll, exposure)}, (base / "shaded_all.png").string());
-    writePng({d.width, d.height, differencePicture(run.shadedCulled, run.shadedAll, e.maxAbs)},
-             (base / "shaded_diff.png").string());
+    writePng(p.culled, (base / "shaded_culled.png").string());
+    writePng(p.all, (base / "shaded_all.png").string());
+    writePng(p.difference, (base / "shaded_diff.png").string());
 }
 
 void exportDiagnostics(const Scene& scene, const CullSettings& settings, const RunOutput& run,

@@ -2,6 +2,7 @@
 // Diagnostics export, shared by the CLI (`run --out`) and the studio.
 
 #include "culling/pipeline.hpp"
+#include "culling/shade.hpp"
 
 #include <string>
 
@@ -26,6 +27,18 @@ void writePng(const RgbImage& img, const std::string& path);
 // exportDiagnostics writes them too when the run kept its shaded images
 // (RunOptions::keepShadedImages).
 void writeShadedImages(const RunOutput& run, const std::string& dir);
+
+// The three pictures writeShadedImages writes (RGB8, row 0 at the top), for a
+// caller that shows them (the studio's camera view shows exactly these
+// pixels), with the exposure of the two shaded ones and the image error that
+// scales the difference (error.maxAbs is white). Throws Error as
+// writeShadedImages does.
+struct ShadedPictures {
+    RgbImage culled, all, difference;
+    double exposure = 1;
+    ImageError error;
+};
+ShadedPictures shadedPictures(const RunOutput& run);
 
 // An extra image a caller adds to the export (the studio's view screenshots):
 // `fileName` must be one of kExportViewImages.
