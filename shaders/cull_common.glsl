@@ -52,6 +52,11 @@ layout(std430, binding = 7) buffer StatusBuf { uint status; uint candidateTests;
 layout(std430, binding = 8) buffer BinBuf { uint binMask[]; };
 // Spot cones (one per light; a 1-element placeholder without cone tests).
 layout(std430, binding = 9) readonly buffer SpotBuf { GpuSpotCone spots[]; };
+// The count pass's stash: the first P.bins.z entries of every list, at
+// stash[list * P.bins.z + i] (cull_lists.comp). A list the stash holds whole
+// is copied, not culled again, by the write pass, and when it holds every
+// list the host reads the entries from here and skips the write pass.
+layout(std430, binding = 10) buffer StashBuf { uint stash[]; };
 
 const uint STATUS_SPLIT_WORKGROUP = 1u; // more than one subgroup per workgroup
 const uint STATUS_COUNT_MISMATCH = 2u;  // write pass found a different count
@@ -67,7 +72,10 @@ bool isOrtho() { return (P.counts.w & LC_FLAG_ORTHO) != 0u; }
 // precision where it cancels (perspective, d near A at the far plane).
 float viewDepthOf(float d) {
     precise float t = (d - P.depth.x) - P.depth.z;
-    return isOrtho() ? t / P.depth.y : P.depth.y / t;
+    // One division, its operands selected (a per-lane choice costs both
+    // divisions on lavapipe, which runs both sides of a varying branch).
+    bool ortho = isOrtho();
+    return (ortho ? t : P.depth.y) / (ortho ? P.depth.y : t);
 }
 
 float widenDown(float v) { return v - (abs(v) * P.cluster.z + P.cluster.w); }

@@ -6,8 +6,10 @@
 // the lights that pass as a 32-bit mask of its word; a subgroup exclusive add
 // of the masks' bit counts places them, so the words go out in order and each
 // list comes out ascending and deterministic, without a sort and without
-// barriers. WRITE_PASS == 0 stores the count; WRITE_PASS == 1 writes the
-// indices at the scanned offset and checks that the count matches. `all` has
+// barriers. WRITE_PASS == 0 stores the count and stashes the list's first
+// P.bins.z entries (cull_common.glsl, binding 10); WRITE_PASS == 1 copies a
+// list the stash holds whole, else tests again and writes the indices at the
+// scanned offset and checks that the count matches. `all` has
 // one list of every light: its count pass is one invocation, its write pass
 // one invocation per light.
 #extension GL_GOOGLE_include_directive : require
@@ -38,6 +40,7 @@ void main() {
         }
         return;
     }
+    uint stashSlots = P.bins.z;
     uint list = id, lane = 0u;
     if (LANES != 1u) {
         if (gl_SubgroupSize != LANES) atomicOr(status, STATUS_SPLIT_WORKGROUP);
@@ -46,7 +49,14 @@ void main() {
     }
     // Uniform per list (so per subgroup): the early exits keep subgroups whole.
     if (list >= P.counts.z) return;
-    if (WRITE_PASS != 0u && listCount[list] == 0u) return;
+    if (WRITE_PASS != 0u) {
+        uint count = listCount[list];
+        if (count <= stashSlots) { // the count pass stashed the whole list
+            uint base = listOffset[list];
+            for (uint i = lane; i < count; i += LANES) lightIndices[base + i] = stash[list * stashSlots + i];
+            return;
+        }
+    }
 
     uint tile = list / P.counts.y, sub = list % P.counts.y;
     // The list's depth range [zlo, zhi] (view depth) and which lights it takes.
@@ -94,6 +104,14 @@ void main() {
                                  max(distance(ch.corners[6], cellCentre), distance(ch.corners[7], cellCentre))));
             cellRadius += (length(cellCentre) + cellRadius) * P.cluster.z + P.cluster.w;
         }
+        // 2.5d: the cell of view depth d is (log2(d) - cellLog0) * cellScale
+        // (log slicing; sliceOf's log(d / lo) / log(hi / lo) x CELLS with the
+        // per-list terms taken out of the light loop; the rounding of the two
+        // logs, ~1e-6 in log2 units, is far inside the light's 2e-5 relative
+        // widening, as for tile_bounds' 2e-5 allowance), else sliceOf's own.
+        bool cellLog = SLICING == LC_SLICING_LOG && maskLo > 0.0 && maskHi > maskLo;
+        float cellLog0 = cellLog ? log2(maskLo) : 0.0;
+        float cellScale = cellLog ? float(CELLS) / log2(maskHi / maskLo) : 0.0;
         uint base = (WRITE_PASS != 0u) ? listOffset[list] : 0u;
         uint tilesX = P.size.z, tilesY = P.size.w, words = P.bins.x;
         uint tx = tile % tilesX, ty = tile / tilesX;
@@ -130,13 +148,40 @@ void main() {
                 }
                 if (pass && ALGORITHM == LC_ALG_25D) {
                     float depth = -L.z;
-                    pass = (sliceRangeMask(maskLo, maskHi, widenDown(depth - r), widenUp(depth + r)) & geomMask) != 0u;
+                    float a = widenDown(depth - r), b = widenUp(depth + r);
+                    uint cells;
+                    if (cellLog) {
+                        // As sliceRangeMask: no cell when [a, b] misses [lo, hi];
+                        // cell 0 for depths at or before lo.
+                        float cellMax = float(CELLS - 1u);
+                        uint c0 = a > maskLo ? uint(clamp((log2(a) - cellLog0) * cellScale, 0.0, cellMax)) : 0u;
+                        uint c1 = b > maskLo ? uint(clamp((log2(b) - cellLog0) * cellScale, 0.0, cellMax)) : 0u;
+                        cells = (b < maskLo || a > maskHi) ? 0u : ((2u << (c1 - c0)) - 1u) << c0;
+                    } else {
+                        cells = sliceRangeMask(maskLo, maskHi, a, b);
+                    }
+                    pass = (cells & geomMask) != 0u;
                 }
-                if (pass) passMask |= 1u << bit;
+                if (pass) {
+                    // One invocation per list: its position is known here.
+                    uint at = n + uint(bitCount(passMask));
+                    if (LANES == 1u && WRITE_PASS == 0u && at < stashSlots) stash[list * stashSlots + at] = w * 32u + bit;
+                    passMask |= 1u << bit;
+                }
             }
             cut = cut || m != 0u;
             uint cnt = uint(bitCount(passMask));
             uint at = n + ((LANES != 1u) ? subgroupExclusiveAdd(cnt) : 0u);
+            if (LANES != 1u && WRITE_PASS == 0u && n < stashSlots) {
+                // A subgroup per list: after the scan. At most 32 iterations
+                // a word, as the write loop below.
+                uint stashMask = passMask;
+                for (uint a = at; stashMask != 0u && a < stashSlots; ++a) {
+                    uint bit = uint(findLSB(stashMask));
+                    stashMask &= stashMask - 1u;
+                    stash[list * stashSlots + a] = w * 32u + bit;
+                }
+            }
             if (WRITE_PASS != 0u) {
                 while (passMask != 0u) {
                     uint bit = uint(findLSB(passMask));

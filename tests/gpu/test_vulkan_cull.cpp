@@ -475,3 +475,38 @@ TEST_F(GpuTest, DeviceMemoryPeakAndNoLeak) {
 }
 
 } // namespace
+
+namespace {
+
+// The count pass stashes each list's first 16 entries (vulkan_backend.cpp,
+// kMaxStashSlots): when every list fits, the host takes the lists from the
+// stash and no write pass runs; otherwise the write pass copies the lists that
+// fit and culls the longer ones again. Both paths against the CPU reference,
+// each with its precondition checked: 16 lights cannot make a list longer
+// than the stash; 3,000 make both short and long lists.
+TEST_F(GpuTest, StashedAndRecomputedListsMatchTheReference) {
+    auto cpuBackend = makeCpuBackend();
+    for (std::uint32_t n : {16u, 3000u}) {
+        Scene scene = sized("forest", 640, 360);
+        scene.lights = generateLights(defaultLightGen(scene, n, 11));
+        const Projection proj(scene.camera);
+        const TileGrid grid = TileGrid::make(640, 360, 16);
+        const ViewLights lights = makeViewLights(scene);
+        const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+        for (Algorithm a : {Algorithm::MinMax, Algorithm::HalfZ, Algorithm::TwoPointFiveD, Algorithm::Clustered}) {
+            CullSettings st;
+            st.algorithm = a;
+            const std::string label = std::to_string(n) + " lights " + toString(a);
+            const CullResult gpu = gputest::vulkan().cull(depth, proj, grid, lights, st);
+            const std::uint32_t longest = *std::max_element(gpu.listCount.begin(), gpu.listCount.end());
+            const bool anyShort = std::any_of(gpu.listCount.begin(), gpu.listCount.end(),
+                                              [](std::uint32_t c) { return c > 0 && c <= 16; });
+            ASSERT_TRUE(anyShort) << label;
+            if (n == 16u) ASSERT_LE(longest, 16u) << label;
+            else ASSERT_GT(longest, 16u) << label << ": no list needs the write pass";
+            checkCase(label, depth, proj, grid, lights, st, *cpuBackend);
+        }
+    }
+}
+
+} // namespace

@@ -80,7 +80,8 @@ struct GpuCullParams {
     vec4 cluster;
     // Light binning (light_bins.comp): x = mask words per column/row (one bit
     // per light: ceil(lightCount / 32)), y = index of the first row mask in the
-    // bin buffer (= x * tilesX); z, w unused.
+    // bin buffer (= x * tilesX); z = stash slots per list (the count pass keeps
+    // each list's first z entries; 0: no stash); w unused.
     uvec4 bins;
 };
 

@@ -291,6 +291,12 @@ Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
         enable13.computeFullSubgroups = fullSubgroups_ ? VK_TRUE : VK_FALSE;
         enable13.subgroupSizeControl = (v13 && f13.subgroupSizeControl) ? VK_TRUE : VK_FALSE;
 
+        VkPhysicalDeviceFeatures f10{};
+        vkGetPhysicalDeviceFeatures(physical_, &f10);
+        int64_ = f10.shaderInt64 == VK_TRUE;
+        VkPhysicalDeviceFeatures enable10{};
+        enable10.shaderInt64 = int64_ ? VK_TRUE : VK_FALSE;
+
         float prio = 1.0f;
         VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
         qci.queueFamilyIndex = queueFamily_;
@@ -299,6 +305,7 @@ Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
         VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
         dci.queueCreateInfoCount = 1;
         dci.pQueueCreateInfos = &qci;
+        dci.pEnabledFeatures = &enable10;
         if (v13) dci.pNext = &enable13;
         LC_VK(vkCreateDevice(physical_, &dci, nullptr, &device_));
         vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);

@@ -163,6 +163,8 @@ public:
     std::string deviceName() const { return props_.deviceName; }
     std::uint32_t subgroupSize() const { return subgroupSize_; }
     bool fullSubgroupsSupported() const { return fullSubgroups_; }
+    // shaderInt64, enabled when the device has it (tile_bounds' pixel-pair loads).
+    bool int64Supported() const { return int64_; }
     // A CPU implementation (lavapipe): device memory is host memory, so
     // buffers stay host-visible and mapped, and compute timestamps are not
     // trusted (DESIGN.md). Elsewhere: device-local buffers, GPU timestamps.
@@ -225,6 +227,7 @@ private:
     VkPhysicalDeviceMemoryProperties memProps_{};
     std::uint32_t subgroupSize_ = 1;
     bool fullSubgroups_ = false;
+    bool int64_ = false;
     bool timestamps_ = false;
     bool emulateGpu_ = false;
     std::uint32_t timestampValidBits_ = 0;

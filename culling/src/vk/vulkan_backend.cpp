@@ -5,10 +5,13 @@
 //   1. tile_bounds  (tilesX x tilesY groups): per-tile view-depth min/max over
 //      the geometry pixels, halfz split, 2.5d cell / clustered slice masks.
 //   2. cull_lists count pass (one group per list): lights tested in strides of
-//      the subgroup size, counted by ballot.
+//      the subgroup size, counted by ballot; each list's first entries (up to
+//      kMaxStashSlots) kept in the stash.
 //   3. prefix_sum: counts -> offsets, total in offsets[N].
-//   -- the host reads the total and allocates the index array exactly --
-//   4. cull_lists write pass: the same tests, indices written ascending.
+//   -- the host reads the total; when the stash holds every list whole it
+//      takes the entries from there and stops (no second submission) --
+//   4. cull_lists write pass: stashed lists copied, the longer ones tested
+//      again, indices written ascending into an index array sized exactly.
 // So memory is the entries the scene produces, with no per-list cap and no
 // tiles x lights x cells allocation.
 #include "vk/vulkan_backend.hpp"
@@ -47,8 +50,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr float kRelEps = 2e-5f;
 constexpr float kAbsEps = 1e-6f;
 
-constexpr std::uint32_t kBindings = 10; // cull_common.glsl bindings 0..9
+constexpr std::uint32_t kBindings = 11; // cull_common.glsl bindings 0..10
 enum Binding : std::uint32_t { bParams, bDepth, bTiles, bLights, bCounts, bOffsets, bIndices, bStatus, bBins };
+// Stash slots per list at most (cull_common.glsl binding 10): the count pass
+// keeps each list's first entries, so a cull whose lists all fit needs no
+// write pass (P1: 1.6 entries per list on average).
+constexpr std::uint32_t kMaxStashSlots = 16;
 // Local size of the one-invocation-per-item passes (light_bins, cull_lists):
 // a multiple of every subgroup size in practice (8 on lavapipe, 32 on NVIDIA,
 // 64 on AMD), so no partial subgroups.
@@ -224,7 +231,7 @@ private:
     Context ctx_;
     DescriptorSetLayoutHandle setLayout_;
     PipelineLayoutHandle computeLayout_;
-    ShaderModuleHandle boundsShader_, binsShader_, cullShader_, scanShader_, vertShader_;
+    ShaderModuleHandle boundsShader_, boundsPairsShader_, binsShader_, cullShader_, scanShader_, vertShader_;
     double lastCullWallMs_ = -1;
     std::map<std::string, PipelineHandle> computePipelines_;
     PipelineLayoutHandle depthLayout_;
@@ -240,6 +247,7 @@ void VulkanBackend::createComputeObjects() {
 
     auto mk = [&](spirv::Code c, const char* n) { return ctx_.createShader(c.words, c.wordCount, n); };
     boundsShader_ = mk(spirv::tileBounds(), "shader.tile_bounds");
+    if (ctx_.int64Supported()) boundsPairsShader_ = mk(spirv::tileBoundsPairs(), "shader.tile_bounds_pairs");
     binsShader_ = mk(spirv::lightBins(), "shader.light_bins");
     cullShader_ = mk(spirv::cullLists(), "shader.cull_lists");
     scanShader_ = mk(spirv::prefixSum(), "shader.prefix_sum");
@@ -570,6 +578,11 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     if (listTotal64 >= std::numeric_limits<std::uint32_t>::max())
         throw SettingsError("tile", "more than 2^32 light lists");
     const std::uint32_t listTotal = std::uint32_t(listTotal64);
+    // Stash slots per list: kMaxStashSlots, fewer where that would outgrow the
+    // depth image (clustered has many lists); none for `all` (one list).
+    const std::uint32_t stashSlots =
+        algo == Algorithm::All ? 0
+                               : std::uint32_t(std::min<std::uint64_t>(kMaxStashSlots, depth.depth.size() / listTotal64));
     // Light bins: one bit per light per tile column and per tile row.
     const std::uint32_t binWords = (n + 31) / 32;
     const std::uint64_t binTotal64 = std::uint64_t(binWords) * (grid.tilesX + grid.tilesY);
@@ -610,7 +623,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         const glm::dvec3 corner = proj.viewPositionAt({double(proj.width()), 0.0}, 1.0);
         p.lens = glm::vec4(float(corner.x), float(corner.y), float(camNear), float(naiveFar));
         p.cluster = glm::vec4(float(res.clusterNear), float(res.clusterFar), kRelEps, kAbsEps);
-        p.bins = glm::uvec4(binWords, binWords * grid.tilesX, 0, 0);
+        p.bins = glm::uvec4(binWords, binWords * grid.tilesX, stashSlots, 0);
     }
     std::vector<GpuLight> gpuLights(n);
     for (std::uint32_t l = 0; l < n; ++l)
@@ -640,6 +653,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     Buffer statusBuf = ctx_.createDeviceBuffer(8, ssbo, "cull.status"); // status bits, candidate tests
     Buffer placeholder = ctx_.createDeviceBuffer(4, ssbo, "cull.indices.placeholder");
     Buffer spotBuf = ctx_.createDeviceBuffer(gpuSpots.size() * sizeof(GpuSpotCone), ssbo, "cull.spots");
+    const std::size_t stashBytes = std::size_t(listTotal) * stashSlots * 4;
+    Buffer stashBuf = ctx_.createDeviceBuffer(std::max<std::size_t>(stashBytes, 4), ssbo, "cull.stash");
 
     Staging staging(ctx_);
     staging.upload(params, &p, sizeof p);
@@ -651,6 +666,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const auto* offs = static_cast<const std::uint32_t*>(staging.download(offsetBuf, (std::size_t(listTotal) + 1) * 4));
     const auto* tb = static_cast<const GpuTileBounds*>(staging.download(tileBuf, std::size_t(tiles) * sizeof(GpuTileBounds)));
     const auto* status = static_cast<const std::uint32_t*>(staging.download(statusBuf, 8));
+    const auto* stashed =
+        stashBytes ? static_cast<const std::uint32_t*>(staging.download(stashBuf, stashBytes)) : nullptr;
 
     // Descriptor sets: one for passes 1-3, one with the sized index array for pass 4.
     VkDevice dev = ctx_.device();
@@ -673,7 +690,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         LC_VK(vkAllocateDescriptorSets(dev, &ai, &set));
         ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_SET, set, nm);
         const Buffer* bufs[kBindings] = {&params,    &depthBuf, &tileBuf,   &lightBuf, &countBuf,
-                                         &offsetBuf, &indices,  &statusBuf, &binBuf,  &spotBuf};
+                                         &offsetBuf, &indices,  &statusBuf, &binBuf,  &spotBuf,
+                                         &stashBuf};
         std::array<VkDescriptorBufferInfo, kBindings> infos{};
         std::array<VkWriteDescriptorSet, kBindings> writes{};
         for (std::uint32_t i = 0; i < kBindings; ++i) {
@@ -705,21 +723,27 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     //
     // lavapipe stops all loops of one invocation after 65,535 iterations in
     // all (silently; the shaders flag it). A list costs at most 65 loop
-    // iterations per mask word (the word, up to 32 tests, up to 32 writes), so
-    // a CPU device takes an invocation per list only while words * 65 fits,
-    // else spreads the words over a subgroup; beyond that it refuses.
-    const std::uint64_t itersPerList = std::uint64_t(binWords) * 65 + 64;
+    // iterations per mask word (the word, up to 32 tests, up to 32 writes)
+    // and as many as it has stash slots (stashing; copying a stashed list), so
+    // a CPU device takes an invocation per list only while that fits, else
+    // spreads the words over a subgroup; beyond that it refuses.
+    const std::uint64_t itersPerList = std::uint64_t(binWords) * 65 + 64 + kMaxStashSlots;
     std::uint32_t lanes = sg;
     if (kLocal % sg != 0) lanes = 1;
     else if (ctx_.isCpuDevice()) lanes = itersPerList <= kLoopLimit ? 1 : sg;
     if (ctx_.isCpuDevice() && itersPerList / lanes > kLoopLimit)
         throw SettingsError("lights", std::to_string(n) + " lights is more than the culling passes can take on '" +
                                           ctx_.deviceName() + "' (at most " +
-                                          std::to_string((kLoopLimit - 64) / 65 * lanes * 32) +
+                                          std::to_string((kLoopLimit - 64 - kMaxStashSlots) / 65 * lanes * 32) +
                                           ": the driver caps a shader invocation at 65,535 loop iterations)");
     const bool subgroupLanes = lanes > 1;
     const std::uint32_t itemsPerGroup = kLocal / lanes;
-    VkPipeline boundsPipe = computePipeline("tile_bounds", boundsShader_, spec(kLocal, 0, lanes), subgroupLanes);
+    // Pixel pairs (tile_bounds.comp, LC_DEPTH_PAIRS): an invocation per tile,
+    // even widths and tile sizes, so every tile row starts on a pair.
+    const bool depthPairs = ctx_.int64Supported() && lanes == 1 && grid.width % 2 == 0 && grid.tileSize % 2 == 0;
+    VkPipeline boundsPipe =
+        depthPairs ? computePipeline("tile_bounds.pairs", boundsPairsShader_, spec(kLocal, 0, lanes), false)
+                   : computePipeline("tile_bounds", boundsShader_, spec(kLocal, 0, lanes), subgroupLanes);
     const Grid boundsGroups = Grid{(grid.tilesX + itemsPerGroup - 1) / itemsPerGroup, grid.tilesY};
     VkPipeline binsPipe = computePipeline("light_bins", binsShader_, spec(kLocal, 0), false);
     VkPipeline countPipe = computePipeline("cull_lists.count", cullShader_, spec(kLocal, 0, lanes), subgroupLanes);
@@ -776,16 +800,25 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     if (*status & 8u) throw DeviceError(loopLimitError);
     res.volumeTests = (status[0] & 4u) ? 0 : status[1]; // wrapped: not counted
     std::uint64_t total64 = 0;
-    for (std::uint32_t l = 0; l < listTotal; ++l) total64 += counts[l];
+    std::uint32_t longest = 0;
+    for (std::uint32_t l = 0; l < listTotal; ++l) {
+        total64 += counts[l];
+        longest = std::max(longest, counts[l]);
+    }
     const std::uint32_t total = offs[listTotal];
     if (total64 != total || total64 * 4 > lim.maxStorageBufferRange)
         throw DeviceError("culling produced " + std::to_string(total64) +
                           " list entries, more than one storage buffer of this device holds (" +
                           std::to_string(lim.maxStorageBufferRange / 4) + ")");
 
-    Buffer indexBuf = ctx_.createDeviceBuffer(std::size_t(total) * 4, ssbo, "cull.indices");
-    const std::uint32_t* idx = nullptr;
-    if (total > 0) {
+    if (total > 0 && longest <= stashSlots) {
+        // The stash holds every list whole: the entries are in, no write pass.
+        res.lightIndices.resize(total);
+        for (std::uint32_t l = 0; l < listTotal; ++l)
+            std::copy_n(stashed + std::size_t(l) * stashSlots, counts[l], res.lightIndices.begin() + offs[l]);
+    } else if (total > 0) {
+        Buffer indexBuf = ctx_.createDeviceBuffer(std::size_t(total) * 4, ssbo, "cull.indices");
+        const std::uint32_t* idx = nullptr;
         VkDescriptorSet set2 = makeSet(indexBuf, "cull.set.write");
         Staging back(ctx_);
         idx = static_cast<const std::uint32_t*>(back.download(indexBuf, std::size_t(total) * 4));
