@@ -160,7 +160,7 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
         diffLut_->SetTableValue(i, g, g, g, 1.0);
     }
     diffLegend_->SetLookupTable(diffLut_);
-    diffLegend_->SetTitle("|culled -\nall|");
+    diffLegend_->SetTitle("abs.\nerror");
     diffLegend_->SetNumberOfLabels(5);
     diffLegend_->SetLabelFormat("%.3g");
     diffLegend_->SetMaximumWidthInPixels(kLegendWidthPx - 10);
@@ -174,6 +174,18 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
     diffLegend_->UnconstrainedFontSizeOn();
     diffLegend_->SetVisibility(false);
     background_->AddActor2D(diffLegend_);
+
+    // Over the picture (the letterbox may leave no room for the caption).
+    imageLabel_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+    imageLabel_->SetPosition(0.01, 0.98);
+    vtkTextProperty* lp = imageLabel_->GetTextProperty();
+    lp->SetFontSize(13);
+    lp->SetColor(1, 1, 1);
+    lp->SetVerticalJustificationToTop();
+    lp->SetBackgroundColor(0, 0, 0);
+    lp->SetBackgroundOpacity(0.6);
+    imageLabel_->SetVisibility(false);
+    scene_->AddActor2D(imageLabel_);
 
     caption_->GetTextProperty()->SetFontSize(13);
     caption_->GetTextProperty()->SetColor(0.9, 0.9, 0.9);
@@ -426,7 +438,9 @@ double CameraView::shownImageMaxError() const {
     return picturesRun_ ? picturesRun_->truth.metrics.imageMaxError : std::nan("");
 }
 
-QString CameraView::captionText() const { return QString::fromUtf8(caption_->GetInput()); }
+QString CameraView::imageLabelText() const {
+    return imageLabel_->GetVisibility() ? QString::fromUtf8(imageLabel_->GetInput()) : QString();
+}
 
 void CameraView::updateImage() {
     const bool pictureMode = imageMode_ != ImageMode::Heat;
@@ -469,13 +483,12 @@ void CameraView::updateLegendAndCaption() {
     const auto run = doc_->runOutput();
     legend_->SetVisibility(run && imageMode_ == ImageMode::Heat);
     diffLegend_->SetVisibility(false);
-    if (imageMode_ == ImageMode::Heat || !run) {
-        caption_->SetInput(heatCaption_.c_str());
-        return;
-    }
+    caption_->SetInput(heatCaption_.c_str());
+    imageLabel_->SetVisibility(run && imageMode_ != ImageMode::Heat);
+    if (!imageLabel_->GetVisibility()) return;
     QString text = imageMode_ == ImageMode::ShadedCulled ? tr("shaded, culled lists")
                    : imageMode_ == ImageMode::ShadedAll  ? tr("shaded, all lights")
-                                                         : tr("|culled - all lights|");
+                                                         : tr("abs(culled - all lights)");
     if (imageActor_->GetVisibility()) {
         const auto& m = picturesRun_->truth.metrics;
         if (imageMode_ == ImageMode::Difference) {
@@ -485,15 +498,15 @@ void CameraView::updateLegendAndCaption() {
         } else {
             text += tr(", exposure %1").arg(picturesExposure_, 0, 'g', 4);
         }
-        text += tr("  |  image RMSE %1, max %2 (%3)")
+        text += tr("\nimage RMSE %1, max %2 (%3)")
                     .arg(m.imageRmse, 0, 'g', 6)
                     .arg(m.imageMaxError, 0, 'g', 6)
                     .arg(QString::fromStdString(picturesRun_->result.backend));
-        if (picturesRun_ != run) text += tr("  |  shading the newer run...");
+        if (picturesRun_ != run) text += tr(", shading the newer run...");
     } else {
         text += tr(": shading...");
     }
-    caption_->SetInput(text.toUtf8().constData());
+    imageLabel_->SetInput(text.toUtf8().constData());
 }
 
 void CameraView::updateReverseLookup() {

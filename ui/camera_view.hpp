@@ -83,8 +83,9 @@ public:
     const lc::RunOutput* shownImageRun() const { return picturesRun_.get(); }
     double shownImageRmse() const;
     double shownImageMaxError() const;
-    // The caption line under the image (mode, exposure, image error).
-    QString captionText() const;
+    // The label over an image mode's picture (mode, exposure or difference
+    // scale, image RMSE and max error, backend); empty in Heat mode.
+    QString imageLabelText() const;
     // Re-renders now (tests, screenshots).
     void renderNow();
     // Renders once when control returns to the event loop, however many
@@ -132,6 +133,7 @@ private:
     double picturesExposure_ = 1;
     vtkNew<vtkLookupTable> diffLut_;
     vtkNew<vtkScalarBarActor> diffLegend_;
+    vtkNew<vtkTextActor> imageLabel_; // in scene_, top left of the picture
     std::string heatCaption_;
 };
 

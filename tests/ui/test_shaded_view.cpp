@@ -213,8 +213,8 @@ private slots:
         QCOMPARE(cv()->shownImageRmse(), rmse);
         QCOMPARE(cv()->shownImageMaxError(), maxError);
         QVERIFY(cv()->legend() && !cv()->legend()->GetVisibility());
-        QVERIFY2(cv()->captionText().contains(QString::number(rmse, 'g', 6)), qPrintable(cv()->captionText()));
-        QVERIFY2(cv()->captionText().contains(QString::number(maxError, 'g', 6)), qPrintable(cv()->captionText()));
+        QVERIFY2(cv()->imageLabelText().contains(QString::number(rmse, 'g', 6)), qPrintable(cv()->imageLabelText()));
+        QVERIFY2(cv()->imageLabelText().contains(QString::number(maxError, 'g', 6)), qPrintable(cv()->imageLabelText()));
 
         // A click on a tile over the picture selects that tile.
         const double* vp = cv()->sceneRenderer()->GetViewport();
@@ -239,6 +239,7 @@ private slots:
         QCOMPARE(started.count(), 0);
         QVERIFY(doc()->runOutput()->shadedAll.empty());
         QVERIFY(cv()->shownImage() == nullptr);
+        QVERIFY(cv()->imageLabelText().isEmpty());
 
         auto* label = w_->findChild<QLabel*>("statusShading");
         QVERIFY(label);
