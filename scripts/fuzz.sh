@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (clang-14, ASan+UBSan+fuzzer) in build-fuzz/ --
+# Builds the libFuzzer targets (clang-14, ASan+UBSan+fuzzer) in build-fuzz/
+# (or $LIGHTCULL_FUZZ_BUILD_DIR) --
 # only the culling library and tests/fuzz -- and runs each for a bounded time
 # on a copy of its seed corpus (tests/fuzz/corpus/<target>/).
 #
@@ -9,6 +10,8 @@
 #                                    same inputs every time (a random seed made it
 #                                    red or green by luck; see docs/TESTING.md)
 #   LIGHTCULL_FUZZ_JOBS=2            targets run side by side
+#   LIGHTCULL_FUZZ_SEED=1            libFuzzer -seed (0: random; for hunting, not CI)
+#   LIGHTCULL_FUZZ_BUILD_DIR=build-fuzz
 #
 # A crash, leak, sanitizer report or timeout fails the script; the input that
 # caused it is kept in build-fuzz/artifacts/ (reproduce: build-fuzz/tests/fuzz/<target>
@@ -20,28 +23,30 @@ jobs="${LIGHTCULL_FUZZ_JOBS:-2}"
 targets=("$@")
 [ ${#targets[@]} -eq 0 ] && targets=(fuzz_scene_json fuzz_mesh_obj fuzz_mesh_ply fuzz_mesh_off fuzz_mesh_stl)
 
-cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+bdir="${LIGHTCULL_FUZZ_BUILD_DIR:-build-fuzz}"
+export bdir
+cmake -S . -B "$bdir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
   -DLIGHTCULL_FUZZ=ON -DLIGHTCULL_TESTS=OFF -DLIGHTCULL_STUDIO=OFF -DLIGHTCULL_BENCHMARKS=OFF >/dev/null
-cmake --build build-fuzz -j"$(nproc)" --target "${targets[@]}"
+cmake --build "$bdir" -j"$(nproc)" --target "${targets[@]}"
 
-mkdir -p build-fuzz/corpus build-fuzz/artifacts build-fuzz/logs
+mkdir -p "$bdir"/corpus "$bdir"/artifacts "$bdir"/logs
 run_one() {
   local t="$1" seconds="$2"
-  local work="build-fuzz/corpus/$t"
+  local work="$bdir/corpus/$t"
   mkdir -p "$work"
   cp -n tests/fuzz/corpus/"$t"/* "$work"/ 2>/dev/null || true
   # Leak checks on: a leak in our code is a bug too (scripts/lsan.supp names
   # the third-party ones, OpenMesh's stream multiplexer among them).
   if ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0" \
      UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-     build-fuzz/tests/fuzz/"$t" "$work" -seed=1 -runs="${LIGHTCULL_FUZZ_RUNS:-20000}" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 \
-       -max_len=16384 -print_final_stats=1 -artifact_prefix="build-fuzz/artifacts/$t-" \
-       >"build-fuzz/logs/$t.log" 2>&1; then
-    echo "fuzz: $t ok ($(grep -m1 -o 'stat::number_of_executed_units: *[0-9]*' "build-fuzz/logs/$t.log" | grep -o '[0-9]*$') runs in ${seconds}s)"
+     "$bdir"/tests/fuzz/"$t" "$work" -seed="${LIGHTCULL_FUZZ_SEED:-1}" -runs="${LIGHTCULL_FUZZ_RUNS:-20000}" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 \
+       -max_len=16384 -print_final_stats=1 -artifact_prefix="$bdir/artifacts/$t-" \
+       >"$bdir/logs/$t.log" 2>&1; then
+    echo "fuzz: $t ok ($(grep -m1 -o 'stat::number_of_executed_units: *[0-9]*' "$bdir/logs/$t.log" | grep -o '[0-9]*$') runs in ${seconds}s)"
   else
-    echo "fuzz: $t FAILED; log build-fuzz/logs/$t.log, input in build-fuzz/artifacts/" >&2
-    tail -40 "build-fuzz/logs/$t.log" >&2
+    echo "fuzz: $t FAILED; log $bdir/logs/$t.log, input in $bdir/artifacts/" >&2
+    tail -40 "$bdir/logs/$t.log" >&2
     return 1
   fi
 }

@@ -1,6 +1,6 @@
 // libFuzzer target: lc::loadMesh on arbitrary bytes written to a temporary
-// file with the extension LC_FUZZ_EXT ("obj" exercises the project's own OBJ
-// parser; "ply", "off", "stl" go through OpenMesh's readers). Any input must
+// file with the extension LC_FUZZ_EXT ("obj", "ply" and "off" exercise the
+// project's own readers; "stl" goes through OpenMesh's). Any input must
 // load into a mesh that validates or throw lc::InputError; a crash, a
 // sanitizer report or any other exception is a bug.
 #include "culling/errors.hpp"
