@@ -54,8 +54,8 @@ constexpr std::uint32_t kBindings = 11; // cull_common.glsl bindings 0..10
 enum Binding : std::uint32_t { bParams, bDepth, bTiles, bLights, bCounts, bOffsets, bIndices, bStatus, bBins };
 // Stash slots per list at most (cull_common.glsl binding 10): the count pass
 // keeps each list's first entries, so a cull whose lists all fit needs no
-// write pass (P1: 1.6 entries per list on average).
-constexpr std::uint32_t kMaxStashSlots = 16;
+// write pass (P1: 1.6 entries per list on average, 21 at most).
+constexpr std::uint32_t kMaxStashSlots = 32;
 // Local size of the one-invocation-per-item passes (light_bins, cull_lists):
 // a multiple of every subgroup size in practice (8 on lavapipe, 32 on NVIDIA,
 // 64 on AMD), so no partial subgroups.
