@@ -34,11 +34,13 @@ bool tileHasGeometry(const CullResult& r, std::uint32_t t) {
 
 glm::dmat4 worldFromView(const Camera& camera) { return glm::inverse(camera.viewFromWorld()); }
 
-double cameraFarDepth(const Projection& proj, const ViewLights& lights) {
+double cameraFarDepth(const Projection& proj, const ViewLights& lights, SpotTest spotTest) {
     if (std::isfinite(proj.farPlane())) return proj.farPlane();
     double lightFar = 0.0;
-    for (std::size_t l = 0; l < lights.size(); ++l)
-        lightFar = std::max(lightFar, -lights.centers[l].z + lights.radii[l]);
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+        const BoundingSphere b = lights.cullSphere(l, spotTest);
+        lightFar = std::max(lightFar, -b.center.z + b.radius);
+    }
     return std::max(lightFar, proj.nearPlane());
 }
 
@@ -53,7 +55,7 @@ std::optional<FrustumChunk> tileFrustum(const CullResult& r, const Projection& p
     if (tile >= r.grid.tileCount()) return std::nullopt;
     const auto rect = r.grid.tileRect(tile % r.grid.tilesX, tile / r.grid.tilesX);
     if (r.algorithm == Algorithm::Naive || r.algorithm == Algorithm::All)
-        return makeFrustumChunk(proj, rect, proj.nearPlane(), cameraFarDepth(proj, lights));
+        return makeFrustumChunk(proj, rect, proj.nearPlane(), cameraFarDepth(proj, lights, r.settings.spotTest));
     if (!tileHasGeometry(r, tile)) return std::nullopt;
     return makeFrustumChunk(proj, rect, r.tileDepthMin[tile], r.tileDepthMax[tile]);
 }
@@ -147,6 +149,45 @@ std::vector<std::uint32_t> tilesHoldingLight(const CullResult& r, std::uint32_t 
     for (std::uint32_t l : lists)
         if (out.empty() || out.back() != l / per) out.push_back(l / per);
     return out;
+}
+
+std::optional<SpotTestPrimitive> spotTestPrimitive(const RunOutput& run, const Projection& proj,
+                                                   std::uint32_t light, int tile) {
+    const CullResult& r = run.result;
+    if (light >= run.lights.size() || !run.lights.isSpot(light)) return std::nullopt;
+    SpotTestPrimitive p;
+    p.test = r.settings.spotTest;
+    p.cone = run.lights.spotCone(light);
+    p.cullSphere = run.lights.cullSphere(light, p.test);
+    if (tile < 0 || std::uint32_t(tile) >= r.grid.tileCount() || r.algorithm == Algorithm::All) return p;
+    const auto t = std::uint32_t(tile);
+    auto add = [&](std::uint32_t list, std::uint32_t cell, const FrustumChunk& chunk) {
+        SpotTestChunk c;
+        c.list = list;
+        c.cell = cell;
+        c.chunk = chunk;
+        c.sphere = chunkBoundingSphere(chunk);
+        c.passed = spotIntersectsChunk(p.test, r.settings.test, p.cone, chunk);
+        p.chunks.push_back(c);
+    };
+    switch (r.algorithm) {
+    case Algorithm::Naive:
+    case Algorithm::MinMax:
+    case Algorithm::TwoPointFiveD:
+        if (const auto chunk = tileFrustum(r, proj, run.lights, t)) add(t, 0, *chunk);
+        break;
+    case Algorithm::HalfZ:
+        for (const DepthCell& c : tileCells(r, proj, t)) add(c.list, c.cell, c.chunk);
+        break;
+    case Algorithm::Clustered: {
+        const std::uint32_t range = lightCellRange(r, t, p.cullSphere.center, p.cullSphere.radius);
+        for (const DepthCell& c : tileCells(r, proj, t))
+            if (((range >> c.cell) & 1u) && (c.occupied || !r.settings.skipEmpty)) add(c.list, c.cell, c.chunk);
+        break;
+    }
+    default: break;
+    }
+    return p;
 }
 
 const char* toString(Verdict v) {
@@ -398,7 +439,7 @@ void writeOverlaysVtm(const Scene& scene, const RunOutput& run, const std::strin
     // the edges to the eye.
     PolyPiece camera;
     {
-        const double farD = cameraFarDepth(proj, run.lights);
+        const double farD = cameraFarDepth(proj, run.lights, run.result.settings.spotTest);
         const glm::dvec2 px[4] = {{0, 0}, {double(cam.width), 0}, {double(cam.width), double(cam.height)},
                                   {0, double(cam.height)}};
         for (double d : {proj.nearPlane(), farD})

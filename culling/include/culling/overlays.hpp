@@ -24,9 +24,11 @@ glm::dmat4 worldFromView(const Camera& camera);
 
 // The far view depth of the camera range that `naive` (and `all`, and the
 // camera frustum overlay) use: the far plane, or, when it is infinite
-// (reversed-Z), the farthest depth any light reaches, exactly as the passes
+// (reversed-Z), the farthest depth any light's culling sphere
+// (ViewLights::cullSphere under `spotTest`) reaches, exactly as the passes
 // replace it (never below the near plane).
-double cameraFarDepth(const Projection& proj, const ViewLights& lights);
+double cameraFarDepth(const Projection& proj, const ViewLights& lights,
+                      SpotTest spotTest = SpotTest::ApexSphere);
 
 // The lists of a tile as [first, first + count) in CullResult numbering; for
 // `all`, the one list every tile shares.
@@ -100,6 +102,43 @@ const char* toString(HeatMode m); // "list-length", "false-positives", "efficien
 // For `all` the ground truth keeps no per-tile work (its one list spans every
 // tile), so FalsePositives and Efficiency are NaN there.
 std::vector<double> tileHeat(const RunOutput& run, HeatMode mode);
+
+// ---- the primitive a spot test used ------------------------------------------
+
+// One chunk of a tile that the culling pass tested spot light `light` against
+// (the tile's frustum, a halfz half, or a clustered froxel), with the sphere
+// the cone-sphere test built around it and the chunk test's verdict.
+struct SpotTestChunk {
+    std::uint32_t list = 0; // the list (CullResult numbering) the verdict is for
+    std::uint32_t cell = 0; // tileCells' order; 0 for a tile-wide chunk
+    FrustumChunk chunk;
+    BoundingSphere sphere;  // chunkBoundingSphere(chunk): what ConeSphere tests the cone against
+    // spotIntersectsChunk(test, sphere test, cone, chunk): the light goes into
+    // `list` exactly when this holds (and, for 2.5d, its cull sphere's depth
+    // range meets an occupied cell; and the light's projected screen bounds
+    // cover the tile, a conservative pre-filter).
+    bool passed = false;
+};
+// What the run's spot test evaluated for spot light `light` (ViewLights
+// numbering) and, when `tile` >= 0, for that tile: the light's cone (view
+// space), the culling sphere every chunk test starts with (spotCullSphere:
+// the apex sphere or the tight sphere), and the tile's chunks the pass tested
+// it against, as the pass builds them:
+// - naive, minmax, 2.5d: the tile's frustum (tileFrustum; 2.5d tests its
+//   whole tile, its cells only gate by depth);
+// - halfz: both halves (tileCells);
+// - clustered: the froxels of the tile that the cull sphere's depth range
+//   reaches (lightCellRange), only occupied ones under skip-empty;
+// - all, and tiles the pass skips (no geometry): none.
+// nullopt when `light` is not a spot light of the run.
+struct SpotTestPrimitive {
+    SpotTest test = SpotTest::ApexSphere;
+    SpotCone cone;
+    BoundingSphere cullSphere;
+    std::vector<SpotTestChunk> chunks;
+};
+std::optional<SpotTestPrimitive> spotTestPrimitive(const RunOutput& run, const Projection& proj,
+                                                   std::uint32_t light, int tile);
 
 // ---- overlays.vtm -----------------------------------------------------------
 
