@@ -5,6 +5,7 @@
 #include "vtk_adapters.hpp"
 #include "spot_actor.hpp"
 
+#include "spot_handles.hpp"
 #include "culling/projection.hpp"
 
 #include <QTimer>
@@ -166,6 +167,7 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
         scheduleRender();
     });
     connect(doc_, &Document::lightChanged, this, [this](int i) {
+    spotHandles_ = std::make_unique<SpotHandles>(doc_, renderer_, interactor());
         updateLight(i);
         updateSelection();
         scheduleRender();
@@ -482,7 +484,8 @@ void InspectorView::onLeftPress() { interactor()->GetEventPosition(pressX_, pres
 void InspectorView::onLeftRelease() {
     int x = 0, y = 0;
     interactor()->GetEventPosition(x, y);
-    if (std::abs(x - pressX_) > 3 || std::abs(y - pressY_) > 3 || handleActive_ || radiusActive_)
+    if (std::abs(x - pressX_) > 3 || std::abs(y - pressY_) > 3 || handleActive_ || radiusActive_ ||
+        spotHandles_->dragging())
         return; // an orbit or a handle drag, not a click
     const double dpr = devicePixelRatioF();
     const QPoint pos(int(x / dpr), int(height() - 1 - y / dpr));

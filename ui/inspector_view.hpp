@@ -39,6 +39,7 @@ class InspectorView : public QVTKOpenGLNativeWidget {
 public:
     // Depth peeling (order-independent translucency) is used up to this many
     // lights; beyond it every frame would redraw all spheres once per peel.
+class SpotHandles;
     static constexpr std::size_t kMaxPeeledLights = 256;
     explicit InspectorView(Document* doc, QWidget* parent = nullptr);
     ~InspectorView() override;
@@ -76,6 +77,8 @@ private:
     void rebuildLights();
     void updateLight(int index);
     void updateSelection();
+    // The selected spot light's direction and outer-angle handles (ui/spot_handles.hpp).
+    SpotHandles* spotHandles() const { return spotHandles_.get(); }
     void updateFrustum();
     void updateOverlays();
     void onHandleStart();
@@ -116,3 +119,4 @@ private:
 };
 
 } // namespace lcui
+    std::unique_ptr<SpotHandles> spotHandles_;  // after the handles above: destroyed first

@@ -6,6 +6,7 @@
 #include "camera_view.hpp"
 #include "document.hpp"
 #include "inspector_view.hpp"
+#include "overlay_actors.hpp"
 
 #include "culling/errors.hpp"
 #include "culling/export.hpp"
@@ -63,6 +64,18 @@ void MainWindow::buildOverlayMenus(QMenu* file, QMenu* view) {
     toggle(tr("Light's cell range"), "actionOverlayLightRange", &Options::lightCellRange);
     toggle(tr("Highlight listed lights"), "actionOverlayListHighlight", &Options::listHighlight);
     toggle(tr("Tiles holding the selected light"), "actionOverlayReverse", &Options::reverseLookup);
+    // A view toggle of the inspector (not a document option): the culling
+    // sphere, chunk spheres or chunk planes the run's spot test evaluated for
+    // the current spot light and the selected tile (overlay_actors.hpp).
+    QAction* spotPrimitive = overlays->addAction(tr("Spot test primitive"));
+    spotPrimitive->setObjectName("actionOverlaySpotPrimitive");
+    spotPrimitive->setCheckable(true);
+    spotPrimitive->setChecked(inspectorView_->overlays()->showSpotPrimitive());
+    connect(spotPrimitive, &QAction::toggled, this, [this](bool on) {
+        inspectorView_->overlays()->setShowSpotPrimitive(on);
+        inspectorView_->overlays()->update(*doc_);
+        inspectorView_->scheduleRender();
+    });
 
     QMenu* heat = view->addMenu(tr("&Heat map"));
     auto* group = new QActionGroup(this);

@@ -15,8 +15,17 @@
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
 #include <vtkSphereSource.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+
+#include <glm/gtc/constants.hpp>
+
+#include <QObject>
+#include <QString>
 
 #include <algorithm>
+#include <cmath>
+#include <tuple>
 
 namespace lcui {
 
@@ -66,6 +75,23 @@ struct ChunkGeometry {
     }
 };
 
+// A sphere as three orthogonal great circles (view-space centre, world
+// lines): light enough for dozens of cells, and every point lies on it.
+void addSphereCircles(vtkPoints* points, vtkCellArray* lines, const glm::dmat4& worldFromView,
+                      const lc::BoundingSphere& s, int segments = 48) {
+    const glm::dvec3 axes[3][2] = {{{1, 0, 0}, {0, 1, 0}}, {{0, 1, 0}, {0, 0, 1}}, {{0, 0, 1}, {1, 0, 0}}};
+    for (const auto& e : axes) {
+        std::vector<vtkIdType> ids;
+        for (int i = 0; i <= segments; ++i) {
+            const double t = 2.0 * glm::pi<double>() * (i % segments) / segments;
+            const glm::dvec3 v = s.center + s.radius * (std::cos(t) * e[0] + std::sin(t) * e[1]);
+            const glm::dvec4 w = worldFromView * glm::dvec4(v, 1.0);
+            ids.push_back(points->InsertNextPoint(w.x, w.y, w.z));
+        }
+        lines->InsertNextCell(vtkIdType(ids.size()), ids.data());
+    }
+}
+
 vtkSmartPointer<vtkActor> makeActor(vtkPolyData* pd, double r, double g, double b, double opacity,
                                     double lineWidth = 1.0) {
     vtkNew<vtkPolyDataMapper> m;
@@ -85,6 +111,9 @@ vtkSmartPointer<vtkActor> makeActor(vtkPolyData* pd, double r, double g, double 
 
 struct InspectorOverlays::Impl {
     vtkRenderer* renderer;
+    vtkNew<vtkPolyData> spotSphere, spotPassed, spotRejected;
+    vtkSmartPointer<vtkActor> spotSphereA, spotPassedA, spotRejectedA;
+    vtkNew<vtkTextActor> spotCaption;
     vtkNew<vtkPolyData> tileSolid, tileOutline, cellFill, cellOutline, cellSelected, splitQuad, lightRange,
         allTiles, reverse;
     vtkSmartPointer<vtkActor> tileSolidA, tileOutlineA, cellFillA, cellOutlineA, cellSelectedA, splitA, rangeA,
@@ -105,6 +134,20 @@ InspectorOverlays::InspectorOverlays(vtkRenderer* renderer, vtkSphereSource* sph
     d_->splitA = makeActor(d_->splitQuad, 1.0, 0.3, 0.9, 0.4);
     d_->rangeA = makeActor(d_->lightRange, 0.3, 1.0, 0.35, 1.0, 3.0);
     d_->reverseA = makeActor(d_->reverse, 1.0, 0.3, 1.0, 0.8, 1.5);
+    d_->spotSphereA = makeActor(d_->spotSphere, 1.0, 0.5, 0.7, 1.0, 2.0); // pink: a spot is often white
+    d_->spotPassedA = makeActor(d_->spotPassed, 0.25, 0.55, 1.0, 1.0, 2.0); // not the cell range's green
+    d_->spotRejectedA = makeActor(d_->spotRejected, 1.0, 0.25, 0.2, 1.0, 2.0);
+    for (vtkActor* a : {d_->spotSphereA.Get(), d_->spotPassedA.Get(), d_->spotRejectedA.Get()}) {
+        a->SetVisibility(false);
+        renderer->AddActor(a);
+    }
+    d_->spotCaption->GetTextProperty()->SetFontSize(13);
+    d_->spotCaption->GetTextProperty()->SetColor(1.0, 1.0, 0.85);
+    d_->spotCaption->GetTextProperty()->SetBackgroundColor(0, 0, 0);
+    d_->spotCaption->GetTextProperty()->SetBackgroundOpacity(0.55);
+    d_->spotCaption->SetDisplayPosition(8, 8);
+    d_->spotCaption->SetVisibility(false);
+    renderer->AddActor2D(d_->spotCaption);
 
     // All tiles: one wireframe actor, lines coloured by the tile's list length.
     d_->lut->SetHueRange(0.667, 0.0);
@@ -173,6 +216,10 @@ vtkPolyData* InspectorOverlays::lightRange() const { return d_->lightRange; }
 vtkPolyData* InspectorOverlays::allTiles() const { return d_->allTiles; }
 vtkPolyData* InspectorOverlays::reverse() const { return d_->reverse; }
 vtkActor* InspectorOverlays::allTilesActor() const { return d_->allTilesA; }
+vtkPolyData* InspectorOverlays::spotCullSphere() const { return d_->spotSphere; }
+vtkPolyData* InspectorOverlays::spotChunksPassed() const { return d_->spotPassed; }
+vtkPolyData* InspectorOverlays::spotChunksRejected() const { return d_->spotRejected; }
+vtkTextActor* InspectorOverlays::spotCaption() const { return d_->spotCaption; }
 
 void InspectorOverlays::update(const Document& doc) {
     for (vtkPolyData* pd : {d_->tileSolid.Get(), d_->tileOutline.Get(), d_->cellFill.Get(), d_->cellOutline.Get(),
@@ -197,6 +244,7 @@ void InspectorOverlays::update(const Document& doc) {
             show(a, false);
         d_->allTiles->Initialize();
         allTilesRun_ = nullptr;
+        updateSpotPrimitive(doc, nullptr, -1);
         return;
     }
     const lc::CullResult& r = run->result;
@@ -331,6 +379,79 @@ void InspectorOverlays::update(const Document& doc) {
         allTilesRun_ = nullptr;
     }
     show(d_->allTilesA, d_->allTiles->GetNumberOfCells() > 0);
+
+    updateSpotPrimitive(doc, run.get(), tileOk ? tile : -1);
+}
+
+void InspectorOverlays::updateSpotPrimitive(const Document& doc, const lc::RunOutput* run, int tile) {
+    for (vtkPolyData* pd : {d_->spotSphere.Get(), d_->spotPassed.Get(), d_->spotRejected.Get()}) pd->Initialize();
+    spotPrimitive_.reset();
+    const int light = doc.currentLight();
+    // The run's own light (what was culled), not the scene's current one.
+    if (showSpotPrimitive_ && run && light >= 0 && std::size_t(light) < run->lights.size()) {
+        const lc::Camera& cam = doc.scene().camera;
+        spotPrimitive_ = lc::spotTestPrimitive(*run, lc::Projection(cam), std::uint32_t(light), tile);
+    }
+    QString caption;
+    if (spotPrimitive_) {
+        const lc::SpotTestPrimitive& p = *spotPrimitive_;
+        const glm::dmat4 w = lc::worldFromView(doc.scene().camera);
+        {
+            vtkNew<vtkPoints> pts;
+            vtkNew<vtkCellArray> lines;
+            addSphereCircles(pts, lines, w, p.cullSphere);
+            d_->spotSphere->SetPoints(pts);
+            d_->spotSphere->SetLines(lines);
+        }
+        ChunkGeometry passedEdges, rejectedEdges;
+        passedEdges.worldFromView = rejectedEdges.worldFromView = w;
+        vtkNew<vtkPoints> passedPts, rejectedPts;
+        vtkNew<vtkCellArray> passedLines, rejectedLines;
+        std::size_t passed = 0;
+        for (const lc::SpotTestChunk& c : p.chunks) {
+            passed += c.passed;
+            if (p.test == lc::SpotTest::ConeSphere)
+                addSphereCircles(c.passed ? passedPts : rejectedPts, c.passed ? passedLines : rejectedLines, w,
+                                 c.sphere, 32);
+            else if (p.test == lc::SpotTest::ConePlanes)
+                (c.passed ? passedEdges : rejectedEdges).edges(c.chunk);
+        }
+        if (p.test == lc::SpotTest::ConeSphere) {
+            for (auto [pd, pts, lines] : {std::tuple{d_->spotPassed.Get(), passedPts.Get(), passedLines.Get()},
+                                          std::tuple{d_->spotRejected.Get(), rejectedPts.Get(), rejectedLines.Get()}}) {
+                pd->SetPoints(pts);
+                if (lines->GetNumberOfCells()) pd->SetLines(lines);
+            }
+        } else if (p.test == lc::SpotTest::ConePlanes) {
+            passedEdges.into(d_->spotPassed);
+            rejectedEdges.into(d_->spotRejected);
+        }
+        const QString sphere = p.test == lc::SpotTest::ApexSphere ? QObject::tr("apex sphere") : QObject::tr("tight sphere");
+        // Short lines: the inspector is often a narrow dock.
+        caption = QObject::tr("spot test %1, light %2\n%3 r=%4 (pink)")
+                      .arg(lc::toString(p.test))
+                      .arg(light)
+                      .arg(sphere)
+                      .arg(p.cullSphere.radius, 0, 'g', 4);
+        const QString verdict = QObject::tr("%1 passed (blue), %2 rejected (red)")
+                                    .arg(passed)
+                                    .arg(p.chunks.size() - passed);
+        if (tile < 0)
+            caption += QObject::tr("\nselect a tile to see its chunks");
+        else if (p.chunks.empty())
+            caption += QObject::tr("\ntile %1: not tested (no geometry or\nno chunk in the sphere's depth range)").arg(tile);
+        else if (p.test == lc::SpotTest::ConeSphere)
+            caption += QObject::tr("\ntile %1: cone vs each chunk's bounding sphere\n%2").arg(tile).arg(verdict);
+        else if (p.test == lc::SpotTest::ConePlanes)
+            caption += QObject::tr("\ntile %1: cone vs the 6 planes of each chunk\n%2").arg(tile).arg(verdict);
+        else
+            caption += QObject::tr("\ntile %1: sphere vs the tile's chunks\n%2").arg(tile).arg(verdict);
+    }
+    d_->spotCaption->SetInput(caption.toUtf8().constData());
+    d_->spotCaption->SetVisibility(!caption.isEmpty());
+    d_->spotSphereA->SetVisibility(d_->spotSphere->GetNumberOfCells() > 0);
+    d_->spotPassedA->SetVisibility(d_->spotPassed->GetNumberOfCells() > 0);
+    d_->spotRejectedA->SetVisibility(d_->spotRejected->GetNumberOfCells() > 0);
 }
 
 } // namespace lcui

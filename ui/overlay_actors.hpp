@@ -11,6 +11,12 @@
 //   hold the current light, magenta;
 // - the selected tile's listed lights highlighted (the light glyph actor is
 //   dimmed meanwhile), missing lights in red.
+// - the primitive the run's spot test used for the current spot light (View >
+//   Overlays > Spot test primitive, off by default; lc::spotTestPrimitive):
+//   its culling sphere (apex or tight sphere, pink), and for the selected
+//   tile under cone-sphere the bounding sphere of every chunk the cone was
+//   tested against, under cone-planes those chunks' outlines (blue: passed,
+//   red: rejected), with a caption saying which test and what was tested.
 // Each part follows its Document::OverlayOptions toggle. Translucent parts
 // rely on the renderer's depth peeling (set up by InspectorView).
 
@@ -28,6 +34,7 @@ class vtkLookupTable;
 class vtkPolyData;
 class vtkRenderer;
 class vtkSphereSource;
+class vtkTextActor;
 
 namespace lcui {
 
@@ -56,6 +63,16 @@ public:
     const std::vector<int>& missingLights() const { return missing_; } // red
     const std::vector<std::uint32_t>& reverseLists() const { return reverseLists_; }
 
+    // The spot test primitive overlay: a view toggle, not a document option.
+    void setShowSpotPrimitive(bool on) { showSpotPrimitive_ = on; }
+    bool showSpotPrimitive() const { return showSpotPrimitive_; }
+    // What was drawn last (nullopt: nothing), in view space as the culling has it.
+    const std::optional<lc::SpotTestPrimitive>& spotPrimitive() const { return spotPrimitive_; }
+    vtkPolyData* spotCullSphere() const;     // 3 great circles, world space
+    vtkPolyData* spotChunksPassed() const;   // cone-sphere: circles; cone-planes: chunk edges
+    vtkPolyData* spotChunksRejected() const;
+    vtkTextActor* spotCaption() const;
+
 private:
     struct Impl;
     std::unique_ptr<Impl> d_;
@@ -63,6 +80,9 @@ private:
     std::vector<int> listed_, missing_;
     std::vector<std::uint32_t> reverseLists_;
     const void* allTilesRun_ = nullptr; // run the all-tiles wireframe was built for
+    bool showSpotPrimitive_ = false;
+    std::optional<lc::SpotTestPrimitive> spotPrimitive_;
+    void updateSpotPrimitive(const Document& doc, const lc::RunOutput* run, int tile);
 };
 
 } // namespace lcui
