@@ -502,3 +502,42 @@ TEST(MeshOff, TruncatedAndGarbageInputGiveExactErrors) {
     EXPECT_EQ(error("l.off", "OFF\n3 x 0\n"),
               ":2: OFF file: the counts line is \"<vertices> <faces> <edges>\", not '3 x 0'");
 }
+
+// The OFF and binary PLY readers report progress and honour cancel every 64k
+// elements too (70,000 faces: one report inside the faces, then 1.0).
+TEST(MeshFormats, OffAndBinaryPlyReportProgressAndCancel) {
+    constexpr int kFaces = 70000;
+    std::string off = "OFF\n3 " + std::to_string(kFaces) + " 0\n0 0 0\n1 0 0\n0 1 0\n";
+    Body ply(false);
+    for (float x : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f})
+        ply.put<float>(x);
+    for (int f = 0; f < kFaces; ++f) {
+        off += "3 0 1 2\n";
+        ply.put<std::uint8_t>(3).put<std::int32_t>(0).put<std::int32_t>(1).put<std::int32_t>(2);
+    }
+    TempFile offFile("many.off", off);
+    TempFile plyFile("many.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+                                 "property float y\nproperty float z\nelement face " +
+                                     std::to_string(kFaces) +
+                                     "\nproperty list uchar int vertex_indices\nend_header\n" + ply.bytes);
+    for (const std::string& path : {offFile.path, plyFile.path}) {
+        SCOPED_TRACE(path);
+        std::vector<double> seen;
+        const Mesh m = loadMesh(path, nullptr, nullptr, [&](double f) { seen.push_back(f); });
+        EXPECT_EQ(m.triangleCount(), std::size_t(kFaces));
+        ASSERT_EQ(seen.size(), 2u);
+        EXPECT_GT(seen[0], 0.5); // 65,535 of 70,000 faces read
+        EXPECT_LT(seen[0], 0.9);
+        EXPECT_DOUBLE_EQ(seen[1], 1.0);
+
+        CancelToken token;
+        int reports = 0;
+        EXPECT_THROW(loadMesh(path, nullptr, &token,
+                              [&](double) {
+                                  ++reports;
+                                  token.cancelled = true;
+                              }),
+                     Cancelled);
+        EXPECT_EQ(reports, 1);
+    }
+}
