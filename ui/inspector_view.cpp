@@ -1,11 +1,12 @@
 #include "inspector_view.hpp"
 
 #include "document.hpp"
+#include "light_silhouettes.hpp"
 #include "overlay_actors.hpp"
 #include "vtk_adapters.hpp"
 #include "spot_actor.hpp"
-
 #include "spot_handles.hpp"
+
 #include "culling/projection.hpp"
 
 #include <QTimer>
@@ -17,7 +18,6 @@
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkGlyph3D.h>
 #include <vtkHandleWidget.h>
-#include <vtkIdTypeArray.h>
 #include <vtkInteractorStyleTrackballCamera.h>
 #include <vtkPointData.h>
 #include <vtkPointHandleRepresentation3D.h>
@@ -34,6 +34,15 @@
 #include <cmath>
 
 namespace lcui {
+
+namespace {
+// Rings are lines: opaque they would be as loud as the selection outline.
+// Fainter as they get denser (10,000 rings at 0.55 hide the scene), and a
+// sixth of that while a tile's listed lights are highlighted.
+double ringOpacity(std::size_t lights) {
+    return std::clamp(0.55 * std::sqrt(1024.0 / double(std::max<std::size_t>(lights, 1))), 0.15, 0.55);
+}
+} // namespace
 
 InspectorView::InspectorView(Document* doc, QWidget* parent)
     : QVTKOpenGLNativeWidget(parent), doc_(doc) {
@@ -58,7 +67,6 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     glyph_->SetScaleFactor(1.0);
     glyph_->ClampingOff();
     glyph_->SetColorModeToColorByScalar();
-    glyph_->GeneratePointIdsOn(); // "InputPointIds": glyph output point -> light index
     glyph_->OrientOff();
     vtkNew<vtkPolyDataMapper> lightMapper;
     lightMapper->SetInputConnection(glyph_->GetOutputPort());
@@ -71,6 +79,23 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     // Back faces add nothing but overdraw to a translucent convex shell.
     lightActor_->GetProperty()->BackfaceCullingOn();
     renderer_->AddActor(lightActor_);
+
+    // Many lights: silhouette rings over the same light poly data.
+    rings_->SetCamera(renderer_->GetActiveCamera());
+    rings_->SetInputData(lightData_);
+    vtkNew<vtkPolyDataMapper> ringMapper;
+    ringMapper->SetInputConnection(rings_->GetOutputPort());
+    ringMapper->SetScalarModeToUsePointFieldData();
+    ringMapper->SelectColorArray("color");
+    ringMapper->SetColorModeToDirectScalars();
+    ringMapper->ScalarVisibilityOn();
+    ringActor_->SetMapper(ringMapper);
+    ringActor_->GetProperty()->SetLighting(false);
+    ringActor_->GetProperty()->SetLineWidth(1);
+    ringActor_->GetProperty()->SetPointSize(3);
+    ringActor_->PickableOff();
+    ringActor_->VisibilityOff();
+    renderer_->AddActor(ringActor_);
 
     // Selected lights: the same spheres as an opaque yellow wireframe.
     selData_ = lightsToPolyData({});
@@ -142,13 +167,18 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     radiusHandle_->EnabledOff();
     // After an orbit, the radius handle goes back to the right of the centre.
     style->AddObserver(vtkCommand::EndInteractionEvent, this, &InspectorView::placeRadiusHandle);
+    spotHandles_ = std::make_unique<SpotHandles>(doc_, renderer_, interactor());
 
     picker_->SetTolerance(0.0005);
     picker_->PickFromListOn();
     // High priority: see the press before the trackball style or the handle take it.
     interactor()->AddObserver(vtkCommand::LeftButtonPressEvent, this, &InspectorView::onLeftPress, 10.0f);
-    interactor()->AddObserver(vtkCommand::LeftButtonReleaseEvent, this, &InspectorView::onLeftRelease,
-                              10.0f);
+    // Passive: on a press the trackball style grabs the interactor's focus,
+    // and until it lets go only passive observers see the release (a click
+    // on a light never reached onLeftRelease before).
+    const unsigned long releaseTag = interactor()->AddObserver(vtkCommand::LeftButtonReleaseEvent, this,
+                                                               &InspectorView::onLeftRelease, 10.0f);
+    interactor()->GetCommand(releaseTag)->PassiveObserverOn();
 
     connect(doc_, &Document::sceneReset, this, [this] {
         cameraFramed_ = false;
@@ -167,7 +197,6 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
         scheduleRender();
     });
     connect(doc_, &Document::lightChanged, this, [this](int i) {
-    spotHandles_ = std::make_unique<SpotHandles>(doc_, renderer_, interactor());
         updateLight(i);
         updateSelection();
         scheduleRender();
@@ -205,6 +234,8 @@ void InspectorView::updateOverlays() {
     overlays_->update(*doc_);
     // Dim the other lights while a tile's listed lights are highlighted.
     lightActor_->GetProperty()->SetOpacity(overlays_->dimLights() ? 0.06 : 0.22);
+    const double rings = ringOpacity(doc_->scene().lights.size());
+    ringActor_->GetProperty()->SetOpacity(overlays_->dimLights() ? 0.15 * rings : rings);
 }
 
 vtkRenderer* InspectorView::renderer() const { return renderer_.Get(); }
@@ -212,7 +243,7 @@ vtkHandleWidget* InspectorView::handleWidget() const { return handle_.Get(); }
 vtkPointHandleRepresentation3D* InspectorView::handleRepresentation() const { return handleRep_.Get(); }
 vtkHandleWidget* InspectorView::radiusHandleWidget() const { return radiusHandle_.Get(); }
 vtkPointHandleRepresentation3D* InspectorView::radiusHandleRepresentation() const { return radiusRep_.Get(); }
-vtkActor* InspectorView::lightActor() const { return lightActor_.Get(); }
+vtkActor* InspectorView::lightActor() const { return silhouettes_ ? ringActor_.Get() : lightActor_.Get(); }
 
 void InspectorView::scheduleRender() {
     if (renderPending_) return;
@@ -269,8 +300,8 @@ void InspectorView::resetCamera() {
 void InspectorView::rebuildMeshes() {
     for (auto& a : meshActors_) renderer_->RemoveActor(a);
     meshActors_.clear();
+    // The picker sees meshes only: lights are picked as exact spheres (pickLight).
     picker_->InitializePickList();
-    picker_->AddPickList(lightActor_);
     for (const auto& m : doc_->scene().meshes) {
         auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
         mapper->SetInputData(meshToPolyData(m));
@@ -284,9 +315,14 @@ void InspectorView::rebuildMeshes() {
 }
 
 void InspectorView::rebuildLights() {
-    renderer_->SetUseDepthPeeling(doc_->scene().lights.size() <= kMaxPeeledLights ? 1 : 0);
+    const std::size_t n = doc_->scene().lights.size();
+    renderer_->SetUseDepthPeeling(n <= kMaxPeeledLights ? 1 : 0);
+    silhouettes_ = n > kMaxFilledLights;
+    lightActor_->SetVisibility(!silhouettes_);
+    ringActor_->SetVisibility(silhouettes_);
     lightData_ = lightsToPolyData(doc_->scene().lights);
     glyph_->SetInputData(lightData_);
+    rings_->SetInputData(lightData_);
     spotCones_->update(doc_->scene().lights);
 }
 
@@ -443,28 +479,50 @@ void InspectorView::onRadiusEnd() {
 int InspectorView::pickLight(const QPoint& pos, glm::dvec3* hit) {
     const double dpr = devicePixelRatioF();
     const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
-    if (!picker_->Pick(x, y, 0, renderer_)) return -1;
-    if (picker_->GetActor() != lightActor_.Get()) return -1;
-    vtkDataSet* out = picker_->GetDataSet();
-    const vtkIdType pt = picker_->GetPointId();
-    if (!out || pt < 0) return -1;
-    vtkDataArray* ids = out->GetPointData()->GetArray("InputPointIds");
-    if (!ids) return -1;
-    if (hit) {
+    // The view ray through the pixel, from the near to the far clipping plane.
+    auto worldAt = [&](double z) {
+        renderer_->SetDisplayPoint(x, y, z);
+        renderer_->DisplayToWorld();
+        double w[4];
+        renderer_->GetWorldPoint(w);
+        return glm::dvec3(w[0], w[1], w[2]) / (w[3] != 0.0 ? w[3] : 1.0);
+    };
+    const glm::dvec3 origin = worldAt(0.0), farPoint = worldAt(1.0);
+    double nearest = glm::length(farPoint - origin);
+    if (!(nearest > 0)) return -1;
+    const glm::dvec3 dir = (farPoint - origin) / nearest;
+    // A mesh surface in front hides the spheres behind it.
+    if (picker_->Pick(x, y, 0, renderer_) && picker_->GetActor()) {
         double p[3];
         picker_->GetPickPosition(p);
-        *hit = {p[0], p[1], p[2]};
+        nearest = std::min(nearest, glm::dot(glm::dvec3(p[0], p[1], p[2]) - origin, dir));
     }
-    return int(ids->GetTuple1(pt));
+    // The first sphere the ray enters. A sphere around the ray's origin is
+    // skipped: its surface is behind the viewer, nothing of it is in view.
+    int best = -1;
+    const auto& lights = doc_->scene().lights;
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+        const double r = lightDisplayRadius(lights[i]);
+        if (!(r > 0)) continue;
+        const glm::dvec3 oc = lights[i].position - origin;
+        const double b = glm::dot(oc, dir), c = glm::dot(oc, oc) - r * r;
+        if (c <= 0) continue;
+        const double disc = b * b - c;
+        if (disc < 0) continue;
+        const double t = b - std::sqrt(disc);
+        if (t > 0 && t < nearest) {
+            nearest = t;
+            best = int(i);
+        }
+    }
+    if (best >= 0 && hit) *hit = origin + nearest * dir;
+    return best;
 }
 
 bool InspectorView::pickSurface(const QPoint& pos, glm::dvec3* point, glm::dvec3* normal) {
     const double dpr = devicePixelRatioF();
     const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
-    lightActor_->PickableOff();
-    const bool hit = picker_->Pick(x, y, 0, renderer_) && picker_->GetActor() != nullptr;
-    lightActor_->PickableOn();
-    if (!hit) return false;
+    if (!picker_->Pick(x, y, 0, renderer_) || !picker_->GetActor()) return false;
     double p[3], n[3];
     picker_->GetPickPosition(p);
     picker_->GetPickNormal(n);

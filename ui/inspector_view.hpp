@@ -1,13 +1,18 @@
 #pragma once
 // The inspector view: a free-orbit 3D view of the whole scene. Meshes, every
-// light's bounding sphere as ONE glyph actor (a low-resolution sphere scaled by
-// the radius, coloured by the light's colour, translucent: 10,000 lights stay
-// interactive), the culling camera's frustum as lines, the selection
-// highlighted, and a handle widget to drag the selected light.
+// light's bounding sphere, the culling camera's frustum as lines, the
+// selection highlighted, and a handle widget to drag the selected light.
 //
-// Picking: a click (press and release without moving) on a sphere selects its
-// light: the cell picker hits the glyph output and the glyph filter's
-// "InputPointIds" array maps the hit back to the light index.
+// Lights are ONE actor either way. Up to kMaxFilledLights: a glyph actor of
+// low-resolution spheres scaled by the radius, coloured by the light's colour,
+// translucent (depth-peeled). Above it: each sphere's silhouette ring and a
+// dot at its centre (LightSilhouettes), because the software rasteriser pays
+// per covered pixel and a thousand overlapping translucent spheres cover the
+// view many times; a ring costs its perimeter.
+//
+// Picking: a click (press and release without moving) selects the light whose
+// sphere the view ray through the cursor enters first, unless a mesh surface
+// is nearer (exact spheres in world space, whichever way they are drawn).
 
 #include <QVTKOpenGLNativeWidget.h>
 
@@ -32,15 +37,20 @@ namespace lcui {
 class Document;
 class InspectorOverlays;
 
+class LightSilhouettes;
 class SpotConesActor;
+class SpotHandles;
 
 class InspectorView : public QVTKOpenGLNativeWidget {
     Q_OBJECT
 public:
     // Depth peeling (order-independent translucency) is used up to this many
     // lights; beyond it every frame would redraw all spheres once per peel.
-class SpotHandles;
     static constexpr std::size_t kMaxPeeledLights = 256;
+    // Up to this many lights the spheres are drawn filled, above it as
+    // silhouette rings (same threshold: filled spheres without peeling would
+    // blend in arbitrary order).
+    static constexpr std::size_t kMaxFilledLights = kMaxPeeledLights;
     explicit InspectorView(Document* doc, QWidget* parent = nullptr);
     ~InspectorView() override;
 
@@ -61,9 +71,14 @@ class SpotHandles;
     // centre as seen from this view): dragging it sets the explicit radius.
     vtkHandleWidget* radiusHandleWidget() const;
     vtkPointHandleRepresentation3D* radiusHandleRepresentation() const;
-    // The glyph actor showing every light's sphere.
+    // The actor drawing every light's sphere: the filled glyph actor, or the
+    // silhouette rings above kMaxFilledLights. Its mapper's input algorithm
+    // reads the lights' poly data (points, "radius", "color").
     vtkActor* lightActor() const;
+    bool silhouettes() const { return silhouettes_; }
     SpotConesActor* spotCones() const { return spotCones_.get(); }
+    // The selected spot light's direction and outer-angle handles (ui/spot_handles.hpp).
+    SpotHandles* spotHandles() const { return spotHandles_.get(); }
     // Tile frustums, cells, reverse look-up and list highlights (overlay_actors.hpp).
     InspectorOverlays* overlays() const { return overlays_.get(); }
     void renderNow();
@@ -77,8 +92,6 @@ private:
     void rebuildLights();
     void updateLight(int index);
     void updateSelection();
-    // The selected spot light's direction and outer-angle handles (ui/spot_handles.hpp).
-    SpotHandles* spotHandles() const { return spotHandles_.get(); }
     void updateFrustum();
     void updateOverlays();
     void onHandleStart();
@@ -98,6 +111,9 @@ private:
     vtkNew<vtkSphereSource> sphere_;
     vtkNew<vtkGlyph3D> glyph_;
     vtkNew<vtkActor> lightActor_;
+    vtkNew<LightSilhouettes> rings_;
+    vtkNew<vtkActor> ringActor_;
+    bool silhouettes_ = false;
     vtkSmartPointer<vtkPolyData> selData_;
     vtkNew<vtkGlyph3D> selGlyph_;
     vtkNew<vtkActor> selActor_;
@@ -116,7 +132,7 @@ private:
     bool cameraFramed_ = false;
     std::unique_ptr<InspectorOverlays> overlays_;
     std::unique_ptr<SpotConesActor> spotCones_; // spot lights' cones (ui/spot_actor.hpp)
+    std::unique_ptr<SpotHandles> spotHandles_;  // after the handles above: destroyed first
 };
 
 } // namespace lcui
-    std::unique_ptr<SpotHandles> spotHandles_;  // after the handles above: destroyed first
