@@ -14,16 +14,29 @@
 namespace lcui {
 
 namespace {
-// Same meshes and camera: the depth image of one scene is the depth of the other.
-bool sameGeometry(const lc::Scene& a, const lc::Scene& b) {
-    if (!(a.camera == b.camera) || a.meshes.size() != b.meshes.size()) return false;
-    for (std::size_t i = 0; i < a.meshes.size(); ++i) {
-        const lc::Mesh &x = a.meshes[i], &y = b.meshes[i];
+bool sameMeshes(const std::vector<lc::Mesh>& a, const std::vector<lc::Mesh>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const lc::Mesh &x = a[i], &y = b[i];
         if (x.transform != y.transform || x.positions != y.positions || x.indices != y.indices) return false;
     }
     return true;
 }
+
+// A Live edit's ground truth starts once no edit came for this long (or at
+// once when the worker is otherwise idle at the end of a drag): during a drag
+// it would take the CPU from the views' redraw, and the next edit cancels it.
+constexpr auto kTruthAfterPause = std::chrono::milliseconds(150);
 } // namespace
+
+// Same camera and meshes: the depth image of one is the depth of the other.
+// The same geometry revision means the same meshes (no comparison by value).
+bool CullWorker::sameGeometry(const CullRequest& req) const {
+    if (!depth_ || !depthCamera_ || !(*depthCamera_ == req.scene->camera)) return false;
+    if (req.geometryRevision != 0) return req.geometryRevision == depthRevision_;
+    const std::vector<lc::Mesh>& meshes = req.meshes ? *req.meshes : req.scene->meshes;
+    return depthMeshes_ && (depthMeshes_.get() == &meshes || sameMeshes(*depthMeshes_, meshes));
+}
 
 void CullWorker::post(CullRequest request) {
     bool schedule = false;
@@ -35,6 +48,7 @@ void CullWorker::post(CullRequest request) {
         if (shadeCancel_) shadeCancel_->cancelled = true;
         if (!scheduled_) scheduled_ = schedule = true;
     }
+    posted_.notify_all();
     if (schedule) QMetaObject::invokeMethod(this, "drain", Qt::QueuedConnection);
 }
 
@@ -144,8 +158,9 @@ std::shared_ptr<const lc::RunOutput> CullWorker::addDeferredTruth(const CullRequ
     auto truthCancel = std::make_shared<lc::CancelToken>();
     std::shared_ptr<const lc::RunOutput> done;
     {
-        std::lock_guard lock(mutex_);
-        if (pending_) return done; // the newer request will bring its own
+        std::unique_lock lock(mutex_);
+        // The newer request will bring its own.
+        if (posted_.wait_for(lock, kTruthAfterPause, [this] { return pending_.has_value(); })) return done;
         truthCancel_ = truthCancel;
     }
     try {
@@ -255,7 +270,8 @@ void CullWorker::drain() {
             if (!backend_ || req.backend != backendName_ || req.device != deviceSelector_) {
                 backend_.reset(); // release the old device before opening a new one
                 backendName_.clear();
-                depthScene_.reset();
+                depthCamera_.reset();
+                depthMeshes_.reset();
                 depth_.reset();
                 backend_ = lc::makeBackend(req.backend, req.device);
                 backendName_ = req.backend;
@@ -267,14 +283,25 @@ void CullWorker::drain() {
             // The Lambert image error (pixels x lights) is left to the shading
             // phase below, which runs only when asked (CullRequest::shade).
             options.truthOptions.imageError = false;
-            if (depth_ && depthScene_ && sameGeometry(*depthScene_, *req.scene))
-                options.reuseDepth = depth_.get();
+            const bool reuse = sameGeometry(req);
+            if (reuse) options.reuseDepth = depth_.get();
+            // Rendering depth needs the meshes: a scene with them, built here
+            // (worker thread) and only then.
+            std::shared_ptr<const lc::Scene> runScene = req.scene;
+            if (!reuse && req.meshes && runScene->meshes.empty() && !req.meshes->empty()) {
+                auto full = std::make_shared<lc::Scene>(*req.scene);
+                full->meshes = *req.meshes;
+                runScene = std::move(full);
+            }
             options.groundTruth = !req.deferTruth;
             auto out = std::make_shared<lc::RunOutput>(
-                lc::runPipeline(*req.scene, req.settings, *backend_, options, cancel.get()));
+                lc::runPipeline(*runScene, req.settings, *backend_, options, cancel.get()));
             if (!out->depthReused) {
                 depth_ = std::make_shared<const lc::DepthImage>(out->depth);
-                depthScene_ = req.scene;
+                depthCamera_ = req.scene->camera;
+                depthMeshes_ = req.meshes;
+                if (!depthMeshes_) depthMeshes_ = std::make_shared<const std::vector<lc::Mesh>>(req.scene->meshes);
+                depthRevision_ = req.geometryRevision;
             }
             emit finished(req.generation, std::shared_ptr<const lc::RunOutput>(out));
             lastGeneration_ = req.generation;
@@ -323,10 +350,22 @@ CullService::~CullService() {
 }
 
 quint64 CullService::request(const lc::Scene& scene, const lc::CullSettings& settings,
-                             const QString& backend, const QString& device, bool deferTruth, bool shade) {
+                             const QString& backend, const QString& device, bool deferTruth, bool shade,
+                             quint64 geometryRevision) {
     CullRequest r;
     r.generation = ++generation_;
-    r.scene = std::make_shared<const lc::Scene>(scene);
+    // Lights and camera are copied; the meshes only when their revision changed.
+    auto copy = std::make_shared<lc::Scene>();
+    copy->name = scene.name;
+    copy->lights = scene.lights;
+    copy->camera = scene.camera;
+    r.scene = std::move(copy);
+    if (geometryRevision == 0 || geometryRevision != meshesRevision_ || !meshes_) {
+        meshes_ = std::make_shared<const std::vector<lc::Mesh>>(scene.meshes);
+        meshesRevision_ = geometryRevision;
+    }
+    r.meshes = meshes_;
+    r.geometryRevision = geometryRevision;
     r.settings = settings;
     r.backend = backend.toStdString();
     r.device = device.toStdString();

@@ -18,6 +18,8 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <condition_variable>
+#include <vector>
 
 namespace lcui {
 
@@ -32,6 +34,11 @@ struct CullRequest {
     // request arrives first (ground truth costs more than culling, so a drag
     // would otherwise be paced by it).
     bool deferTruth = false;
+    // The meshes, apart from `scene` (whose meshes are then empty): shared by
+    // every request of one Document::geometryRevision, so a Live drag copies
+    // lights and camera only. `geometryRevision` 0: unknown (compared by value).
+    std::shared_ptr<const std::vector<lc::Mesh>> meshes;
+    quint64 geometryRevision = 0;
     // Shade the culled and the all-lights image (lc::shadeAndCompare, on the
     // request's backend, at the camera's resolution) once the lists (and
     // ground truth) are out: a further result of the same generation that
@@ -79,6 +86,7 @@ private:
 
 private:
     mutable std::mutex mutex_;
+    std::condition_variable posted_; // post(): wakes a deferred ground truth waiting for a pause
     std::optional<CullRequest> pending_;
     bool scheduled_ = false;
     quint64 dropped_ = 0;
@@ -91,7 +99,11 @@ private:
     std::string backendName_, deviceSelector_;
     // The last run's scene and depth: a request that changes only lights (a
     // Live drag) reuses the depth image instead of re-rendering it.
-    std::shared_ptr<const lc::Scene> depthScene_;
+    // What the depth image was rendered from: camera, meshes and revision.
+    bool sameGeometry(const CullRequest& req) const;
+    std::optional<lc::Camera> depthCamera_;
+    std::shared_ptr<const std::vector<lc::Mesh>> depthMeshes_;
+    quint64 depthRevision_ = 0;
     std::shared_ptr<const lc::DepthImage> depth_;
     // The last finished run (its most complete output) and its request: what
     // requestShading() shades.
@@ -107,13 +119,17 @@ public:
     explicit CullService(QObject* parent = nullptr);
     ~CullService() override;
 
-    // Copies the scene and posts it; returns the request's generation.
+    // Copies the scene and posts it; returns the request's generation. With a
+    // `geometryRevision` (Document::geometryRevision) the meshes are copied
+    // only when it changes and shared by the requests in between.
     quint64 request(const lc::Scene& scene, const lc::CullSettings& settings,
                     const QString& backend, const QString& device, bool deferTruth = false,
-                    bool shade = false);
+                    bool shade = false, quint64 geometryRevision = 0);
     // CullWorker::requestShading.
     void requestShading(quint64 generation) { worker_->requestShading(generation); }
     quint64 lastGeneration() const { return generation_; }
+    // The meshes the last request shared with the worker (see CullRequest::meshes).
+    std::shared_ptr<const std::vector<lc::Mesh>> meshSnapshot() const { return meshes_; }
     CullWorker* worker() { return worker_; }
     // "vulkan" when this build and machine have it, else "cpu".
     static QString defaultBackend();
@@ -130,6 +146,8 @@ private:
     QThread thread_;
     CullWorker* worker_;
     quint64 generation_ = 0;
+    std::shared_ptr<const std::vector<lc::Mesh>> meshes_;
+    quint64 meshesRevision_ = 0;
 };
 
 } // namespace lcui

@@ -13,6 +13,7 @@ Document::Document(QObject* parent) : QObject(parent) {
 
 void Document::resetScene(lc::Scene scene, const QString& path) {
     scene_ = std::move(scene);
+    ++geometryRevision_;
     undo_.clear();
     undo_.setClean();
     filePath_ = path;
@@ -197,12 +198,14 @@ void Document::applyCamera(const lc::Camera& c) {
 
 void Document::applyAddMesh(const lc::Mesh& m) {
     scene_.meshes.push_back(m);
+    ++geometryRevision_;
     emit meshesChanged();
     emit sceneEdited();
 }
 
 void Document::applyRemoveLastMesh() {
     scene_.meshes.pop_back();
+    ++geometryRevision_;
     emit meshesChanged();
     emit sceneEdited();
 }

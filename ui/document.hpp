@@ -24,6 +24,11 @@ public:
     explicit Document(QObject* parent = nullptr);
 
     const lc::Scene& scene() const { return scene_; }
+    // Changes whenever the meshes do (import, its undo, a new scene), never
+    // for a light or camera edit: what depends on the meshes only (the depth
+    // image with an unchanged camera, a copy of the meshes) is still valid
+    // while it is the same. Never 0.
+    quint64 geometryRevision() const { return geometryRevision_; }
     QUndoStack* undoStack() { return &undo_; }
 
     // --- file state ---------------------------------------------------------
@@ -125,6 +130,7 @@ signals:
 
 private:
     lc::Scene scene_;
+    quint64 geometryRevision_ = 1;
     lc::CullSettings settings_;
     QUndoStack undo_;
     QString filePath_;

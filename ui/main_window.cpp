@@ -438,7 +438,8 @@ void MainWindow::setBackend(const QString& backend, const QString& device) {
 quint64 MainWindow::runCulling(bool liveEdit) {
     const quint64 gen = service_->request(doc_->scene(), doc_->settings(), backendCombo_->currentText(),
                                           deviceEdit_->text(), liveEdit,
-                                          CameraView::needsShading(cameraView_->imageMode()));
+                                          CameraView::needsShading(cameraView_->imageMode()),
+                                          doc_->geometryRevision());
     statusBar()->showMessage(tr("culling (run %1)...").arg(gen));
     return gen;
 }
