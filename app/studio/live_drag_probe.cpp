@@ -1,5 +1,6 @@
 #include "live_drag_probe.hpp"
 
+#include "camera_view.hpp"
 #include "cull_worker.hpp"
 #include "document.hpp"
 #include "inspector_view.hpp"
@@ -10,6 +11,7 @@
 #include <vtkCommand.h>
 #include <vtkHandleWidget.h>
 #include <vtkPointHandleRepresentation3D.h>
+#include <vtkRenderWindow.h>
 
 #include <algorithm>
 #include <cmath>
@@ -36,7 +38,27 @@ void LiveDragProbe::start() {
     // is deterministic for a given scene and seed.
     light_ = int(doc->scene().lights.size() / 2);
     doc->setSelectedLights({light_});
+    // Each view's frame on its own, before anything moves.
+    std::vector<double> iv, cv;
+    for (int i = 0; i < 3; ++i) {
+        QElapsedTimer t;
+        t.start();
+        window_->inspectorView()->renderNow();
+        iv.push_back(t.nsecsElapsed() * 1e-6);
+        t.restart();
+        window_->cameraView()->renderNow();
+        cv.push_back(t.nsecsElapsed() * 1e-6);
+    }
+    staticInspectorMs_ = median(iv);
+    staticCameraMs_ = median(cv);
     window_->setLive(true);
+    // Render times of both views, from the render window's own start/end.
+    vtkRenderWindow* iw = window_->inspectorView()->renderWindow();
+    iw->AddObserver(vtkCommand::StartEvent, this, &LiveDragProbe::onInspectorStart);
+    iw->AddObserver(vtkCommand::EndEvent, this, &LiveDragProbe::onInspectorEnd);
+    vtkRenderWindow* cw = window_->cameraView()->renderWindow();
+    cw->AddObserver(vtkCommand::StartEvent, this, &LiveDragProbe::onCameraStart);
+    cw->AddObserver(vtkCommand::EndEvent, this, &LiveDragProbe::onCameraEnd);
     window_->inspectorView()->handleWidget()->InvokeEvent(vtkCommand::StartInteractionEvent);
     clock_.start();
     motion_.start();
@@ -54,8 +76,11 @@ void LiveDragProbe::step() {
     const double a = 0.002 * now;
     const glm::dvec3 p = p0 + glm::dvec3(0.05 * std::cos(a), 0.0, 0.05 * std::sin(a));
     double wp[3] = {p.x, p.y, p.z};
+    QElapsedTimer edit;
+    edit.start();
     window_->inspectorView()->handleRepresentation()->SetWorldPosition(wp);
     window_->inspectorView()->handleWidget()->InvokeEvent(vtkCommand::InteractionEvent);
+    edit_.push_back(edit.nsecsElapsed() * 1e-6);
     ++edits_;
     if (firstEditMs_ < 0) firstEditMs_ = now;
     // Live mode posted a request for this edit: its generation is the newest.
@@ -83,6 +108,14 @@ void LiveDragProbe::onFinished(quint64 generation) {
     });
 }
 
+void LiveDragProbe::onInspectorEnd() {
+    if (firstEditMs_ >= 0 && inspectorClock_.isValid()) inspector_.push_back(inspectorClock_.nsecsElapsed() * 1e-6);
+}
+
+void LiveDragProbe::onCameraEnd() {
+    if (firstEditMs_ >= 0 && cameraClock_.isValid()) camera_.push_back(cameraClock_.nsecsElapsed() * 1e-6);
+}
+
 void LiveDragProbe::finish() {
     if (stopping_) return;
     stopping_ = true;
@@ -98,5 +131,15 @@ void LiveDragProbe::finish() {
     r.medianDepthMs = median(depth_);
     r.medianTruthMs = median(truth_);
     r.truths = int(truth_.size());
+    r.medianEditMs = median(edit_);
+    r.staticInspectorMs = staticInspectorMs_;
+    r.staticCameraMs = staticCameraMs_;
+    r.medianInspectorMs = median(inspector_);
+    r.medianCameraMs = median(camera_);
+    r.inspectorFrames = int(inspector_.size());
+    r.cameraFrames = int(camera_.size());
+    r.lights = window_->document()->scene().lights.size();
+    r.inspectorWidth = window_->inspectorView()->width();
+    r.inspectorHeight = window_->inspectorView()->height();
     emit done(r);
 }

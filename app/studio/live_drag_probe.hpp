@@ -25,6 +25,14 @@ struct LiveDragReport {
     double medianCullMs = 0, medianDepthMs = 0;
     double medianTruthMs = 0; // of the ground truths that completed (a newer edit cancels one)
     int truths = 0;
+    // Where a cycle's time goes on the UI thread: handling one edit (undo
+    // command, view updates, scene copy and post), one render of each view.
+    double medianEditMs = 0, medianInspectorMs = 0, medianCameraMs = 0;
+    // Before the drag: full frames of each view alone (median of 3), no edit.
+    double staticInspectorMs = 0, staticCameraMs = 0;
+    int inspectorFrames = 0, cameraFrames = 0;
+    std::size_t lights = 0;
+    int inspectorWidth = 0, inspectorHeight = 0;
     double rateHz() const { return seconds > 0 ? shown / seconds : 0; }
 };
 
@@ -41,6 +49,10 @@ private:
     void step();
     void onFinished(quint64 generation);
     void finish();
+    void onInspectorStart() { inspectorClock_.start(); }
+    void onInspectorEnd();
+    void onCameraStart() { cameraClock_.start(); }
+    void onCameraEnd();
 
     lcui::MainWindow* window_;
     double seconds_;
@@ -51,5 +63,7 @@ private:
     bool stopping_ = false;
     double firstEditMs_ = -1, lastShownMs_ = 0;
     std::map<quint64, double> editAtMs_; // request generation -> time of its edit
-    std::vector<double> latencies_, cull_, depth_, truth_;
+    double staticInspectorMs_ = 0, staticCameraMs_ = 0;
+    std::vector<double> latencies_, cull_, depth_, truth_, edit_, inspector_, camera_;
+    QElapsedTimer inspectorClock_, cameraClock_;
 };
