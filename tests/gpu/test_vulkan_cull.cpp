@@ -512,3 +512,41 @@ TEST_F(GpuTest, StashedAndRecomputedListsMatchTheReference) {
 }
 
 } // namespace
+
+namespace {
+
+// On lavapipe tile_bounds reads even-width depth images as 64-bit pixel pairs
+// (LC_DEPTH_PAIRS); the GPU work layout, emulated, reads single pixels. The
+// two must agree exactly: the same depth bounds and cell / slice masks, the
+// same lists. An even width with partial edge tiles (16 px tiles: 330 =
+// 20 x 16 + 10 across, 186 = 11 x 16 + 10 down; 10 px tiles: 186 = 18 x 10
+// + 6 down), and a tile size that is not a multiple of 8.
+TEST_F(GpuTest, PixelPairLoadsMatchSinglePixelLoads) {
+    setenv("LIGHTCULL_VK_EMULATE_GPU", "1", 1);
+    std::unique_ptr<CullBackend> emulated = makeVulkanBackend("");
+    unsetenv("LIGHTCULL_VK_EMULATE_GPU");
+    for (std::uint32_t tile : {16u, 10u}) {
+        Scene scene = sized("forest", 330, 186, tile);
+        scene.lights = generateLights(defaultLightGen(scene, 300, 4));
+        const Projection proj(scene.camera);
+        const TileGrid grid = TileGrid::make(330, 186, tile);
+        const ViewLights lights = makeViewLights(scene);
+        const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+        for (Algorithm a : {Algorithm::MinMax, Algorithm::TwoPointFiveD, Algorithm::Clustered}) {
+            CullSettings st;
+            st.algorithm = a;
+            st.cells = 16;
+            const std::string label = "tile " + std::to_string(tile) + " " + toString(a);
+            const CullResult pairs = gputest::vulkan().cull(depth, proj, grid, lights, st);
+            const CullResult single = emulated->cull(depth, proj, grid, lights, st);
+            EXPECT_EQ(pairs.tileDepthMin, single.tileDepthMin) << label;
+            EXPECT_EQ(pairs.tileDepthMax, single.tileDepthMax) << label;
+            EXPECT_EQ(pairs.cellMask, single.cellMask) << label;
+            EXPECT_EQ(pairs.listCount, single.listCount) << label;
+            EXPECT_EQ(pairs.lightIndices, single.lightIndices) << label;
+            EXPECT_GT(pairs.entries(), 0u) << label;
+        }
+    }
+}
+
+} // namespace
