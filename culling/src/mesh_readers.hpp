@@ -43,7 +43,8 @@ std::string readFileBytes(const std::string& path, std::uint64_t size, const Can
 // PLY: ascii, binary_little_endian, binary_big_endian.
 void readPly(std::string_view bytes, const ReadContext& ctx, FlatMesh& out);
 // OFF: ASCII ([ST][C][N]OFF keyword, comments, colour columns after a face's
-// indices); binary OFF is refused with a clear error.
+// indices) and binary OFF ("OFF BINARY": little-endian as OpenMesh writes it,
+// big-endian as Geomview specifies it; mesh_off.cpp says how they differ).
 void readOff(std::string_view bytes, const ReadContext& ctx, FlatMesh& out);
 
 // Text helpers shared by the ASCII readers.

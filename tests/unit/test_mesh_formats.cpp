@@ -5,6 +5,8 @@
 #include "culling/errors.hpp"
 #include "culling/scene_io.hpp"
 
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -489,8 +491,6 @@ TEST(MeshOff, TruncatedAndGarbageInputGiveExactErrors) {
               ":6: OFF file: face 0 announces 4 vertices but its line holds 3 numbers after the count");
     EXPECT_EQ(error("f.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2.5\n"),
               ":6: OFF file: face 0: '2.5' is not a vertex index");
-    EXPECT_EQ(error("g.off", "OFF BINARY\n"),
-              ":1: OFF file: binary OFF is not supported; use ASCII OFF or PLY");
     EXPECT_EQ(error("h.off", "4OFF\n1 1 0\n0 0 0 1\n"),
               ":1: OFF file: 4OFF (4-D or n-D vertices) is not supported");
     EXPECT_EQ(error("i.off", "PLY\n3 1 0\n"),
@@ -501,6 +501,230 @@ TEST(MeshOff, TruncatedAndGarbageInputGiveExactErrors) {
               ":5: vertex 2 has a non-finite coordinate '1e39'");
     EXPECT_EQ(error("l.off", "OFF\n3 x 0\n"),
               ":2: OFF file: the counts line is \"<vertices> <faces> <edges>\", not '3 x 0'");
+}
+
+// ---- binary OFF ------------------------------------------------------------
+
+// The square mesh (a quad and a triangle) as binary OFF under `keyword`'s
+// prefixes, in OpenMesh's little-endian layout (colours 3 int32 per vertex and
+// face, no face colour count) or Geomview's big-endian one (vertex colour 4
+// float32, per face a colour count and that many float32). Prefix data are
+// filled with values that are not coordinates so a misplaced read shows.
+std::string squareBinaryOff(const std::string& keyword, bool big, int faceColours = 0) {
+    const bool st = keyword.find("ST") != std::string::npos;
+    const bool c = keyword.find('C') != std::string::npos;
+    const bool n = keyword.find('N') != std::string::npos;
+    Body b(big);
+    b.put<std::int32_t>(5).put<std::int32_t>(2).put<std::int32_t>(7);
+    for (std::size_t v = 0; v < 5; ++v) {
+        for (int k = 0; k < 3; ++k)
+            b.put<float>(kSquarePositions[3 * v + std::size_t(k)]);
+        if (n) b.put<float>(-7.f).put<float>(-8.f).put<float>(-9.f);
+        if (c && big) b.put<float>(0.25f).put<float>(0.5f).put<float>(0.75f).put<float>(1.f);
+        if (c && !big) b.put<std::int32_t>(200).put<std::int32_t>(100).put<std::int32_t>(50);
+        if (st) b.put<float>(0.125f).put<float>(0.875f);
+    }
+    auto colour = [&] {
+        if (big) {
+            b.put<std::int32_t>(faceColours);
+            for (int k = 0; k < faceColours; ++k)
+                b.put<float>(0.5f);
+        } else if (c) {
+            b.put<std::int32_t>(255).put<std::int32_t>(0).put<std::int32_t>(3);
+        }
+    };
+    b.put<std::int32_t>(4).put<std::int32_t>(0).put<std::int32_t>(1).put<std::int32_t>(2).put<std::int32_t>(
+        3);
+    colour();
+    b.put<std::int32_t>(3).put<std::int32_t>(1).put<std::int32_t>(4).put<std::int32_t>(2);
+    colour();
+    return keyword + " BINARY\n" + b.bytes;
+}
+
+TEST(MeshOff, BinaryBothByteOrdersAndPrefixesEqualTheAsciiOff) {
+    TempFile ascii("square_ascii.off", "OFF\n5 2 0\n0 0 0\n2 0 0\n2 2 0\n0 2 0\n1.5 -0.25 3\n"
+                                       "4 0 1 2 3\n3 1 4 2\n");
+    const Mesh reference = loadMesh(ascii.path);
+    ASSERT_EQ(reference.positions, kSquarePositions);
+    ASSERT_EQ(reference.indices, kSquareIndices);
+    for (const char* keyword : {"OFF", "COFF", "NOFF", "STOFF", "CNOFF", "STCNOFF"})
+        for (bool big : {false, true})
+            for (int faceColours : {0, 3, 4}) {
+                if (!big && faceColours != 0) continue; // OpenMesh's layout has no colour count
+                SCOPED_TRACE(std::string(keyword) +
+                             (big ? " big-endian, face colours " : " little-endian, ") +
+                             std::to_string(faceColours));
+                TempFile f("square_bin.off", squareBinaryOff(keyword, big, faceColours));
+                const Mesh m = loadMesh(f.path);
+                EXPECT_EQ(m.positions, reference.positions);
+                EXPECT_EQ(m.indices, reference.indices);
+            }
+}
+
+// Independent check: the spot mesh written as binary OFF by OpenMesh 9's own
+// writer (plain, and with normals, colours and texture coordinates) loads to
+// the same mesh as the OBJ it came from.
+TEST(MeshOff, BinaryWrittenByOpenMeshEqualsTheObj) {
+    const Mesh obj = loadMesh(kAssets + "/spot/spot.obj");
+    ASSERT_GT(obj.triangleCount(), 0u);
+    using PolyMesh = OpenMesh::PolyMesh_ArrayKernelT<>;
+    PolyMesh om;
+    om.request_vertex_normals();
+    om.request_vertex_colors();
+    om.request_face_colors();
+    om.request_vertex_texcoords2D();
+    std::vector<PolyMesh::VertexHandle> vh;
+    for (std::size_t v = 0; v < obj.vertexCount(); ++v) {
+        vh.push_back(
+            om.add_vertex({obj.positions[3 * v], obj.positions[3 * v + 1], obj.positions[3 * v + 2]}));
+        om.set_normal(vh.back(), {1e30f, -1e30f, 3.f}); // not coordinates: a misplaced read shows
+        om.set_color(vh.back(), {10, 20, 30});
+        om.set_texcoord2D(vh.back(), {0.5f, 2e20f});
+    }
+    for (std::size_t t = 0; t < obj.triangleCount(); ++t) {
+        const auto f =
+            om.add_face(vh[obj.indices[3 * t]], vh[obj.indices[3 * t + 1]], vh[obj.indices[3 * t + 2]]);
+        ASSERT_TRUE(f.is_valid()) << "triangle " << t;
+        om.set_color(f, {255, 0, 7});
+    }
+    using Opt = OpenMesh::IO::Options;
+    for (Opt::Flag extra : {Opt::Default, Opt::Flag(Opt::VertexNormal | Opt::VertexColor | Opt::FaceColor |
+                                                    Opt::VertexTexCoord)}) {
+        SCOPED_TRACE(extra == Opt::Default ? "OFF BINARY" : "STCNOFF BINARY");
+        const std::string path = tempPath("spot_openmesh.off");
+        ASSERT_TRUE(OpenMesh::IO::write_mesh(om, path, Opt(Opt::Binary | extra)));
+        const Mesh m = loadMesh(path);
+        std::remove(path.c_str());
+        EXPECT_EQ(m.positions, obj.positions);
+        EXPECT_EQ(m.indices, obj.indices);
+    }
+}
+
+TEST(MeshOff, BinaryTruncatedAndGarbageInputGiveExactErrors) {
+    auto error = [](const std::string& name, const std::string& bytes) {
+        TempFile f(name, bytes);
+        const std::string e = loadErrorText(f.path);
+        return e.rfind(f.path, 0) == 0 ? e.substr(f.path.size()) : "(no file name) " + e;
+    };
+    const std::string le = squareBinaryOff("OFF", false); // header 11 bytes, counts, 60 + 36 bytes
+    const std::string be = squareBinaryOff("OFF", true, 3);
+    ASSERT_EQ(le.size(), 11u + 12u + 60u + 20u + 16u);
+    EXPECT_EQ(
+        error("a.off", "OFF BINARY\n"),
+        ": binary OFF file ends inside its counts (three int32: vertices, faces, edges) (byte offset 11)");
+    EXPECT_EQ(error("b.off", "OFF BINARY"), ":1: binary OFF file ends after its header line");
+    EXPECT_EQ(error("c.off", "OFF BINARY 5 2 0\n"),
+              ":1: OFF file: binary data must start on the line after \"OFF BINARY\", not after '5'");
+    // Cut inside the last face: the counts still fit at minimum face size.
+    EXPECT_EQ(
+        error("d.off", le.substr(0, le.size() - 4)),
+        ": binary OFF file (little-endian (OpenMesh)): face 1 of 2 announces 3 vertices; expected a count "
+        "the rest of the file can hold (byte offset 103)");
+    EXPECT_EQ(
+        error("e.off", be.substr(0, be.size() - 4)),
+        ": binary OFF file (big-endian (Geomview)): face 1 of 2 announces 3 colour components; expected a "
+        "count the rest of the file can hold (byte offset 135)");
+    EXPECT_EQ(error("f.off", be.substr(0, be.size() - 16)),
+              ": binary OFF file (big-endian (Geomview)): ends before the colour count of face 1 of 2 "
+              "(byte offset 135)");
+    // Cut inside the vertices: neither byte order's counts fit.
+    EXPECT_EQ(
+        error("g.off", le.substr(0, 40)),
+        ": binary OFF file announces 5 vertices and 2 faces little-endian (OpenMesh) or 83886080 vertices "
+        "and 33554432 faces big-endian (Geomview), more than the 17 bytes after the counts can hold "
+        "(byte offset 11)");
+    // Garbage: an index out of range, a negative vertex count, a NaN.
+    std::string bad = le;
+    bad[le.size() - 4] = 9; // face 1's last index (little-endian low byte)
+    EXPECT_EQ(error("h.off", bad),
+              ": binary OFF file (little-endian (OpenMesh)): face 1 refers to vertex 9, outside 0..4 "
+              "(byte offset 115)");
+    bad = le;
+    bad[103] = '\xff', bad[104] = '\xff', bad[105] = '\xff', bad[106] = '\xff';
+    EXPECT_EQ(
+        error("i.off", bad),
+        ": binary OFF file (little-endian (OpenMesh)): face 1 of 2 announces -1 vertices; expected a count "
+        "the rest of the file can hold (byte offset 103)");
+    bad = le;
+    bad[23 + 12 + 6] = '\xc0', bad[23 + 12 + 7] = '\x7f'; // vertex 1's z: 0x7fc00000, a NaN
+    EXPECT_EQ(error("j.off", bad),
+              ": binary OFF file (little-endian (OpenMesh)): vertex 1 has a non-finite coordinate "
+              "(byte offset 35)");
+    Body noFaces(false);
+    noFaces.put<std::int32_t>(1)
+        .put<std::int32_t>(0)
+        .put<std::int32_t>(0)
+        .put<float>(0)
+        .put<float>(0)
+        .put<float>(0);
+    EXPECT_EQ(error("k.off", "OFF BINARY\n" + noFaces.bytes),
+              ": binary OFF file (little-endian (OpenMesh)) announces 1 vertices and 0 faces: no triangles "
+              "(byte offset 11)");
+}
+
+// Counts that both byte orders can hold: 65,536 vertices and 256 faces written
+// big-endian read as 256 and 65,536 little-endian, which a 790 kB file can
+// also hold. Little-endian is tried first, fails on face 0, and the
+// big-endian reading wins; the little-endian twin loads as little-endian.
+TEST(MeshOff, BinaryCountsThatFitBothByteOrdersFallBackToTheOneThatParses) {
+    for (bool big : {true, false}) {
+        SCOPED_TRACE(big ? "big-endian file" : "little-endian file");
+        const std::int32_t nv = big ? 65536 : 256, nf = big ? 256 : 65536;
+        Body b(big);
+        b.put<std::int32_t>(nv).put<std::int32_t>(nf).put<std::int32_t>(0);
+        std::vector<float> positions;
+        for (std::int32_t v = 0; v < nv; ++v)
+            for (float x : {float(v), float(v % 2), 1.f}) {
+                b.put<float>(x);
+                positions.push_back(x);
+            }
+        std::vector<std::uint32_t> indices;
+        for (std::int32_t f = 0; f < nf; ++f) {
+            const std::uint32_t i = std::uint32_t(f % (std::min(nv, nf) - 2));
+            b.put<std::int32_t>(3).put<std::int32_t>(std::int32_t(i)).put<std::int32_t>(std::int32_t(i + 1));
+            b.put<std::int32_t>(std::int32_t(i + 2));
+            if (big) b.put<std::int32_t>(0);
+            indices.insert(indices.end(), {i, i + 1, i + 2});
+        }
+        TempFile file("both_orders.off", "OFF BINARY\n" + b.bytes);
+        MeshLoadReport rep;
+        const Mesh m = loadMesh(file.path, &rep);
+        EXPECT_EQ(m.positions.size(), positions.size());
+        EXPECT_TRUE(m.positions == positions);
+        EXPECT_TRUE(m.indices == indices);
+    }
+}
+
+// Progress and cancel every 64k elements in binary OFF too.
+TEST(MeshOff, BinaryReportsProgressAndCancel) {
+    constexpr int kFaces = 70000;
+    Body b(true);
+    b.put<std::int32_t>(3).put<std::int32_t>(kFaces).put<std::int32_t>(0);
+    for (float x : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f})
+        b.put<float>(x);
+    for (int f = 0; f < kFaces; ++f)
+        b.put<std::int32_t>(3)
+            .put<std::int32_t>(0)
+            .put<std::int32_t>(1)
+            .put<std::int32_t>(2)
+            .put<std::int32_t>(0);
+    TempFile file("many_bin.off", "OFF BINARY\n" + b.bytes);
+    std::vector<double> seen;
+    const Mesh m = loadMesh(file.path, nullptr, nullptr, [&](double f) { seen.push_back(f); });
+    EXPECT_EQ(m.triangleCount(), std::size_t(kFaces));
+    ASSERT_EQ(seen.size(), 2u);
+    EXPECT_GT(seen[0], 0.5);
+    EXPECT_LT(seen[0], 0.9);
+    EXPECT_DOUBLE_EQ(seen[1], 1.0);
+    CancelToken token;
+    int reports = 0;
+    EXPECT_THROW(loadMesh(file.path, nullptr, &token,
+                          [&](double) {
+                              ++reports;
+                              token.cancelled = true;
+                          }),
+                 Cancelled);
+    EXPECT_EQ(reports, 1);
 }
 
 // The OFF and binary PLY readers report progress and honour cancel every 64k
