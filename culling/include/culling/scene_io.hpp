@@ -20,8 +20,8 @@ struct MeshLoadReport {
     std::string warning;                    // non-empty when something was dropped
 };
 
-// Loads OBJ, PLY, OFF, STL (and OM) through OpenMesh; polygons are triangulated,
-// degenerate faces dropped and counted. Throws InputError naming the file for
+// Loads OBJ, PLY and OFF with the project's own readers, STL and OM through
+// OpenMesh; polygons are triangulated, degenerate faces dropped and counted. Throws InputError naming the file for
 // unreadable, empty or invalid (NaN/Inf coordinates, bad indices) input.
 Mesh loadMesh(const std::string& path, MeshLoadReport* report = nullptr,
               const CancelToken* cancel = nullptr, const Progress& progress = {});
