@@ -150,6 +150,34 @@ TEST(MeshHostile, AnnouncedCountsBeyondTheFileSizeAreAClearError) {
     std::remove(ply.c_str());
 }
 
+// Binary OFF: counts (and a face's vertex count) near 2^31 in either byte
+// order neither drive an allocation nor a loop; each is a clear error.
+TEST(MeshHostile, BinaryOffHugeCountsAreAClearErrorWithoutAllocating) {
+    const std::string path = ::testing::TempDir() + "/lc_huge_counts_bin.off";
+    auto le32 = [](std::uint32_t v) {
+        return std::string{char(v & 0xFF), char(v >> 8 & 0xFF), char(v >> 16 & 0xFF), char(v >> 24)};
+    };
+    const std::string zero = le32(0), one = le32(0x3f800000); // 0.0f and 1.0f
+    {
+        std::ofstream(path, std::ios::binary) << "OFF BINARY\n" << le32(0x7FFFFFFF) << le32(1) << le32(0) << zero;
+    }
+    gLargestAllocation = 0;
+    EXPECT_EQ(loadError(path, std::chrono::seconds(20)),
+              path + ": binary OFF file announces 2147483647 vertices and 1 faces little-endian (OpenMesh) or "
+                     "-129 vertices and 16777216 faces big-endian (Geomview), more than the 4 bytes after the "
+                     "counts can hold (byte offset 11)");
+    {
+        std::ofstream(path, std::ios::binary) << "OFF BINARY\n"
+                                              << le32(3) << le32(1) << le32(0) << zero << zero << zero << one
+                                              << zero << zero << zero << one << zero << le32(0x7FFFFFF0) << zero;
+    }
+    EXPECT_EQ(loadError(path, std::chrono::seconds(20)),
+              path + ": binary OFF file (little-endian (OpenMesh)): face 0 of 1 announces 2147483632 vertices; "
+                     "expected a count the rest of the file can hold (byte offset 59)");
+    EXPECT_LT(gLargestAllocation.load(), std::size_t(1) << 20);
+    std::remove(path.c_str());
+}
+
 } // namespace
 
 // fuzz_mesh_off found (out of memory in OpenMesh's reader, which took "-3"
