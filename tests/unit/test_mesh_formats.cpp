@@ -559,6 +559,13 @@ TEST(MeshOff, BinaryBothByteOrdersAndPrefixesEqualTheAsciiOff) {
                 EXPECT_EQ(m.positions, reference.positions);
                 EXPECT_EQ(m.indices, reference.indices);
             }
+    // Geomview allows white space and a comment between BINARY and the
+    // newline that ends the header, and comment lines before it.
+    const std::string body = squareBinaryOff("OFF", true).substr(std::string("OFF BINARY\n").size());
+    TempFile commented("square_comment.off", "# made by hand\nOFF BINARY\t# binary data follow\r\n" + body);
+    const Mesh m = loadMesh(commented.path);
+    EXPECT_EQ(m.positions, reference.positions);
+    EXPECT_EQ(m.indices, reference.indices);
 }
 
 // Independent check: the spot mesh written as binary OFF by OpenMesh 9's own
