@@ -7,18 +7,19 @@
 // anywhere; blank lines are skipped. 4OFF and nOFF are refused with a clear
 // error.
 //
-// Binary OFF ("[ST][C][N]OFF BINARY" alone on the first line, then binary
+// Binary OFF ("[ST][C][N]OFF BINARY" on the first content line, then binary
 // from the next byte) comes in two incompatible layouts, told apart by the
 // byte order of the three int32 counts (vertices, faces, edges):
 // - little-endian, as OpenMesh 9 writes and reads it: per vertex float32
 //   x y z [N: 3 float32] [C: 3 int32] [ST: 2 float32]; per face int32 n,
 //   n int32 indices [C: 3 int32];
-// - big-endian, as Geomview's OFF(5) specifies: per vertex float32 x y z
+// - big-endian, as Geomview's manual specifies: per vertex float32 x y z
 //   [N: 3 float32] [C: 4 float32] [ST: 2 float32]; per face int32 n, n int32
 //   indices, int32 colour count k, k float32.
 // The order whose counts the bytes after the header can hold wins; when both
-// can (small counts such as 0x00010001 read alike), little-endian is tried
-// first and big-endian if that fails. See mesh_readers.hpp for the promises
+// can (256 vertices and 65,536 faces read 65,536 and 256 the other way round,
+// and a large file holds either), little-endian is tried first and big-endian
+// if that fails. See mesh_readers.hpp for the promises
 // every reader keeps.
 
 #include "culling/errors.hpp"
