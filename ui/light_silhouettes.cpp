@@ -1,5 +1,8 @@
 #include "light_silhouettes.hpp"
 
+#include <array>
+#include <cmath>
+#include <glm/glm.hpp>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
 #include <vtkDataArray.h>
@@ -12,11 +15,6 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkUnsignedCharArray.h>
-
-#include <glm/glm.hpp>
-
-#include <array>
-#include <cmath>
 
 namespace lcui {
 
@@ -117,14 +115,16 @@ int LightSilhouettes::RequestData(vtkInformation*, vtkInformationVector** inputV
         const glm::dvec3 b = glm::cross(normal, a);
         unsigned char col[3] = {255, 255, 255};
         if (color)
-            for (int k = 0; k < 3; ++k) col[k] = (unsigned char)color->GetComponent(i, k);
+            for (int k = 0; k < 3; ++k)
+                col[k] = (unsigned char)color->GetComponent(i, k);
         for (int k = 0; k < S; ++k) {
             const glm::dvec3 w = ringCentre + ringRadius * (cs[std::size_t(k)] * a + sn[std::size_t(k)] * b);
             const vtkIdType id = i * S + k;
             p[3 * id + 0] = float(w.x);
             p[3 * id + 1] = float(w.y);
             p[3 * id + 2] = float(w.z);
-            for (int m = 0; m < 3; ++m) c[3 * id + m] = col[m];
+            for (int m = 0; m < 3; ++m)
+                c[3 * id + m] = col[m];
             lc[i * (S + 1) + k] = id;
         }
         lc[i * (S + 1) + S] = i * S; // close the loop
@@ -133,7 +133,8 @@ int LightSilhouettes::RequestData(vtkInformation*, vtkInformationVector** inputV
         p[3 * cid + 0] = float(centre.x);
         p[3 * cid + 1] = float(centre.y);
         p[3 * cid + 2] = float(centre.z);
-        for (int m = 0; m < 3; ++m) c[3 * cid + m] = col[m];
+        for (int m = 0; m < 3; ++m)
+            c[3 * cid + m] = col[m];
         vertConn->SetValue(i, cid);
     }
     lo[n] = n * (S + 1);

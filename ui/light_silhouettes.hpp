@@ -25,7 +25,7 @@ class vtkCamera;
 namespace lcui {
 
 class LightSilhouettes : public vtkPolyDataAlgorithm {
-public:
+  public:
     static LightSilhouettes* New();
     vtkTypeMacro(LightSilhouettes, vtkPolyDataAlgorithm);
 
@@ -35,12 +35,12 @@ public:
     vtkCamera* GetCamera() const { return camera_; }
     vtkMTimeType GetMTime() override;
 
-protected:
+  protected:
     LightSilhouettes();
     ~LightSilhouettes() override;
     int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-private:
+  private:
     LightSilhouettes(const LightSilhouettes&) = delete;
     void operator=(const LightSilhouettes&) = delete;
     vtkSmartPointer<vtkCamera> camera_;

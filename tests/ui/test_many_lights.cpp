@@ -5,23 +5,23 @@
 // whose sphere is under the cursor; a Live drag ends on the newest result;
 // the document's geometry revision follows mesh edits only.
 
-#include "studio_test_support.hpp"
-
 #include "cull_worker.hpp"
+#include "culling/backend.hpp"
+#include "culling/pipeline.hpp"
+#include "culling/scene_io.hpp"
 #include "document.hpp"
 #include "inspector_view.hpp"
 #include "light_silhouettes.hpp"
 #include "main_window.hpp"
-
-#include "culling/backend.hpp"
-#include "culling/pipeline.hpp"
-#include "culling/scene_io.hpp"
+#include "studio_test_support.hpp"
 
 #include <QDir>
 #include <QElapsedTimer>
 #include <QImage>
 #include <QUndoStack>
-
+#include <cmath>
+#include <limits>
+#include <memory>
 #include <vtkActor.h>
 #include <vtkAlgorithm.h>
 #include <vtkCamera.h>
@@ -34,10 +34,6 @@
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 
-#include <cmath>
-#include <limits>
-#include <memory>
-
 using namespace lcui;
 
 namespace {
@@ -46,7 +42,9 @@ constexpr int kRunTimeoutMs = 120000;
 
 // The selection outline's colour (InspectorView: opaque, unlit 1, 0.85, 0.1),
 // with room for blending under the translucent rings.
-bool selectionYellow(QRgb c) { return qRed(c) > 200 && qGreen(c) > 160 && qGreen(c) < 240 && qBlue(c) < 90; }
+bool selectionYellow(QRgb c) {
+    return qRed(c) > 200 && qGreen(c) > 160 && qGreen(c) < 240 && qBlue(c) < 90;
+}
 
 } // namespace
 
@@ -64,7 +62,8 @@ class ManyLightsTest : public QObject {
         auto done = [&] {
             return doc()->runGeneration() >= generation && (!truth || doc()->runOutput()->truthComputed);
         };
-        while (!done() && t.elapsed() < kRunTimeoutMs) QTest::qWait(20);
+        while (!done() && t.elapsed() < kRunTimeoutMs)
+            QTest::qWait(20);
         return done();
     }
 
@@ -123,7 +122,7 @@ class ManyLightsTest : public QObject {
         return t > 0 ? t : std::numeric_limits<double>::infinity();
     }
 
-private slots:
+  private slots:
     void init() {
         w_ = std::make_unique<MainWindow>();
         w_->prompts.showError = [](QWidget*, const QString& t, const QString& m) {
@@ -188,9 +187,14 @@ private slots:
                     const glm::dvec3 p(q[0], q[1], q[2]);
                     // On the sphere, and the line of sight touches it there (tangent).
                     QVERIFY2(std::abs(glm::length(p - c) - r) < 1e-4 * (1 + r),
-                             qPrintable(QString("light %1 point %2: |p-c| %3, r %4").arg(i).arg(k).arg(glm::length(p - c)).arg(r)));
+                             qPrintable(QString("light %1 point %2: |p-c| %3, r %4")
+                                            .arg(i)
+                                            .arg(k)
+                                            .arg(glm::length(p - c))
+                                            .arg(r)));
                     const double cosine = glm::dot(glm::normalize(p - c), glm::normalize(p - eye));
-                    QVERIFY2(std::abs(cosine) < 1e-3, qPrintable(QString("light %1: not tangent (%2)").arg(i).arg(cosine)));
+                    QVERIFY2(std::abs(cosine) < 1e-3,
+                             qPrintable(QString("light %1: not tangent (%2)").arg(i).arg(cosine)));
                 }
             }
             QVERIFY(checked > 5);
@@ -215,7 +219,8 @@ private slots:
         // ... and in front at its centre (no mesh or other sphere hides it there).
         for (std::size_t i = 0; i < lights.size() && pick < 0; ++i) {
             const QPoint at = toWidget(lights[i].position);
-            if (inner.contains(at) && lights[i].radius() > 1.5 && view()->pickLight(at) == int(i)) pick = int(i);
+            if (inner.contains(at) && lights[i].radius() > 1.5 && view()->pickLight(at) == int(i))
+                pick = int(i);
         }
         QVERIFY(pick >= 0);
         const QImage before = view()->grabFramebuffer();
@@ -233,7 +238,8 @@ private slots:
             double dop[3], up[3];
             view()->renderer()->GetActiveCamera()->GetDirectionOfProjection(dop);
             view()->renderer()->GetActiveCamera()->GetViewUp(up);
-            const glm::dvec3 rr = glm::normalize(glm::cross(glm::dvec3(dop[0], dop[1], dop[2]), glm::dvec3(up[0], up[1], up[2])));
+            const glm::dvec3 rr = glm::normalize(
+                glm::cross(glm::dvec3(dop[0], dop[1], dop[2]), glm::dvec3(up[0], up[1], up[2])));
             right[0] = rr.x, right[1] = rr.y, right[2] = rr.z;
         }
         const glm::dvec3 side = lights[std::size_t(pick)].position +
@@ -246,9 +252,10 @@ private slots:
                 ++added;
                 if (std::hypot(x - c.x(), y - c.y()) > rpx * 1.3 + 4) ++addedOutside;
             }
-        qInfo("selected light %d: %d new outline pixels, %d outside its sphere's %.0f px screen radius", pick, added,
-              addedOutside, rpx);
-        QVERIFY2(added > 2.0 * rpx, qPrintable(QString("only %1 outline pixels for a %2 px sphere").arg(added).arg(rpx)));
+        qInfo("selected light %d: %d new outline pixels, %d outside its sphere's %.0f px screen radius", pick,
+              added, addedOutside, rpx);
+        QVERIFY2(added > 2.0 * rpx,
+                 qPrintable(QString("only %1 outline pixels for a %2 px sphere").arg(added).arg(rpx)));
         QVERIFY(addedOutside <= added / 50);
     }
 
@@ -264,7 +271,8 @@ private slots:
             if (!view()->rect().adjusted(10, 10, -10, -10).contains(pos)) continue;
             const auto [o, d] = rayAt(pos);
             double best = std::numeric_limits<double>::infinity();
-            for (std::size_t j = 0; j < lights.size(); ++j) best = std::min(best, entry(o, d, j));
+            for (std::size_t j = 0; j < lights.size(); ++j)
+                best = std::min(best, entry(o, d, j));
             if (!std::isfinite(best)) continue; // the eye is inside every sphere on this ray
             doc()->setSelectedLights({});
             QTest::mouseClick(view(), Qt::LeftButton, {}, pos);
@@ -273,7 +281,10 @@ private slots:
             // No sphere is entered before the selected one (a mesh in front would
             // have left the selection empty, which the comparison above rejects).
             QVERIFY2(entry(o, d, std::size_t(sel)) <= best * (1 + 1e-9),
-                     qPrintable(QString("clicked light %1 at t=%2, nearest entry %3").arg(sel).arg(entry(o, d, std::size_t(sel))).arg(best)));
+                     qPrintable(QString("clicked light %1 at t=%2, nearest entry %3")
+                                    .arg(sel)
+                                    .arg(entry(o, d, std::size_t(sel)))
+                                    .arg(best)));
             ++clicked;
         }
         QVERIFY(clicked > 0);
