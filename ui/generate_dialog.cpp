@@ -52,6 +52,23 @@ GenerateLightsDialog::GenerateLightsDialog(const lc::LightGenSettings& g, QWidge
     form->addRow(tr("Colour max"), triple(colorMax_, g.colorMax, 0, 100));
     minIntensity_ = spin(1e-6, 1e9, g.minIntensity, 6);
     form->addRow(tr("Min intensity (I_min)"), minIntensity_);
+    // Spots get a uniform direction and an outer angle uniform in this range
+    // (lc::generateLights); the same bounds the scene model accepts.
+    spotFraction_ = spin(0, 1, g.spotFraction, 2);
+    spotFraction_->setSingleStep(0.1);
+    spotFraction_->setObjectName("genSpotFraction");
+    form->addRow(tr("Spot light fraction"), spotFraction_);
+    spotAngleMin_ = spin(0.01, 90, g.spotAngleMinDeg, 2);
+    spotAngleMin_->setObjectName("genSpotAngleMin");
+    spotAngleMax_ = spin(0.01, 90, g.spotAngleMaxDeg, 2);
+    spotAngleMax_->setObjectName("genSpotAngleMax");
+    form->addRow(tr("Spot outer angle min (deg)"), spotAngleMin_);
+    form->addRow(tr("Spot outer angle max (deg)"), spotAngleMax_);
+    // An inverted range would be refused by the generator; keep it ordered.
+    connect(spotAngleMin_, qOverload<double>(&QDoubleSpinBox::valueChanged), this,
+            [this](double v) { if (spotAngleMax_->value() < v) spotAngleMax_->setValue(v); });
+    connect(spotAngleMax_, qOverload<double>(&QDoubleSpinBox::valueChanged), this,
+            [this](double v) { if (spotAngleMin_->value() > v) spotAngleMin_->setValue(v); });
     auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
     connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
     connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
@@ -71,6 +88,9 @@ lc::LightGenSettings GenerateLightsDialog::settings() const {
     g.intensityMin = intensityMin_->value();
     g.intensityMax = intensityMax_->value();
     g.minIntensity = minIntensity_->value();
+    g.spotFraction = spotFraction_->value();
+    g.spotAngleMinDeg = spotAngleMin_->value();
+    g.spotAngleMaxDeg = spotAngleMax_->value();
     return g;
 }
 

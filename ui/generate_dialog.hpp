@@ -1,7 +1,8 @@
 #pragma once
 // The Generate lights dialog: the settings of lc::generateLights (count, seed,
 // placement volume, intensity and colour ranges, I_min), prefilled with the
-// scene's default placement volume.
+// scene's default placement volume, and the share of spot lights with their
+// outer-angle range.
 
 #include "culling/scene_io.hpp"
 
@@ -28,6 +29,9 @@ private:
     QDoubleSpinBox* colorMin_[3];
     QDoubleSpinBox* colorMax_[3];
     QDoubleSpinBox* minIntensity_;
+    QDoubleSpinBox* spotFraction_;
+    QDoubleSpinBox* spotAngleMin_;
+    QDoubleSpinBox* spotAngleMax_;
 };
 
 } // namespace lcui

@@ -6,6 +6,7 @@
 // toolbar, checked against the CLI's library path.
 #include "studio_test_support.hpp"
 #include "document.hpp"
+#include "generate_dialog.hpp"
 #include "inspector_view.hpp"
 #include "main_window.hpp"
 #include "property_panel.hpp"
@@ -26,6 +27,7 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -71,6 +73,42 @@ private slots:
     void cleanup() {
         doc()->undoStack()->setClean();
         w_.reset();
+    }
+
+    // The Generate lights dialog's spot fields reach the generator: every
+    // light a spot (fraction 1) with its outer angle in the chosen range, a
+    // mixed fraction gives both kinds, and the range cannot be inverted.
+    void generateDialogMakesSpots() {
+        GenerateLightsDialog dlg(lc::defaultLightGen(doc()->scene(), 200, 3), w_.get());
+        auto* fraction = dlg.findChild<QDoubleSpinBox*>("genSpotFraction");
+        auto* angleMin = dlg.findChild<QDoubleSpinBox*>("genSpotAngleMin");
+        auto* angleMax = dlg.findChild<QDoubleSpinBox*>("genSpotAngleMax");
+        QVERIFY(fraction && angleMin && angleMax);
+        QCOMPARE(fraction->value(), 0.0); // the default stays all point lights
+        angleMax->setValue(20);
+        angleMin->setValue(35); // above the maximum: the maximum follows
+        QCOMPARE(angleMax->value(), 35.0);
+        angleMin->setValue(10);
+        angleMax->setValue(20);
+        fraction->setValue(1.0);
+        const std::size_t before = doc()->scene().lights.size();
+        QVERIFY(w_->generateLights(dlg.settings()));
+        const auto& lights = doc()->scene().lights; // generation appends
+        QCOMPARE(lights.size(), before + 200);
+        for (std::size_t i = before; i < lights.size(); ++i) {
+            const lc::Light& l = lights[i];
+            QVERIFY(l.isSpot());
+            QVERIFY(l.outerAngleDeg >= 10.0 && l.outerAngleDeg <= 20.0);
+        }
+        doc()->undoStack()->undo(); // the whole generation is one step
+        QCOMPARE(doc()->scene().lights.size(), before);
+        fraction->setValue(0.5);
+        QVERIFY(w_->generateLights(dlg.settings()));
+        QCOMPARE(doc()->scene().lights.size(), before + 200);
+        const auto spots = std::count_if(doc()->scene().lights.begin() + std::ptrdiff_t(before),
+                                         doc()->scene().lights.end(),
+                                         [](const lc::Light& l) { return l.isSpot(); });
+        QVERIFY(spots > 50 && spots < 150);
     }
 
     void addSpotLightIsOneUndoableSpot() {
