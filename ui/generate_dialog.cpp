@@ -65,10 +65,12 @@ GenerateLightsDialog::GenerateLightsDialog(const lc::LightGenSettings& g, QWidge
     form->addRow(tr("Spot outer angle min (deg)"), spotAngleMin_);
     form->addRow(tr("Spot outer angle max (deg)"), spotAngleMax_);
     // An inverted range would be refused by the generator; keep it ordered.
-    connect(spotAngleMin_, qOverload<double>(&QDoubleSpinBox::valueChanged), this,
-            [this](double v) { if (spotAngleMax_->value() < v) spotAngleMax_->setValue(v); });
-    connect(spotAngleMax_, qOverload<double>(&QDoubleSpinBox::valueChanged), this,
-            [this](double v) { if (spotAngleMin_->value() > v) spotAngleMin_->setValue(v); });
+    connect(spotAngleMin_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, [this](double v) {
+        if (spotAngleMax_->value() < v) spotAngleMax_->setValue(v);
+    });
+    connect(spotAngleMax_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, [this](double v) {
+        if (spotAngleMin_->value() > v) spotAngleMin_->setValue(v);
+    });
     auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
     connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
     connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
