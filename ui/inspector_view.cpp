@@ -12,6 +12,7 @@
 #include <QTimer>
 #include <vtkActor.h>
 #include <vtkCamera.h>
+#include <vtkCameraPass.h>
 #include <vtkCellArray.h>
 #include <vtkCellPicker.h>
 #include <vtkDataArray.h>
@@ -19,6 +20,9 @@
 #include <vtkGlyph3D.h>
 #include <vtkHandleWidget.h>
 #include <vtkInteractorStyleTrackballCamera.h>
+#include <vtkLightsPass.h>
+#include <vtkOpaquePass.h>
+#include <vtkOverlayPass.h>
 #include <vtkPointData.h>
 #include <vtkPointHandleRepresentation3D.h>
 #include <vtkPoints.h>
@@ -26,8 +30,12 @@
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
 #include <vtkRenderWindowInteractor.h>
+#include <vtkRenderPassCollection.h>
 #include <vtkRenderer.h>
+#include <vtkSequencePass.h>
 #include <vtkSphereSource.h>
+#include <vtkTranslucentPass.h>
+#include <vtkVolumetricPass.h>
 #include <QVTKInteractor.h>
 
 #include <algorithm>
@@ -136,6 +144,21 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     renderer_->SetUseDepthPeeling(1);
     renderer_->SetMaximumNumberOfPeels(6);
     renderer_->SetOcclusionRatio(0.05);
+    // Many lights (rings): VTK's own passes minus the order-independent
+    // translucency it substitutes for peeling (measured 4-6 ms of a 31-42 ms
+    // frame of 1,024 rings at 468x496 on llvmpipe).
+    vtkNew<vtkLightsPass> lightsPass;
+    vtkNew<vtkOpaquePass> opaquePass;
+    vtkNew<vtkTranslucentPass> translucentPass;
+    vtkNew<vtkVolumetricPass> volumetricPass;
+    vtkNew<vtkOverlayPass> overlayPass;
+    vtkNew<vtkRenderPassCollection> passes;
+    for (vtkRenderPass* pass : std::initializer_list<vtkRenderPass*>{lightsPass, opaquePass, translucentPass,
+                                                                     volumetricPass, overlayPass})
+        passes->AddItem(pass);
+    vtkNew<vtkSequencePass> sequence;
+    sequence->SetPasses(passes);
+    blendedPasses_->SetDelegatePass(sequence);
 
     vtkNew<vtkInteractorStyleTrackballCamera> style;
     interactor()->SetInteractorStyle(style);
@@ -318,6 +341,7 @@ void InspectorView::rebuildLights() {
     const std::size_t n = doc_->scene().lights.size();
     renderer_->SetUseDepthPeeling(n <= kMaxPeeledLights ? 1 : 0);
     silhouettes_ = n > kMaxFilledLights;
+    renderer_->SetPass(silhouettes_ ? blendedPasses_.Get() : nullptr);
     lightActor_->SetVisibility(!silhouettes_);
     ringActor_->SetVisibility(silhouettes_);
     lightData_ = lightsToPolyData(doc_->scene().lights);

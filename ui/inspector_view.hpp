@@ -24,6 +24,7 @@
 #include <vector>
 
 class vtkActor;
+class vtkCameraPass;
 class vtkCellPicker;
 class vtkGlyph3D;
 class vtkHandleWidget;
@@ -114,6 +115,11 @@ private:
     vtkNew<LightSilhouettes> rings_;
     vtkNew<vtkActor> ringActor_;
     bool silhouettes_ = false;
+    // The renderer's passes while the rings are drawn: VTK's default, with
+    // depth peeling off, composites translucent geometry through an
+    // order-independent pass (float buffers and a full-view resolve per
+    // frame); this sequence blends it in actor order instead.
+    vtkNew<vtkCameraPass> blendedPasses_;
     vtkSmartPointer<vtkPolyData> selData_;
     vtkNew<vtkGlyph3D> selGlyph_;
     vtkNew<vtkActor> selActor_;
