@@ -17,6 +17,7 @@
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkImageActor.h>
 #include <vtkImageData.h>
+#include <vtkImageMapper.h>
 #include <vtkImageMapper3D.h>
 #include <vtkInteractorStyleUser.h>
 #include <vtkLookupTable.h>
@@ -31,6 +32,7 @@
 #include <vtkScalarBarActor.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkUnsignedCharArray.h>
 #include <QVTKInteractor.h>
 
 #include <algorithm>
@@ -94,14 +96,30 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
     scene_->SetBackground(0.02, 0.02, 0.03);
     // Layer 0: the window background, then the image renderer clearing the
     // letterboxed viewport (and drawing a shaded picture in image modes).
-    // Layer 1: scene_, which draws on top without clearing the colour.
-    rw->SetNumberOfLayers(2);
+    // Layer 1: meshes_, the shaded meshes (or their picture), on top without
+    // clearing the colour. Layer 2: scene_, the 2D overlay, likewise.
+    rw->SetNumberOfLayers(3);
     image_->SetBackground(0.02, 0.02, 0.03);
     image_->InteractiveOff();
-    scene_->SetLayer(1);
+    meshes_->SetLayer(1);
+    meshes_->InteractiveOff();
+    meshes_->SetActiveCamera(scene_->GetActiveCamera());
+    scene_->SetLayer(2);
     rw->AddRenderer(background_);
     rw->AddRenderer(image_);
+    rw->AddRenderer(meshes_);
     rw->AddRenderer(scene_);
+    // The picture of the meshes: bytes 1:1 onto the viewport's pixels.
+    vtkNew<vtkImageMapper> pictureMapper;
+    pictureMapper->SetInputData(meshPicture_);
+    pictureMapper->SetColorWindow(255);
+    pictureMapper->SetColorLevel(127.5);
+    meshPictureActor_->SetMapper(pictureMapper);
+    meshPictureActor_->SetPosition(0, 0);
+    meshPictureActor_->SetVisibility(false);
+    meshes_->AddActor2D(meshPictureActor_);
+    rw->AddObserver(vtkCommand::StartEvent, this, &CameraView::onRenderStart);
+    meshes_->AddObserver(vtkCommand::EndEvent, this, &CameraView::onMeshesRendered);
     imageActor_->InterpolateOff(); // the picture's pixels, not a blur of them
     imageActor_->SetVisibility(false);
     image_->AddActor(imageActor_);
@@ -263,6 +281,7 @@ void CameraView::updateViewport() {
     const double x0 = (availW - vw) / 2, y0 = (h - vh) / 2;
     scene_->SetViewport(x0 / w, y0 / h, (x0 + vw) / w, (y0 + vh) / h);
     image_->SetViewport(scene_->GetViewport());
+    meshes_->SetViewport(scene_->GetViewport());
     for (vtkScalarBarActor* bar : {legend_.Get(), diffLegend_.Get()}) {
         bar->SetPosition((availW + 6) / w, 0.08);
         bar->SetWidth((kLegendWidthPx - 10) / w);
@@ -270,9 +289,44 @@ void CameraView::updateViewport() {
     }
 }
 
+void CameraView::onRenderStart() {
+    // Everything the meshes' pixels depend on: the camera (shared with
+    // scene_), the mesh actors and where the viewport lies in the window.
+    MeshPictureKey key;
+    key.cameraTime = meshes_->GetActiveCamera()->GetMTime();
+    key.meshes = meshesRevision_;
+    meshes_->GetTiledSizeAndOrigin(&key.w, &key.h, &key.x, &key.y);
+    const bool heat = imageMode_ == ImageMode::Heat && !meshActors_.empty() && key.w > 0 && key.h > 0;
+    const bool cached = heat && meshPictureValid_ && key == meshPictureKey_;
+    for (auto& a : meshActors_) a->SetVisibility(heat && !cached);
+    meshPictureActor_->SetVisibility(cached);
+    meshPictureCapture_ = heat && !cached;
+    meshPictureWanted_ = key;
+}
+
+void CameraView::onMeshesRendered() {
+    if (!meshPictureCapture_) return;
+    meshPictureCapture_ = false;
+    const MeshPictureKey& k = meshPictureWanted_;
+    vtkNew<vtkUnsignedCharArray> rgb;
+    if (!renderWindow()->GetPixelData(k.x, k.y, k.x + k.w - 1, k.y + k.h - 1, 0, rgb) ||
+        rgb->GetNumberOfTuples() != vtkIdType(k.w) * k.h) {
+        meshPictureValid_ = false;
+        return;
+    }
+    meshPicture_->SetDimensions(k.w, k.h, 1);
+    meshPicture_->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+    std::memcpy(meshPicture_->GetScalarPointer(), rgb->GetPointer(0), std::size_t(k.w) * k.h * 3);
+    meshPicture_->Modified();
+    meshPictureKey_ = k;
+    meshPictureValid_ = true;
+    ++meshPictureCaptures_;
+}
+
 void CameraView::rebuildMeshes() {
-    for (auto& a : meshActors_) scene_->RemoveActor(a);
+    for (auto& a : meshActors_) meshes_->RemoveActor(a);
     meshActors_.clear();
+    ++meshesRevision_;
     for (const auto& m : doc_->scene().meshes) {
         auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
         mapper->SetInputData(meshToPolyData(m));
@@ -282,7 +336,7 @@ void CameraView::rebuildMeshes() {
         actor->GetProperty()->SetAmbient(0.15);
         actor->GetProperty()->SetDiffuse(0.85);
         actor->SetVisibility(imageMode_ == ImageMode::Heat);
-        scene_->AddActor(actor);
+        meshes_->AddActor(actor);
         meshActors_.push_back(actor);
     }
 }

@@ -71,6 +71,8 @@ public:
 
     vtkRenderer* sceneRenderer() const;
     vtkScalarBarActor* legend() const;
+    // How often the meshes were drawn and read back (diagnostics, probe).
+    int meshPictureCaptures() const { return meshPictureCaptures_; }
 
     ImageMode imageMode() const { return imageMode_; }
     void setImageMode(ImageMode mode);
@@ -101,6 +103,12 @@ protected:
 
 private:
     bool renderPending_ = false;
+    // Heat mode during a Live drag: the meshes do not change, the overlay
+    // does. The meshes' pixels are read back once per camera, meshes and
+    // viewport (the frame that drew them) and drawn as a picture after that;
+    // llvmpipe paid ~12 ms a frame for the meshes at 469x496.
+    void onRenderStart();
+    void onMeshesRendered();
     void rebuildMeshes();
     void updateCamera();
     void updateOverlay();
@@ -114,7 +122,20 @@ private:
     Document* doc_;
     vtkNew<vtkRenderer> background_; // full window: legend and captions
     vtkNew<vtkRenderer> scene_;      // letterboxed: culling camera image + overlay
+    vtkNew<vtkRenderer> meshes_;     // under scene_, same viewport and camera: the shaded meshes
     std::vector<vtkSmartPointer<vtkActor>> meshActors_;
+    vtkNew<vtkImageData> meshPicture_; // meshes_'s last drawn pixels (with image_'s background)
+    vtkNew<vtkActor2D> meshPictureActor_;
+    struct MeshPictureKey {
+        unsigned long cameraTime = 0;
+        quint64 meshes = 0;
+        int x = 0, y = 0, w = 0, h = 0;
+        bool operator==(const MeshPictureKey&) const = default;
+    };
+    MeshPictureKey meshPictureKey_, meshPictureWanted_;
+    bool meshPictureValid_ = false, meshPictureCapture_ = false;
+    quint64 meshesRevision_ = 0;
+    int meshPictureCaptures_ = 0;
     vtkNew<vtkPolyData> heatData_, gridData_, selData_, reverseData_;
     vtkNew<vtkActor2D> heatActor_, gridActor_, selActor_, reverseActor_;
     std::vector<int> reverseTiles_;
