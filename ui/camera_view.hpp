@@ -10,6 +10,13 @@
 // pass's pictures (lc::shadedPictures, the pixels `run --shaded-images`
 // writes) drawn 1:1 in the same letterboxed viewport under the tile grid,
 // the selected tile and the reverse look-up outlines.
+//
+// Renderers, bottom up: background_ (window, legend, caption), image_ (the
+// letterboxed viewport's clear, the shaded pictures), meshes_ (the culling
+// camera's shaded meshes) and scene_ (the 2D overlay). In Heat mode meshes_
+// draws the meshes in the first frame after the camera, the meshes or the
+// viewport changed, reads its pixels back, and draws that picture in the
+// frames after it: a Live drag changes the overlay only.
 
 #include <QVTKOpenGLNativeWidget.h>
 
@@ -107,8 +114,15 @@ private:
     // does. The meshes' pixels are read back once per camera, meshes and
     // viewport (the frame that drew them) and drawn as a picture after that;
     // llvmpipe paid ~12 ms a frame for the meshes at 469x496.
+    struct MeshPictureKey {
+        unsigned long cameraTime = 0;
+        quint64 meshes = 0;
+        int x = 0, y = 0, w = 0, h = 0;
+        bool operator==(const MeshPictureKey&) const = default;
+    };
+    MeshPictureKey meshPictureKey() const;
     void onRenderStart();
-    void onMeshesRendered();
+    void captureMeshPicture();
     void rebuildMeshes();
     void updateCamera();
     void updateOverlay();
@@ -126,13 +140,7 @@ private:
     std::vector<vtkSmartPointer<vtkActor>> meshActors_;
     vtkNew<vtkImageData> meshPicture_; // meshes_'s last drawn pixels (with image_'s background)
     vtkNew<vtkActor2D> meshPictureActor_;
-    struct MeshPictureKey {
-        unsigned long cameraTime = 0;
-        quint64 meshes = 0;
-        int x = 0, y = 0, w = 0, h = 0;
-        bool operator==(const MeshPictureKey&) const = default;
-    };
-    MeshPictureKey meshPictureKey_, meshPictureWanted_;
+    MeshPictureKey meshPictureKey_;
     bool meshPictureValid_ = false, meshPictureCapture_ = false;
     quint64 meshesRevision_ = 0;
     int meshPictureCaptures_ = 0;

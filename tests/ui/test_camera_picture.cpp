@@ -1,0 +1,122 @@
+// The camera view draws the meshes once per camera, meshes and viewport and
+// then shows their read-back picture (what a Live drag redraws is the heat
+// map only). What a user would see go wrong: a stale picture after the camera
+// moved or the view resized, or frames of one camera that differ. Real widgets under Xvfb, real llvmpipe frames.
+// (The picture's anti-aliased edges differ slightly from meshes drawn under
+// the overlay; the render baselines, within their tolerance, cover that.)
+#include "studio_test_support.hpp"
+
+#include "camera_view.hpp"
+#include "document.hpp"
+
+#include "culling/scene_io.hpp"
+
+#include <QImage>
+
+#include <vtkRenderer.h>
+
+#include <memory>
+
+using namespace lcui;
+
+namespace {
+// The letterboxed viewport of the scene (device pixels, Qt rows going down).
+QImage viewportOf(CameraView& view, const QImage& shot) {
+    const double* vp = view.sceneRenderer()->GetViewport();
+    const int w = shot.width(), h = shot.height();
+    const QRect r(int(vp[0] * w + 0.5), int((1 - vp[3]) * h + 0.5), int((vp[2] - vp[0]) * w + 0.5),
+                  int((vp[3] - vp[1]) * h + 0.5));
+    return shot.copy(r).convertToFormat(QImage::Format_RGB32);
+}
+
+int differingPixels(const QImage& a, const QImage& b) {
+    if (a.size() != b.size()) return a.width() * a.height() + 1;
+    int n = 0;
+    for (int y = 0; y < a.height(); ++y)
+        for (int x = 0; x < a.width(); ++x) n += a.pixel(x, y) != b.pixel(x, y);
+    return n;
+}
+} // namespace
+
+class CameraPictureTest : public QObject {
+    Q_OBJECT
+
+    std::unique_ptr<Document> doc_;
+    std::unique_ptr<CameraView> view_;
+
+    QImage frame() {
+        view_->renderNow();
+        return viewportOf(*view_, view_->grabFramebuffer());
+    }
+
+private slots:
+    void init() {
+        doc_ = std::make_unique<Document>();
+        lc::Scene scene = lc::makeBuiltinScene("atrium");
+        scene.lights.resize(16);
+        doc_->resetScene(std::move(scene), {});
+        view_ = std::make_unique<CameraView>(doc_.get());
+        view_->resize(640, 400);
+        view_->show();
+        QVERIFY(QTest::qWaitForWindowExposed(view_.get()));
+    }
+
+    void cleanup() {
+        view_.reset();
+        doc_.reset();
+    }
+
+    // Light edits and repeated frames reuse the picture: the same pixels.
+    void pictureIsReusedWhileOnlyLightsMove() {
+        const QImage first = frame();
+        const int captures = view_->meshPictureCaptures();
+        QVERIFY(captures >= 1);
+        const QImage again = frame();
+        QCOMPARE(view_->meshPictureCaptures(), captures);
+        QCOMPARE(differingPixels(first, again), 0);
+        const int drag = doc_->newDragId();
+        doc_->moveLight(0, doc_->scene().lights[0].position + glm::dvec3(0.5, 0, 0), drag);
+        frame();
+        QCOMPARE(view_->meshPictureCaptures(), captures);
+    }
+
+    // A camera edit draws the meshes again: the view shows the new camera's
+    // image, and going back shows exactly the first image again.
+    void cameraEditRedrawsTheMeshes() {
+        const QImage before = frame();
+        const int captures = view_->meshPictureCaptures();
+        const lc::Camera original = doc_->scene().camera;
+        lc::Camera moved = original;
+        moved.position += glm::dvec3(1.5, 0.5, 0);
+        moved.target += glm::dvec3(1.5, 0.5, 0);
+        doc_->setCamera(moved);
+        const QImage afterMove = frame();
+        QCOMPARE(view_->meshPictureCaptures(), captures + 1);
+        const int changed = differingPixels(before, afterMove);
+        QVERIFY2(changed > before.width() * before.height() / 20,
+                 qPrintable(QString("only %1 pixels changed after the camera moved").arg(changed)));
+        doc_->setCamera(original);
+        const QImage back = frame();
+        QCOMPARE(view_->meshPictureCaptures(), captures + 2);
+        QCOMPARE(differingPixels(before, back), 0);
+        QCOMPARE(differingPixels(back, frame()), 0); // the reused picture of that frame
+        QCOMPARE(view_->meshPictureCaptures(), captures + 2);
+    }
+
+    // A resize moves and scales the viewport: the picture is taken again at
+    // the new size, never stretched or left at the old place.
+    void resizeRedrawsTheMeshes() {
+        frame();
+        const int captures = view_->meshPictureCaptures();
+        view_->resize(800, 420);
+        QTest::qWait(20);
+        const QImage resized = frame();
+        QVERIFY(view_->meshPictureCaptures() > captures);
+        const int after = view_->meshPictureCaptures();
+        QCOMPARE(differingPixels(resized, frame()), 0);
+        QCOMPARE(view_->meshPictureCaptures(), after);
+    }
+};
+
+LC_STUDIO_TEST_MAIN(CameraPictureTest)
+#include "test_camera_picture.moc"
