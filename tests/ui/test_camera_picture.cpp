@@ -1,21 +1,17 @@
 // The camera view draws the meshes once per camera, meshes and viewport and
 // then shows their read-back picture (what a Live drag redraws is the heat
 // map only). What a user would see go wrong: a stale picture after the camera
-// moved or the view resized, or frames of one camera that differ. Real widgets under Xvfb, real llvmpipe frames.
-// (The picture's anti-aliased edges differ slightly from meshes drawn under
-// the overlay; the render baselines, within their tolerance, cover that.)
+// moved or the view resized, or frames of one camera that differ. Real widgets under Xvfb, real llvmpipe
+// frames. (The picture's anti-aliased edges differ slightly from meshes drawn under the overlay; the render
+// baselines, within their tolerance, cover that.)
+#include "camera_view.hpp"
+#include "culling/scene_io.hpp"
+#include "document.hpp"
 #include "studio_test_support.hpp"
 
-#include "camera_view.hpp"
-#include "document.hpp"
-
-#include "culling/scene_io.hpp"
-
 #include <QImage>
-
-#include <vtkRenderer.h>
-
 #include <memory>
+#include <vtkRenderer.h>
 
 using namespace lcui;
 
@@ -33,7 +29,8 @@ int differingPixels(const QImage& a, const QImage& b) {
     if (a.size() != b.size()) return a.width() * a.height() + 1;
     int n = 0;
     for (int y = 0; y < a.height(); ++y)
-        for (int x = 0; x < a.width(); ++x) n += a.pixel(x, y) != b.pixel(x, y);
+        for (int x = 0; x < a.width(); ++x)
+            n += a.pixel(x, y) != b.pixel(x, y);
     return n;
 }
 } // namespace
@@ -49,7 +46,7 @@ class CameraPictureTest : public QObject {
         return viewportOf(*view_, view_->grabFramebuffer());
     }
 
-private slots:
+  private slots:
     void init() {
         doc_ = std::make_unique<Document>();
         lc::Scene scene = lc::makeBuiltinScene("atrium");
