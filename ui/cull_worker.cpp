@@ -6,8 +6,15 @@
 
 #include <algorithm>
 #include <chrono>
+#include <exception>
 #include <numeric>
+#include <thread>
 #include <utility>
+
+#ifdef __linux__
+#include <sys/resource.h>
+#include <unistd.h>
+#endif
 
 #include <QMetaObject>
 
@@ -27,6 +34,30 @@ bool sameMeshes(const std::vector<lc::Mesh>& a, const std::vector<lc::Mesh>& b) 
 // once when the worker is otherwise idle at the end of a drag): during a drag
 // it would take the CPU from the views' redraw, and the next edit cancels it.
 constexpr auto kTruthAfterPause = std::chrono::milliseconds(150);
+
+// Runs `fn` on a thread of its own at nice 10 (Linux: per thread; the ground
+// truth's row-band threads inherit it), then rethrows what `fn` threw. A
+// deferred truth that the next edit of a drag cancels then takes little CPU
+// from the views' redraw (about a fifth of the culling thread's samples went
+// to such truths at nice 0); once the drag stops the machine is idle and it
+// runs at full speed. Not SCHED_IDLE: on a busy machine (a CI run) that could
+// starve the truth.
+template <typename Fn>
+void runAtLowPriority(Fn&& fn) {
+    std::exception_ptr error;
+    std::thread t([&] {
+#ifdef __linux__
+        setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10); // best effort
+#endif
+        try {
+            fn();
+        } catch (...) {
+            error = std::current_exception();
+        }
+    });
+    t.join();
+    if (error) std::rethrow_exception(error);
+}
 } // namespace
 
 // Same camera and meshes: the depth image of one is the depth of the other.
@@ -168,8 +199,10 @@ std::shared_ptr<const lc::RunOutput> CullWorker::addDeferredTruth(const CullRequ
         lc::GroundTruthOptions truthOptions;
         truthOptions.imageError = false;
         const auto t0 = std::chrono::steady_clock::now();
-        full->truth = lc::computeGroundTruth(full->depth, lc::Projection(req.scene->camera), full->lights,
-                                             full->result, truthOptions, truthCancel.get());
+        runAtLowPriority([&] {
+            full->truth = lc::computeGroundTruth(full->depth, lc::Projection(req.scene->camera), full->lights,
+                                                 full->result, truthOptions, truthCancel.get());
+        });
         full->result.timings.groundTruthMs =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         full->truthComputed = true;
