@@ -13,10 +13,11 @@
 //
 // Renderers, bottom up: background_ (window, legend, caption), image_ (the
 // letterboxed viewport's clear, the shaded pictures), meshes_ (the culling
-// camera's shaded meshes) and scene_ (the 2D overlay). In Heat mode meshes_
-// draws the meshes in the first frame after the camera, the meshes or the
-// viewport changed, reads its pixels back, and draws that picture in the
-// frames after it: a Live drag changes the overlay only.
+// camera's shaded meshes) and scene_ (the 2D overlay). In Heat mode,
+// renderNow() after the camera, the meshes or the viewport changed first
+// renders a frame of the meshes alone and reads it back; meshes_ then draws
+// that picture instead of the meshes (a Live drag changes the overlay only).
+// Renders Qt starts itself draw the meshes while the picture is stale.
 
 #include <QVTKOpenGLNativeWidget.h>
 
@@ -112,7 +113,7 @@ private:
     bool renderPending_ = false;
     // Heat mode during a Live drag: the meshes do not change, the overlay
     // does. The meshes' pixels are read back once per camera, meshes and
-    // viewport (the frame that drew them) and drawn as a picture after that;
+    // viewport (a meshes-only frame) and drawn as a picture after that;
     // llvmpipe paid ~12 ms a frame for the meshes at 469x496.
     struct MeshPictureKey {
         unsigned long cameraTime = 0;
@@ -138,7 +139,7 @@ private:
     vtkNew<vtkRenderer> scene_;      // letterboxed: culling camera image + overlay
     vtkNew<vtkRenderer> meshes_;     // under scene_, same viewport and camera: the shaded meshes
     std::vector<vtkSmartPointer<vtkActor>> meshActors_;
-    vtkNew<vtkImageData> meshPicture_; // meshes_'s last drawn pixels (with image_'s background)
+    vtkNew<vtkImageData> meshPicture_; // the meshes-only frame's viewport pixels (with image_'s background)
     vtkNew<vtkActor2D> meshPictureActor_;
     MeshPictureKey meshPictureKey_;
     bool meshPictureValid_ = false, meshPictureCapture_ = false;
