@@ -1,7 +1,8 @@
 #pragma once
 // Shared by the ui and render tests: their own main (the GL surface format
 // must be set before QApplication, so QTEST_MAIN cannot be used), isolated
-// QSettings, and small waiting helpers.
+// QSettings, the test window every ui test starts from, and small waiting
+// helpers.
 
 #include <QApplication>
 #include <QDir>
@@ -11,8 +12,11 @@
 #include <QTest>
 #include <QVTKOpenGLNativeWidget.h>
 
+#include "main_window.hpp"
+
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 
 namespace lctest {
 
@@ -39,6 +43,22 @@ inline int runQtTest(QObject* (*make)(), int argc, char** argv) {
     const int rc = QTest::qExec(test, argc, argv);
     delete test;
     return rc;
+}
+
+// A studio window as the ui tests start it: the CPU backend, Live off, no run
+// on open (tests shrink the resolution first), any error dialog a test
+// failure, shown at `size`. The caller waits for it to be exposed.
+inline std::unique_ptr<lcui::MainWindow> makeTestWindow(QSize size = QSize(1400, 850)) {
+    auto w = std::make_unique<lcui::MainWindow>();
+    w->prompts.showError = [](QWidget*, const QString& t, const QString& m) {
+        QFAIL(qPrintable("unexpected error dialog: " + t + ": " + m));
+    };
+    w->setBackend("cpu");
+    w->setLive(false);
+    w->runOnOpen = false;
+    w->resize(size);
+    w->show();
+    return w;
 }
 
 } // namespace lctest

@@ -49,15 +49,7 @@ class ReportDockTest : public QObject {
 
 private slots:
     void init() {
-        w_ = std::make_unique<MainWindow>();
-        w_->prompts.showError = [](QWidget*, const QString& t, const QString& m) {
-            QFAIL(qPrintable("unexpected error dialog: " + t + ": " + m));
-        };
-        w_->setBackend("cpu");
-        w_->setLive(false);
-        w_->runOnOpen = false;
-        w_->resize(1400, 900);
-        w_->show();
+        w_ = lctest::makeTestWindow(QSize(1400, 900));
         QVERIFY(QTest::qWaitForWindowExposed(w_.get()));
         QVERIFY(w_->openBuiltin("atrium"));
         QVERIFY(w_->setParamFromUi("width", "96"));

@@ -94,15 +94,7 @@ class SpotHandlesTest : public QObject {
 
 private slots:
     void init() {
-        w_ = std::make_unique<MainWindow>();
-        w_->prompts.showError = [](QWidget*, const QString& t, const QString& m) {
-            QFAIL(qPrintable("unexpected error dialog: " + t + ": " + m));
-        };
-        w_->setBackend("cpu");
-        w_->setLive(false);
-        w_->runOnOpen = false;
-        w_->resize(1400, 850);
-        w_->show();
+        w_ = lctest::makeTestWindow();
         QVERIFY(QTest::qWaitForWindowExposed(w_.get()));
         QVERIFY(w_->openBuiltin("wall"));
         QVERIFY(w_->setParamFromUi("width", "320"));
