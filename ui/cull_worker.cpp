@@ -2,12 +2,9 @@
 
 #include "culling/errors.hpp"
 #include "culling/projection.hpp"
-#include "culling/shade.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <exception>
-#include <numeric>
 #include <thread>
 #include <utility>
 
@@ -108,80 +105,11 @@ quint64 CullWorker::droppedRequests() const {
 }
 
 namespace {
-// Wall time one slice of shadeInSlices aims at: how long a newer request may
-// wait for shading it cancels.
+// Wall time of one shading slice (lc::shadeAndCompare's sliceMs): how long a
+// newer request may wait for shading it cancels. Whole images cost seconds
+// with many lights (the all-lights image is pixels x lights; docs/STUDIO.md
+// has the measured times).
 constexpr double kShadeSliceMs = 100.0;
-
-// Rows [y0, y1) of a G-buffer.
-lc::ShadeInputs rowsOf(const lc::ShadeInputs& in, std::uint32_t y0, std::uint32_t y1) {
-    lc::ShadeInputs s;
-    s.width = in.width;
-    s.height = y1 - y0;
-    const std::size_t a = std::size_t(in.width) * y0, b = std::size_t(in.width) * y1;
-    s.position.assign(in.position.begin() + std::ptrdiff_t(3 * a), in.position.begin() + std::ptrdiff_t(3 * b));
-    s.normal.assign(in.normal.begin() + std::ptrdiff_t(3 * a), in.normal.begin() + std::ptrdiff_t(3 * b));
-    s.list.assign(in.list.begin() + std::ptrdiff_t(a), in.list.begin() + std::ptrdiff_t(b));
-    return s;
-}
-
-// One image of the shading pass in row slices on `backend`, checking `cancel`
-// between slices. Returns RGB (3 floats per pixel) and adds the backend's
-// shading time to `shadeMs`. Slices start on multiples of `align` rows, where
-// the CPU reference's own row bands start, so each pixel gets the arithmetic
-// of one whole-image call (the ui test compares with the CLI's PNGs and RMSE).
-std::vector<float> shadeImageInSlices(lc::CullBackend& backend, const lc::ShadeInputs& in,
-                                      const lc::ViewLights& lights, const lc::CullResult* culled,
-                                      std::uint32_t align, const lc::CancelToken& cancel, double& shadeMs) {
-    std::vector<float> rgb(in.position.size(), 0.0f);
-    std::uint32_t rows = align;
-    for (std::uint32_t y0 = 0; y0 < in.height;) {
-        const std::uint32_t y1 = std::min(in.height, y0 + rows);
-        const auto t0 = std::chrono::steady_clock::now();
-        const std::vector<float> part = backend.shade(rowsOf(in, y0, y1), lights, culled);
-        const double wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-        shadeMs += backend.lastShadeMs() >= 0 ? backend.lastShadeMs() : wallMs;
-        std::copy(part.begin(), part.end(), rgb.begin() + std::ptrdiff_t(std::size_t(in.width) * y0 * 3));
-        if (cancel.cancelled) throw lc::Cancelled();
-        // The next slice: as many aligned rows as fit kShadeSliceMs at this rate.
-        const double perRowMs = std::max(wallMs, 1e-3) / double(y1 - y0);
-        rows = std::max(align, std::uint32_t(kShadeSliceMs / perRowMs) / align * align);
-        y0 = y1;
-    }
-    return rgb;
-}
-
-// lc::shadeAndCompare, sliced so that a newer request stops it within about
-// kShadeSliceMs: whole images cost seconds with many lights (the all-lights
-// image is pixels x lights; docs/STUDIO.md has the measured times).
-void shadeInSlices(lc::CullBackend& backend, lc::RunOutput& out, const lc::Projection& proj,
-                   const lc::CancelToken& cancel) {
-    const lc::CullResult& r = out.result;
-    const lc::ShadeInputs culledIn = lc::makeShadeInputs(out.depth, proj, &r);
-    // shadeCpu's row bands: a tile row (at least 4) for lists, 16 rows for all lights.
-    const std::uint32_t align = std::lcm(std::max(r.grid.tileSize, 4u), 16u);
-    double culledMs = 0, allMs = 0;
-    std::vector<float> culled = shadeImageInSlices(backend, culledIn, out.lights, &r, align, cancel, culledMs);
-    // `all` with one list of every light in order shades exactly the reference.
-    bool identity = r.listCount.size() == 1 && r.listCount[0] == out.lights.size();
-    for (std::size_t i = 0; identity && i < out.lights.size(); ++i)
-        identity = r.lightIndices[r.listOffset[0] + i] == i;
-    std::vector<float> all;
-    if (identity) {
-        all = culled;
-    } else {
-        lc::ShadeInputs allIn = culledIn;
-        for (std::uint32_t& l : allIn.list)
-            if (l != lc::ShadeInputs::kNoList) l = 0;
-        all = shadeImageInSlices(backend, allIn, out.lights, nullptr, align, cancel, allMs);
-    }
-    const lc::ImageError e = lc::compareShadedImages(out.depth, culled, all);
-    out.result.timings.shadeMs = culledMs; // as runPipeline: the culled image
-    out.truth.metrics.imageRmse = e.rmse;
-    out.truth.metrics.imageMaxError = e.maxAbs;
-    out.truth.metrics.imageErrorComputed = true;
-    out.shadedCulled = std::move(culled);
-    out.shadedAll = std::move(all);
-}
 } // namespace
 
 std::shared_ptr<const lc::RunOutput> CullWorker::addDeferredTruth(const CullRequest& req,
@@ -234,7 +162,8 @@ bool CullWorker::shadeLast() {
     try {
         if (cancel->cancelled) throw lc::Cancelled();
         auto full = std::make_shared<lc::RunOutput>(*last_);
-        shadeInSlices(*backend_, *full, lc::Projection(lastScene_->camera), *cancel);
+        lc::shadeAndCompare(*backend_, *full, lc::Projection(lastScene_->camera), true, cancel.get(),
+                            kShadeSliceMs);
         last_ = full;
         shaded = true;
         emit finished(generation, last_);

@@ -7,7 +7,9 @@
 #include "culling/errors.hpp"
 #include "culling/shade.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <numeric>
 
 namespace lc {
 
@@ -28,14 +30,65 @@ void throwIfCancelled(const CancelToken* cancel) {
 
 } // namespace
 
+namespace {
+
+// Rows [y0, y1) of a G-buffer.
+ShadeInputs rowsOf(const ShadeInputs& in, std::uint32_t y0, std::uint32_t y1) {
+    ShadeInputs s;
+    s.width = in.width;
+    s.height = y1 - y0;
+    const std::size_t a = std::size_t(in.width) * y0, b = std::size_t(in.width) * y1;
+    s.position.assign(in.position.begin() + std::ptrdiff_t(3 * a), in.position.begin() + std::ptrdiff_t(3 * b));
+    s.normal.assign(in.normal.begin() + std::ptrdiff_t(3 * a), in.normal.begin() + std::ptrdiff_t(3 * b));
+    s.list.assign(in.list.begin() + std::ptrdiff_t(a), in.list.begin() + std::ptrdiff_t(b));
+    return s;
+}
+
+// One image of the shading pass: whole (sliceMs <= 0), or in row slices of
+// about sliceMs wall time, checking `cancel` between slices. Slices start on
+// multiples of `align` rows, where shadeCpu's own row bands start, so each
+// pixel gets the arithmetic of one whole-image call. Returns RGB and the
+// backend's shading time (the sum of the slices').
+std::vector<float> shadeImage(CullBackend& backend, const ShadeInputs& in, const ViewLights& lights,
+                              const CullResult* culled, std::uint32_t align, double sliceMs,
+                              const CancelToken* cancel, double& shadeMs) {
+    if (sliceMs <= 0) {
+        std::vector<float> rgb = backend.shade(in, lights, culled);
+        shadeMs = backend.lastShadeMs();
+        return rgb;
+    }
+    std::vector<float> rgb(in.position.size(), 0.0f);
+    shadeMs = 0;
+    std::uint32_t rows = align;
+    for (std::uint32_t y0 = 0; y0 < in.height;) {
+        const std::uint32_t y1 = std::min(in.height, y0 + rows);
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::vector<float> part = backend.shade(rowsOf(in, y0, y1), lights, culled);
+        const double wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        shadeMs += backend.lastShadeMs() >= 0 ? backend.lastShadeMs() : wallMs;
+        std::copy(part.begin(), part.end(), rgb.begin() + std::ptrdiff_t(std::size_t(in.width) * y0 * 3));
+        throwIfCancelled(cancel);
+        // The next slice: as many aligned rows as fit sliceMs at this rate.
+        const double perRowMs = std::max(wallMs, 1e-3) / double(y1 - y0);
+        rows = std::max(align, std::uint32_t(sliceMs / perRowMs) / align * align);
+        y0 = y1;
+    }
+    return rgb;
+}
+
+} // namespace
+
 void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
-                     const CancelToken* cancel) {
+                     const CancelToken* cancel, double sliceMs) {
     const ShadeInputs culledIn = makeShadeInputs(out.depth, proj, &out.result);
-    std::vector<float> culled = backend.shade(culledIn, out.lights, &out.result);
-    out.result.timings.shadeMs = backend.lastShadeMs();
+    const CullResult& r = out.result;
+    // shadeCpu's row bands: a tile row (at least 4) for lists, 16 rows for all lights.
+    const std::uint32_t align = std::lcm(std::max(r.grid.tileSize, 4u), 16u);
+    double culledMs = 0, allMs = 0;
+    std::vector<float> culled = shadeImage(backend, culledIn, out.lights, &r, align, sliceMs, cancel, culledMs);
+    out.result.timings.shadeMs = culledMs;
     throwIfCancelled(cancel);
     // `all` with one list of every light in order shades exactly the reference.
-    const CullResult& r = out.result;
     bool identity = r.listCount.size() == 1 && r.listCount[0] == out.lights.size();
     for (std::size_t i = 0; identity && i < out.lights.size(); ++i)
         identity = r.lightIndices[r.listOffset[0] + i] == i;
@@ -46,7 +99,7 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
         ShadeInputs allIn = culledIn;
         for (std::uint32_t& l : allIn.list)
             if (l != ShadeInputs::kNoList) l = 0;
-        all = backend.shade(allIn, out.lights, nullptr);
+        all = shadeImage(backend, allIn, out.lights, nullptr, align, sliceMs, cancel, allMs);
         throwIfCancelled(cancel);
     }
     const ImageError e = compareShadedImages(out.depth, culled, all);

@@ -43,8 +43,11 @@ RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBack
 // The shading phase of runPipeline on its own: shades `out.result`'s lists and
 // every light on `backend` over out.depth, sets timings.shadeMs (the culled
 // image) and the image error in out.truth.metrics; keeps the images in `out`
-// when asked.
+// when asked. sliceMs > 0 shades each image in row slices of about that wall
+// time and checks `cancel` between them (the studio: a newer edit waits one
+// slice, not a whole image), with the same pixels as whole images; shadeMs is
+// then the sum of the slices'.
 void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
-                     const CancelToken* cancel = nullptr);
+                     const CancelToken* cancel = nullptr, double sliceMs = 0);
 
 } // namespace lc
