@@ -38,7 +38,8 @@ ShadeInputs rowsOf(const ShadeInputs& in, std::uint32_t y0, std::uint32_t y1) {
     s.width = in.width;
     s.height = y1 - y0;
     const std::size_t a = std::size_t(in.width) * y0, b = std::size_t(in.width) * y1;
-    s.position.assign(in.position.begin() + std::ptrdiff_t(3 * a), in.position.begin() + std::ptrdiff_t(3 * b));
+    s.position.assign(in.position.begin() + std::ptrdiff_t(3 * a),
+                      in.position.begin() + std::ptrdiff_t(3 * b));
     s.normal.assign(in.normal.begin() + std::ptrdiff_t(3 * a), in.normal.begin() + std::ptrdiff_t(3 * b));
     s.list.assign(in.list.begin() + std::ptrdiff_t(a), in.list.begin() + std::ptrdiff_t(b));
     return s;
@@ -64,7 +65,8 @@ std::vector<float> shadeImage(CullBackend& backend, const ShadeInputs& in, const
         const std::uint32_t y1 = std::min(in.height, y0 + rows);
         const auto t0 = std::chrono::steady_clock::now();
         const std::vector<float> part = backend.shade(rowsOf(in, y0, y1), lights, culled);
-        const double wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        const double wallMs =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         shadeMs += backend.lastShadeMs() >= 0 ? backend.lastShadeMs() : wallMs;
         std::copy(part.begin(), part.end(), rgb.begin() + std::ptrdiff_t(std::size_t(in.width) * y0 * 3));
         throwIfCancelled(cancel);
@@ -85,7 +87,8 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
     // shadeCpu's row bands: a tile row (at least 4) for lists, 16 rows for all lights.
     const std::uint32_t align = std::lcm(std::max(r.grid.tileSize, 4u), 16u);
     double culledMs = 0, allMs = 0;
-    std::vector<float> culled = shadeImage(backend, culledIn, out.lights, &r, align, sliceMs, cancel, culledMs);
+    std::vector<float> culled =
+        shadeImage(backend, culledIn, out.lights, &r, align, sliceMs, cancel, culledMs);
     out.result.timings.shadeMs = culledMs;
     throwIfCancelled(cancel);
     // `all` with one list of every light in order shades exactly the reference.
@@ -138,8 +141,7 @@ RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBack
         out.depth.depth.size() != std::size_t(grid.width) * grid.height) {
         const std::string size = std::to_string(out.depth.width) + "x" + std::to_string(out.depth.height);
         const std::string cam = std::to_string(grid.width) + "x" + std::to_string(grid.height);
-        if (out.depthReused)
-            throw Error("the reused depth image is " + size + " but the camera is " + cam);
+        if (out.depthReused) throw Error("the reused depth image is " + size + " but the camera is " + cam);
         throw Error("backend '" + backend.name() + "' returned a " + size + " depth image for a " + cam +
                     " camera");
     }
@@ -151,7 +153,7 @@ RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBack
     if (const std::string bad = out.result.validate(out.lights.size()); !bad.empty())
         throw Error("backend '" + backend.name() + "' produced an inconsistent result: " + bad);
     // A backend that did not time a phase gets the wall time around the call.
-    out.result.timings.depthMs = out.depthReused           ? 0.0
+    out.result.timings.depthMs = out.depthReused              ? 0.0
                                  : backend.lastDepthMs() >= 0 ? backend.lastDepthMs()
                                                               : depthWallMs;
     if (out.result.timings.cullMs < 0) out.result.timings.cullMs = cullWallMs;
