@@ -515,6 +515,39 @@ TEST_F(GpuTest, StashedAndRecomputedListsMatchTheReference) {
 
 namespace {
 
+// On a CPU device the stash grows after a cull whose longest list outgrew
+// 32 slots (to 64 or 128; vulkan_backend.cpp, kMaxStashSlotsCpu), so the
+// next cull of such a scene takes every list from the stash. The first cull
+// (32 slots: the write pass) and the second (the grown stash, seen as more
+// device memory) must match each other exactly and the CPU reference.
+TEST_F(GpuTest, GrownStashHoldsListsOfUpTo128Entries) {
+    setenv("LIGHTCULL_VALIDATION", "1", 1);
+    std::unique_ptr<CullBackend> fresh = makeVulkanBackend(""); // no earlier cull sized its stash
+    auto cpuBackend = makeCpuBackend();
+    Scene scene = sized("forest", 640, 360);
+    scene.lights = generateLights(defaultLightGen(scene, 2500, 11));
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(640, 360, 16);
+    const ViewLights lights = makeViewLights(scene);
+    const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+    CullSettings st;
+    st.algorithm = Algorithm::TwoPointFiveD;
+    fresh->resetPeakDeviceBytes();
+    const CullResult first = fresh->cull(depth, proj, grid, lights, st);
+    const std::size_t firstPeak = fresh->peakDeviceBytes();
+    const std::uint32_t longest = *std::max_element(first.listCount.begin(), first.listCount.end());
+    ASSERT_GT(longest, 32u) << "no list outgrows the first cull's stash";
+    ASSERT_LE(longest, 128u) << "a list outgrows the grown stash";
+    fresh->resetPeakDeviceBytes();
+    const CullResult second = fresh->cull(depth, proj, grid, lights, st);
+    EXPECT_GT(fresh->peakDeviceBytes(), firstPeak) << "the stash did not grow";
+    EXPECT_EQ(second.listCount, first.listCount);
+    EXPECT_EQ(second.lightIndices, first.lightIndices);
+    // A third cull (the grown stash again) against the CPU reference: the
+    // first two are equal, so all three are checked.
+    checkCase("grown stash", depth, proj, grid, lights, st, *cpuBackend, *fresh);
+}
+
 // On lavapipe tile_bounds reads even-width depth images as 64-bit pixel pairs
 // (LC_DEPTH_PAIRS); the GPU work layout, emulated, reads single pixels. The
 // two must agree exactly: the same depth bounds and cell / slice masks, the

@@ -55,11 +55,14 @@ enum Binding : std::uint32_t { bParams, bDepth, bTiles, bLights, bCounts, bOffse
 // Stash slots per list at most (cull_common.glsl binding 10): the count pass
 // keeps each list's first entries, so a cull whose lists all fit needs no
 // write pass (P1: 1.6 entries per list on average, 21 at most). A CPU device
-// (lavapipe) keeps more: there the stash is host memory read in place, and
-// every list it holds whole is copied instead of culled a second time
+// (lavapipe) keeps up to kMaxStashSlotsCpu when the previous cull's longest
+// list needed more than 32: there the stash is host memory read in place,
+// and every list it holds whole is copied instead of culled a second time
 // (measured, atrium 1280x720 with 1,024 lights, 73 entries per list: cull
-// 27 ms with 32 slots, 18 ms with 128, 18 ms with 256). A GPU keeps 32: its
-// stash is read back through a staging copy, and it culls again cheaply.
+// 27 ms with 32 slots, 18 ms with 128, 18 ms with 256), but a larger stash
+// is fresh memory the count pass faults in (P1 measured slower with 128
+// slots it does not need). A GPU keeps 32: its stash is read back through
+// a staging copy, and it culls again cheaply.
 constexpr std::uint32_t kMaxStashSlots = 32;
 constexpr std::uint32_t kMaxStashSlotsCpu = 128;
 // Local size of the one-invocation-per-item passes (light_bins, cull_lists):
@@ -239,6 +242,7 @@ private:
     PipelineLayoutHandle computeLayout_;
     ShaderModuleHandle boundsShader_, boundsPairsShader_, binsShader_, cullShader_, scanShader_, vertShader_;
     double lastCullWallMs_ = -1;
+    std::uint32_t lastLongestList_ = 0; // of the previous cull: sizes a CPU device's stash
     std::map<std::string, PipelineHandle> computePipelines_;
     PipelineLayoutHandle depthLayout_;
     RenderPassHandle renderPass_[2];
@@ -586,7 +590,9 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const std::uint32_t listTotal = std::uint32_t(listTotal64);
     // Stash slots per list: kMaxStashSlots(Cpu), fewer where that would
     // outgrow the depth image (clustered has many lists); none for `all`.
-    const std::uint32_t maxStashSlots = ctx_.isCpuDevice() ? kMaxStashSlotsCpu : kMaxStashSlots;
+    std::uint32_t maxStashSlots = kMaxStashSlots;
+    while (ctx_.isCpuDevice() && maxStashSlots < kMaxStashSlotsCpu && maxStashSlots < lastLongestList_)
+        maxStashSlots *= 2;
     const std::uint32_t stashSlots =
         algo == Algorithm::All ? 0
                                : std::uint32_t(std::min<std::uint64_t>(maxStashSlots, depth.depth.size() / listTotal64));
@@ -734,14 +740,15 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     // and as many as it has stash slots (stashing; copying a stashed list), so
     // a CPU device takes an invocation per list only while that fits, else
     // spreads the words over a subgroup; beyond that it refuses.
-    const std::uint64_t itersPerList = std::uint64_t(binWords) * 65 + 64 + maxStashSlots;
+    const std::uint32_t stashCap = ctx_.isCpuDevice() ? kMaxStashSlotsCpu : kMaxStashSlots; // any cull's
+    const std::uint64_t itersPerList = std::uint64_t(binWords) * 65 + 64 + stashCap;
     std::uint32_t lanes = sg;
     if (kLocal % sg != 0) lanes = 1;
     else if (ctx_.isCpuDevice()) lanes = itersPerList <= kLoopLimit ? 1 : sg;
     if (ctx_.isCpuDevice() && itersPerList / lanes > kLoopLimit)
         throw SettingsError("lights", std::to_string(n) + " lights is more than the culling passes can take on '" +
                                           ctx_.deviceName() + "' (at most " +
-                                          std::to_string((kLoopLimit - 64 - maxStashSlots) / 65 * lanes * 32) +
+                                          std::to_string((kLoopLimit - 64 - stashCap) / 65 * lanes * 32) +
                                           ": the driver caps a shader invocation at 65,535 loop iterations)");
     const bool subgroupLanes = lanes > 1;
     const std::uint32_t itemsPerGroup = kLocal / lanes;
@@ -872,6 +879,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     res.timings.cullMs = gpuClock ? gpuMs : wallMs;
     res.timings.depthMs = lastDepthMs_;
     lastCullWallMs_ = wallMs;
+    lastLongestList_ = longest;
     return res;
 }
 
