@@ -8,6 +8,7 @@
 // and both views have rendered; --quit exits afterwards (exit code 0 only when
 // every requested step worked).
 
+#include "camera_view.hpp"
 #include "cull_worker.hpp"
 #include "document.hpp"
 #include "live_drag_probe.hpp"
@@ -152,6 +153,8 @@ int main(int argc, char** argv) {
                          r.lights, r.medianEditMs, r.inspectorWidth, r.inspectorHeight, r.inspectorFrames,
                          r.medianInspectorMs, r.cameraFrames, r.medianCameraMs, r.staticInspectorMs,
                          r.staticCameraMs);
+            std::fprintf(stdout, "live drag: camera view mesh pictures taken: %d\n",
+                         window.cameraView()->meshPictureCaptures());
             window.document()->undoStack()->setClean();
             app.exit(r.shown > 0 ? 0 : 1);
         });
