@@ -478,9 +478,9 @@ TEST_F(GpuTest, DeviceMemoryPeakAndNoLeak) {
 
 namespace {
 
-// The count pass stashes each list's first entries (vulkan_backend.cpp: 128
-// on a CPU device such as lavapipe, kMaxStashSlotsCpu; fewer for clustered's
-// many lists): when every list fits, the host takes the lists from the stash
+// The count pass stashes each list's first entries (vulkan_backend.cpp: 32,
+// and on a CPU device such as lavapipe up to 128 after a cull with longer
+// lists; fewer for clustered's many lists): when every list fits, the host takes the lists from the stash
 // and no write pass runs; otherwise the write pass copies the lists that fit
 // and culls the longer ones again. Both paths against the CPU reference, each
 // with its precondition checked: 16 lights cannot make a list longer than the

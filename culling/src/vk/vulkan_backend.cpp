@@ -588,11 +588,12 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     if (listTotal64 >= std::numeric_limits<std::uint32_t>::max())
         throw SettingsError("tile", "more than 2^32 light lists");
     const std::uint32_t listTotal = std::uint32_t(listTotal64);
-    // Stash slots per list: kMaxStashSlots(Cpu), fewer where that would
+    // Stash slots per list: kMaxStashSlots, doubled up to stashCap while the
+    // previous cull's longest list needed more; fewer where that would
     // outgrow the depth image (clustered has many lists); none for `all`.
+    const std::uint32_t stashCap = ctx_.isCpuDevice() ? kMaxStashSlotsCpu : kMaxStashSlots;
     std::uint32_t maxStashSlots = kMaxStashSlots;
-    while (ctx_.isCpuDevice() && maxStashSlots < kMaxStashSlotsCpu && maxStashSlots < lastLongestList_)
-        maxStashSlots *= 2;
+    while (maxStashSlots < stashCap && maxStashSlots < lastLongestList_) maxStashSlots *= 2;
     const std::uint32_t stashSlots =
         algo == Algorithm::All ? 0
                                : std::uint32_t(std::min<std::uint64_t>(maxStashSlots, depth.depth.size() / listTotal64));
@@ -740,7 +741,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     // and as many as it has stash slots (stashing; copying a stashed list), so
     // a CPU device takes an invocation per list only while that fits, else
     // spreads the words over a subgroup; beyond that it refuses.
-    const std::uint32_t stashCap = ctx_.isCpuDevice() ? kMaxStashSlotsCpu : kMaxStashSlots; // any cull's
+    // (stashCap: the largest stash any cull of this device takes.)
     const std::uint64_t itersPerList = std::uint64_t(binWords) * 65 + 64 + stashCap;
     std::uint32_t lanes = sg;
     if (kLocal % sg != 0) lanes = 1;
