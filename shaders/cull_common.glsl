@@ -28,6 +28,11 @@ layout(constant_id = 6) const uint WRITE_PASS = 0u;   // cull_lists: 0 count, 1 
 // Lanes sharing one tile (tile_bounds) or one list (cull_lists): 1 (an
 // invocation each: CPU devices), or the subgroup size (a subgroup each: GPUs).
 layout(constant_id = 7) const uint LANES = 1u;
+// tile_bounds with LC_WIDE_DEPTH_LOADS: pixels per depth load, 2 or 8.
+layout(constant_id = 8) const uint DEPTH_LOAD = 2u;
+// light_bins and cull_lists: 1 when the lists filter their candidates through
+// the depth bins (binding 8, after the row masks).
+layout(constant_id = 9) const uint DEPTH_BINS = 0u;
 
 layout(std430, binding = 0) readonly buffer Params { GpuCullParams params; };
 // A private copy of the parameters, filled by loadParams() at the top of every
@@ -45,11 +50,16 @@ layout(std430, binding = 6) buffer IndexBuf { uint lightIndices[]; };
 // status: STATUS_* bits; candidateTests: light-versus-volume tests the count
 // pass performed (the write pass repeats them), for the benchmarks.
 layout(std430, binding = 7) buffer StatusBuf { uint status; uint candidateTests; };
-// Light bins (light_bins.comp): one bit per light. Column tx's word w is
-// binMask[w * tilesX + tx], row ty's word w is binMask[P.bins.y + w * tilesY + ty].
-// A set bit means the light's sphere is not outside either side plane of that
-// tile column / row; (tilesX + tilesY) x lightCount bits in all.
+// Light bins (light_bins.comp): one bit per light, P.bins.x words per bin
+// (padded with zero words to a multiple of 4). Column tx's words start at
+// binMask[tx * P.bins.x], row ty's at binMask[P.bins.y + ty * P.bins.x]; a
+// set bit means the light's sphere is not outside either side plane of that
+// tile column / row. With DEPTH_BINS, near bin s's words start at P.bins.w +
+// s * P.bins.x (a set bit: the light's near end is at or before bin s), far
+// bin s's at P.bins.w + (LC_DEPTH_BINS + s) * P.bins.x (its far end is at or
+// beyond bin s). Every bin's words are contiguous and start on a uvec4.
 layout(std430, binding = 8) buffer BinBuf { uint binMask[]; };
+layout(std430, binding = 8) readonly buffer BinQuads { uvec4 binQuads[]; }; // the same, 4 words a load
 // Spot cones (one per light; a 1-element placeholder without cone tests).
 layout(std430, binding = 9) readonly buffer SpotBuf { GpuSpotCone spots[]; };
 // The count pass's stash: the first P.bins.z entries of every list, at
@@ -67,6 +77,19 @@ const uint STATUS_TESTS_OVERFLOW = 4u;  // candidateTests wrapped around 2^32
 const uint STATUS_LOOP_LIMIT = 8u;
 
 bool isOrtho() { return (P.counts.w & LC_FLAG_ORTHO) != 0u; }
+
+// Depth-bin coordinate of view depth d (GpuCullParams.depthBins): its bin is
+// the floor, clamped to [0, LC_DEPTH_BINS - 1]. Non-decreasing in d up to
+// the rounding of log2, far below DEPTH_BIN_MARGIN; d <= 0 under log slices
+// reads as a depth before every bin.
+float depthBinCoord(float d) {
+    return P.depthBins.z > 0.5 ? (log2(max(d, 1e-30)) - P.depthBins.x) * P.depthBins.y
+                               : (d - P.depthBins.x) * P.depthBins.y;
+}
+// A light's depth extent is binned with this much to spare (in bins), so that
+// rounding never leaves out a bin the chunk test reaches.
+const float DEPTH_BIN_MARGIN = 0.01;
+uint depthBinOf(float d) { return uint(clamp(depthBinCoord(d), 0.0, float(LC_DEPTH_BINS - 1u))); }
 
 // View depth of window depth d, float. A = aHi + aLo so that d - A keeps its
 // precision where it cancels (perspective, d near A at the far plane).

@@ -6,7 +6,10 @@
 // the lights that pass as a 32-bit mask of its word; a subgroup exclusive add
 // of the masks' bit counts places them, so the words go out in order and each
 // list comes out ascending and deterministic, without a sort and without
-// barriers. WRITE_PASS == 0 stores the count and stashes the list's first
+// barriers. With DEPTH_BINS a word is also ANDed with the words of the
+// depth bins that hold the list's depth range (light_bins.comp), so lights
+// in front of or behind the tile's geometry are not tested at all.
+// WRITE_PASS == 0 stores the count and stashes the list's first
 // P.bins.z entries (cull_common.glsl, binding 10); WRITE_PASS == 1 copies a
 // list the stash holds whole, else tests again and writes the indices at the
 // scanned offset and checks that the count matches. `all` has
@@ -25,6 +28,50 @@ float sliceBoundary(float lo, float hi, uint i) {
 
 bool spotConeOutsideChunkPlane(GpuSpotCone s, vec4 plane, float eps) {
     return spotConeOutsidePlane(s.apexRange.xyz, s.axisCos.xyz, s.apexRange.w, s.axisCos.w, s.sinAngle.x, plane, eps);
+}
+
+// Whether light l (a candidate of the list's bins) goes into the list: the
+// sphere against the list's chunk, then the spot cone refinements and the
+// 2.5d cell test, as the CPU reference.
+bool lightKept(uint l, Chunk ch, uint spotMode, vec3 cellCentre, float cellRadius, bool cellLog, float cellLog0,
+               float cellScale, float maskLo, float maskHi, uint geomMask) {
+    vec4 L = lights[l].centerRadius;
+    float r = widenedRadius(L);
+    bool pass = sphereHitsChunk(ch, L.xyz, r);
+    if (pass && spotMode != 0u) {
+        GpuSpotCone s = spots[l];
+        if (s.apexRange.w > 0.0) {
+            float eps = (length(s.apexRange.xyz) + s.apexRange.w) * P.cluster.z + P.cluster.w;
+            if (spotMode == LC_FLAG_SPOT_CONE_SPHERE) {
+                pass = spotConeHitsSphere(s.apexRange.xyz, s.axisCos.xyz, s.apexRange.w, s.axisCos.w,
+                                          s.sinAngle.x, cellCentre, cellRadius, eps);
+            } else {
+                pass = !(spotConeOutsideChunkPlane(s, ch.planes[0], eps) ||
+                         spotConeOutsideChunkPlane(s, ch.planes[1], eps) ||
+                         spotConeOutsideChunkPlane(s, ch.planes[2], eps) ||
+                         spotConeOutsideChunkPlane(s, ch.planes[3], eps) ||
+                         spotConeOutsideChunkPlane(s, ch.planes[4], eps) ||
+                         spotConeOutsideChunkPlane(s, ch.planes[5], eps));
+            }
+        }
+    }
+    if (pass && ALGORITHM == LC_ALG_25D) {
+        float depth = -L.z;
+        float a = widenDown(depth - r), b = widenUp(depth + r);
+        uint cells;
+        if (cellLog) {
+            // As sliceRangeMask: no cell when [a, b] misses [lo, hi];
+            // cell 0 for depths at or before lo.
+            float cellMax = float(CELLS - 1u);
+            uint c0 = a > maskLo ? uint(clamp((log2(a) - cellLog0) * cellScale, 0.0, cellMax)) : 0u;
+            uint c1 = b > maskLo ? uint(clamp((log2(b) - cellLog0) * cellScale, 0.0, cellMax)) : 0u;
+            cells = (b < maskLo || a > maskHi) ? 0u : ((2u << (c1 - c0)) - 1u) << c0;
+        } else {
+            cells = sliceRangeMask(maskLo, maskHi, a, b);
+        }
+        pass = (cells & geomMask) != 0u;
+    }
+    return pass;
 }
 
 void main() {
@@ -86,7 +133,8 @@ void main() {
     }
     uint n = 0u, tested = 0u;
     if (listLive) {
-        Chunk ch = makeChunk(tile, max(widenDown(zlo), isOrtho() ? -3.4e38 : 0.0), widenUp(zhi));
+        float chunkLo = max(widenDown(zlo), isOrtho() ? -3.4e38 : 0.0), chunkHi = widenUp(zhi);
+        Chunk ch = makeChunk(tile, chunkLo, chunkHi);
         // Spot cone refinements (spot_tests.glsl), as the CPU reference runs
         // them after the (tight) sphere test. The chunk's bounding sphere once
         // per list: centroid of the corners, farthest corner, widened.
@@ -113,87 +161,92 @@ void main() {
         float cellLog0 = cellLog ? log2(maskLo) : 0.0;
         float cellScale = cellLog ? float(CELLS) / log2(maskHi / maskLo) : 0.0;
         uint base = (WRITE_PASS != 0u) ? listOffset[list] : 0u;
-        uint tilesX = P.size.z, tilesY = P.size.w, words = P.bins.x;
+        uint tilesX = P.size.z, words = P.bins.x;
         uint tx = tile % tilesX, ty = tile / tilesX;
-        uint rowBase = P.bins.y + ty;
-        uint w0 = 0u;
+        uint columnBase = tx * words, rowBase = P.bins.y + ty * words;
+        // The depth bins (light_bins.comp): lights that reach no deeper than
+        // the chunk's far end and no nearer than its near end. naive's chunk
+        // spans every light's depth.
+        bool depthBins = DEPTH_BINS != 0u && ALGORITHM != LC_ALG_NAIVE;
+        uint nearBase = P.bins.w + depthBinOf(chunkHi) * words;
+        uint farBase = P.bins.w + (LC_DEPTH_BINS + depthBinOf(chunkLo)) * words;
         bool cut = false;
-        for (; w0 < words; w0 += LANES) {
-            uint w = w0 + lane;
-            uint m = w < words ? binMask[w * tilesX + tx] & binMask[rowBase + w * tilesY] : 0u;
-            uint passMask = 0u;
-            tested += uint(bitCount(m));
-            while (m != 0u) {
-                uint bit = uint(findLSB(m));
+        if (LANES == 1u) {
+            // An invocation per list (CPU devices): one loop over the list's
+            // candidates, each turn fetching words until one has a candidate
+            // left. (gallivm runs a loop's body at least once per entry, with
+            // no lane active if need be, so a bit loop nested in a word loop
+            // would run the whole test once per word even where no list of
+            // the SIMD group has a candidate: measured, the empty entries cost
+            // more than the tests.) lavapipe loads a storage buffer lane by
+            // lane in a loop, one pass of it per load whatever its width, so
+            // the words come four at a time.
+            uint w = 0u, m = 0u;
+            uvec4 quad = uvec4(0u);
+            while (true) {
+                while (m == 0u && w < words) {
+                    if ((w & 3u) == 0u) {
+                        quad = binQuads[(columnBase + w) >> 2u] & binQuads[(rowBase + w) >> 2u];
+                        if (depthBins) quad &= binQuads[(nearBase + w) >> 2u] & binQuads[(farBase + w) >> 2u];
+                    }
+                    m = quad[w & 3u];
+                    ++w;
+                }
+                if (m == 0u) break;
+                uint l = (w - 1u) * 32u + uint(findLSB(m));
                 m &= m - 1u;
-                vec4 L = lights[w * 32u + bit].centerRadius;
-                float r = widenedRadius(L);
-                bool pass = sphereHitsChunk(ch, L.xyz, r);
-                if (pass && spotMode != 0u) {
-                    GpuSpotCone s = spots[w * 32u + bit];
-                    if (s.apexRange.w > 0.0) {
-                        float eps = (length(s.apexRange.xyz) + s.apexRange.w) * P.cluster.z + P.cluster.w;
-                        if (spotMode == LC_FLAG_SPOT_CONE_SPHERE) {
-                            pass = spotConeHitsSphere(s.apexRange.xyz, s.axisCos.xyz, s.apexRange.w, s.axisCos.w,
-                                                      s.sinAngle.x, cellCentre, cellRadius, eps);
-                        } else {
-                            pass = !(spotConeOutsideChunkPlane(s, ch.planes[0], eps) ||
-                                     spotConeOutsideChunkPlane(s, ch.planes[1], eps) ||
-                                     spotConeOutsideChunkPlane(s, ch.planes[2], eps) ||
-                                     spotConeOutsideChunkPlane(s, ch.planes[3], eps) ||
-                                     spotConeOutsideChunkPlane(s, ch.planes[4], eps) ||
-                                     spotConeOutsideChunkPlane(s, ch.planes[5], eps));
-                        }
+                ++tested;
+                if (lightKept(l, ch, spotMode, cellCentre, cellRadius, cellLog, cellLog0, cellScale, maskLo, maskHi,
+                              geomMask)) {
+                    if (WRITE_PASS != 0u) lightIndices[base + n] = l;
+                    else if (n < stashSlots) stash[list * stashSlots + n] = l;
+                    ++n;
+                }
+            }
+            cut = w < words; // a loop ended by the driver's cap, not by the list
+        } else {
+            // A subgroup per list (GPUs): lane i takes words i, i + LANES, ...
+            uint w0 = 0u;
+            for (; w0 < words; w0 += LANES) {
+                uint w = w0 + lane;
+                uint m = w < words ? binMask[columnBase + w] & binMask[rowBase + w] : 0u;
+                if (depthBins && w < words) m &= binMask[nearBase + w] & binMask[farBase + w];
+                uint passMask = 0u;
+                tested += uint(bitCount(m));
+                while (m != 0u) {
+                    uint bit = uint(findLSB(m));
+                    m &= m - 1u;
+                    if (lightKept(w * 32u + bit, ch, spotMode, cellCentre, cellRadius, cellLog, cellLog0, cellScale,
+                                  maskLo, maskHi, geomMask))
+                        passMask |= 1u << bit;
+                }
+                cut = cut || m != 0u;
+                uint cnt = uint(bitCount(passMask));
+                uint at = n + subgroupExclusiveAdd(cnt);
+                if (WRITE_PASS == 0u && n < stashSlots) {
+                    // After the scan. At most 32 iterations a word, as the
+                    // write loop below.
+                    uint stashMask = passMask;
+                    for (uint a = at; stashMask != 0u && a < stashSlots; ++a) {
+                        uint bit = uint(findLSB(stashMask));
+                        stashMask &= stashMask - 1u;
+                        stash[list * stashSlots + a] = w * 32u + bit;
                     }
                 }
-                if (pass && ALGORITHM == LC_ALG_25D) {
-                    float depth = -L.z;
-                    float a = widenDown(depth - r), b = widenUp(depth + r);
-                    uint cells;
-                    if (cellLog) {
-                        // As sliceRangeMask: no cell when [a, b] misses [lo, hi];
-                        // cell 0 for depths at or before lo.
-                        float cellMax = float(CELLS - 1u);
-                        uint c0 = a > maskLo ? uint(clamp((log2(a) - cellLog0) * cellScale, 0.0, cellMax)) : 0u;
-                        uint c1 = b > maskLo ? uint(clamp((log2(b) - cellLog0) * cellScale, 0.0, cellMax)) : 0u;
-                        cells = (b < maskLo || a > maskHi) ? 0u : ((2u << (c1 - c0)) - 1u) << c0;
-                    } else {
-                        cells = sliceRangeMask(maskLo, maskHi, a, b);
+                if (WRITE_PASS != 0u) {
+                    while (passMask != 0u) {
+                        uint bit = uint(findLSB(passMask));
+                        passMask &= passMask - 1u;
+                        lightIndices[base + at] = w * 32u + bit;
+                        ++at;
                     }
-                    pass = (cells & geomMask) != 0u;
+                    cut = cut || passMask != 0u;
                 }
-                if (pass) {
-                    // One invocation per list: its position is known here.
-                    uint at = n + uint(bitCount(passMask));
-                    if (LANES == 1u && WRITE_PASS == 0u && at < stashSlots) stash[list * stashSlots + at] = w * 32u + bit;
-                    passMask |= 1u << bit;
-                }
+                n += subgroupAdd(cnt);
             }
-            cut = cut || m != 0u;
-            uint cnt = uint(bitCount(passMask));
-            uint at = n + ((LANES != 1u) ? subgroupExclusiveAdd(cnt) : 0u);
-            if (LANES != 1u && WRITE_PASS == 0u && n < stashSlots) {
-                // A subgroup per list: after the scan. At most 32 iterations
-                // a word, as the write loop below.
-                uint stashMask = passMask;
-                for (uint a = at; stashMask != 0u && a < stashSlots; ++a) {
-                    uint bit = uint(findLSB(stashMask));
-                    stashMask &= stashMask - 1u;
-                    stash[list * stashSlots + a] = w * 32u + bit;
-                }
-            }
-            if (WRITE_PASS != 0u) {
-                while (passMask != 0u) {
-                    uint bit = uint(findLSB(passMask));
-                    passMask &= passMask - 1u;
-                    lightIndices[base + at] = w * 32u + bit;
-                    ++at;
-                }
-                cut = cut || passMask != 0u;
-            }
-            n += (LANES != 1u) ? subgroupAdd(cnt) : cnt;
+            cut = cut || w0 < words;
         }
-        if (cut || w0 < words) atomicOr(status, STATUS_LOOP_LIMIT);
+        if (cut) atomicOr(status, STATUS_LOOP_LIMIT);
     }
     if (WRITE_PASS == 0u) {
         if (LANES != 1u) tested = subgroupAdd(tested);

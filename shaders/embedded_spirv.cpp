@@ -6,14 +6,14 @@
 #include "prefix_sum_comp.spv.h"
 #include "shade_comp.spv.h"
 #include "tile_bounds_comp.spv.h"
-#include "tile_bounds_pairs_comp.spv.h"
+#include "tile_bounds_wide_comp.spv.h"
 
 namespace lc::spirv {
 #define LC_SPV(fn, arr) \
     Code fn() { return {arr, sizeof(arr) / sizeof(arr[0])}; }
 LC_SPV(depthVert, lc_spv_depth_vert)
 LC_SPV(tileBounds, lc_spv_tile_bounds_comp)
-LC_SPV(tileBoundsPairs, lc_spv_tile_bounds_pairs_comp)
+LC_SPV(tileBoundsWide, lc_spv_tile_bounds_wide_comp)
 LC_SPV(lightBins, lc_spv_light_bins_comp)
 LC_SPV(cullLists, lc_spv_cull_lists_comp)
 LC_SPV(prefixSum, lc_spv_prefix_sum_comp)

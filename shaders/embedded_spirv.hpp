@@ -14,7 +14,7 @@ struct Code {
 
 Code depthVert();   // depth pre-pass vertex shader (no fragment shader)
 Code tileBounds();  // per-tile depth bounds, halfz split, cell / slice masks
-Code tileBoundsPairs(); // the same, depth read as 64-bit pixel pairs (needs shaderInt64)
+Code tileBoundsWide();  // the same, depth read 2 or 8 pixels a load (needs shaderInt64)
 Code lightBins();  // per tile column / row bitmask of the lights not outside its side planes
 Code cullLists();   // per-list light tests: count pass and write pass
 Code prefixSum();   // exclusive scan of the list counts into offsets

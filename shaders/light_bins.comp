@@ -7,8 +7,18 @@
 // test keeps always has its bit set. cull_lists then tests only the lights set
 // in both its column's and its row's word: candidates come out of a word in
 // ascending order, and the work is (tilesX + tilesY) x lights plane tests here
-// instead of tiles x lights chunk tests there. No subgroup operations, no
-// barrier(): any local size.
+// instead of tiles x lights chunk tests there.
+//
+// With DEPTH_BINS, one more invocation per (mask word, depth bin) writes that
+// word of the near bin and of the far bin (cull_common.glsl, binding 8): the
+// lights whose near end a = depth - r is at or before the bin, and those
+// whose far end b = depth + r is at or beyond it, r widened as above and the
+// bin coordinates moved out by DEPTH_BIN_MARGIN. A list whose (widened) depth
+// range [zlo, zhi] lies in bins t0..t1 takes only lights in near bin t1 and
+// far bin t0: a light the chunk test keeps has a <= zhi and b >= zlo, so it
+// is in both (the last near bin and the first far bin hold every light, for
+// depths clamped into them). No subgroup operations, no barrier(): any local
+// size.
 #extension GL_GOOGLE_include_directive : require
 #include "cull_common.glsl"
 
@@ -17,16 +27,38 @@ void main() {
     uint idx = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
                gl_LocalInvocationIndex;
     uint words = P.bins.x, tilesX = P.size.z, tilesY = P.size.w;
-    uint columnWords = words * tilesX;
-    if (idx >= columnWords + words * tilesY) return;
+    uint columnWords = words * tilesX, planeWords = columnWords + words * tilesY;
+    uint lightCount = P.counts.x;
+    if (DEPTH_BINS != 0u && idx >= planeWords) {
+        uint j = idx - planeWords;
+        if (j >= LC_DEPTH_BINS * words) return;
+        uint bin = j / words, w = j % words;
+        uint first = w * 32u, end = min(first + 32u, lightCount);
+        uint nearMask = 0u, farMask = 0u;
+        float binF = float(bin);
+        for (uint i = first; i < end; ++i) {
+            vec4 L = lights[i].centerRadius;
+            float r = widenedRadius(L) + (length(L.xyz) + L.w) * P.cluster.z;
+            float depth = -L.z;
+            if (depthBinCoord(depth - r) - DEPTH_BIN_MARGIN < binF + 1.0) nearMask |= 1u << (i - first);
+            if (depthBinCoord(depth + r) + DEPTH_BIN_MARGIN >= binF) farMask |= 1u << (i - first);
+        }
+        uint all = end > first ? (0xffffffffu >> (32u - (end - first))) : 0u;
+        binMask[P.bins.w + j] = bin == LC_DEPTH_BINS - 1u ? all : nearMask;
+        binMask[P.bins.w + LC_DEPTH_BINS * words + j] = bin == 0u ? all : farMask;
+        return;
+    }
+    if (idx >= planeWords) return;
+    // Invocations run across the lines of one word (so on a GPU a subgroup
+    // reads the same 32 lights) and write each line's words contiguously.
     bool column = idx < columnWords;
     uint j = column ? idx : idx - columnWords;
     uint lines = column ? tilesX : tilesY;
     uint w = j / lines, line = j % lines;
+    uint at = (column ? 0u : P.bins.y) + line * words + w;
     vec4 a, b;
     if (column) columnPlanes(columnNdc(line), a, b);
     else rowPlanes(rowNdc(line), a, b);
-    uint lightCount = P.counts.x;
     uint first = w * 32u, end = min(first + 32u, lightCount);
     uint mask = 0u;
     for (uint i = first; i < end; ++i) {
@@ -37,5 +69,5 @@ void main() {
         float da = dot(a.xyz, L.xyz) + a.w, db = dot(b.xyz, L.xyz) + b.w;
         if (da >= -r && db >= -r) mask |= 1u << (i - first);
     }
-    binMask[idx] = mask;
+    binMask[at] = mask;
 }

@@ -12,37 +12,62 @@
 // per tile cost more, a workgroup per tile far more). Either way the column
 // loop has a constant trip count (unrolled; x < tw masks partial edge tiles).
 //
-// Built twice (shaders/CMakeLists.txt): with LC_DEPTH_PAIRS, for an
-// invocation per tile on devices with shaderInt64 and even widths and tile
-// sizes, each storage-buffer load fetches two neighbouring pixels as one
-// 64-bit word. lavapipe loads a storage buffer lane by lane in a loop, so that
-// halves the cost of the loads (measured: the min/max walk of 1080p from 4.0
-// to 2.4 ms of CPU).
+// Built twice (shaders/CMakeLists.txt): with LC_WIDE_DEPTH_LOADS, for an
+// invocation per tile on devices with shaderInt64, each storage-buffer load
+// fetches DEPTH_LOAD neighbouring pixels: 8 as a u64vec4 when the width and
+// the tile size are multiples of 8, else 2 as one 64-bit word (even widths
+// and tile sizes). lavapipe loads a storage buffer lane by lane in a loop,
+// one pass of it per load whatever its width, so fewer, wider loads cost
+// less (measured: pairs took the min/max walk of 1080p from 4.0 to 2.4 ms of
+// CPU; 8 pixels a load took P1's whole cull from 8.6-9.1 to 7.8-8.2 ms,
+// fastest of 63, against pairs).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
-#ifdef LC_DEPTH_PAIRS
+#ifdef LC_WIDE_DEPTH_LOADS
 #extension GL_ARB_gpu_shader_int64 : require
 #endif
 #include "cull_common.glsl"
 
-#ifdef LC_DEPTH_PAIRS
-// The depth buffer (binding 1) as pixel pairs; LANES == 1, even W and TILE_SIZE.
+// DEPTH_LOAD pixels of a tile row from column x on (row: the row's first
+// pixel); clear depth at and past column tw. Unused lanes of Pixels read clear.
+struct Pixels {
+    vec4 a, b; // pixels x .. x + 3, x + 4 .. x + 7
+};
+#ifdef LC_WIDE_DEPTH_LOADS
+// The depth buffer (binding 1) as 2- and 8-pixel words; LANES == 1, and W and
+// TILE_SIZE multiples of DEPTH_LOAD, so every load is aligned.
 layout(std430, binding = 1) readonly buffer DepthPairs { uint64_t depthPairs[]; };
-const uint STEP = 2u;
-// Pixels x and x + 1 of a tile row starting at `row`; clear depth past tw.
-vec2 depthAt(uint row, uint x, uint tw, float clearDepth) {
-    vec2 d = vec2(clearDepth);
-    if (x < tw) d = uintBitsToFloat(unpackUint2x32(depthPairs[(row + x) >> 1u]));
-    if (x + 1u >= tw) d.y = clearDepth;
-    return d;
+layout(std430, binding = 1) readonly buffer DepthOctets { u64vec4 depthOctets[]; };
+const uint STEP = DEPTH_LOAD;
+Pixels depthAt(uint row, uint x, uint tw, float clearDepth) {
+    Pixels p;
+    p.a = vec4(clearDepth);
+    p.b = vec4(clearDepth);
+    if (x < tw) { // no load past the image's last pixel
+        if (DEPTH_LOAD == 8u) {
+            u64vec4 q = depthOctets[(row + x) >> 3u];
+            p.a = vec4(uintBitsToFloat(unpackUint2x32(q.x)), uintBitsToFloat(unpackUint2x32(q.y)));
+            p.b = vec4(uintBitsToFloat(unpackUint2x32(q.z)), uintBitsToFloat(unpackUint2x32(q.w)));
+        } else {
+            p.a.xy = uintBitsToFloat(unpackUint2x32(depthPairs[(row + x) >> 1u]));
+        }
+    }
+    p.a = mix(vec4(clearDepth), p.a, lessThan(uvec4(x) + uvec4(0u, 1u, 2u, 3u), uvec4(tw)));
+    p.b = mix(vec4(clearDepth), p.b, lessThan(uvec4(x) + uvec4(4u, 5u, 6u, 7u), uvec4(tw)));
+    return p;
 }
 #else
 const uint STEP = 1u;
-vec2 depthAt(uint row, uint x, uint tw, float clearDepth) {
-    return vec2(x < tw ? depthBuf[row + x] : clearDepth, clearDepth);
+Pixels depthAt(uint row, uint x, uint tw, float clearDepth) {
+    Pixels p;
+    p.a = vec4(x < tw ? depthBuf[row + x] : clearDepth, clearDepth, clearDepth, clearDepth);
+    p.b = vec4(clearDepth);
+    return p;
 }
 #endif
+// Pixel i (a constant after unrolling) of a load.
+float pixelOf(Pixels p, uint i) { return i < 4u ? p.a[i] : p.b[i - 4u]; }
 
 void main() {
     loadParams();
@@ -75,9 +100,9 @@ void main() {
     for (uint y = ly; y < th; y += laneRows) {
         uint row = (y0 + y) * W + x0;
         for (uint x = lx; x < TILE_SIZE; x += laneCols * STEP) {
-            vec2 d2 = depthAt(row, x, tw, clearDepth);
+            Pixels px = depthAt(row, x, tw, clearDepth);
             for (uint pix = 0u; pix < STEP; ++pix) {
-                float d = d2[pix];
+                float d = pixelOf(px, pix);
                 if (d != clearDepth) {
                     wLo = min(wLo, d);
                     wHi = max(wHi, d);
@@ -130,9 +155,9 @@ void main() {
                 for (uint y = ly; y < th; y += laneRows) {
                     uint row = (y0 + y) * W + x0;
                     for (uint x = lx; x < TILE_SIZE; x += laneCols * STEP) {
-                        vec2 d2 = depthAt(row, x, tw, clearDepth);
+                        Pixels px = depthAt(row, x, tw, clearDepth);
                         for (uint pix = 0u; pix < STEP; ++pix) {
-                            float d = d2[pix];
+                            float d = pixelOf(px, pix);
                             if (d != clearDepth) {
                                 float c;
                                 if (useLog) {

@@ -49,6 +49,9 @@ const uint LC_TEST_PLANES_AABB = 1u;
 const uint LC_TEST_EXACT = 2u;
 const uint LC_SLICING_LOG = 0u;
 const uint LC_SLICING_LINEAR = 1u;
+// Depth bins (light_bins.comp, cull_lists.comp): slices of the lights' depth
+// range, and two bin families of one bit per light each.
+const uint LC_DEPTH_BINS = 32u;
 // GpuCullParams.flags bits.
 const uint LC_FLAG_ORTHO = 1u;         // orthographic projection
 const uint LC_FLAG_REVERSED = 2u;      // reversed-Z (nearer = larger window depth)
@@ -81,8 +84,14 @@ struct GpuCullParams {
     // Light binning (light_bins.comp): x = mask words per column/row (one bit
     // per light: ceil(lightCount / 32)), y = index of the first row mask in the
     // bin buffer (= x * tilesX); z = stash slots per list (the count pass keeps
-    // each list's first z entries; 0: no stash); w unused.
+    // each list's first z entries; 0: no stash); w = index of the first depth
+    // bin word (after the row masks).
     uvec4 bins;
+    // Depth bins: the bin coordinate of view depth d is (log2(d) - x) * y for
+    // log slices (z = 1), (d - x) * y for linear ones (z = 0); bin s takes
+    // coordinates [s, s + 1), the first and the last bin reach to infinity.
+    // w unused.
+    vec4 depthBins;
 };
 
 // One light as the culling passes read it (std430, 16 bytes per light; binding
@@ -111,12 +120,13 @@ struct GpuTileBounds {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(GpuCullParams) == 96, "GpuCullParams must match std430");
+static_assert(sizeof(GpuCullParams) == 112, "GpuCullParams must match std430");
 static_assert(offsetof(GpuCullParams, counts) == 16, "GpuCullParams.counts offset");
 static_assert(offsetof(GpuCullParams, depth) == 32, "GpuCullParams.depth offset");
 static_assert(offsetof(GpuCullParams, lens) == 48, "GpuCullParams.lens offset");
 static_assert(offsetof(GpuCullParams, cluster) == 64, "GpuCullParams.cluster offset");
 static_assert(offsetof(GpuCullParams, bins) == 80, "GpuCullParams.bins offset");
+static_assert(offsetof(GpuCullParams, depthBins) == 96, "GpuCullParams.depthBins offset");
 static_assert(sizeof(GpuLight) == 16, "GpuLight must match std430");
 static_assert(sizeof(GpuSpotCone) == 48, "GpuSpotCone must match std430");
 static_assert(offsetof(GpuSpotCone, axisCos) == 16, "GpuSpotCone.axisCos offset");

@@ -51,6 +51,8 @@ constexpr float kRelEps = 2e-5f;
 constexpr float kAbsEps = 1e-6f;
 
 constexpr std::uint32_t kBindings = 11; // cull_common.glsl bindings 0..10
+constexpr std::uint32_t kSpecConstants = 10; // cull_common.glsl constant_id 0..9
+using SpecConstants = std::array<std::uint32_t, kSpecConstants>;
 enum Binding : std::uint32_t { bParams, bDepth, bTiles, bLights, bCounts, bOffsets, bIndices, bStatus, bBins };
 // Stash slots per list at most (cull_common.glsl binding 10): the count pass
 // keeps each list's first entries, so a cull whose lists all fit needs no
@@ -186,6 +188,23 @@ void computeBarrier(VkCommandBuffer cmd, VkAccessFlags dstAccess, VkPipelineStag
 
 // Window depth d = A + B / v (perspective) or A + B * v (orthographic), with A
 // and B recovered in double from the projection itself (two exact samples).
+// GpuCullParams.depthBins: LC_DEPTH_BINS slices of the lights' depth extent
+// [lightNear, lightFar] (view depth). Log slices when the camera is a
+// perspective one and the extent spans more than a doubling from the near
+// plane on (every bin then covers the same ratio of depths, as a tile's
+// depth range does at any distance), else linear ones; a flat extent gets
+// scale 0 (every depth in bin 0, every light in every bin: no filtering).
+glm::vec4 depthBinSlicing(const Projection& proj, double camNear, double lightNear, double lightFar) {
+    const double bins = LC_DEPTH_BINS;
+    if (!proj.orthographic()) {
+        const double lo = std::max(lightNear, camNear);
+        if (lo > 0 && lightFar > 2 * lo)
+            return glm::vec4(float(std::log2(lo)), float(bins / std::log2(lightFar / lo)), 1.0f, 0.0f);
+    }
+    if (!(lightFar > lightNear) || !std::isfinite(lightFar - lightNear)) return glm::vec4(0.0f);
+    return glm::vec4(float(lightNear), float(bins / (lightFar - lightNear)), 0.0f, 0.0f);
+}
+
 void depthConstants(const Projection& proj, double& a, double& b) {
     const double v1 = proj.nearPlane(), v2 = proj.orthographic() ? proj.nearPlane() + 1.0 : 2.0 * proj.nearPlane();
     const double d1 = proj.windowDepthFromViewDepth(v1), d2 = proj.windowDepthFromViewDepth(v2);
@@ -232,7 +251,7 @@ private:
     void createComputeObjects();
     // `oneSubgroup`: the local size is the subgroup size and the pass relies on
     // the workgroup being one subgroup (REQUIRE_FULL_SUBGROUPS where supported).
-    VkPipeline computePipeline(const char* what, VkShaderModule module, const std::array<std::uint32_t, 8>& spec,
+    VkPipeline computePipeline(const char* what, VkShaderModule module, const SpecConstants& spec,
                                bool oneSubgroup);
     VkPipeline depthPipeline(bool reversed);
     VkRenderPass depthRenderPass(bool reversed);
@@ -240,7 +259,7 @@ private:
     Context ctx_;
     DescriptorSetLayoutHandle setLayout_;
     PipelineLayoutHandle computeLayout_;
-    ShaderModuleHandle boundsShader_, boundsPairsShader_, binsShader_, cullShader_, scanShader_, vertShader_;
+    ShaderModuleHandle boundsShader_, boundsWideShader_, binsShader_, cullShader_, scanShader_, vertShader_;
     double lastCullWallMs_ = -1;
     std::uint32_t lastLongestList_ = 0; // of the previous cull: sizes a CPU device's stash
     std::map<std::string, PipelineHandle> computePipelines_;
@@ -257,7 +276,7 @@ void VulkanBackend::createComputeObjects() {
 
     auto mk = [&](spirv::Code c, const char* n) { return ctx_.createShader(c.words, c.wordCount, n); };
     boundsShader_ = mk(spirv::tileBounds(), "shader.tile_bounds");
-    if (ctx_.int64Supported()) boundsPairsShader_ = mk(spirv::tileBoundsPairs(), "shader.tile_bounds_pairs");
+    if (ctx_.int64Supported()) boundsWideShader_ = mk(spirv::tileBoundsWide(), "shader.tile_bounds_wide");
     binsShader_ = mk(spirv::lightBins(), "shader.light_bins");
     cullShader_ = mk(spirv::cullLists(), "shader.cull_lists");
     scanShader_ = mk(spirv::prefixSum(), "shader.prefix_sum");
@@ -265,18 +284,19 @@ void VulkanBackend::createComputeObjects() {
 }
 
 // Specialisation constants, ids as in cull_common.glsl: 0 local size, 1 tile
-// size, 2 cells, 3 slicing, 4 algorithm, 5 sphere test, 6 write pass, and
-// tile_bounds.comp's 7 lanes per tile. Pipelines are cached per combination.
+// size, 2 cells, 3 slicing, 4 algorithm, 5 sphere test, 6 write pass, 7 lanes
+// per tile or list, 8 pixels per depth load, 9 depth bins. Pipelines are
+// cached per combination.
 VkPipeline VulkanBackend::computePipeline(const char* what, VkShaderModule module,
-                                          const std::array<std::uint32_t, 8>& spec, bool oneSubgroup) {
+                                          const SpecConstants& spec, bool oneSubgroup) {
     std::string key = what;
     for (auto v : spec) key += "." + std::to_string(v);
     auto it = computePipelines_.find(key);
     if (it != computePipelines_.end()) return it->second;
-    std::array<VkSpecializationMapEntry, 8> entries{};
-    for (std::uint32_t i = 0; i < 8; ++i) entries[i] = {i, i * 4u, 4u};
+    std::array<VkSpecializationMapEntry, kSpecConstants> entries{};
+    for (std::uint32_t i = 0; i < kSpecConstants; ++i) entries[i] = {i, i * 4u, 4u};
     VkSpecializationInfo si{};
-    si.mapEntryCount = 8;
+    si.mapEntryCount = kSpecConstants;
     si.pMapEntries = entries.data();
     si.dataSize = sizeof(spec);
     si.pData = spec.data();
@@ -597,18 +617,26 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const std::uint32_t stashSlots =
         algo == Algorithm::All ? 0
                                : std::uint32_t(std::min<std::uint64_t>(maxStashSlots, depth.depth.size() / listTotal64));
-    // Light bins: one bit per light per tile column and per tile row.
-    const std::uint32_t binWords = (n + 31) / 32;
-    const std::uint64_t binTotal64 = std::uint64_t(binWords) * (grid.tilesX + grid.tilesY);
+    // Light bins: one bit per light per tile column and per tile row, then
+    // per depth bin twice (near ends, far ends; light_bins.comp). `naive`
+    // spans every light's depth and `all` tests nothing: no depth bins.
+    const bool depthBins = algo != Algorithm::All && algo != Algorithm::Naive && n > 0;
+    // Words per column, row or depth bin: a bit per light, padded to whole
+    // uvec4s (cull_lists.comp reads four words a load on a CPU device).
+    const std::uint32_t binWords = (n + 127) / 128 * 4;
+    const std::uint64_t planeBinWords = std::uint64_t(binWords) * (grid.tilesX + grid.tilesY);
+    const std::uint64_t depthBinWords = depthBins ? std::uint64_t(binWords) * LC_DEPTH_BINS : 0;
+    const std::uint64_t binTotal64 = planeBinWords + 2 * depthBinWords;
     if (binTotal64 * 4 > lim.maxStorageBufferRange)
         throw SettingsError("lights", "too many lights for the light bins of this device");
 
     // The depth ranges of naive and clustered, exactly as the CPU reference.
-    double lightFar = 0.0;
+    double lightFar = 0.0, lightNear = kInf;
     std::vector<BoundingSphere> cullSpheres(n); // range spheres, or each spot test's sphere
     for (std::size_t l = 0; l < n; ++l) {
         cullSpheres[l] = lights.cullSphere(l, settings.spotTest);
         lightFar = std::max(lightFar, -cullSpheres[l].center.z + cullSpheres[l].radius);
+        lightNear = std::min(lightNear, -cullSpheres[l].center.z - cullSpheres[l].radius);
     }
     const double camNear = proj.nearPlane();
     const bool farInfinite = !std::isfinite(proj.farPlane());
@@ -637,7 +665,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         const glm::dvec3 corner = proj.viewPositionAt({double(proj.width()), 0.0}, 1.0);
         p.lens = glm::vec4(float(corner.x), float(corner.y), float(camNear), float(naiveFar));
         p.cluster = glm::vec4(float(res.clusterNear), float(res.clusterFar), kRelEps, kAbsEps);
-        p.bins = glm::uvec4(binWords, binWords * grid.tilesX, stashSlots, 0);
+        p.bins = glm::uvec4(binWords, binWords * grid.tilesX, stashSlots, std::uint32_t(planeBinWords));
+        p.depthBins = depthBinSlicing(proj, camNear, lightNear, lightFar);
     }
     std::vector<GpuLight> gpuLights(n);
     for (std::uint32_t l = 0; l < n; ++l)
@@ -725,9 +754,10 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const std::uint32_t sg = ctx_.subgroupSize();
     const std::uint32_t algoId = std::uint32_t(algo), testId = std::uint32_t(settings.test),
                         slicingId = std::uint32_t(settings.slicing);
-    auto spec = [&](std::uint32_t local, std::uint32_t write, std::uint32_t lanesPerTile = 1) {
-        return std::array<std::uint32_t, 8>{local, grid.tileSize, cells, slicingId, algoId, testId, write,
-                                            lanesPerTile};
+    auto spec = [&](std::uint32_t local, std::uint32_t write, std::uint32_t lanesPerTile = 1,
+                    std::uint32_t depthLoad = 2) {
+        return SpecConstants{local, grid.tileSize, cells,        slicingId, algoId, testId,
+                             write, lanesPerTile,  depthLoad, depthBins ? 1u : 0u};
     };
     // Work layout per device kind (the LANES constant): on a CPU device
     // (lavapipe) an invocation per tile and per list, so SIMD lanes are tiles /
@@ -753,12 +783,15 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                                           ": the driver caps a shader invocation at 65,535 loop iterations)");
     const bool subgroupLanes = lanes > 1;
     const std::uint32_t itemsPerGroup = kLocal / lanes;
-    // Pixel pairs (tile_bounds.comp, LC_DEPTH_PAIRS): an invocation per tile,
-    // even widths and tile sizes, so every tile row starts on a pair.
-    const bool depthPairs = ctx_.int64Supported() && lanes == 1 && grid.width % 2 == 0 && grid.tileSize % 2 == 0;
+    // Wide depth loads (tile_bounds.comp, LC_WIDE_DEPTH_LOADS): an invocation
+    // per tile, 8 or 2 pixels a load where the width and the tile size are
+    // multiples of it, so every tile row starts on a whole load.
+    auto loadsOf = [&](std::uint32_t px) { return grid.width % px == 0 && grid.tileSize % px == 0; };
+    const std::uint32_t depthLoad =
+        !ctx_.int64Supported() || lanes != 1 ? 1 : loadsOf(8) ? 8 : loadsOf(2) ? 2 : 1;
     VkPipeline boundsPipe =
-        depthPairs ? computePipeline("tile_bounds.pairs", boundsPairsShader_, spec(kLocal, 0, lanes), false)
-                   : computePipeline("tile_bounds", boundsShader_, spec(kLocal, 0, lanes), subgroupLanes);
+        depthLoad > 1 ? computePipeline("tile_bounds.wide", boundsWideShader_, spec(kLocal, 0, lanes, depthLoad), false)
+                      : computePipeline("tile_bounds", boundsShader_, spec(kLocal, 0, lanes), subgroupLanes);
     const Grid boundsGroups = Grid{(grid.tilesX + itemsPerGroup - 1) / itemsPerGroup, grid.tilesY};
     VkPipeline binsPipe = computePipeline("light_bins", binsShader_, spec(kLocal, 0), false);
     VkPipeline countPipe = computePipeline("cull_lists.count", cullShader_, spec(kLocal, 0, lanes), subgroupLanes);
@@ -770,7 +803,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         wideScan ? std::min({1024u, lim.maxComputeWorkGroupInvocations, lim.maxComputeWorkGroupSize[0], 128 * sg}) : sg;
     VkPipeline scanPipe = computePipeline("prefix_sum", scanShader_, spec(scanLocal, 0, wideScan ? sg : 1), true);
     const bool all = algo == Algorithm::All;
-    const Grid binGroups = groupsFor(binTotal64, lim);
+    // One bins invocation per plane word and per pair of depth-bin words.
+    const Grid binGroups = groupsFor(planeBinWords + depthBinWords, lim);
     const Grid countGroups = groupsFor(all ? 1 : std::uint64_t(listTotal) * lanes, lim);
     const Grid writeGroups = groupsFor(all ? n : std::uint64_t(listTotal) * lanes, lim);
 
