@@ -22,6 +22,11 @@
 #extension GL_GOOGLE_include_directive : require
 #include "cull_common.glsl"
 
+// A light's radius as the bins take it: twice the chunk test's widening, as
+// the two evaluations of the same distance may round differently
+// (contraction), never by 2e-5.
+float binRadius(vec4 L) { return widenedRadius(L) + (length(L.xyz) + L.w) * P.cluster.z; }
+
 void main() {
     loadParams();
     uint idx = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
@@ -38,7 +43,7 @@ void main() {
         float binF = float(bin);
         for (uint i = first; i < end; ++i) {
             vec4 L = lights[i].centerRadius;
-            float r = widenedRadius(L) + (length(L.xyz) + L.w) * P.cluster.z;
+            float r = binRadius(L);
             float depth = -L.z;
             if (depthBinCoord(depth - r) - DEPTH_BIN_MARGIN < binF + 1.0) nearMask |= 1u << (i - first);
             if (depthBinCoord(depth + r) + DEPTH_BIN_MARGIN >= binF) farMask |= 1u << (i - first);
@@ -63,9 +68,7 @@ void main() {
     uint mask = 0u;
     for (uint i = first; i < end; ++i) {
         vec4 L = lights[i].centerRadius;
-        // Twice the chunk test's widening: the two evaluations of the same
-        // plane distance may round differently (contraction), never by 2e-5.
-        float r = widenedRadius(L) + (length(L.xyz) + L.w) * P.cluster.z;
+        float r = binRadius(L);
         float da = dot(a.xyz, L.xyz) + a.w, db = dot(b.xyz, L.xyz) + b.w;
         if (da >= -r && db >= -r) mask |= 1u << (i - first);
     }

@@ -81,9 +81,10 @@ struct GpuCullParams {
     // bounds and radii are widened so the GPU lists are a superset of the
     // double-precision reference's.
     vec4 cluster;
-    // Light binning (light_bins.comp): x = mask words per column/row (one bit
-    // per light: ceil(lightCount / 32)), y = index of the first row mask in the
-    // bin buffer (= x * tilesX); z = stash slots per list (the count pass keeps
+    // Light binning (light_bins.comp): x = mask words per bin (one bit per
+    // light, padded to a multiple of 4: ceil(lightCount / 128) x 4), y = index
+    // of the first row mask in the bin buffer (= x * tilesX); z = stash slots
+    // per list (the count pass keeps
     // each list's first z entries; 0: no stash); w = index of the first depth
     // bin word (after the row masks).
     uvec4 bins;

@@ -186,8 +186,6 @@ void computeBarrier(VkCommandBuffer cmd, VkAccessFlags dstAccess, VkPipelineStag
                          nullptr);
 }
 
-// Window depth d = A + B / v (perspective) or A + B * v (orthographic), with A
-// and B recovered in double from the projection itself (two exact samples).
 // GpuCullParams.depthBins: LC_DEPTH_BINS slices of the lights' depth extent
 // [lightNear, lightFar] (view depth). Log slices when the camera is a
 // perspective one and the extent spans more than a doubling from the near
@@ -205,6 +203,8 @@ glm::vec4 depthBinSlicing(const Projection& proj, double camNear, double lightNe
     return glm::vec4(float(lightNear), float(bins / (lightFar - lightNear)), 0.0f, 0.0f);
 }
 
+// Window depth d = A + B / v (perspective) or A + B * v (orthographic), with A
+// and B recovered in double from the projection itself (two exact samples).
 void depthConstants(const Projection& proj, double& a, double& b) {
     const double v1 = proj.nearPlane(), v2 = proj.orthographic() ? proj.nearPlane() + 1.0 : 2.0 * proj.nearPlane();
     const double d1 = proj.windowDepthFromViewDepth(v1), d2 = proj.windowDepthFromViewDepth(v2);
