@@ -9,6 +9,8 @@ PACKAGES=(
   cmake ninja-build g++ pkg-config git
   # culling core
   libglm-dev libopenmesh-dev nlohmann-json3-dev libcli11-dev libpng-dev
+  # glTF 2.0 scenes (tinygltf's header, compiled into the library)
+  libtinygltf-dev
   # Vulkan: headers, loader, lavapipe, shader compiler, validation in tests
   libvulkan-dev mesa-vulkan-drivers glslang-tools glslang-dev spirv-tools
   vulkan-validationlayers

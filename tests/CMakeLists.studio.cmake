@@ -31,4 +31,6 @@ endfunction()
 lc_add_studio_tests(ui ui 300)
 # The overlays test reads overlays.vtm back with VTK's own XML reader.
 target_link_libraries(ui_test_overlays PRIVATE VTK::IOXML)
+# The glTF test reads our files back with VTK's own importer as a second reader.
+target_link_libraries(ui_test_gltf_studio PRIVATE VTK::IOImport)
 lc_add_studio_tests(render render 300)

@@ -25,6 +25,7 @@
 #include <QDragEnterEvent>
 #include <QDropEvent>
 #include <QFileDialog>
+#include <QInputDialog>
 #include <QFileInfo>
 #include <QLabel>
 #include <QLineEdit>
@@ -71,6 +72,13 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     };
     prompts.savePath = [](QWidget* parent, const QString& caption, const QString& filter) {
         return QFileDialog::getSaveFileName(parent, caption, {}, filter);
+    };
+    prompts.askNumber = [](QWidget* parent, const QString& title, const QString& label, double min, double max,
+                           double& value) {
+        bool ok = false;
+        const double v = QInputDialog::getDouble(parent, title, label, value, min, max, 6, &ok);
+        if (ok) value = v;
+        return ok;
     };
 
     // Views: side by side in a splitter; "tabbed" shows one at a time through
@@ -182,21 +190,31 @@ void MainWindow::buildActions() {
     };
     connect(make(tr("&New"), "actionNew", QKeySequence::New), &QAction::triggered, this, [this] { newScene(); });
     connect(make(tr("&Open scene..."), "actionOpen", QKeySequence::Open), &QAction::triggered, this, [this] {
-        const QString p = prompts.openPath(this, tr("Open scene"), tr("Scene (*.json)"));
+        const QString p = prompts.openPath(this, tr("Open scene"),
+                                           tr("Scenes (*.json *.gltf *.glb);;Scene JSON (*.json);;glTF 2.0 (*.gltf *.glb)"));
         if (!p.isEmpty()) openSceneFile(p);
     });
     connect(make(tr("&Import mesh..."), "actionImport", QKeySequence(tr("Ctrl+I"))), &QAction::triggered, this,
             [this] {
                 const QString p = prompts.openPath(this, tr("Import mesh"),
-                                                   tr("Meshes (*.obj *.ply *.off *.stl *.om)"));
+                                                   tr("Meshes (*.obj *.ply *.off *.stl *.om *.gltf *.glb)"));
                 if (!p.isEmpty()) importMeshFile(p);
             });
     connect(make(tr("&Save"), "actionSave", QKeySequence::Save), &QAction::triggered, this, [this] { save(); });
     connect(make(tr("Save &as..."), "actionSaveAs", QKeySequence::SaveAs), &QAction::triggered, this, [this] {
-        const QString p = prompts.savePath(this, tr("Save scene as"), tr("Scene (*.json)"));
+        const QString p = prompts.savePath(this, tr("Save scene as"),
+                                           tr("Scene JSON (*.json);;Binary glTF (*.glb);;glTF 2.0 (*.gltf)"));
         if (!p.isEmpty()) saveAs(p);
     });
     connect(make(tr("&Quit"), "actionQuit", QKeySequence::Quit), &QAction::triggered, this, &QWidget::close);
+    connect(make(tr("glTF light &cut-off..."), "actionGltfCutoff"), &QAction::triggered, this, [this] {
+        double v = gltfOptions.minIntensity;
+        if (prompts.askNumber(this, tr("glTF light cut-off"),
+                              tr("I_min (lux) for glTF lights without a range:\nradius = sqrt(intensity x colour / "
+                                 "I_min). Applies to the next glTF opened."),
+                              1e-6, 1e6, v))
+            setGltfMinIntensity(v);
+    });
 
     QAction* undo = doc_->undoStack()->createUndoAction(this, tr("&Undo"));
     undo->setObjectName("actionUndo");
@@ -252,6 +270,7 @@ void MainWindow::buildMenus() {
         connect(a, &QAction::triggered, this, [this, name] { openBuiltin(name); });
     }
     file->addAction(action("actionImport"));
+    file->addAction(action("actionGltfCutoff"));
     file->addSeparator();
     file->addAction(action("actionSave"));
     file->addAction(action("actionSaveAs"));
@@ -568,11 +587,20 @@ bool MainWindow::openBuiltin(const QString& name) {
 bool MainWindow::openSceneFile(const QString& path) {
     if (!maybeSave()) return false;
     const std::string p = path.toStdString();
+    lc::GltfReadReport gltfReport;
     try {
         lc::Scene s = runWithProgressResult<lc::Scene>(
             this, tr("Loading %1...").arg(QFileInfo(path).fileName()),
-            [p](const lc::CancelToken& c, const lc::Progress& pr) { return lc::loadSceneFile(p, &c, pr); });
+            [p, o = gltfOptions, &gltfReport](const lc::CancelToken& c, const lc::Progress& pr) {
+                return lc::loadSceneAny(p, o, &gltfReport, &c, pr);
+            });
         doc_->resetScene(std::move(s), path);
+        for (const std::string& w : gltfReport.warnings) log(QString::fromStdString(w), true);
+        if (lc::isGltfPath(p))
+            log(tr("%1: %2 lights, camera: %3")
+                    .arg(path)
+                    .arg(doc_->scene().lights.size())
+                    .arg(QString::fromStdString(gltfReport.camera)));
     } catch (const lc::Cancelled&) {
         log(tr("loading %1 cancelled").arg(path));
         return false;
@@ -614,7 +642,8 @@ bool MainWindow::importMeshFile(const QString& path) {
 
 bool MainWindow::save() {
     if (doc_->filePath().isEmpty()) {
-        const QString p = prompts.savePath(this, tr("Save scene"), tr("Scene (*.json)"));
+        const QString p = prompts.savePath(this, tr("Save scene"),
+                                           tr("Scene JSON (*.json);;Binary glTF (*.glb);;glTF 2.0 (*.gltf)"));
         return !p.isEmpty() && saveAs(p);
     }
     return saveAs(doc_->filePath());
@@ -622,7 +651,7 @@ bool MainWindow::save() {
 
 bool MainWindow::saveAs(const QString& path) {
     try {
-        lc::saveSceneFile(doc_->scene(), path.toStdString());
+        lc::saveSceneAny(doc_->scene(), path.toStdString()); // .gltf/.glb as glTF, else scene JSON
     } catch (const std::exception& e) {
         log(tr("cannot save %1: %2").arg(path, describe(e)), true);
         prompts.showError(this, tr("Save scene"), describe(e));
@@ -751,8 +780,19 @@ void MainWindow::setTabbedViews(bool tabbed) {
     }
 }
 
+void MainWindow::setGltfMinIntensity(double lux) {
+    if (!(lux > 0.0) || !std::isfinite(lux)) return;
+    gltfOptions.minIntensity = lux;
+    QSettings().setValue("gltf/minIntensity", lux);
+    log(tr("glTF light cut-off I_min = %1 lux (for the next glTF opened)").arg(lux));
+}
+
 void MainWindow::restoreSettings() {
     QSettings st;
+    {
+        const double lux = st.value("gltf/minIntensity", lc::kGltfDefaultMinIntensity).toDouble();
+        if (lux > 0.0 && std::isfinite(lux)) gltfOptions.minIntensity = lux;
+    }
     restoreGeometry(st.value("window/geometry").toByteArray());
     restoreState(st.value("window/state").toByteArray());
     viewSplitter_->restoreState(st.value("window/splitter").toByteArray());
@@ -814,7 +854,8 @@ void MainWindow::dropEvent(QDropEvent* e) {
     for (const QUrl& url : e->mimeData()->urls()) {
         if (!url.isLocalFile()) continue;
         const QString f = url.toLocalFile();
-        if (f.endsWith(".json", Qt::CaseInsensitive)) openSceneFile(f);
+        // Scene files (with lights and a camera) open; meshes are imported.
+        if (f.endsWith(".json", Qt::CaseInsensitive) || lc::isGltfPath(f.toStdString())) openSceneFile(f);
         else importMeshFile(f);
     }
     e->acceptProposedAction();

@@ -9,6 +9,8 @@
 #include "culling/params.hpp"
 #include "culling/scene_io.hpp"
 
+#include "culling/gltf_io.hpp"
+
 #include <QMainWindow>
 #include <QMessageBox>
 
@@ -47,6 +49,9 @@ struct Prompts {
     // File dialogs; an empty string means cancelled.
     std::function<QString(QWidget*, const QString& caption, const QString& filter)> openPath;
     std::function<QString(QWidget*, const QString& caption, const QString& filter)> savePath;
+    // A number in [min, max]; false when cancelled.
+    std::function<bool(QWidget*, const QString& title, const QString& label, double min, double max, double& value)>
+        askNumber;
 };
 
 class MainWindow : public QMainWindow {
@@ -67,6 +72,11 @@ public:
     Prompts prompts;
     // Opening a scene runs culling once (tests turn this off to set up first).
     bool runOnOpen = true;
+    // How glTF scenes are read: I_min of lights without `range` (File > glTF
+    // light cut-off..., kept in the settings) and the camera (empty: the
+    // file's first).
+    lc::GltfReadOptions gltfOptions;
+    void setGltfMinIntensity(double lux);
 
     // --- file operations (return false on failure or cancel; the current
     // scene is then untouched and the error is logged and shown) -------------

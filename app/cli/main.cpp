@@ -1,10 +1,13 @@
 // lightcull: the command-line front end of the culling library.
 //
 //   lightcull scenes
-//   lightcull run (--scene FILE.json | --builtin NAME) [culling flags] [--lights N [--seed S]]
+//   lightcull run (--scene FILE | --builtin NAME) [culling flags] [--lights N [--seed S]]
 //                 [--backend cpu|vulkan] [--device D] [--no-image-error] --out DIR
-//   lightcull bench (--scene FILE.json | --builtin NAME) [run flags] [--repeat N] [--warmup N]
+//   lightcull bench (--scene FILE | --builtin NAME) [run flags] [--repeat N] [--warmup N]
 //                   [--sweep KEY=V1,V2,...]... [--json FILE]
+//   lightcull convert IN OUT        (IN: scene JSON, .gltf, .glb; OUT by extension: .json, .gltf, .glb)
+//
+// FILE is scene JSON, .gltf or .glb (with --camera and --min-intensity for glTF).
 //
 // The culling flags are generated from lc::cullParams(), the one parameter
 // table (see docs/CLI.md). Errors print one line on stderr and exit non-zero:
@@ -17,6 +20,7 @@
 #include "culling/pipeline.hpp"
 #include "culling/scene_io.hpp"
 #include "report.hpp"
+#include "scene_source.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -98,7 +102,8 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
 // Flags shared by `run` and `bench`: the scene, the culling parameters (from
 // the one table), generated lights and the backend.
 struct SceneFlags {
-    std::string sceneFile, builtin, backendName, device;
+    lcli::SceneSource source;
+    std::string backendName, device;
     long long lightCount = -1;
     unsigned long long seed = 1;
     double spotFraction = 0.0;
@@ -107,11 +112,7 @@ struct SceneFlags {
     CLI::Option* optLights = nullptr;
 
     void addTo(CLI::App* cmd) {
-        CLI::Option* optScene =
-            cmd->add_option("--scene", sceneFile, "Scene JSON file to load")->type_name("FILE.json");
-        CLI::Option* optBuiltin = cmd->add_option("--builtin", builtin, "Built-in scene to use (see `lightcull scenes`)")
-                                      ->type_name("NAME");
-        optScene->excludes(optBuiltin);
+        source.addTo(cmd);
         // One flag per culling parameter, straight from the parameter table.
         for (const lc::ParamSpec& p : lc::cullParams()) {
             CLI::Option* o = cmd->add_option("--" + p.name, paramValues[p.name], paramDescription(p));
@@ -139,10 +140,10 @@ struct SceneFlags {
             ->type_name("D");
     }
 
-    bool hasScene() const { return !sceneFile.empty() || !builtin.empty(); }
+    bool hasScene() const { return source.given(); }
 
     lc::Scene loadScene() const {
-        lc::Scene scene = sceneFile.empty() ? lc::makeBuiltinScene(builtin) : lc::loadSceneFile(sceneFile);
+        lc::Scene scene = source.load();
         if (optLights->count()) replaceLights(scene, lightCount);
         return scene;
     }
@@ -384,10 +385,20 @@ int main(int argc, char** argv) {
     lcli::ReportCommand report;
     report.add(app);
 
+    CLI::App* convert = app.add_subcommand(
+        "convert", "Convert a scene between scene JSON, glTF 2.0 (.gltf) and binary glTF (.glb), by extension; "
+                   "the output is written atomically");
+    lcli::SceneSource convertIn;
+    convertIn.addTo(convert, true);
+    std::string convertOut;
+    convert->add_option("out", convertOut, "File to write: .json, .gltf or .glb")->type_name("OUT")->required();
+
     // CLI11 reports a missing subcommand before an unknown word; name the word.
     if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "scenes" && std::string(argv[1]) != "run" &&
-        std::string(argv[1]) != "bench" && std::string(argv[1]) != "report")
-        return fail(2, std::string("unknown command '") + argv[1] + "' (commands: scenes, run, bench, report; see --help)");
+        std::string(argv[1]) != "bench" && std::string(argv[1]) != "report" &&
+        std::string(argv[1]) != "convert")
+        return fail(2, std::string("unknown command '") + argv[1] +
+                           "' (commands: scenes, run, bench, report, convert; see --help)");
 
     try {
         app.parse(argc, argv);
@@ -407,13 +418,22 @@ int main(int argc, char** argv) {
         }
 
         if (app.got_subcommand("bench")) {
-            if (!benchFlags.hasScene()) return fail(2, "bench: give --scene FILE.json or --builtin NAME");
+            if (!benchFlags.hasScene()) return fail(2, "bench: give --scene FILE or --builtin NAME");
             return runBench(benchFlags, benchOptions);
         }
 
         if (report.chosen()) return report.run();
 
-        if (!runFlags.hasScene()) return fail(2, "run: give --scene FILE.json or --builtin NAME");
+        if (app.got_subcommand("convert")) {
+            const lc::Scene scene = convertIn.load();
+            lc::saveSceneAny(scene, convertOut);
+            std::cout << "wrote " << convertOut << ": " << scene.triangleCount() << " triangles, " << scene.lights.size()
+                      << " lights, camera " << lc::toString(scene.camera.projection) << " " << scene.camera.width << "x"
+                      << scene.camera.height << "\n";
+            return 0;
+        }
+
+        if (!runFlags.hasScene()) return fail(2, "run: give --scene FILE or --builtin NAME");
         {
             // Fail before the (possibly long) run when the output cannot be written.
             namespace fs = std::filesystem;

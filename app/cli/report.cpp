@@ -36,10 +36,7 @@ void ReportCommand::add(CLI::App& app) {
     cmd_ = app.add_subcommand(
         "report", "Sweep algorithm x tile size x cells x slicing x sphere test (every culling parameter that "
                   "applies) on every backend; write report.csv, report.md and pareto.png into --out DIR");
-    CLI::Option* optScene = cmd_->add_option("--scene", sceneFile_, "Scene JSON file to load")->type_name("FILE.json");
-    CLI::Option* optBuiltin =
-        cmd_->add_option("--builtin", builtin_, "Built-in scene to use (see `lightcull scenes`)")->type_name("NAME");
-    optScene->excludes(optBuiltin);
+    source_.addTo(cmd_);
     optLights_ = cmd_->add_option("--lights", lights_,
                                   "Replace the scene's lights with N generated ones (deterministic)")
                      ->type_name("N");
@@ -74,7 +71,7 @@ void ReportCommand::add(CLI::App& app) {
 }
 
 int ReportCommand::run() {
-    if (sceneFile_.empty() && builtin_.empty()) return usage("report: give --scene FILE.json or --builtin NAME");
+    if (!source_.given()) return usage("report: give --scene FILE or --builtin NAME");
     {
         namespace fs = std::filesystem;
         fs::path target = fs::path(outDir_).lexically_normal();
@@ -86,7 +83,7 @@ int ReportCommand::run() {
             return usage("--out: parent folder " + parent.string() + " of " + outDir_ + " does not exist");
     }
 
-    lc::Scene scene = sceneFile_.empty() ? lc::makeBuiltinScene(builtin_) : lc::loadSceneFile(sceneFile_);
+    lc::Scene scene = source_.load();
     if (optLights_->count()) {
         if (lights_ < 0 || lights_ > 1000000)
             throw lc::SettingsError("lights", "must be in 0..1000000, got " + std::to_string(lights_));

@@ -1,6 +1,8 @@
 #pragma once
 // `lightcull report`: the speed-against-error sweep (culling/report.hpp) of
 // one scene, written as report.csv, report.md and pareto.png.
+#include "scene_source.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <map>
@@ -20,7 +22,8 @@ public:
 
 private:
     CLI::App* cmd_ = nullptr;
-    std::string sceneFile_, builtin_, outDir_, device_;
+    SceneSource source_;
+    std::string outDir_, device_;
     std::vector<std::string> backends_;
     long long lights_ = -1;
     unsigned long long seed_ = 1;

@@ -21,6 +21,7 @@
 #include "mesh_readers.hpp"
 
 #include "culling/errors.hpp"
+#include "culling/gltf_io.hpp"
 #include "culling/scene_io.hpp"
 
 #include <OpenMesh/Core/IO/IOManager.hh>
@@ -434,10 +435,21 @@ Mesh loadMesh(const std::string& path, MeshLoadReport* report, const CancelToken
               const Progress& progress) {
     namespace fs = std::filesystem;
     const std::string ext = lowerExtension(path);
-    static const char* kFormats[] = {"obj", "ply", "off", "stl", "om"};
+    static const char* kFormats[] = {"obj", "ply", "off", "stl", "om", "gltf", "glb"};
     if (std::find(std::begin(kFormats), std::end(kFormats), ext) == std::end(kFormats))
         throw InputError(path, "", 0,
-                         "unsupported mesh format '" + ext + "' (use obj, ply, off, stl or om)");
+                         "unsupported mesh format '" + ext + "' (use obj, ply, off, stl, om, gltf or glb)");
+    if (ext == "gltf" || ext == "glb") {
+        // The geometry of the file's default scene, flattened to world space.
+        GltfReadReport gr;
+        Mesh m = loadGltfMesh(path, &gr, cancel, progress);
+        if (report) {
+            *report = MeshLoadReport{};
+            report->degenerateFacesDropped = gr.degenerateTrianglesDropped;
+            for (const std::string& w : gr.warnings) report->warning += (report->warning.empty() ? "" : "\n") + w;
+        }
+        return m;
+    }
 
     std::error_code ec;
     if (!fs::exists(path, ec)) throw InputError(path, "", 0, "file not found");

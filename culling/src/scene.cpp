@@ -77,6 +77,8 @@ std::string PointLight::validate() const {
         if (glm::length(direction) == 0.0) return "direction: must not be zero";
         if (!std::isfinite(outerAngleDeg) || !(outerAngleDeg > 0.0) || outerAngleDeg > 90.0)
             return "outer_angle_deg: must be in (0, 90] degrees (got " + fmt(outerAngleDeg) + ")";
+        if (!std::isfinite(innerAngleDeg) || innerAngleDeg < 0.0 || innerAngleDeg > outerAngleDeg)
+            return "inner_angle_deg: must be in [0, outer_angle_deg] degrees (got " + fmt(innerAngleDeg) + ")";
     } else if (kind != LightKind::Point) {
         return "type: unknown light kind";
     }

@@ -360,7 +360,7 @@ PointLight readLight(const SceneReader& r, const json& v, std::size_t i) {
     const std::string p = SceneReader::at("lights", i);
     r.requireObject(v, p);
     r.checkKeys(v, p, {"name", "type", "position", "color", "intensity", "min_intensity", "radius",
-                       "direction", "outer_angle_deg"});
+                       "direction", "outer_angle_deg", "inner_angle_deg"});
     PointLight l;
     l.name = "light_" + std::to_string(i);
     if (const json* x = r.find(v, "name")) l.name = r.string(*x, SceneReader::at(p, "name"));
@@ -373,13 +373,14 @@ PointLight readLight(const SceneReader& r, const json& v, std::size_t i) {
     }
     // Spot fields on a point light are refused rather than ignored: a
     // forgotten "type": "spot" must not silently give a point light.
-    for (const char* key : {"direction", "outer_angle_deg"})
+    for (const char* key : {"direction", "outer_angle_deg", "inner_angle_deg"})
         if (!l.isSpot() && r.find(v, key))
             r.fail(SceneReader::at(p, key), "light '" + l.name + "': only spot lights have '" +
                                                 key + "' (add \"type\": \"spot\")");
     if (l.isSpot()) {
         l.direction = r.vec3(r.require(v, p, "direction"), SceneReader::at(p, "direction"));
         l.outerAngleDeg = r.number(r.require(v, p, "outer_angle_deg"), SceneReader::at(p, "outer_angle_deg"));
+        l.innerAngleDeg = r.numberOr(v, p, "inner_angle_deg", 0.0);
     }
     l.position = r.vec3(r.require(v, p, "position"), SceneReader::at(p, "position"));
     if (const json* x = r.find(v, "color")) l.color = r.vec3(*x, SceneReader::at(p, "color"));
@@ -577,6 +578,7 @@ std::string serializeScene(const Scene& scene, const std::string& baseDir) {
         if (l.isSpot()) {
             jl["direction"] = v3(l.direction);
             jl["outer_angle_deg"] = l.outerAngleDeg;
+            if (l.innerAngleDeg != 0.0) jl["inner_angle_deg"] = l.innerAngleDeg;
         }
         lights.push_back(std::move(jl));
     }

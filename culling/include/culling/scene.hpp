@@ -56,6 +56,10 @@ struct PointLight {
     LightKind kind = LightKind::Point;
     glm::dvec3 direction{0.0, -1.0, 0.0}; // spot: cone axis, world space, non-zero (normalised on use)
     double outerAngleDeg = 30.0;     // spot: half-angle of the cone, in (0, 90] degrees
+    // spot: half-angle where the falloff towards the outer angle starts, in
+    // [0, outer]. Kept for the shading and for glTF round trips; culling uses
+    // only the outer angle.
+    double innerAngleDeg = 0.0;
 
     bool isSpot() const { return kind == LightKind::Spot; }
     // Bounding-sphere radius in world units (a spot light's range).

@@ -1,0 +1,58 @@
+#pragma once
+// Where a CLI command's scene comes from: --scene FILE (scene JSON, .gltf or
+// .glb) or --builtin NAME, plus the glTF reading options. One definition
+// shared by run, bench, report and convert.
+#include "culling/gltf_io.hpp"
+#include "culling/scene_io.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <string>
+
+namespace lcli {
+
+struct SceneSource {
+    std::string sceneFile, builtin;
+    lc::GltfReadOptions gltf;
+
+    // Adds --scene and --builtin (or, with `positional`, the first positional
+    // argument IN), --camera and --min-intensity.
+    void addTo(CLI::App* cmd, bool positional = false) {
+        CLI::Option* optScene =
+            cmd->add_option(positional ? "in" : "--scene", sceneFile,
+                            "Scene to load: scene JSON, glTF 2.0 (.gltf) or binary glTF (.glb)")
+                ->type_name(positional ? "IN" : "FILE");
+        if (positional) {
+            optScene->required();
+        } else {
+            CLI::Option* optBuiltin =
+                cmd->add_option("--builtin", builtin, "Built-in scene to use (see `lightcull scenes`)")->type_name("NAME");
+            optScene->excludes(optBuiltin);
+        }
+        cmd->add_option("--camera", gltf.camera,
+                        "glTF: the culling camera, by camera or node name or by index into the file's cameras "
+                        "(default: the first camera in the scene's node order; none: one framing the scene)")
+            ->type_name("NAME|INDEX")
+            ->needs(optScene);
+        cmd->add_option("--min-intensity", gltf.minIntensity,
+                        "glTF: I_min in lux that sets the culling radius of a light without `range`, "
+                        "r = sqrt(intensity x max colour / I_min) (default: 0.01)")
+            ->type_name("LUX")
+            ->needs(optScene);
+    }
+
+    bool given() const { return !sceneFile.empty() || !builtin.empty(); }
+
+    // Loads it; glTF warnings go to stderr, one line each.
+    lc::Scene load() const {
+        if (sceneFile.empty()) return lc::makeBuiltinScene(builtin);
+        lc::GltfReadReport report;
+        lc::Scene s = lc::loadSceneAny(sceneFile, gltf, &report);
+        for (const std::string& w : report.warnings) std::cerr << "lightcull: warning: " << w << "\n";
+        if (lc::isGltfPath(sceneFile)) std::cerr << "lightcull: camera: " << report.camera << "\n";
+        return s;
+    }
+};
+
+} // namespace lcli

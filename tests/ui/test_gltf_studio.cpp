@@ -1,0 +1,259 @@
+// glTF in the studio, as a user gets there: File > Open and drag-and-drop of a
+// .glb (its lights culled through its own camera), a broken file that leaves
+// the scene being edited intact, Save As .glb, the light cut-off setting, and
+// an independent check of our reader and writer against VTK's own glTF
+// importer (triangles, bounds and light positions of the same file).
+
+#include "studio_test_support.hpp"
+
+#include "document.hpp"
+#include "main_window.hpp"
+
+#include "culling/gltf_io.hpp"
+#include "culling/pipeline.hpp"
+#include "culling/scene_io.hpp"
+
+#include <QAction>
+#include <QElapsedTimer>
+#include <QMessageBox>
+#include <QMimeData>
+#include <QPlainTextEdit>
+#include <QUndoStack>
+#include <QUrl>
+
+#include <vtkActor.h>
+#include <vtkActorCollection.h>
+#include <vtkGLTFImporter.h>
+#include <vtkLight.h>
+#include <vtkLightCollection.h>
+#include <vtkMapper.h>
+#include <vtkMatrix4x4.h>
+#include <vtkNew.h>
+#include <vtkPolyData.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+using namespace lcui;
+
+namespace {
+
+constexpr int kRunTimeoutMs = 120000;
+
+// The atrium with 48 lights (a third of them spots) at 320x180, as a glTF.
+lc::Scene smallAtrium() {
+    lc::Scene s = lc::makeBuiltinScene("atrium");
+    lc::LightGenSettings g = lc::defaultLightGen(s, 48, 5);
+    g.spotFraction = 0.33;
+    s.lights = lc::generateLights(g);
+    s.camera.width = 320;
+    s.camera.height = 180;
+    return s;
+}
+
+} // namespace
+
+class GltfStudioTest : public QObject {
+    Q_OBJECT
+    std::unique_ptr<MainWindow> w_;
+    QTemporaryDir tmp_;
+    Document* doc() const { return w_->document(); }
+
+    bool waitRun() {
+        QSignalSpy done(w_.get(), &MainWindow::runFinished);
+        QSignalSpy failed(w_.get(), &MainWindow::runFailed);
+        QElapsedTimer t;
+        t.start();
+        while (!doc()->runOutput() && failed.isEmpty() && t.elapsed() < kRunTimeoutMs) done.wait(200);
+        return doc()->runOutput() != nullptr;
+    }
+    QString writeAtrium(const QString& name) {
+        const QString p = tmp_.path() + "/" + name;
+        lc::saveGltfScene(smallAtrium(), p.toStdString());
+        return p;
+    }
+
+private slots:
+    void init() {
+        w_ = lctest::makeTestWindow();
+        QVERIFY(QTest::qWaitForWindowExposed(w_.get()));
+    }
+    void cleanup() {
+        doc()->undoStack()->setClean();
+        w_.reset();
+    }
+
+    void openGlbThroughFileMenuCullsItsLightsThroughItsCamera() {
+        const QString p = writeAtrium("atrium.glb");
+        w_->prompts.openPath = [&](QWidget*, const QString&, const QString& filter) {
+            // The dialog offers glTF beside scene JSON.
+            if (!filter.contains("*.glb") || !filter.contains("*.gltf")) return QString();
+            return p;
+        };
+        w_->runOnOpen = true;
+        w_->action("actionOpen")->trigger();
+        QCOMPARE(doc()->scene().lights.size(), std::size_t(48));
+        QCOMPARE(doc()->scene().camera.width, 320u); // the file's camera, its resolution kept
+        QVERIFY(doc()->scene().camera == lc::loadGltfScene(p.toStdString()).camera);
+        QVERIFY(waitRun());
+        const auto out = doc()->runOutput();
+        QCOMPARE(out->truth.metrics.falseNegatives, std::uint64_t(0));
+        QVERIFY(out->truth.metrics.shadingWork > 0);
+        QVERIFY(w_->messageLog()->toPlainText().contains("48 lights, camera: cameras[0] 'culling camera'"));
+    }
+
+    void dropOfAGlbOpensItAsAScene() {
+        QVERIFY(w_->openBuiltin("forest"));
+        const QString p = writeAtrium("dropped.glb");
+        QMimeData mime;
+        mime.setUrls({QUrl::fromLocalFile(p)});
+        QDragEnterEvent enter(QPoint(200, 200), Qt::CopyAction, &mime, Qt::LeftButton, Qt::NoModifier);
+        QApplication::sendEvent(w_.get(), &enter);
+        QVERIFY(enter.isAccepted());
+        QDropEvent drop(QPointF(200, 200), Qt::CopyAction, &mime, Qt::LeftButton, Qt::NoModifier);
+        QApplication::sendEvent(w_.get(), &drop);
+        QCOMPARE(doc()->scene().lights.size(), std::size_t(48));
+        QCOMPARE(doc()->filePath(), p);
+    }
+
+    void brokenGltfLeavesTheEditedSceneIntact() {
+        QVERIFY(w_->openBuiltin("atrium"));
+        doc()->deleteLights({0}); // an unsaved edit
+        const std::string before = lc::serializeScene(doc()->scene());
+        const QString good = writeAtrium("good.glb");
+        std::string bytes;
+        {
+            std::ifstream in(good.toStdString(), std::ios::binary);
+            bytes.assign(std::istreambuf_iterator<char>(in), {});
+        }
+        const QString bad = tmp_.path() + "/truncated.glb";
+        std::ofstream(bad.toStdString(), std::ios::binary).write(bytes.data(), std::streamsize(bytes.size() / 2));
+        QString shown;
+        w_->prompts.showError = [&](QWidget*, const QString&, const QString& m) { shown = m; };
+        w_->prompts.askUnsaved = [](QWidget*, const QString&) { return QMessageBox::Discard; };
+        QVERIFY(!w_->openSceneFile(bad));
+        QVERIFY2(shown.contains("truncated.glb: header.length"), qPrintable(shown));
+        QCOMPARE(lc::serializeScene(doc()->scene()), before);
+    }
+
+    void saveAsGlbWritesWhatReadsBack() {
+        QVERIFY(w_->openBuiltin("atrium"));
+        const QString p = tmp_.path() + "/saved.glb";
+        w_->prompts.savePath = [&](QWidget*, const QString&, const QString& filter) {
+            return filter.contains("*.glb") ? p : QString();
+        };
+        w_->action("actionSaveAs")->trigger();
+        const lc::Scene back = lc::loadGltfScene(p.toStdString());
+        QCOMPARE(back.triangleCount(), doc()->scene().triangleCount());
+        QCOMPARE(back.lights.size(), doc()->scene().lights.size());
+        for (std::size_t i = 0; i < back.lights.size(); ++i)
+            QVERIFY(std::abs(back.lights[i].radius() - doc()->scene().lights[i].radius()) < 1e-9);
+        QCOMPARE(doc()->filePath(), p);
+        QVERIFY(doc()->undoStack()->isClean());
+    }
+
+    void lightCutoffSettingSetsTheRadiusOfLightsWithoutRange() {
+        // A glTF light without `range`: its radius comes from I_min.
+        lc::Scene s = smallAtrium();
+        s.lights.resize(1);
+        s.lights[0].kind = lc::LightKind::Point;
+        s.lights[0].intensity = 8.0;
+        s.lights[0].color = glm::dvec3(1.0);
+        s.lights[0].explicitRadius = 0.0;
+        const QString p = tmp_.path() + "/norange.gltf";
+        {
+            // Drop our extras and the range so the reader falls back to I_min.
+            std::string text = lc::serializeGltf(s, false);
+            auto j = nlohmann::json::parse(text);
+            auto& light = j["extensions"]["KHR_lights_punctual"]["lights"][0];
+            light.erase("range");
+            light.erase("extras");
+            std::ofstream(p.toStdString()) << j.dump();
+        }
+        w_->prompts.askNumber = [](QWidget*, const QString&, const QString&, double, double, double& v) {
+            v = 0.5;
+            return true;
+        };
+        w_->action("actionGltfCutoff")->trigger();
+        QCOMPARE(w_->gltfOptions.minIntensity, 0.5);
+        QVERIFY(w_->openSceneFile(p));
+        QCOMPARE(doc()->scene().lights.size(), std::size_t(1));
+        QVERIFY(std::abs(doc()->scene().lights[0].radius() - std::sqrt(8.0 / 0.5)) < 1e-12);
+        // The setting persists into a new window.
+        w_.reset();
+        w_ = lctest::makeTestWindow();
+        QCOMPARE(w_->gltfOptions.minIntensity, 0.5);
+        w_->setGltfMinIntensity(lc::kGltfDefaultMinIntensity);
+    }
+
+    // VTK's importer is a second, independent reader of the same files.
+    void vtkImporterAgreesWithOurReaderAndWriter() {
+        const lc::Scene scene = smallAtrium();
+        for (const char* name : {"vtk.glb", "vtk.gltf"}) {
+            const QString p = tmp_.path() + "/" + name;
+            lc::saveGltfScene(scene, p.toStdString());
+            const lc::Scene ours = lc::loadGltfScene(p.toStdString());
+
+            vtkNew<vtkRenderer> ren;
+            vtkNew<vtkRenderWindow> rw;
+            rw->SetOffScreenRendering(1);
+            rw->AddRenderer(ren);
+            vtkNew<vtkGLTFImporter> imp;
+            imp->SetFileName(p.toUtf8().constData());
+            imp->SetRenderWindow(rw);
+            imp->Update();
+
+            vtkIdType tris = 0;
+            double b[6] = {1e300, -1e300, 1e300, -1e300, 1e300, -1e300};
+            vtkActorCollection* actors = ren->GetActors();
+            actors->InitTraversal();
+            while (vtkActor* a = actors->GetNextActor()) {
+                auto* pd = vtkPolyData::SafeDownCast(a->GetMapper()->GetInput());
+                QVERIFY(pd);
+                tris += pd->GetNumberOfPolys();
+                double ab[6];
+                a->GetBounds(ab);
+                for (int k = 0; k < 3; ++k) {
+                    b[2 * k] = std::min(b[2 * k], ab[2 * k]);
+                    b[2 * k + 1] = std::max(b[2 * k + 1], ab[2 * k + 1]);
+                }
+            }
+            QCOMPARE(std::size_t(tris), ours.triangleCount());
+            QCOMPARE(std::size_t(tris), scene.triangleCount());
+            const auto [lo, hi] = ours.bounds();
+            for (int k = 0; k < 3; ++k) {
+                QVERIFY2(std::abs(b[2 * k] - lo[k]) < 1e-4, qPrintable(QString("min %1: vtk %2 ours %3").arg(k).arg(b[2 * k]).arg(lo[k])));
+                QVERIFY2(std::abs(b[2 * k + 1] - hi[k]) < 1e-4, qPrintable(QString("max %1").arg(k)));
+            }
+            // Lights: VTK adds each KHR_lights_punctual light with its node's
+            // world matrix as the light's transform (the light sits at that
+            // frame's origin; VTK's own position is left at its default).
+            std::vector<glm::dvec3> vtkPositions;
+            vtkLightCollection* lights = ren->GetLights();
+            lights->InitTraversal();
+            while (vtkLight* l = lights->GetNextItem()) {
+                if (!l->GetPositional()) continue;
+                vtkMatrix4x4* m = l->GetTransformMatrix();
+                QVERIFY(m);
+                vtkPositions.emplace_back(m->GetElement(0, 3), m->GetElement(1, 3), m->GetElement(2, 3));
+            }
+            QCOMPARE(vtkPositions.size(), ours.lights.size());
+            for (const auto& l : ours.lights) {
+                double best = 1e300;
+                for (const auto& v : vtkPositions) best = std::min(best, glm::length(v - l.position));
+                // VTK keeps the node matrices in single precision: 1e-4 at
+                // coordinates of tens of metres is a few float ulps.
+                QVERIFY2(best < 1e-4, qPrintable(QString("%1 at %2 %3 %4; vtk's first at %5 %6 %7")
+                                                     .arg(QString::fromStdString(l.name))
+                                                     .arg(l.position.x).arg(l.position.y).arg(l.position.z)
+                                                     .arg(vtkPositions[0].x).arg(vtkPositions[0].y).arg(vtkPositions[0].z)));
+            }
+        }
+    }
+};
+
+LC_STUDIO_TEST_MAIN(GltfStudioTest)
+#include "test_gltf_studio.moc"
