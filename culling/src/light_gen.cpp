@@ -94,7 +94,8 @@ LightGenSettings defaultLightGen(const Scene& scene, std::uint32_t count, std::u
     s.count = count;
     s.seed = seed;
     auto [lo, hi] = scene.bounds();
-    if (lo == hi && scene.triangleCount() == 0) {
+    const bool noGeometry = lo == hi && scene.triangleCount() == 0;
+    if (noGeometry) {
         lo = glm::dvec3(-10, 0, -10);  // no geometry: the settings' default box
         hi = glm::dvec3(10, 5, 10);
     }
@@ -103,6 +104,18 @@ LightGenSettings defaultLightGen(const Scene& scene, std::uint32_t count, std::u
     const double grow = std::max(0.1, 0.05 * glm::length(hi - lo));
     s.boxMin = lo - glm::dvec3(grow);
     s.boxMax = hi + glm::dvec3(grow);
+    // Radii relative to the scene's size: the brightest light's radius,
+    // sqrt(intensityMax / minIntensity) (14.1 units with the defaults), is
+    // kept within 1%..20% of the box diagonal by adjusting I_min. Scenes of
+    // tens to a thousand units (every built-in scene) stay inside that band
+    // and keep their lights; a 2 m model no longer gets lights that each
+    // cover all of it, nor a 20 km terrain lights of a pixel.
+    if (!noGeometry) {
+        const double diagonal = glm::length(s.boxMax - s.boxMin);
+        const double rMax = std::sqrt(s.intensityMax / s.minIntensity);
+        const double wanted = std::clamp(rMax, kLightRadiusMinFraction * diagonal, kLightRadiusMaxFraction * diagonal);
+        if (wanted != rMax && wanted > 0.0) s.minIntensity = s.intensityMax / (wanted * wanted);
+    }
     return s;
 }
 

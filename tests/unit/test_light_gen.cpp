@@ -3,6 +3,7 @@
 #include "culling/errors.hpp"
 #include "culling/scene_io.hpp"
 
+#include <glm/glm.hpp>
 #include <gtest/gtest.h>
 
 using namespace lc;
@@ -39,4 +40,32 @@ TEST(LightGen, CancelStopsGeneration) {
                                 }),
                  Cancelled);
     EXPECT_EQ(calls, 2);
+}
+
+// Generated radii follow the scene's size: a 2 m model and a 20 km terrain get
+// lights whose largest radius is 1%..20% of the placement box's diagonal,
+// while scenes of the built-ins' sizes keep I_min = 0.05 (radius 14.1 units).
+TEST(LightGen, RadiiAreRelativeToTheSceneSize) {
+    auto boxScene = [](double size) {
+        Scene s;
+        Mesh m;
+        m.name = "box";
+        m.positions = {0, 0, 0, float(size), 0, 0, 0, float(size), 0, 0, 0, float(size)};
+        m.indices = {0, 1, 2, 0, 2, 3, 0, 3, 1};
+        s.meshes.push_back(m);
+        return s;
+    };
+    for (const double size : {2.0, 20000.0}) {
+        const Scene s = boxScene(size);
+        const LightGenSettings g = defaultLightGen(s, 500, 3);
+        const double diagonal = glm::length(g.boxMax - g.boxMin);
+        double largest = 0;
+        for (const PointLight& l : generateLights(g)) largest = std::max(largest, l.radius());
+        EXPECT_LE(largest, kLightRadiusMaxFraction * diagonal * (1 + 1e-12)) << size;
+        EXPECT_GE(largest, 0.5 * kLightRadiusMinFraction * diagonal) << size;
+        if (size == 2.0) EXPECT_LT(largest, 1.0); // not the 14 units that covered the whole model
+        else EXPECT_GT(largest, 100.0);
+    }
+    for (const auto& b : builtinScenes())
+        EXPECT_EQ(defaultLightGen(makeBuiltinScene(b.name), 10, 1).minIntensity, 0.05) << b.name;
 }

@@ -73,7 +73,11 @@ struct LightGenSettings {
 // every few thousand lights; a set `cancel` stops it with lc::Cancelled.
 std::vector<PointLight> generateLights(const LightGenSettings& s, const CancelToken* cancel = nullptr,
                                        const Progress& progress = {});
-// A placement volume suited to a scene: its mesh bounds, slightly grown.
+// Settings suited to a scene: placed in its mesh bounds, slightly grown, with
+// I_min chosen so that the brightest light's radius is between
+// kLightRadiusMinFraction and kLightRadiusMaxFraction of that box's diagonal
+// (unchanged, 14.1 units, where it already is; docs/FORMATS.md).
+constexpr double kLightRadiusMinFraction = 0.01, kLightRadiusMaxFraction = 0.2;
 LightGenSettings defaultLightGen(const Scene& scene, std::uint32_t count, std::uint64_t seed);
 
 } // namespace lc
