@@ -24,6 +24,7 @@
 #include <QDockWidget>
 #include <QDragEnterEvent>
 #include <QDropEvent>
+#include <QElapsedTimer>
 #include <QFileDialog>
 #include <QInputDialog>
 #include <QFileInfo>
@@ -588,6 +589,8 @@ bool MainWindow::openSceneFile(const QString& path) {
     if (!maybeSave()) return false;
     const std::string p = path.toStdString();
     lc::GltfReadReport gltfReport;
+    QElapsedTimer loadTimer;
+    loadTimer.start();
     try {
         lc::Scene s = runWithProgressResult<lc::Scene>(
             this, tr("Loading %1...").arg(QFileInfo(path).fileName()),
@@ -597,10 +600,12 @@ bool MainWindow::openSceneFile(const QString& path) {
         doc_->resetScene(std::move(s), path);
         for (const std::string& w : gltfReport.warnings) log(QString::fromStdString(w), true);
         if (lc::isGltfPath(p))
-            log(tr("%1: %2 lights, camera: %3")
+            log(tr("%1: %2 triangles, %3 lights, camera: %4; loaded in %5 ms")
                     .arg(path)
+                    .arg(doc_->scene().triangleCount())
                     .arg(doc_->scene().lights.size())
-                    .arg(QString::fromStdString(gltfReport.camera)));
+                    .arg(QString::fromStdString(gltfReport.camera))
+                    .arg(loadTimer.elapsed()));
     } catch (const lc::Cancelled&) {
         log(tr("loading %1 cancelled").arg(path));
         return false;

@@ -7,6 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <chrono>
+#include <cmath>
 #include <iostream>
 #include <string>
 
@@ -48,9 +50,13 @@ struct SceneSource {
     lc::Scene load() const {
         if (sceneFile.empty()) return lc::makeBuiltinScene(builtin);
         lc::GltfReadReport report;
+        const auto t0 = std::chrono::steady_clock::now();
         lc::Scene s = lc::loadSceneAny(sceneFile, gltf, &report);
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         for (const std::string& w : report.warnings) std::cerr << "lightcull: warning: " << w << "\n";
-        if (lc::isGltfPath(sceneFile)) std::cerr << "lightcull: camera: " << report.camera << "\n";
+        if (lc::isGltfPath(sceneFile))
+            std::cerr << "lightcull: " << sceneFile << ": " << s.triangleCount() << " triangles, " << s.lights.size()
+                      << " lights, camera " << report.camera << "; loaded in " << std::lround(ms) << " ms\n";
         return s;
     }
 };

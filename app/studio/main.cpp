@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
     parser.setApplicationDescription("LightCull Studio: place lights, run tiled/clustered light culling, "
                                      "see the result.");
     parser.addHelpOption();
-    QCommandLineOption sceneOpt("scene", "Open a scene JSON file.", "FILE");
+    QCommandLineOption sceneOpt("scene", "Open a scene: scene JSON, .gltf or .glb.", "FILE");
     QCommandLineOption builtinOpt("builtin", QString("Open a built-in scene (default %1).").arg(lc::kDefaultBuiltin),
                                   "NAME");
     QCommandLineOption runOpt("run", "Run culling once the scene is open.");

@@ -18,6 +18,7 @@
 #include <QMessageBox>
 #include <QMimeData>
 #include <QPlainTextEdit>
+#include <QRegularExpression>
 #include <QUndoStack>
 #include <QUrl>
 
@@ -103,6 +104,7 @@ private slots:
         QCOMPARE(out->truth.metrics.falseNegatives, std::uint64_t(0));
         QVERIFY(out->truth.metrics.shadingWork > 0);
         QVERIFY(w_->messageLog()->toPlainText().contains("48 lights, camera: cameras[0] 'culling camera'"));
+        QVERIFY(w_->messageLog()->toPlainText().contains(QRegularExpression("loaded in [0-9]+ ms")));
     }
 
     void dropOfAGlbOpensItAsAScene() {
