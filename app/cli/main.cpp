@@ -19,6 +19,7 @@
 #include "culling/params.hpp"
 #include "culling/pipeline.hpp"
 #include "culling/scene_io.hpp"
+#include "custom.hpp"
 #include "report.hpp"
 #include "scene_source.hpp"
 
@@ -80,7 +81,7 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
     std::cout << "scene " << scene.name << ": " << r.grid.width << "x" << r.grid.height << ", tile "
               << r.grid.tileSize << " (" << r.grid.tilesX << "x" << r.grid.tilesY << " tiles), "
               << run.lights.size() << " lights\n"
-              << "algorithm " << lc::toString(settings.algorithm) << ", test "
+              << "algorithm " << (run.custom ? "custom" : lc::toString(settings.algorithm)) << ", test "
               << lc::toString(settings.test) << ", cells " << settings.cells << ", slicing "
               << lc::toString(settings.slicing) << ", backend " << r.backend << " (" << r.device << ")\n"
               << "false negatives " << m.falseNegatives << ", efficiency " << fmt("%.4f", m.efficiency)
@@ -373,6 +374,25 @@ int main(int argc, char** argv) {
     run->add_option("--out", outDir, "Folder to write the diagnostics into (written atomically; its parent must exist)")
         ->type_name("DIR")
         ->required();
+    lcli::CustomFlags runCustom;
+    runCustom.addToRun(run);
+
+    CLI::App* check = app.add_subcommand(
+        "check", "Judge an engine's own light lists (a buffer dump or CSV) against ground truth on its depth buffer; "
+                 "writes the same diagnostics as run");
+    SceneFlags checkFlags;
+    checkFlags.addTo(check);
+    std::string checkLists, checkLayout = "fixed:64", checkRule = "tile", checkOut;
+    check->add_option("--lists", checkLists, "The lists: raw little-endian 32-bit words in --layout, or .csv (list,light,...)")
+        ->type_name("FILE")
+        ->required();
+    check->add_option("--layout", checkLayout, "Layout of a raw dump: fixed:N, compact[:N] or bitmask (default fixed:64)")
+        ->type_name("LAYOUT");
+    check->add_option("--rule", checkRule, "Which list a pixel loops over: tile, halfz or froxel:N[:log|linear] (default tile)")
+        ->type_name("RULE");
+    lcli::CustomFlags checkDepth;
+    checkDepth.addDepth(check);
+    check->add_option("--out", checkOut, "Folder to write the diagnostics into")->type_name("DIR")->required();
 
     CLI::App* bench = app.add_subcommand(
         "bench", "Time the depth pre-pass and the culling pass over repeats (median/min/max), "
@@ -396,9 +416,9 @@ int main(int argc, char** argv) {
     // CLI11 reports a missing subcommand before an unknown word; name the word.
     if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "scenes" && std::string(argv[1]) != "run" &&
         std::string(argv[1]) != "bench" && std::string(argv[1]) != "report" &&
-        std::string(argv[1]) != "convert")
+        std::string(argv[1]) != "convert" && std::string(argv[1]) != "check")
         return fail(2, std::string("unknown command '") + argv[1] +
-                           "' (commands: scenes, run, bench, report, convert; see --help)");
+                           "' (commands: scenes, run, bench, report, convert, check; see --help)");
 
     try {
         app.parse(argc, argv);
@@ -433,6 +453,30 @@ int main(int argc, char** argv) {
             return 0;
         }
 
+        if (app.got_subcommand("check")) {
+            if (!checkFlags.hasScene()) return fail(2, "check: give --scene FILE or --builtin NAME (the scene the lists were culled for)");
+            lc::Scene scene = checkFlags.loadScene();
+            lc::CullSettings settings;
+            checkFlags.applyParams(settings, scene.camera);
+            const lc::Projection proj(scene.camera);
+            lc::DepthImage depth;
+            if (!checkDepth.depthFile.empty()) {
+                depth = lc::loadDepthFile(checkDepth.depthFile, proj);
+            } else {
+                scene.validate();
+                depth = checkFlags.openBackend()->renderDepth(scene, proj);
+            }
+            lc::CustomCullReport report;
+            lc::RunOptions options;
+            options.truthOptions.imageError = false;
+            const lc::RunOutput result = lc::checkListDump(scene, checkLists, lc::parseLayout(checkLayout),
+                                                           lc::parseListSpec(checkRule), depth, options, report);
+            lc::exportDiagnostics(scene, settings, result, checkOut);
+            printSummary(scene, settings, result, checkOut);
+            lcli::printCustomReport(result, scene, proj);
+            return 0;
+        }
+
         if (!runFlags.hasScene()) return fail(2, "run: give --scene FILE or --builtin NAME");
         {
             // Fail before the (possibly long) run when the output cannot be written.
@@ -455,6 +499,22 @@ int main(int argc, char** argv) {
         options.truthOptions.imageError = !noImageError;
         options.keepShadedImages = shadedImages;
         if (shadedImages && noImageError) return fail(2, "--shaded-images needs the shading pass: drop --no-image-error");
+        lc::DepthImage engineDepth;
+        if (!runCustom.depthFile.empty()) {
+            scene.validate();
+            engineDepth = lc::loadDepthFile(runCustom.depthFile, lc::Projection(scene.camera));
+            options.reuseDepth = &engineDepth;
+        }
+        if (!runCustom.shader.empty()) {
+            lc::CustomCullReport report;
+            const lc::RunOutput result =
+                lc::runCustomPipeline(scene, runCustom.shaderOptions(runFlags.device), *backend, options, report,
+                                      options.reuseDepth);
+            lc::exportDiagnostics(scene, settings, result, outDir);
+            printSummary(scene, settings, result, outDir);
+            lcli::printCustomReport(result, scene, lc::Projection(scene.camera));
+            return 0;
+        }
         const lc::RunOutput result = lc::runPipeline(scene, settings, *backend, options);
         lc::exportDiagnostics(scene, settings, result, outDir);
         printSummary(scene, settings, result, outDir);

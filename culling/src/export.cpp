@@ -3,6 +3,8 @@
 // documented in docs/CLI.md.
 
 #include "culling/export.hpp"
+
+#include "culling/custom_cull.hpp"
 #include "culling/file_io.hpp"
 #include "culling/overlays.hpp"
 
@@ -136,7 +138,7 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     const Metrics& m = run.truth.metrics;
     nlohmann::ordered_json j;
     j["scene"] = scene.name;
-    j["algorithm"] = toString(settings.algorithm);
+    j["algorithm"] = run.custom ? std::string("custom") : std::string(toString(settings.algorithm));
     j["test"] = toString(settings.test);
     j["backend"] = r.backend;
     j["device"] = r.device;
@@ -173,6 +175,41 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     mj["image_max_error"] =
         m.imageErrorComputed ? nlohmann::ordered_json(m.imageMaxError) : nlohmann::ordered_json(nullptr);
     j["metrics"] = mj;
+    if (run.custom) {
+        // docs/CUSTOM_CULLING.md: what the user's culling did beside its lists.
+        const CustomCullReport& c = *run.custom;
+        nlohmann::ordered_json cj;
+        cj["source"] = c.source;
+        cj["layout"] = c.layout;
+        cj["lists"] = c.lists;
+        cj["pass_ms"] = c.passMs >= 0 ? nlohmann::ordered_json(c.passMs) : nlohmann::ordered_json(nullptr);
+        cj["overflow_lists"] = c.overflowLists;
+        cj["overflow_entries"] = c.overflowEntries;
+        cj["invalid_indices"] = c.invalidIndices;
+        cj["duplicate_indices"] = c.duplicateIndices;
+        cj["validation_messages"] = c.validationMessages;
+        cj["builtin_algorithm"] = c.builtinAlgorithm;
+        cj["builtin_entries"] = c.builtinEntries;
+        cj["lists_differing_from_builtin"] = c.listsDifferingFromBuiltin;
+        // Every false negative located: tile, list, light and the pixels that
+        // needed it (the 1,000 with most pixels; the total is in metrics).
+        const Projection proj(scene.camera);
+        nlohmann::ordered_json missed = nlohmann::ordered_json::array();
+        const std::vector<MissedLight> located = locateFalseNegatives(run, proj);
+        for (std::size_t i = 0; i < located.size() && i < 1000; ++i) {
+            const MissedLight& ml = located[i];
+            nlohmann::ordered_json e;
+            e["tile"] = {ml.tile % r.grid.tilesX, ml.tile / r.grid.tilesX};
+            e["list"] = ml.list;
+            e["light"] = ml.light;
+            e["light_name"] = ml.light < scene.lights.size() ? scene.lights[ml.light].name : std::string();
+            e["pixels"] = ml.pixels;
+            missed.push_back(std::move(e));
+        }
+        cj["missed"] = std::move(missed);
+        cj["missed_pairs"] = located.size();
+        j["custom"] = std::move(cj);
+    }
     return j.dump(2) + "\n";
 }
 

@@ -240,7 +240,7 @@ pixelsNeedingLights(const DepthImage& depth, const Projection& proj, const ViewL
             if (!depth.hasGeometry(x, y)) continue;
             const glm::dvec3 p = proj.viewPositionFromDepth(x, y, depth.at(x, y));
             for (std::size_t i = 0; i < lights.size(); ++i)
-                if (detail::lightContains(lights.centers[i], lights.radii[i], p)) ++count[i];
+                if (detail::lightNeeds(lights, i, p)) ++count[i]; // a spot light only inside its cone
         }
     std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
     for (std::size_t i = 0; i < count.size(); ++i)

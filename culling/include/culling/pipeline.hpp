@@ -6,7 +6,11 @@
 #include "culling/ground_truth.hpp"
 #include "culling/scene.hpp"
 
+#include <memory>
+
 namespace lc {
+
+struct CustomCullReport; // culling/custom_cull.hpp
 
 struct RunOutput {
     DepthImage depth;
@@ -20,6 +24,9 @@ struct RunOutput {
     bool depthReused = false;
     // False when RunOptions::groundTruth was off: `truth` is then empty.
     bool truthComputed = false;
+    // Set when the lists came from a custom shader or an engine's dump
+    // (culling/custom_cull.hpp): what it did beside its lists.
+    std::shared_ptr<const CustomCullReport> custom;
 };
 
 struct RunOptions {

@@ -24,6 +24,10 @@ void clearValidationMessages() {
     std::lock_guard<std::mutex> lock(gMutex);
     gMessages.clear();
 }
+void eraseValidationMessagesFrom(std::size_t count) {
+    std::lock_guard<std::mutex> lock(gMutex);
+    if (gMessages.size() > count) gMessages.resize(count);
+}
 void recordValidationMessage(const std::string& message) {
     std::lock_guard<std::mutex> lock(gMutex);
     gMessages.push_back(message);

@@ -16,6 +16,9 @@ bool validationRequested();
 // Messages (warnings and errors) recorded since the last clear, all instances.
 std::vector<std::string> validationMessages();
 void clearValidationMessages();
+// Removes the messages recorded after the first `count` (a custom shader's
+// messages are reported as its own, not as failures of the built-in passes).
+void eraseValidationMessagesFrom(std::size_t count);
 // Records one message (called by the debug messenger).
 void recordValidationMessage(const std::string& message);
 // True once an instance was created with the validation layer enabled (and

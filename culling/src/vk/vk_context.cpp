@@ -111,7 +111,7 @@ VkPhysicalDevice chooseDevice(const std::vector<VkPhysicalDevice>& devs, std::st
 
 // Creates an instance (with validation when requested). Returns the instance
 // and whether VK_EXT_debug_utils is enabled.
-VkInstance createInstance(bool& debugUtils, bool& validation) {
+VkInstance createInstance(bool& debugUtils, bool& validation, bool forceValidation) {
     std::uint32_t n = 0;
     LC_VK(vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr));
     std::vector<VkExtensionProperties> exts(n);
@@ -119,7 +119,7 @@ VkInstance createInstance(bool& debugUtils, bool& validation) {
     std::vector<const char*> enabled;
     debugUtils = hasExtension(exts, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
 
-    validation = validationRequested();
+    validation = validationRequested() || forceValidation;
     std::vector<const char*> layers;
     bool validationFeatures = false;
     if (validation) {
@@ -222,7 +222,7 @@ std::vector<std::string> physicalDeviceNames() {
 Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
     if (const char* e = std::getenv("LIGHTCULL_VK_EMULATE_GPU")) emulateGpu_ = std::string(e) == "1";
     bool validation = false;
-    instance_ = createInstance(debugUtils_, validation);
+    instance_ = createInstance(debugUtils_, validation, opt.validation);
     try {
         if (validation) {
             VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
@@ -296,6 +296,11 @@ Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
         int64_ = f10.shaderInt64 == VK_TRUE;
         VkPhysicalDeviceFeatures enable10{};
         enable10.shaderInt64 = int64_ ? VK_TRUE : VK_FALSE;
+        if (opt.robustAccess) {
+            if (!f10.robustBufferAccess)
+                throw DeviceError(std::string("Vulkan device '") + props_.deviceName + "' lacks robustBufferAccess");
+            enable10.robustBufferAccess = VK_TRUE;
+        }
 
         float prio = 1.0f;
         VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
@@ -547,6 +552,35 @@ Context::StorageLayouts Context::createStorageLayouts(std::uint32_t bindings, co
     out.pipeline = PipelineLayoutHandle(device_, pl);
     name(VK_OBJECT_TYPE_PIPELINE_LAYOUT, pl, n + ".pipelineLayout");
     return out;
+}
+
+bool Context::submitAndWaitFor(const std::function<void(VkCommandBuffer)>& record, const std::string& n,
+                               double timeoutMs, double& wallMs) {
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = commandPool_;
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = 1;
+    VkCommandBuffer cmd;
+    LC_VK(vkAllocateCommandBuffers(device_, &ai, &cmd));
+    name(VK_OBJECT_TYPE_COMMAND_BUFFER, cmd, n);
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    LC_VK(vkBeginCommandBuffer(cmd, &bi));
+    record(cmd);
+    LC_VK(vkEndCommandBuffer(cmd));
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cmd;
+    VkFence f = fence_;
+    LC_VK(vkResetFences(device_, 1, &f));
+    const auto t0 = std::chrono::steady_clock::now();
+    LC_VK(vkQueueSubmit(queue_, 1, &si, f));
+    const VkResult r = vkWaitForFences(device_, 1, &f, VK_TRUE, std::uint64_t(std::max(timeoutMs, 1.0) * 1e6));
+    wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (r == VK_TIMEOUT) return false; // the command buffer is still pending: left to the abandoned pool
+    if (r != VK_SUCCESS) throwVkError("vkWaitForFences", r, __FILE__, __LINE__);
+    vkFreeCommandBuffers(device_, commandPool_, 1, &cmd);
+    return true;
 }
 
 double Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record, const std::string& n) {

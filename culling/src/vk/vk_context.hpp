@@ -146,6 +146,8 @@ private:
 struct ContextOptions {
     std::string device;   // index or case-insensitive name substring; empty: default rule
     std::string purpose;  // prefix of debug names, e.g. "lc.render"
+    bool validation = false;   // the validation layer even without LIGHTCULL_VALIDATION=1 (user shaders)
+    bool robustAccess = false; // robustBufferAccess: out-of-range accesses of user shaders stay harmless
 };
 
 // Instance, chosen physical device, logical device and its one queue. The
@@ -209,6 +211,12 @@ public:
     // Records a one-time command buffer, submits it, waits. Returns the CPU
     // wall-clock milliseconds from submit to the fence signalling.
     double submitAndWait(const std::function<void(VkCommandBuffer)>& record, const std::string& name);
+    // The same with a time limit: false when the work has not finished after
+    // `timeoutMs`. The device is then still running it, and destroying what
+    // it uses is undefined: the caller must leak this context and everything
+    // created on it (never destroy them) and open a new one.
+    bool submitAndWaitFor(const std::function<void(VkCommandBuffer)>& record, const std::string& name,
+                          double timeoutMs, double& wallMs);
 
 private:
     void release(); // destroys everything, in reverse order of creation

@@ -1,0 +1,100 @@
+#pragma once
+// `lightcull run --shader FILE` and `lightcull check --lists FILE`: a
+// renderer's own culling judged like a built-in algorithm
+// (docs/CUSTOM_CULLING.md). The flags live here; main.cpp runs the commands.
+#include "culling/custom_cull.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <string>
+
+namespace lcli {
+
+struct CustomFlags {
+    std::string shader, layout, lists, entry, depthFile;
+    bool noValidation = false;
+    double timeoutMs = 10000;
+    CLI::Option *optLayout = nullptr, *optLists = nullptr, *optEntry = nullptr;
+
+    // run: --shader, --layout, --lists, --entry, --no-validation, --timeout-ms, --depth.
+    void addToRun(CLI::App* cmd) {
+        CLI::Option* s = cmd->add_option("--shader", shader,
+                                         "Judge your own culling compute shader instead of a built-in algorithm: GLSL "
+                                         "(.comp/.glsl), HLSL (.hlsl) or SPIR-V (.spv); docs/CUSTOM_CULLING.md")
+                             ->type_name("FILE");
+        optLayout = cmd->add_option("--layout", layout,
+                                    "Custom shader: how it writes its lists: fixed:N, compact[:N] or bitmask "
+                                    "(default: the shader's first line, else fixed:64)")
+                        ->type_name("LAYOUT")
+                        ->needs(s);
+        optLists = cmd->add_option("--lists", lists,
+                                   "Custom shader: which list a pixel loops over: tile, halfz or froxel:N[:log|linear] "
+                                   "(default: the shader's first line, else tile)")
+                       ->type_name("RULE")
+                       ->needs(s);
+        optEntry = cmd->add_option("--entry", entry, "Custom shader: entry point of HLSL or SPIR-V (default: main)")
+                       ->type_name("NAME")
+                       ->needs(s);
+        cmd->add_flag("--no-validation", noValidation,
+                      "Custom shader: run it without the Khronos validation layer (on by default: it is user code)")
+            ->needs(s);
+        cmd->add_option("--timeout-ms", timeoutMs,
+                        "Custom shader: a dispatch still running after this long is reported as a hang (default 10000)")
+            ->type_name("MS")
+            ->check(CLI::Range(1.0, 3600000.0))
+            ->needs(s);
+        addDepth(cmd);
+    }
+    void addDepth(CLI::App* cmd) {
+        cmd->add_option("--depth", depthFile,
+                        "Judge against this depth buffer instead of the pre-pass: raw float32 window depth (width x "
+                        "height, top row first) or a 16-bit PNG, in the scene camera's depth convention")
+            ->type_name("FILE");
+    }
+
+    lc::CustomShaderOptions shaderOptions(const std::string& device) const {
+        lc::CustomShaderOptions o;
+        o.path = shader;
+        o.device = device;
+        o.validation = !noValidation;
+        o.timeoutMs = timeoutMs;
+        if (!layout.empty()) o.layout = lc::parseLayout(layout);
+        if (!lists.empty()) o.lists = lc::parseListSpec(lists);
+        if (!entry.empty()) o.entry = entry;
+        if (shader.size() < 4 || shader.substr(shader.size() - 4) != ".spv") {
+            std::ifstream in(shader, std::ios::binary);
+            if (!in) throw lc::InputError(shader, "", 0, "cannot open shader for reading");
+            std::string first;
+            std::getline(in, first);
+            lc::applyShaderHeader(first, shader, o, !layout.empty(), !lists.empty(), !entry.empty());
+        }
+        return o;
+    }
+};
+
+// The lines `run --shader` and `check` add to the summary.
+inline void printCustomReport(const lc::RunOutput& run, const lc::Scene& scene, const lc::Projection& proj) {
+    if (!run.custom) return;
+    const lc::CustomCullReport& c = *run.custom;
+    std::cout << "custom: " << c.source << ", layout " << c.layout << ", lists " << c.lists;
+    if (c.passMs >= 0) std::cout << ", pass " << c.passMs << " ms on " << c.device;
+    std::cout << "\n  overflowed lists " << c.overflowLists << " (" << c.overflowEntries << " entries lost), invalid indices "
+              << c.invalidIndices << ", duplicates " << c.duplicateIndices << ", validation messages "
+              << c.validationMessages.size() << "\n  against built-in " << c.builtinAlgorithm << " (cpu): "
+              << c.listsDifferingFromBuiltin << " lists differ, " << run.result.entries() << " entries vs "
+              << c.builtinEntries << "\n";
+    for (std::size_t i = 0; i < c.validationMessages.size() && i < 5; ++i)
+        std::cout << "  validation: " << c.validationMessages[i].substr(0, 300) << "\n";
+    const auto missed = lc::locateFalseNegatives(run, proj);
+    for (std::size_t i = 0; i < missed.size() && i < 10; ++i) {
+        const auto& m = missed[i];
+        std::cout << "  MISSING light " << m.light
+                  << (m.light < scene.lights.size() ? " '" + scene.lights[m.light].name + "'" : std::string())
+                  << " in tile " << m.tile % run.result.grid.tilesX << "," << m.tile / run.result.grid.tilesX
+                  << " (list " << m.list << "): " << m.pixels << " pixels need it\n";
+    }
+    if (missed.size() > 10) std::cout << "  ... " << missed.size() - 10 << " more (summary.json custom.missed)\n";
+}
+
+} // namespace lcli

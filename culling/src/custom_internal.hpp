@@ -1,0 +1,15 @@
+#pragma once
+// Internal to custom culling: shared by custom_cull.cpp and vk/custom_pass.cpp.
+#include "culling/custom_cull.hpp"
+
+namespace lc::detail {
+
+// The CPU reference of the built-in algorithm with the list rule of `lists`:
+// the grid, tile depth bounds, halfz splits and froxel range a custom result
+// shares, and the reference lists it is compared with.
+CullResult ruleSkeleton(const DepthImage& depth, const Projection& proj, const TileGrid& grid, const ViewLights& lights,
+                        const ListSpec& lists);
+// Fills report.builtin*: how the custom lists differ from the built-in ones.
+void compareWithBuiltin(const CullResult& custom, const CullResult& builtin, CustomCullReport& report);
+
+} // namespace lc::detail

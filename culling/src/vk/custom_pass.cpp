@@ -1,0 +1,486 @@
+// A user's culling compute shader on a Vulkan device of its own: compiled at
+// run time with glslang (GLSL or HLSL) or taken as SPIR-V, bound to the
+// inputs docs/CUSTOM_CULLING.md fixes, dispatched one workgroup per tile with
+// robust buffer access and (by default) the validation layer on, waited for
+// with a time limit, read back and decoded into a CullResult.
+#include "culling/custom_cull.hpp"
+
+#include "culling/errors.hpp"
+#include "custom_internal.hpp"
+#include "vk/validation.hpp"
+#include "vk/vk_context.hpp"
+
+#include <glslang/Public/ResourceLimits.h>
+#include <glslang/Public/ShaderLang.h>
+#include <glslang/SPIRV/GlslangToSpv.h>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <regex>
+#include <sstream>
+
+namespace lc {
+
+extern const char* const kCustomCullingHeader; // shaders/custom/lightcull.glsl, embedded at build time
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The uniform block of binding 0 (std140; lightcull.glsl's LcParamsBlock).
+struct CustomParams {
+    glm::uvec4 size;
+    glm::uvec4 counts;
+    glm::uvec4 mode;
+    glm::vec4 depthParams;
+    glm::vec4 planes;
+    glm::vec4 lens;
+    glm::mat4 proj;
+    glm::mat4 invProj;
+};
+static_assert(sizeof(CustomParams) == 224, "CustomParams must match LcParamsBlock (std140)");
+static_assert(offsetof(CustomParams, lens) == 80, "CustomParams.lens offset");
+static_assert(offsetof(CustomParams, proj) == 96, "CustomParams.proj offset");
+
+// lightcull.glsl's LcLight (std430).
+struct CustomLight {
+    glm::vec4 positionRadius;
+    glm::vec4 spotAxisAngle;
+};
+static_assert(sizeof(CustomLight) == 32, "CustomLight must match LcLight (std430)");
+
+std::string readFile(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, "", 0, "cannot open shader for reading");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+void initGlslang() {
+    static std::once_flag once;
+    std::call_once(once, [] { glslang::InitializeProcess(); });
+}
+
+// Serves "lightcull.glsl" from the build, anything else from the shader's folder.
+class Includer : public glslang::TShader::Includer {
+public:
+    explicit Includer(fs::path dir) : dir_(std::move(dir)) {}
+    IncludeResult* includeLocal(const char* name, const char*, size_t depth) override { return include(name, depth); }
+    IncludeResult* includeSystem(const char* name, const char*, size_t depth) override { return include(name, depth); }
+    void releaseInclude(IncludeResult* r) override {
+        if (r) delete static_cast<std::string*>(r->userData);
+        delete r;
+    }
+
+private:
+    IncludeResult* include(const char* name, size_t depth) {
+        if (depth > 16) return nullptr;
+        auto* text = new std::string;
+        std::string resolved = name;
+        if (std::string(name) == "lightcull.glsl") {
+            *text = kCustomCullingHeader;
+        } else {
+            const fs::path p = dir_ / name;
+            std::ifstream in(p, std::ios::binary);
+            if (!in) {
+                delete text;
+                return nullptr;
+            }
+            std::ostringstream ss;
+            ss << in.rdbuf();
+            *text = ss.str();
+            resolved = p.string();
+        }
+        return new IncludeResult(resolved, text->data(), text->size(), text);
+    }
+    fs::path dir_;
+};
+
+// glslang's first "ERROR: file:line: message" as file:line: message.
+[[noreturn]] void throwCompileError(const std::string& path, const std::string& log, const char* stage) {
+    static const std::regex re(R"(ERROR: ([^\n]*?):(\d+): ([^\n]*))");
+    std::smatch m;
+    if (std::regex_search(log, m, re)) {
+        const std::string file = m[1].str() == path || m[1].str().empty() ? path : m[1].str();
+        throw InputError(file, "", std::stoi(m[2].str()), std::string(stage) + ": " + m[3].str());
+    }
+    std::string first = log.substr(0, log.find('\n'));
+    if (first.rfind("ERROR: ", 0) == 0) first = first.substr(7);
+    throw InputError(path, "", 0, std::string(stage) + ": " + (first.empty() ? "failed" : first));
+}
+
+std::vector<std::uint32_t> compileSource(const std::string& path, const std::string& text, bool hlsl,
+                                         const std::string& entry, const std::string& preamble) {
+    initGlslang();
+    glslang::TShader shader(EShLangCompute);
+    const char* strings[] = {text.c_str()};
+    const int lengths[] = {int(text.size())};
+    const char* names[] = {path.c_str()};
+    shader.setStringsWithLengthsAndNames(strings, lengths, names, 1);
+    shader.setPreamble(preamble.c_str());
+    shader.setEnvInput(hlsl ? glslang::EShSourceHlsl : glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan,
+                       100);
+    shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_1);
+    shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_3);
+    if (hlsl) {
+        shader.setEntryPoint(entry.c_str());
+        shader.setSourceEntryPoint(entry.c_str());
+    }
+    auto messages = EShMessages(EShMsgSpvRules | EShMsgVulkanRules | (hlsl ? EShMsgReadHlsl : 0));
+    Includer includer(fs::path(path).parent_path());
+    if (!shader.parse(GetDefaultResources(), hlsl ? 100 : 450, false, messages, includer))
+        throwCompileError(path, shader.getInfoLog(), "compile error");
+    glslang::TProgram program;
+    program.addShader(&shader);
+    if (!program.link(messages)) throwCompileError(path, program.getInfoLog(), "link error");
+    std::vector<std::uint32_t> spirv;
+    spv::SpvBuildLogger logger;
+    glslang::SpvOptions opts;
+    opts.generateDebugInfo = false;
+    glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), spirv, &logger, &opts);
+    if (spirv.empty()) throw InputError(path, "", 0, "no SPIR-V generated: " + logger.getAllMessages());
+    return spirv;
+}
+
+std::string definesFor(const CustomShaderOptions& o, const TileGrid& grid, std::uint32_t listsPerTile,
+                       std::uint32_t lightCount, std::uint64_t compactEntries) {
+    std::ostringstream d;
+    d << "#define TILE_SIZE " << grid.tileSize << "\n";
+    d << "#define MAX_LIGHTS_PER_TILE " << (o.layout.kind == ListLayout::Fixed ? o.layout.capacity : 0u) << "\n";
+    d << "#define LC_LAYOUT " << int(o.layout.kind) << "\n";
+    d << "#define LC_LISTS " << int(o.lists.kind) << "\n";
+    d << "#define LC_LISTS_PER_TILE " << listsPerTile << "\n";
+    d << "#define LC_MASK_WORDS " << std::max<std::uint32_t>(1, (lightCount + 31) / 32) << "\n";
+    d << "#define LC_COMPACT_ENTRIES " << compactEntries << "\n";
+    return d.str();
+}
+
+std::vector<std::uint32_t> loadSpirv(const std::string& path) {
+    const std::string bytes = readFile(path);
+    if (bytes.size() < 20 || bytes.size() % 4 != 0)
+        throw InputError(path, "", 0, "not SPIR-V: " + std::to_string(bytes.size()) + " bytes is not a whole module");
+    std::vector<std::uint32_t> words(bytes.size() / 4);
+    std::memcpy(words.data(), bytes.data(), bytes.size());
+    if (words[0] != 0x07230203u) throw InputError(path, "", 0, "not SPIR-V: wrong magic number");
+    return words;
+}
+
+// Everything created on the device for one run, owned together so that a
+// hang can leak all of it at once (see Context::submitAndWaitFor).
+struct RunState {
+    std::unique_ptr<vk::Context> ctx;
+    vk::Buffer params, depthBuf, lightBuf, out, staging;
+    vk::Image depthImage;
+    vk::DeviceHandle<VkSampler, vkDestroySampler> sampler;
+    vk::DescriptorSetLayoutHandle setLayout;
+    vk::PipelineLayoutHandle pipelineLayout;
+    vk::ShaderModuleHandle module;
+    vk::PipelineHandle pipeline;
+    vk::DescriptorPoolHandle pool;
+    // Members die in reverse order: the context, declared first, goes last.
+};
+
+vk::Image createSampledImage(const vk::Context& ctx, std::uint32_t w, std::uint32_t h) {
+    vk::Image img;
+    const VkDevice dev = ctx.device();
+    VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    ici.imageType = VK_IMAGE_TYPE_2D;
+    ici.format = VK_FORMAT_R32_SFLOAT;
+    ici.extent = {w, h, 1};
+    ici.mipLevels = 1;
+    ici.arrayLayers = 1;
+    ici.samples = VK_SAMPLE_COUNT_1_BIT;
+    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
+    ici.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    VkImage im;
+    LC_VK(vkCreateImage(dev, &ici, nullptr, &im));
+    img.image = vk::ImageHandle(dev, im);
+    ctx.name(VK_OBJECT_TYPE_IMAGE, im, "custom.depthTexture");
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(dev, im, &req);
+    VkPhysicalDeviceMemoryProperties mp;
+    vkGetPhysicalDeviceMemoryProperties(ctx.physicalDevice(), &mp);
+    std::uint32_t type = UINT32_MAX;
+    for (std::uint32_t i = 0; i < mp.memoryTypeCount && type == UINT32_MAX; ++i)
+        if ((req.memoryTypeBits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
+            type = i;
+    if (type == UINT32_MAX) throw DeviceError("no device-local memory for the depth texture");
+    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    ai.allocationSize = req.size;
+    ai.memoryTypeIndex = type;
+    VkDeviceMemory mem;
+    LC_VK(vkAllocateMemory(dev, &ai, nullptr, &mem));
+    img.memory = vk::MemoryHandle(dev, mem);
+    LC_VK(vkBindImageMemory(dev, im, mem, 0));
+    VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    vci.image = im;
+    vci.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    vci.format = VK_FORMAT_R32_SFLOAT;
+    vci.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    VkImageView view;
+    LC_VK(vkCreateImageView(dev, &vci, nullptr, &view));
+    img.view = vk::ImageViewHandle(dev, view);
+    return img;
+}
+
+} // namespace
+
+CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth, const Projection& proj,
+                           const TileGrid& grid, const ViewLights& lights, CustomCullReport& report) {
+    report.source = o.path;
+    report.layout = toString(o.layout);
+    report.lists = toString(o.lists);
+    const auto lightCount = std::uint32_t(lights.size());
+
+    // The list rule's CPU reference: grid, tile bounds, halfz splits, froxel
+    // range, and the lists a built-in algorithm of that rule makes.
+    const CullResult skeleton = detail::ruleSkeleton(depth, proj, grid, lights, o.lists);
+    const auto listCount = std::uint32_t(skeleton.listOffset.size());
+    const std::uint64_t compactEntries =
+        o.layout.kind == ListLayout::Compact ? (o.layout.capacity ? o.layout.capacity : 64ull * listCount) : 0;
+    const std::uint64_t outWords = layoutWords(o.layout, listCount, lightCount);
+    if (outWords * 4 > (std::uint64_t(1) << 30))
+        throw SettingsError("layout", toString(o.layout) + " needs " + std::to_string(outWords * 4 >> 20) +
+                                          " MiB of lists here; more than the 1 GiB allowed");
+
+    // The shader: SPIR-V as given, or compiled with the contract's defines.
+    const std::string ext = fs::path(o.path).extension().string();
+    std::vector<std::uint32_t> spirv;
+    std::string entry = o.entry;
+    if (ext == ".spv") {
+        spirv = loadSpirv(o.path);
+    } else {
+        const bool hlsl = ext == ".hlsl";
+        if (!hlsl) entry = "main";
+        spirv = compileSource(o.path, readFile(o.path), hlsl, o.entry,
+                              definesFor(o, grid, skeleton.listsPerTile, lightCount, compactEntries));
+    }
+
+    const std::size_t messagesBefore = vk::validationMessages().size();
+    // Whatever the layer says during this run is the shader's report, not a
+    // failure of the built-in passes: taken out of the global list on every path.
+    struct TakeMessages {
+        std::size_t from;
+        ~TakeMessages() { vk::eraseValidationMessagesFrom(from); }
+    } takeMessages{messagesBefore};
+    auto firstMessage = [&]() -> std::string {
+        const auto m = vk::validationMessages();
+        return m.size() > messagesBefore ? "; validation: " + m[messagesBefore] : std::string();
+    };
+    auto st = std::make_unique<RunState>();
+    vk::ContextOptions co;
+    co.device = o.device;
+    co.purpose = "lc.custom";
+    co.validation = o.validation;
+    co.robustAccess = true;
+    st->ctx = std::make_unique<vk::Context>(co);
+    const vk::Context& ctx = *st->ctx;
+    const VkDevice dev = ctx.device();
+    report.device = ctx.deviceName();
+
+    // Inputs.
+    CustomParams params{};
+    params.size = {grid.width, grid.height, grid.tilesX, grid.tilesY};
+    const std::uint32_t capacity = o.layout.kind == ListLayout::Fixed   ? o.layout.capacity
+                                   : o.layout.kind == ListLayout::Bitmask ? std::max<std::uint32_t>(1, (lightCount + 31) / 32)
+                                                                          : std::uint32_t(compactEntries);
+    params.counts = {lightCount, skeleton.listsPerTile, listCount, capacity};
+    params.mode = {std::uint32_t(proj.kind()), std::uint32_t(o.layout.kind), std::uint32_t(o.lists.kind),
+                   std::uint32_t(o.lists.slicing)};
+    const DepthParams dp = proj.depthParams();
+    params.depthParams = {dp.ab_ortho_clear.x, dp.ab_ortho_clear.y, dp.ab_ortho_clear.z, dp.ab_ortho_clear.w};
+    params.planes = {float(proj.nearPlane()), std::isinf(proj.farPlane()) ? 0.0f : float(proj.farPlane()),
+                     float(skeleton.clusterNear), float(skeleton.clusterFar)};
+    const glm::dvec3 corner = proj.viewPositionAt({double(proj.width()), 0.0}, 1.0);
+    params.lens = {float(corner.x), float(corner.y), proj.orthographic() ? 1.0f : 0.0f, 0.0f};
+    params.proj = glm::mat4(proj.clipFromView());
+    params.invProj = glm::mat4(glm::inverse(proj.clipFromView()));
+    st->params = ctx.createBuffer(sizeof params, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "custom.params");
+    std::memcpy(st->params.mapped, &params, sizeof params);
+
+    const std::size_t pixels = std::size_t(depth.width) * depth.height;
+    st->depthBuf = ctx.createBuffer(pixels * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                    "custom.depthBuffer");
+    std::memcpy(st->depthBuf.mapped, depth.depth.data(), pixels * 4);
+
+    std::vector<CustomLight> gl(lightCount);
+    for (std::uint32_t i = 0; i < lightCount; ++i) {
+        gl[i].positionRadius = glm::vec4(glm::vec3(lights.centers[i]), float(lights.radii[i]));
+        if (lights.isSpot(i))
+            gl[i].spotAxisAngle = glm::vec4(glm::vec3(lights.spotAxes[i]), float(lights.spotAngles[i]));
+    }
+    st->lightBuf = ctx.createBuffer(std::max<std::size_t>(gl.size(), 1) * sizeof(CustomLight),
+                                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "custom.lights");
+    if (!gl.empty()) std::memcpy(st->lightBuf.mapped, gl.data(), gl.size() * sizeof(CustomLight));
+    st->out = ctx.createBuffer(outWords * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                               "custom.lists");
+
+    // The depth texture, from the depth buffer through a copy.
+    st->depthImage = createSampledImage(ctx, depth.width, depth.height);
+    VkSamplerCreateInfo sci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+    sci.magFilter = sci.minFilter = VK_FILTER_NEAREST;
+    sci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+    sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    VkSampler sampler;
+    LC_VK(vkCreateSampler(dev, &sci, nullptr, &sampler));
+    st->sampler = vk::DeviceHandle<VkSampler, vkDestroySampler>(dev, sampler);
+    st->ctx->submitAndWait(
+        [&](VkCommandBuffer cmd) {
+            VkImageMemoryBarrier toDst{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+            // Hazard: the copy must not start before the image leaves UNDEFINED.
+            toDst.srcAccessMask = 0;
+            toDst.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+            toDst.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+            toDst.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+            toDst.srcQueueFamilyIndex = toDst.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+            toDst.image = st->depthImage.image;
+            toDst.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr,
+                                 0, nullptr, 1, &toDst);
+            VkBufferImageCopy region{};
+            region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+            region.imageExtent = {depth.width, depth.height, 1};
+            vkCmdCopyBufferToImage(cmd, st->depthBuf.buffer, st->depthImage.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                   1, &region);
+            VkImageMemoryBarrier toRead = toDst;
+            // Hazard: the shader's reads must see the finished copy.
+            toRead.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+            toRead.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+            toRead.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+            toRead.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
+                                 nullptr, 0, nullptr, 1, &toRead);
+        },
+        "custom.uploadDepth");
+
+    // Layouts, pipeline, descriptors.
+    VkDescriptorSetLayoutBinding b[5]{};
+    const VkDescriptorType types[5] = {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+    for (std::uint32_t i = 0; i < 5; ++i) {
+        b[i].binding = i;
+        b[i].descriptorType = types[i];
+        b[i].descriptorCount = 1;
+        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    }
+    VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    lci.bindingCount = 5;
+    lci.pBindings = b;
+    VkDescriptorSetLayout sl;
+    LC_VK(vkCreateDescriptorSetLayout(dev, &lci, nullptr, &sl));
+    st->setLayout = vk::DescriptorSetLayoutHandle(dev, sl);
+    VkPipelineLayoutCreateInfo plci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    plci.setLayoutCount = 1;
+    plci.pSetLayouts = &sl;
+    VkPipelineLayout pl;
+    LC_VK(vkCreatePipelineLayout(dev, &plci, nullptr, &pl));
+    st->pipelineLayout = vk::PipelineLayoutHandle(dev, pl);
+    st->module = ctx.createShader(spirv.data(), spirv.size(), "custom.shader");
+    VkComputePipelineCreateInfo cpi{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    cpi.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    cpi.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    cpi.stage.module = st->module;
+    cpi.stage.pName = entry.c_str();
+    cpi.layout = pl;
+    VkPipeline pipe;
+    const VkResult pr = vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &cpi, nullptr, &pipe);
+    if (pr != VK_SUCCESS)
+        throw InputError(o.path, "", 0, std::string("the device refused the pipeline (") + vk::resultName(pr) +
+                                            "): check the entry point '" + entry + "' and the bindings" + firstMessage());
+    st->pipeline = vk::PipelineHandle(dev, pipe);
+
+    VkDescriptorPoolSize sizes[3] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
+                                     {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
+                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3}};
+    VkDescriptorPoolCreateInfo dpci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    dpci.maxSets = 1;
+    dpci.poolSizeCount = 3;
+    dpci.pPoolSizes = sizes;
+    VkDescriptorPool pool;
+    LC_VK(vkCreateDescriptorPool(dev, &dpci, nullptr, &pool));
+    st->pool = vk::DescriptorPoolHandle(dev, pool);
+    VkDescriptorSetAllocateInfo dsai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    dsai.descriptorPool = pool;
+    dsai.descriptorSetCount = 1;
+    dsai.pSetLayouts = &sl;
+    VkDescriptorSet set;
+    LC_VK(vkAllocateDescriptorSets(dev, &dsai, &set));
+    VkDescriptorBufferInfo bi[4] = {{st->params.buffer, 0, VK_WHOLE_SIZE},
+                                    {st->depthBuf.buffer, 0, VK_WHOLE_SIZE},
+                                    {st->lightBuf.buffer, 0, VK_WHOLE_SIZE},
+                                    {st->out.buffer, 0, VK_WHOLE_SIZE}};
+    VkDescriptorImageInfo ii{sampler, st->depthImage.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    VkWriteDescriptorSet w[5]{};
+    for (std::uint32_t i = 0; i < 5; ++i) {
+        w[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        w[i].dstSet = set;
+        w[i].dstBinding = i;
+        w[i].descriptorCount = 1;
+        w[i].descriptorType = types[i];
+    }
+    w[0].pBufferInfo = &bi[0];
+    w[1].pImageInfo = &ii;
+    w[2].pBufferInfo = &bi[1];
+    w[3].pBufferInfo = &bi[2];
+    w[4].pBufferInfo = &bi[3];
+    vkUpdateDescriptorSets(dev, 5, w, 0, nullptr);
+
+    double wallMs = 0;
+    const bool finished = st->ctx->submitAndWaitFor(
+        [&](VkCommandBuffer cmd) {
+            vkCmdFillBuffer(cmd, st->out.buffer, 0, VK_WHOLE_SIZE, 0);
+            VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+            // Hazard: the shader's list writes and atomics must follow the zero fill.
+            mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+            mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb,
+                                 0, nullptr, 0, nullptr);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, st->pipeline);
+            vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pl, 0, 1, &set, 0, nullptr);
+            vkCmdDispatch(cmd, grid.tilesX, grid.tilesY, 1);
+            // Hazard: the host reads the lists only after the shader's writes.
+            VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+            toHost.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+            toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost,
+                                 0, nullptr, 0, nullptr);
+        },
+        "custom.cull", o.timeoutMs, wallMs);
+    if (!finished) {
+        // The device is still running the shader: leak everything it uses (a
+        // CPU device keeps one thread busy until the process ends) and let
+        // the next run open a fresh device.
+        (void)st.release();
+        throw DeviceError(o.path + ": the culling shader did not finish within " + std::to_string(int(o.timeoutMs)) +
+                          " ms (an endless loop?); that device was abandoned and the next run opens a fresh one");
+    }
+    report.passMs = wallMs;
+
+    std::vector<std::uint32_t> words(outWords);
+    std::memcpy(words.data(), st->out.mapped, outWords * 4);
+    st.reset();
+    std::vector<std::string> messages = vk::validationMessages();
+    if (messages.size() > messagesBefore)
+        report.validationMessages.assign(messages.begin() + std::ptrdiff_t(messagesBefore), messages.end());
+
+    CullResult r = skeleton;
+    decodeLists(words, o.layout, lightCount, r, report);
+    detail::compareWithBuiltin(r, skeleton, report);
+    r.backend = "custom";
+    r.device = report.device;
+    r.timingMethod = "cpu-wall-clock around vkQueueSubmit+vkWaitForFences (custom shader dispatch)";
+    r.timings = Timings{};
+    r.timings.cullMs = wallMs;
+    r.volumeTests = 0;
+    return r;
+}
+
+} // namespace lc

@@ -1,0 +1,417 @@
+// Bring your own culling (docs/CUSTOM_CULLING.md): the example shaders of
+// resources/culling-examples/ run on lavapipe with the validation layer on.
+// The correct ones report false negatives 0 and lists equal (within float
+// widening) to the built-in algorithm of their rule; the flawed one misses
+// lights where its tile frustums drift; overflow, invalid indices, a hang and
+// a compile error are reported, never followed; an engine's lists read from
+// a dump or CSV are judged the same way.
+#include "gpu_test_env.hpp"
+
+#include "culling/custom_cull.hpp"
+#include "culling/errors.hpp"
+#include "culling/export.hpp"
+#include "culling/scene_io.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
+
+using namespace lc;
+using lc::gputest::GpuTest;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kExamples = std::string(LC_SOURCE_DIR) + "/resources/culling-examples/";
+const std::string kData = std::string(LC_TEST_DATA_DIR) + "/custom/";
+
+// The atrium with 200 lights (a quarter spots; or `lights`) at a size that is not a whole
+// number of tiles, so edge tiles are partial.
+Scene atrium(std::uint32_t w = 330, std::uint32_t h = 190, std::uint32_t lights = 200) {
+    Scene s = makeBuiltinScene("atrium");
+    LightGenSettings g = defaultLightGen(s, lights, 4);
+    g.spotFraction = 0.25;
+    s.lights = generateLights(g);
+    s.camera.width = w;
+    s.camera.height = h;
+    return s;
+}
+
+CustomShaderOptions optionsFor(const std::string& path, const std::string& layout = {}, const std::string& lists = {}) {
+    CustomShaderOptions o;
+    o.path = path;
+    std::ifstream in(path);
+    std::string first;
+    std::getline(in, first);
+    if (!layout.empty()) o.layout = parseLayout(layout);
+    if (!lists.empty()) o.lists = parseListSpec(lists);
+    applyShaderHeader(first, path, o, !layout.empty(), !lists.empty(), false);
+    return o;
+}
+
+RunOutput runShader(const Scene& s, const CustomShaderOptions& o, CustomCullReport& rep) {
+    RunOptions ro;
+    ro.truthOptions.imageError = false;
+    return runCustomPipeline(s, o, gputest::vulkan(), ro, rep);
+}
+
+// Every entry of `ref` is in `got`; returns the extra entries of `got`.
+std::uint64_t supersetExtra(const CullResult& ref, const CullResult& got, std::string& firstLost) {
+    std::uint64_t extra = 0;
+    for (std::size_t l = 0; l < ref.listCount.size(); ++l) {
+        const auto rb = ref.lightIndices.begin() + ref.listOffset[l], re = rb + ref.listCount[l];
+        const auto gb = got.lightIndices.begin() + got.listOffset[l], ge = gb + got.listCount[l];
+        std::vector<std::uint32_t> lost;
+        std::set_difference(rb, re, gb, ge, std::back_inserter(lost));
+        if (!lost.empty() && firstLost.empty())
+            firstLost = "list " + std::to_string(l) + " lacks light " + std::to_string(lost[0]);
+        extra += got.listCount[l] - (ref.listCount[l] - lost.size());
+    }
+    return extra;
+}
+
+CullResult cpuReference(const Scene& s, const DepthImage& depth, Algorithm a, std::uint32_t cells = 1,
+                        Slicing slicing = Slicing::Log) {
+    CullSettings cs;
+    cs.algorithm = a;
+    cs.cells = cells;
+    cs.slicing = slicing;
+    cs.skipEmpty = false;
+    const Projection proj(s.camera);
+    return makeCpuBackend()->cull(depth, proj, TileGrid::make(s.camera.width, s.camera.height, s.camera.tileSize),
+                                  makeViewLights(s), cs);
+}
+
+void expectCorrect(const RunOutput& out, const CustomCullReport& rep, const CullResult& ref, const std::string& label) {
+    EXPECT_EQ(out.truth.metrics.falseNegatives, 0u) << label;
+    EXPECT_TRUE(rep.validationMessages.empty()) << label << ": " << rep.validationMessages.front();
+    EXPECT_EQ(rep.overflowLists, 0u) << label;
+    EXPECT_EQ(rep.invalidIndices, 0u) << label;
+    EXPECT_EQ(rep.duplicateIndices, 0u) << label;
+    std::string lost;
+    const std::uint64_t extra = supersetExtra(ref, out.result, lost);
+    EXPECT_TRUE(lost.empty()) << label << ": " << lost;
+    // Equal to the built-in lists up to the float widening: at most 0.5% extra.
+    EXPECT_LE(extra * 200, ref.entries()) << label << ": " << extra << " extra of " << ref.entries();
+    EXPECT_GT(out.result.entries(), 0u) << label;
+    EXPECT_GT(rep.passMs, 0.0) << label;
+}
+
+} // namespace
+
+TEST_F(GpuTest, GlslTiledExampleMatchesMinMax) {
+    const Scene s = atrium();
+    CustomCullReport rep;
+    const RunOutput out = runShader(s, optionsFor(kExamples + "tiled_fixed.comp"), rep);
+    EXPECT_EQ(rep.layout, "fixed:256"); // from the shader's first line
+    EXPECT_EQ(rep.lists, "tile");
+    expectCorrect(out, rep, cpuReference(s, out.depth, Algorithm::MinMax), "tiled_fixed.comp");
+    EXPECT_EQ(rep.builtinAlgorithm, "minmax");
+}
+
+TEST_F(GpuTest, HlslTiledExampleMatchesMinMax) {
+    const Scene s = atrium();
+    CustomCullReport rep;
+    CustomShaderOptions o = optionsFor(kExamples + "tiled_fixed.hlsl");
+    EXPECT_EQ(o.entry, "CSMain");
+    const RunOutput out = runShader(s, o, rep);
+    expectCorrect(out, rep, cpuReference(s, out.depth, Algorithm::MinMax), "tiled_fixed.hlsl");
+}
+
+TEST_F(GpuTest, BitmaskLayoutGivesTheSameListsAsFixed) {
+    const Scene s = atrium();
+    CustomCullReport a, b;
+    const RunOutput fixed = runShader(s, optionsFor(kExamples + "tiled_fixed.comp"), a);
+    const RunOutput mask = runShader(s, optionsFor(kExamples + "tiled_fixed.comp", "bitmask"), b);
+    EXPECT_EQ(b.layout, "bitmask");
+    EXPECT_EQ(fixed.result.listCount, mask.result.listCount);
+    EXPECT_EQ(fixed.result.lightIndices, mask.result.lightIndices);
+}
+
+TEST_F(GpuTest, TwoPointFiveDExampleIsConservativeAndTighterThanMinMax) {
+    // The forest: foliage in front of far hills, depth gaps in most tiles.
+    Scene s = makeBuiltinScene("forest");
+    s.lights = generateLights(defaultLightGen(s, 1000, 4));
+    s.camera.width = 330;
+    s.camera.height = 190;
+    CustomCullReport rep;
+    const RunOutput out = runShader(s, optionsFor(kExamples + "twofived_fixed.comp"), rep);
+    EXPECT_EQ(out.truth.metrics.falseNegatives, 0u);
+    EXPECT_TRUE(rep.validationMessages.empty());
+    const CullResult minmax = cpuReference(s, out.depth, Algorithm::MinMax);
+    EXPECT_LT(out.result.entries(), minmax.entries()); // the cells reject lights in depth gaps
+    // Never tighter than the exact built-in 2.5d of the same cells (32, linear).
+    const CullResult exact = cpuReference(s, out.depth, Algorithm::TwoPointFiveD, 32, Slicing::Linear);
+    std::string lost;
+    supersetExtra(exact, out.result, lost);
+    EXPECT_TRUE(lost.empty()) << lost;
+}
+
+TEST_F(GpuTest, ClusteredCompactExampleMatchesClustered) {
+    const Scene s = atrium();
+    CustomCullReport rep;
+    const RunOutput out = runShader(s, optionsFor(kExamples + "clustered_compact.comp"), rep);
+    EXPECT_EQ(rep.layout, "compact");
+    EXPECT_EQ(rep.lists, "froxel:16:log");
+    expectCorrect(out, rep, cpuReference(s, out.depth, Algorithm::Clustered, 16, Slicing::Log), "clustered_compact.comp");
+    // The same shader with linear froxels, chosen on the command line.
+    CustomCullReport lin;
+    const RunOutput outLin = runShader(s, optionsFor(kExamples + "clustered_compact.comp", "", "froxel:8:linear"), lin);
+    expectCorrect(outLin, lin, cpuReference(s, outLin.depth, Algorithm::Clustered, 8, Slicing::Linear),
+                  "clustered_compact.comp froxel:8:linear");
+}
+
+TEST_F(GpuTest, FlawedExampleMissesLightsWhereItsFrustumsDrift) {
+    // 650 px = 40.6 tiles: the flawed frustum of column tx spans pixels
+    // [tx, tx + 1] * 650 / 41 instead of [16 tx, 16 tx + 16]; 368 rows are
+    // exactly 23 tiles, so only the columns drift.
+    const Scene s = atrium(650, 368, 3000);
+    CustomCullReport rep;
+    // Bitmask lists: 3,000 lights would overflow fixed:256 lists, and only
+    // the drift may cause misses here.
+    const RunOutput out = runShader(s, optionsFor(kExamples + "flawed_tile_edges.comp", "bitmask"), rep);
+    EXPECT_EQ(rep.overflowLists, 0u);
+    ASSERT_GT(out.truth.metrics.falseNegatives, 0u);
+    const auto missed = locateFalseNegatives(out, Projection(s.camera));
+    ASSERT_FALSE(missed.empty());
+    const TileGrid& g = out.result.grid;
+    // A tile can miss only where some pixel centre of it lies outside its
+    // drifted frustum; every other tile's lights are all found.
+    auto hasUncoveredPixel = [&](std::uint32_t tx) {
+        const double left = double(tx) * g.width / g.tilesX, right = double(tx + 1) * g.width / g.tilesX;
+        const TileGrid::Rect r = g.tileRect(tx, 0);
+        for (std::uint32_t x = r.x0; x < r.x1; ++x)
+            if (x + 0.5 < left || x + 0.5 > right) return true;
+        return false;
+    };
+    std::uint64_t pixels = 0;
+    std::uint32_t driftingColumns = 0;
+    for (std::uint32_t tx = 0; tx < g.tilesX; ++tx) driftingColumns += hasUncoveredPixel(tx);
+    ASSERT_GT(driftingColumns, 0u);
+    ASSERT_LT(driftingColumns, g.tilesX);
+    for (const MissedLight& m : missed) {
+        EXPECT_TRUE(hasUncoveredPixel(m.tile % g.tilesX)) << "light " << m.light << " missed in tile " << m.tile;
+        // Each located miss is real: the list lacks the light.
+        const auto b = out.result.lightIndices.begin() + out.result.listOffset[m.list];
+        EXPECT_FALSE(std::binary_search(b, b + out.result.listCount[m.list], m.light));
+        pixels += m.pixels;
+    }
+    EXPECT_EQ(pixels, out.truth.metrics.falseNegatives); // every false negative is located
+    // The correct shader at the same size misses nothing.
+    CustomCullReport ok;
+    EXPECT_EQ(runShader(s, optionsFor(kExamples + "tiled_fixed.comp", "bitmask"), ok).truth.metrics.falseNegatives, 0u);
+}
+
+TEST_F(GpuTest, OverflowingFixedListsAreReportedNotHidden) {
+    const Scene s = atrium();
+    CustomCullReport rep;
+    const RunOutput out = runShader(s, optionsFor(kExamples + "tiled_fixed.comp", "fixed:2"), rep);
+    EXPECT_GT(rep.overflowLists, 0u);
+    EXPECT_GT(rep.overflowEntries, 0u);
+    EXPECT_GT(out.truth.metrics.falseNegatives, 0u); // the lights that did not fit are missed
+    EXPECT_LE(out.truth.metrics.maxList, 2u);
+}
+
+TEST_F(GpuTest, InvalidAndDuplicateIndicesAreReportedNeverFollowed) {
+    const Scene s = atrium(96, 64);
+    CustomCullReport rep;
+    const RunOutput out = runShader(s, optionsFor(kData + "out_of_range.comp"), rep);
+    const std::uint64_t tiles = out.result.grid.tileCount();
+    EXPECT_EQ(rep.invalidIndices, tiles);
+    EXPECT_EQ(rep.duplicateIndices, tiles);
+    for (std::uint32_t i : out.result.lightIndices) EXPECT_LT(i, s.lights.size());
+    EXPECT_EQ(out.result.entries(), tiles); // light 0 once per tile
+}
+
+TEST_F(GpuTest, AHangIsATimeoutAndTheNextRunWorks) {
+    const Scene s = atrium(320, 180);
+    CustomShaderOptions o = optionsFor(kData + "hang.comp");
+    o.timeoutMs = 300;
+    CustomCullReport rep;
+    try {
+        runShader(s, o, rep);
+        FAIL() << "no timeout";
+    } catch (const DeviceError& e) {
+        EXPECT_NE(std::string(e.what()).find("did not finish within 300 ms"), std::string::npos) << e.what();
+    }
+    CustomCullReport ok;
+    EXPECT_EQ(runShader(s, optionsFor(kExamples + "tiled_fixed.comp"), ok).truth.metrics.falseNegatives, 0u);
+}
+
+TEST_F(GpuTest, CompileErrorsNameFileAndLine) {
+    const Scene s = atrium(64, 64);
+    CustomCullReport rep;
+    try {
+        runShader(s, optionsFor(kData + "syntax_error.comp"), rep);
+        FAIL() << "no compile error";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.line(), 6);
+        EXPECT_NE(std::string(e.what()).find("syntax_error.comp:6: compile error: 'undeclaredThing'"), std::string::npos)
+            << e.what();
+    }
+}
+
+TEST_F(GpuTest, SpirvFromTheCompilerRunsToo) {
+    // Compile the GLSL example with glslangValidator as a build would, with
+    // the tool's defines, then hand the tool the .spv.
+    const Scene s = atrium();
+    const fs::path dir = fs::temp_directory_path() / ("lc_spv_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    fs::copy_file(kExamples + "tiled_fixed.comp", dir / "t.comp", fs::copy_options::overwrite_existing);
+    std::ofstream(dir / "lightcull.glsl") << std::ifstream(std::string(LC_SOURCE_DIR) + "/shaders/custom/lightcull.glsl").rdbuf();
+    const std::string cmd = "glslangValidator -V --target-env vulkan1.1 -DTILE_SIZE=16 -DMAX_LIGHTS_PER_TILE=256 "
+                            "-DLC_LAYOUT=0 -DLC_LISTS=0 -DLC_LISTS_PER_TILE=1 -DLC_MASK_WORDS=7 -DLC_COMPACT_ENTRIES=0 -o " +
+                            (dir / "t.spv").string() + " " + (dir / "t.comp").string() + " > /dev/null";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    CustomShaderOptions o;
+    o.path = (dir / "t.spv").string();
+    o.layout = parseLayout("fixed:256");
+    CustomCullReport rep;
+    const RunOutput out = runShader(s, o, rep);
+    expectCorrect(out, rep, cpuReference(s, out.depth, Algorithm::MinMax), "t.spv");
+    fs::remove_all(dir);
+}
+
+TEST_F(GpuTest, EngineListDumpsAreJudgedLikeShaders) {
+    const Scene s = atrium();
+    const Projection proj(s.camera);
+    const DepthImage depth = gputest::vulkan().renderDepth(s, proj);
+    const CullResult ref = cpuReference(s, depth, Algorithm::MinMax);
+    const fs::path dir = fs::temp_directory_path() / ("lc_dump_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    // As a GPU debugger exports a fixed:N buffer: count + N indices per tile.
+    const std::uint32_t n = *std::max_element(ref.listCount.begin(), ref.listCount.end());
+    const std::string fixedN = "fixed:" + std::to_string(n);
+    std::vector<std::uint32_t> words(ref.listCount.size() * (n + 1), 0);
+    for (std::size_t l = 0; l < ref.listCount.size(); ++l) {
+        words[l * (n + 1)] = ref.listCount[l];
+        for (std::uint32_t k = 0; k < ref.listCount[l]; ++k)
+            words[l * (n + 1) + 1 + k] = ref.lightIndices[ref.listOffset[l] + k];
+    }
+    std::ofstream(dir / "lists.bin", std::ios::binary)
+        .write(reinterpret_cast<const char*>(words.data()), std::streamsize(words.size() * 4));
+    RunOptions ro;
+    ro.truthOptions.imageError = false;
+    CustomCullReport rep;
+    const RunOutput out =
+        checkListDump(s, (dir / "lists.bin").string(), parseLayout(fixedN), parseListSpec("tile"), depth, ro, rep);
+    EXPECT_EQ(out.truth.metrics.falseNegatives, 0u);
+    EXPECT_EQ(rep.listsDifferingFromBuiltin, 0u);
+    EXPECT_EQ(out.result.lightIndices, ref.lightIndices);
+
+    // CSV with one light dropped from the busiest list: exactly that miss.
+    std::size_t busiest = 0;
+    for (std::size_t l = 0; l < ref.listCount.size(); ++l)
+        if (ref.listCount[l] > ref.listCount[busiest]) busiest = l;
+    std::uint32_t dropped = 0;
+    {
+        std::ofstream csv(dir / "lists.csv");
+        csv << "list,lights\n";
+        for (std::size_t l = 0; l < ref.listCount.size(); ++l) {
+            csv << l;
+            for (std::uint32_t k = 0; k < ref.listCount[l]; ++k) {
+                const std::uint32_t light = ref.lightIndices[ref.listOffset[l] + k];
+                if (l == busiest && k == 0) {
+                    dropped = light;
+                    continue;
+                }
+                csv << "," << light;
+            }
+            csv << "\n";
+        }
+    }
+    // Judged on the engine's own depth, written as raw float32.
+    std::ofstream(dir / "depth.f32", std::ios::binary)
+        .write(reinterpret_cast<const char*>(depth.depth.data()), std::streamsize(depth.depth.size() * 4));
+    const DepthImage engineDepth = loadDepthFile((dir / "depth.f32").string(), proj);
+    EXPECT_EQ(engineDepth.depth, depth.depth);
+    CustomCullReport csvRep;
+    const RunOutput csvOut = checkListDump(s, (dir / "lists.csv").string(), parseLayout("fixed:32"), parseListSpec("tile"),
+                                           engineDepth, ro, csvRep);
+    const auto missed = locateFalseNegatives(csvOut, proj);
+    const std::uint64_t needing = [&] {
+        for (const auto& [light, count] : pixelsNeedingLights(depth, proj, csvOut.lights, csvOut.result.grid, std::uint32_t(busiest)))
+            if (light == dropped) return std::uint64_t(count);
+        return std::uint64_t(0);
+    }();
+    if (needing == 0) {
+        EXPECT_TRUE(missed.empty()); // a false positive was dropped: nothing missed
+    } else {
+        ASSERT_EQ(missed.size(), 1u);
+        EXPECT_EQ(missed[0].tile, busiest);
+        EXPECT_EQ(missed[0].light, dropped);
+        EXPECT_EQ(missed[0].pixels, needing);
+    }
+    // Bad dumps: one line naming the file and the line.
+    std::ofstream(dir / "bad.csv") << "0,1,2\n99999,3\n";
+    try {
+        checkListDump(s, (dir / "bad.csv").string(), parseLayout("fixed:32"), parseListSpec("tile"), depth, ro, csvRep);
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("bad.csv:2: list 99999 is outside"), std::string::npos) << e.what();
+    }
+    std::ofstream(dir / "short.bin", std::ios::binary) << "abcd";
+    EXPECT_THROW(checkListDump(s, (dir / "short.bin").string(), parseLayout("fixed:32"), parseListSpec("tile"), depth, ro,
+                               csvRep),
+                 InputError);
+    fs::remove_all(dir);
+}
+
+TEST(CustomSpecs, LayoutsListsAndFirstLineSettings) {
+    EXPECT_EQ(toString(parseLayout("fixed:64")), "fixed:64");
+    EXPECT_EQ(toString(parseLayout("compact")), "compact");
+    EXPECT_EQ(toString(parseLayout("compact:1000")), "compact:1000");
+    EXPECT_EQ(toString(parseLayout("bitmask")), "bitmask");
+    EXPECT_THROW(parseLayout("fixed"), SettingsError);
+    EXPECT_THROW(parseLayout("fixed:0"), SettingsError);
+    EXPECT_THROW(parseLayout("list"), SettingsError);
+    EXPECT_EQ(toString(parseListSpec("froxel:24")), "froxel:24:log");
+    EXPECT_EQ(toString(parseListSpec("froxel:8:linear")), "froxel:8:linear");
+    EXPECT_THROW(parseListSpec("froxel:33"), SettingsError);
+    EXPECT_THROW(parseListSpec("cells"), SettingsError);
+    EXPECT_EQ(layoutWords(parseLayout("fixed:4"), 10, 100), 50u);
+    EXPECT_EQ(layoutWords(parseLayout("bitmask"), 10, 33), 20u);
+    EXPECT_EQ(layoutWords(parseLayout("compact:7"), 10, 100), 1u + 20u + 7u);
+
+    CustomShaderOptions o;
+    applyShaderHeader("// lightcull: --layout bitmask --lists halfz --entry CS\n", "x.comp", o, false, false, false);
+    EXPECT_EQ(toString(o.layout), "bitmask");
+    EXPECT_EQ(toString(o.lists), "halfz");
+    EXPECT_EQ(o.entry, "CS");
+    CustomShaderOptions given;
+    given.layout = parseLayout("fixed:8");
+    applyShaderHeader("// lightcull: --layout bitmask\n", "x.comp", given, true, false, false); // the flag wins
+    EXPECT_EQ(toString(given.layout), "fixed:8");
+    EXPECT_THROW(applyShaderHeader("// lightcull: --layout nonsense\n", "x.comp", o, false, false, false), InputError);
+    EXPECT_THROW(applyShaderHeader("// lightcull: --frobnicate 3\n", "x.comp", o, false, false, false), InputError);
+}
+
+TEST(CustomDecode, EveryLayoutDecodesCountsOverflowAndBadIndices) {
+    CullResult r;
+    r.listOffset.assign(3, 0);
+    CustomCullReport rep;
+    // fixed:2 -> 3 lists: {1, 0}, count 3 (overflow 1) {2, 2}, {9 (invalid)}
+    decodeLists({2, 1, 0, 3, 2, 2, 1, 9, 0}, parseLayout("fixed:2"), 5, r, rep);
+    EXPECT_EQ(r.listCount, (std::vector<std::uint32_t>{2, 1, 0}));
+    EXPECT_EQ(r.lightIndices, (std::vector<std::uint32_t>{0, 1, 2}));
+    EXPECT_EQ(rep.overflowLists, 1u);
+    EXPECT_EQ(rep.overflowEntries, 1u);
+    EXPECT_EQ(rep.duplicateIndices, 1u);
+    EXPECT_EQ(rep.invalidIndices, 1u);
+    // bitmask with 40 lights: 2 words per list.
+    CustomCullReport b;
+    decodeLists({0b101, 1u << 7, 0, 0, 0xFFFFFFFFu, 0}, parseLayout("bitmask"), 40, r, b);
+    EXPECT_EQ(r.listCount, (std::vector<std::uint32_t>{3, 0, 32}));
+    EXPECT_EQ(r.lightIndices[2], 39u);
+    // compact:4: counter, (offset, count) x 3, 4 entries; list 2 runs past the array.
+    CustomCullReport c;
+    decodeLists({6, 0, 2, 2, 0, 3, 3, 4, 1, 3, 0}, parseLayout("compact:4"), 5, r, c);
+    EXPECT_EQ(r.listCount, (std::vector<std::uint32_t>{2, 0, 1}));
+    EXPECT_EQ(c.overflowLists, 1u);
+    EXPECT_EQ(c.overflowEntries, 2u);
+    // Too few words for the layout is an error, not a read past the end.
+    EXPECT_THROW(decodeLists({1, 2}, parseLayout("fixed:2"), 5, r, c), Error);
+}
