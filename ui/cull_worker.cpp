@@ -256,8 +256,15 @@ void CullWorker::drain() {
                 runScene = std::move(full);
             }
             options.groundTruth = !req.deferTruth;
-            auto out = std::make_shared<lc::RunOutput>(
-                lc::runPipeline(*runScene, req.settings, *backend_, options, cancel.get()));
+            std::shared_ptr<lc::RunOutput> out;
+            if (req.custom) {
+                lc::CustomCullReport report;
+                out = std::make_shared<lc::RunOutput>(
+                    lc::runCustomPipeline(*runScene, *req.custom, *backend_, options, report, options.reuseDepth));
+            } else {
+                out = std::make_shared<lc::RunOutput>(
+                    lc::runPipeline(*runScene, req.settings, *backend_, options, cancel.get()));
+            }
             if (!out->depthReused) {
                 depth_ = std::make_shared<const lc::DepthImage>(out->depth);
                 depthCamera_ = req.scene->camera;
@@ -313,8 +320,9 @@ CullService::~CullService() {
 
 quint64 CullService::request(const lc::Scene& scene, const lc::CullSettings& settings,
                              const QString& backend, const QString& device, bool deferTruth, bool shade,
-                             quint64 geometryRevision) {
+                             quint64 geometryRevision, std::shared_ptr<const lc::CustomShaderOptions> custom) {
     CullRequest r;
+    r.custom = std::move(custom);
     r.generation = ++generation_;
     // Lights and camera are copied; the meshes only when their revision changed.
     auto copy = std::make_shared<lc::Scene>();

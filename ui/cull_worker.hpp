@@ -9,6 +9,7 @@
 // document keeps the result with the highest generation number.
 
 #include "culling/backend.hpp"
+#include "culling/custom_cull.hpp"
 #include "culling/pipeline.hpp"
 
 #include <QObject>
@@ -45,6 +46,9 @@ struct CullRequest {
     // carries RunOutput::shadedCulled/shadedAll and the image error. A newer
     // request cancels shading that has not finished.
     bool shade = false;
+    // A custom culling shader (docs/CUSTOM_CULLING.md) instead of
+    // settings.algorithm; null: the built-in algorithm.
+    std::shared_ptr<const lc::CustomShaderOptions> custom;
 };
 
 class CullWorker : public QObject {
@@ -124,7 +128,8 @@ public:
     // only when it changes and shared by the requests in between.
     quint64 request(const lc::Scene& scene, const lc::CullSettings& settings,
                     const QString& backend, const QString& device, bool deferTruth = false,
-                    bool shade = false, quint64 geometryRevision = 0);
+                    bool shade = false, quint64 geometryRevision = 0,
+                    std::shared_ptr<const lc::CustomShaderOptions> custom = nullptr);
     // CullWorker::requestShading.
     void requestShading(quint64 generation) { worker_->requestShading(generation); }
     quint64 lastGeneration() const { return generation_; }

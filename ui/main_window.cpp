@@ -25,6 +25,8 @@
 #include <QDragEnterEvent>
 #include <QDropEvent>
 #include <QElapsedTimer>
+#include <QFileSystemWatcher>
+#include <QFile>
 #include <QFileDialog>
 #include <QInputDialog>
 #include <QFileInfo>
@@ -249,6 +251,13 @@ void MainWindow::buildActions() {
 
     connect(make(tr("&Run culling"), "actionRun", QKeySequence(Qt::Key_F5)), &QAction::triggered, this,
             [this] { runCulling(); });
+    connect(make(tr("Custom &shader..."), "actionCustomShader"), &QAction::triggered, this, [this] {
+        const QString p = prompts.openPath(this, tr("Custom culling shader"),
+                                           tr("Culling shaders (*.comp *.glsl *.hlsl *.spv)"));
+        if (!p.isEmpty()) setCustomShader(p);
+    });
+    connect(make(tr("&Built-in algorithm"), "actionBuiltinAlgorithm"), &QAction::triggered, this,
+            [this] { setCustomShader({}); });
     QAction* live = make(tr("Live"), "actionLive");
     live->setCheckable(true);
     live->setToolTip(tr("Re-run culling after every edit"));
@@ -303,6 +312,9 @@ void MainWindow::buildMenus() {
     QMenu* cull = menuBar()->addMenu(tr("&Culling"));
     cull->addAction(action("actionRun"));
     cull->addAction(action("actionLive"));
+    cull->addSeparator();
+    cull->addAction(action("actionCustomShader"));
+    cull->addAction(action("actionBuiltinAlgorithm"));
 }
 
 void MainWindow::buildToolbar() {
@@ -358,6 +370,7 @@ void MainWindow::buildToolbar() {
     }
     for (auto& [name, w] : paramWidgets_) w->setObjectName(QString::fromStdString("param_" + name));
 
+    bar->addAction(action("actionCustomShader"));
     bar->addSeparator();
     bar->addWidget(new QLabel(tr("backend ")));
     backendCombo_ = new QComboBox;
@@ -459,7 +472,7 @@ quint64 MainWindow::runCulling(bool liveEdit) {
     const quint64 gen = service_->request(doc_->scene(), doc_->settings(), backendCombo_->currentText(),
                                           deviceEdit_->text(), liveEdit,
                                           CameraView::needsShading(cameraView_->imageMode()),
-                                          doc_->geometryRevision());
+                                          doc_->geometryRevision(), customShader_);
     statusBar()->showMessage(tr("culling (run %1)...").arg(gen));
     return gen;
 }
@@ -481,9 +494,22 @@ void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::Run
         emit runFinished(generation);
         return;
     }
+    if (out->custom && out->truthComputed) {
+        const lc::CustomCullReport& c = *out->custom;
+        log(tr("custom shader %1 (%2, %3): overflowed lists %4, invalid indices %5, validation messages %6, "
+               "%7 lists differ from built-in %8")
+                .arg(QString::fromStdString(c.source), QString::fromStdString(c.layout), QString::fromStdString(c.lists))
+                .arg(c.overflowLists)
+                .arg(c.invalidIndices)
+                .arg(c.validationMessages.size())
+                .arg(c.listsDifferingFromBuiltin)
+                .arg(QString::fromStdString(c.builtinAlgorithm)),
+            c.overflowLists > 0 || c.invalidIndices > 0 || !c.validationMessages.empty());
+        for (const std::string& m : c.validationMessages) log(QString::fromStdString(m), true);
+    }
     if (out->truthComputed) log(tr("run %1: %2, %3 lights, depth %4 ms, cull %5 ms, false negatives %6, efficiency %7")
             .arg(generation)
-            .arg(lc::toString(out->result.algorithm))
+            .arg(out->custom ? QStringLiteral("custom") : QString(lc::toString(out->result.algorithm)))
             .arg(out->lights.size())
             .arg(out->result.timings.depthMs, 0, 'f', 2)
             .arg(out->result.timings.cullMs, 0, 'f', 2)
@@ -783,6 +809,69 @@ void MainWindow::setTabbedViews(bool tabbed) {
         cameraView_->setVisible(true);
         inspectorView_->setVisible(true);
     }
+}
+
+bool MainWindow::setCustomShader(const QString& path) {
+    if (!shaderWatcher_) {
+        shaderWatcher_ = new QFileSystemWatcher(this);
+        connect(shaderWatcher_, &QFileSystemWatcher::fileChanged, this, [this] { reloadCustomShader(); });
+    }
+    if (!shaderWatcher_->files().isEmpty()) shaderWatcher_->removePaths(shaderWatcher_->files());
+    if (path.isEmpty()) {
+        if (customShader_) log(tr("culling with the built-in algorithm again"));
+        customShader_.reset();
+        runCulling();
+        return true;
+    }
+    auto o = std::make_shared<lc::CustomShaderOptions>();
+    o->path = path.toStdString();
+    try {
+        if (!path.endsWith(".spv", Qt::CaseInsensitive)) {
+            QFile f(path);
+            if (!f.open(QIODevice::ReadOnly)) throw lc::InputError(o->path, "", 0, "cannot open shader for reading");
+            lc::applyShaderHeader(f.readLine().toStdString(), o->path, *o, false, false, false);
+        }
+    } catch (const std::exception& e) {
+        log(tr("cannot use %1: %2").arg(path, describe(e)), true);
+        prompts.showError(this, tr("Custom shader"), describe(e));
+        return false;
+    }
+    customShader_ = o;
+    shaderWatcher_->addPath(path);
+    log(tr("culling with custom shader %1 (layout %2, lists %3); saving it re-runs")
+            .arg(path, QString::fromStdString(lc::toString(o->layout)), QString::fromStdString(lc::toString(o->lists))));
+    runCulling();
+    return true;
+}
+
+QString MainWindow::customShaderPath() const {
+    return customShader_ ? QString::fromStdString(customShader_->path) : QString();
+}
+
+void MainWindow::reloadCustomShader() {
+    if (!customShader_) return;
+    const QString path = customShaderPath();
+    // Editors often save by replacing the file: watch the new one.
+    if (QFileInfo::exists(path) && !shaderWatcher_->files().contains(path)) shaderWatcher_->addPath(path);
+    if (!QFileInfo::exists(path)) return; // mid-save; the new file's change follows
+    log(tr("%1 changed: culling again").arg(path));
+    auto o = std::make_shared<lc::CustomShaderOptions>(*customShader_);
+    try {
+        if (!path.endsWith(".spv", Qt::CaseInsensitive)) {
+            QFile f(path);
+            if (f.open(QIODevice::ReadOnly)) {
+                lc::CustomShaderOptions fresh;
+                fresh.path = o->path;
+                lc::applyShaderHeader(f.readLine().toStdString(), o->path, fresh, false, false, false);
+                o = std::make_shared<lc::CustomShaderOptions>(fresh);
+            }
+        }
+    } catch (const std::exception& e) {
+        log(tr("cannot use %1: %2").arg(path, describe(e)), true);
+        return;
+    }
+    customShader_ = o;
+    runCulling();
 }
 
 void MainWindow::setGltfMinIntensity(double lux) {

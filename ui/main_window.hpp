@@ -9,6 +9,7 @@
 #include "culling/params.hpp"
 #include "culling/scene_io.hpp"
 
+#include "culling/custom_cull.hpp"
 #include "culling/gltf_io.hpp"
 
 #include <QMainWindow>
@@ -31,6 +32,8 @@ class QTabBar;
 namespace lc {
 struct RunOutput;
 }
+
+class QFileSystemWatcher;
 
 namespace lcui {
 
@@ -77,6 +80,13 @@ public:
     // file's first).
     lc::GltfReadOptions gltfOptions;
     void setGltfMinIntensity(double lux);
+
+    // A custom culling shader (Culling > Custom shader...; docs/CUSTOM_CULLING.md)
+    // runs instead of the built-in algorithm, its first-line settings applied.
+    // The file is watched: saving it re-runs culling. An empty path goes back
+    // to the built-in algorithm. False (logged, shown) for a bad first line.
+    bool setCustomShader(const QString& path);
+    QString customShaderPath() const;
 
     // --- file operations (return false on failure or cancel; the current
     // scene is then untouched and the error is logged and shown) -------------
@@ -135,6 +145,7 @@ protected:
     void dropEvent(QDropEvent* e) override;
 
 private:
+    void reloadCustomShader(); // the watched file changed
     void buildActions();
     void buildMenus();
     void buildToolbar();
@@ -177,6 +188,8 @@ private:
     QLabel* statusLists_;
     QLabel* statusShading_ = nullptr; // "shading..." while the worker shades
     QString lastBackendName_, lastDeviceName_;
+    std::shared_ptr<const lc::CustomShaderOptions> customShader_;
+    QFileSystemWatcher* shaderWatcher_ = nullptr;
     quint64 pendingRuns_ = 0;
 };
 

@@ -1,0 +1,162 @@
+// A custom culling shader in the studio, as a user works with it: Culling >
+// Custom shader... picks the file, the run is judged like a built-in one, and
+// saving the file in an editor re-runs culling: a flawed edit shows its missed
+// lights in the tile inspector (MISSING, in red), a syntax error lands in the
+// message log with file and line and leaves the scene alone, and Built-in
+// algorithm goes back.
+
+#include "studio_test_support.hpp"
+
+#include "document.hpp"
+#include "main_window.hpp"
+#include "tile_inspector.hpp"
+
+#include "culling/custom_cull.hpp"
+#include "culling/scene_io.hpp"
+
+#include <QAction>
+#include <QElapsedTimer>
+#include <QFile>
+#include <QPlainTextEdit>
+#include <QTableView>
+#include <QUndoStack>
+
+#include <fstream>
+#include <sstream>
+
+using namespace lcui;
+
+namespace {
+
+constexpr int kWaitMs = 120000;
+const QString kExamples = QStringLiteral(LC_SOURCE_DIR) + "/resources/culling-examples/";
+
+std::string readAll(const QString& path) {
+    std::ifstream in(path.toStdString());
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+} // namespace
+
+class CustomShaderStudioTest : public QObject {
+    Q_OBJECT
+    std::unique_ptr<MainWindow> w_;
+    QTemporaryDir tmp_;
+    Document* doc() const { return w_->document(); }
+
+    // Waits for a run newer than `after` to finish (true) or fail (false).
+    bool waitRunAfter(quint64 after, QString* failure = nullptr) {
+        QSignalSpy done(w_.get(), &MainWindow::runFinished);
+        QSignalSpy failed(w_.get(), &MainWindow::runFailed);
+        QElapsedTimer t;
+        t.start();
+        while (t.elapsed() < kWaitMs) {
+            for (const auto& f : failed)
+                if (f.at(0).toULongLong() > after) {
+                    if (failure) *failure = f.at(1).toString();
+                    return false;
+                }
+            if (doc()->runGeneration() > after && doc()->runOutput() && doc()->runOutput()->truthComputed) return true;
+            done.wait(100);
+        }
+        return false;
+    }
+    // Rewrites the watched file as an editor saving it would.
+    void save(const QString& path, const std::string& text) {
+        std::ofstream(path.toStdString(), std::ios::trunc) << text;
+    }
+
+private slots:
+    void init() {
+        w_ = lctest::makeTestWindow();
+        QVERIFY(QTest::qWaitForWindowExposed(w_.get()));
+        w_->setBackend("vulkan"); // the custom shader runs on Vulkan; depth too
+        QVERIFY(w_->openBuiltin("atrium"));
+        // 650 x 368: 40.6 tiles across, so the flawed edit below drifts.
+        QVERIFY(w_->setParamFromUi("width", "650"));
+        QVERIFY(w_->setParamFromUi("height", "368"));
+        doc()->undoStack()->clear();
+    }
+    void cleanup() {
+        doc()->undoStack()->setClean();
+        w_.reset();
+    }
+
+    void shaderIsPickedRunAndWatched() {
+        const QString mine = tmp_.path() + "/mine.comp";
+        save(mine, readAll(kExamples + "tiled_fixed.comp"));
+        w_->prompts.openPath = [&](QWidget*, const QString&, const QString& filter) {
+            return filter.contains("*.hlsl") && filter.contains("*.spv") ? mine : QString();
+        };
+        quint64 before = doc()->runGeneration();
+        w_->action("actionCustomShader")->trigger();
+        QCOMPARE(w_->customShaderPath(), mine);
+        QString why;
+        QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
+        auto run = doc()->runOutput();
+        QVERIFY(run->custom);
+        QCOMPARE(run->truth.metrics.falseNegatives, std::uint64_t(0));
+        QCOMPARE(QString::fromStdString(run->custom->layout), QString("fixed:256")); // its first line
+        QVERIFY(w_->messageLog()->toPlainText().contains("custom shader " + mine));
+
+        // Save a flawed version: the watcher re-runs, and the misses show.
+        std::string flawed = readAll(kExamples + "flawed_tile_edges.comp");
+        flawed.replace(flawed.find("fixed:256"), 9, "bitmask"); // no overflow: only the drift misses
+        before = doc()->runGeneration();
+        save(mine, flawed);
+        QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
+        run = doc()->runOutput();
+        QVERIFY(run->custom);
+        QCOMPARE(QString::fromStdString(run->custom->layout), QString("bitmask"));
+        QVERIFY(run->truth.metrics.falseNegatives > 0);
+        QVERIFY(w_->messageLog()->toPlainText().contains("mine.comp changed: culling again"));
+        // The tile of the first located miss shows it as MISSING, in red.
+        const auto missed = lc::locateFalseNegatives(*run, lc::Projection(doc()->scene().camera));
+        QVERIFY(!missed.empty());
+        doc()->setSelectedTile(int(missed[0].tile));
+        TileInspector* ti = w_->tileInspector();
+        bool shown = false;
+        for (int r = 0; r < ti->model()->rowCount(); ++r) {
+            const QModelIndex verdict = ti->model()->index(r, TileLightsModel::ColVerdict);
+            const QModelIndex light = ti->model()->index(r, TileLightsModel::ColLight);
+            if (light.data().toUInt() == missed[0].light && verdict.data().toString() == "MISSING") {
+                shown = true;
+                QCOMPARE(verdict.data(Qt::BackgroundRole).value<QBrush>().color(), QColor(200, 40, 40));
+            }
+        }
+        QVERIFY2(shown, "the missed light is not listed as MISSING in the tile inspector");
+
+        // A syntax error: the run fails with file and line, the scene stays.
+        const std::string sceneBefore = lc::serializeScene(doc()->scene());
+        before = doc()->runGeneration();
+        std::string broken = readAll(kExamples + "tiled_fixed.comp");
+        broken.replace(broken.find("void main() {"), 13, "void main() { undeclaredThing = 1;");
+        save(mine, broken);
+        QVERIFY(!waitRunAfter(before, &why));
+        QVERIFY2(why.contains("mine.comp:") && why.contains("compile error"), qPrintable(why));
+        QVERIFY(w_->messageLog()->toPlainText().contains("compile error"));
+        QCOMPARE(lc::serializeScene(doc()->scene()), sceneBefore);
+
+        // Back to the built-in algorithm.
+        before = doc()->runGeneration();
+        w_->action("actionBuiltinAlgorithm")->trigger();
+        QVERIFY(w_->customShaderPath().isEmpty());
+        QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
+        QVERIFY(!doc()->runOutput()->custom);
+    }
+
+    void badFirstLineIsRefusedAndShown() {
+        const QString bad = tmp_.path() + "/bad.comp";
+        save(bad, "// lightcull: --layout fixed:zero\n#version 450\nvoid main() {}\n");
+        QString shown;
+        w_->prompts.showError = [&](QWidget*, const QString&, const QString& m) { shown = m; };
+        QVERIFY(!w_->setCustomShader(bad));
+        QVERIFY2(shown.contains("bad.comp:1:") && shown.contains("fixed:zero"), qPrintable(shown));
+        QVERIFY(w_->customShaderPath().isEmpty());
+    }
+};
+
+LC_STUDIO_TEST_MAIN(CustomShaderStudioTest)
+#include "test_custom_shader_studio.moc"
