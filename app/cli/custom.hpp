@@ -3,13 +3,34 @@
 // renderer's own culling judged like a built-in algorithm
 // (docs/CUSTOM_CULLING.md). The flags live here; main.cpp runs the commands.
 #include "culling/custom_cull.hpp"
+#include "culling/errors.hpp"
 
 #include <CLI/CLI.hpp>
 
+#include <fstream>
 #include <iostream>
 #include <string>
 
 namespace lcli {
+
+// A shader file's options: its first-line settings, then what the caller set
+// (non-empty `layout`/`lists`/`entry` win).
+inline lc::CustomShaderOptions shaderFromFile(const std::string& path, const std::string& layout = {},
+                                              const std::string& lists = {}, const std::string& entry = {}) {
+    lc::CustomShaderOptions o;
+    o.path = path;
+    if (!layout.empty()) o.layout = lc::parseLayout(layout);
+    if (!lists.empty()) o.lists = lc::parseListSpec(lists);
+    if (!entry.empty()) o.entry = entry;
+    if (path.size() < 4 || path.substr(path.size() - 4) != ".spv") {
+        std::ifstream in(path, std::ios::binary);
+        if (!in) throw lc::InputError(path, "", 0, "cannot open shader for reading");
+        std::string first;
+        std::getline(in, first);
+        lc::applyShaderHeader(first, path, o, !layout.empty(), !lists.empty(), !entry.empty());
+    }
+    return o;
+}
 
 struct CustomFlags {
     std::string shader, layout, lists, entry, depthFile;
@@ -54,21 +75,10 @@ struct CustomFlags {
     }
 
     lc::CustomShaderOptions shaderOptions(const std::string& device) const {
-        lc::CustomShaderOptions o;
-        o.path = shader;
+        lc::CustomShaderOptions o = shaderFromFile(shader, layout, lists, entry);
         o.device = device;
         o.validation = !noValidation;
         o.timeoutMs = timeoutMs;
-        if (!layout.empty()) o.layout = lc::parseLayout(layout);
-        if (!lists.empty()) o.lists = lc::parseListSpec(lists);
-        if (!entry.empty()) o.entry = entry;
-        if (shader.size() < 4 || shader.substr(shader.size() - 4) != ".spv") {
-            std::ifstream in(shader, std::ios::binary);
-            if (!in) throw lc::InputError(shader, "", 0, "cannot open shader for reading");
-            std::string first;
-            std::getline(in, first);
-            lc::applyShaderHeader(first, shader, o, !layout.empty(), !lists.empty(), !entry.empty());
-        }
         return o;
     }
 };

@@ -2,6 +2,8 @@
 //                  [--backend NAME]... [--repeat N] [culling flags] --out DIR
 #include "report.hpp"
 
+#include "custom.hpp"
+
 #include "culling/errors.hpp"
 #include "culling/report.hpp"
 #include "culling/scene_io.hpp"
@@ -47,6 +49,10 @@ void ReportCommand::add(CLI::App& app) {
     for (const std::string& b : lc::availableBackends()) backendHelp += " " + b;
     cmd_->add_option("--backend", backends_, backendHelp + ")")->type_name("NAME");
     cmd_->add_option("--device", device_, "Vulkan device: index or name substring")->type_name("D");
+    cmd_->add_option("--shader", shaders_,
+                     "A custom culling shader as one more row (repeatable; its first-line settings give layout and "
+                     "lists; docs/CUSTOM_CULLING.md)")
+        ->type_name("FILE");
     cmd_->add_option("--repeat", repeat_, "Timed culls and shades per configuration; medians reported (default: 3)")
         ->type_name("N")
         ->check(CLI::Range(1, 1000));
@@ -92,6 +98,11 @@ int ReportCommand::run() {
 
     lc::ReportOptions options;
     options.device = device_;
+    for (const std::string& sh : shaders_) {
+        lc::CustomShaderOptions so = shaderFromFile(sh);
+        so.device = device_;
+        options.shaders.push_back(std::move(so));
+    }
     options.repeat = repeat_;
     options.warmup = warmup_;
     for (const std::string& b : backends_)

@@ -84,6 +84,7 @@ bool paramAppliesTo(const std::string& name, Algorithm a, std::uint32_t cells, b
 }
 
 std::string ReportConfig::label() const {
+    if (!customLabel.empty()) return customLabel;
     std::string s = toString(settings.algorithm);
     for (const ParamSpec& p : cullParams()) {
         if (p.name == "algorithm") continue;
@@ -195,9 +196,15 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
         work.emplace_back(std::move(b), std::move(cfgs));
     }
 
+    total += options.shaders.size();
     const ViewLights lights = makeViewLights(sceneIn);
     const Projection proj(sceneIn.camera);
     std::size_t done = 0;
+    // For the custom shaders: the depth, shading backend and all-lights image
+    // of the vulkan backend (else the first that ran).
+    std::shared_ptr<const DepthImage> shaderDepth;
+    std::shared_ptr<const std::vector<float>> shaderAll;
+    CullBackend* shaderShade = nullptr;
     for (auto& [backend, cfgs] : work) {
         if (cancelled(cancel)) throw Cancelled();
         rep.backendDevices.emplace_back(backend->name(), backend->deviceName());
@@ -207,6 +214,11 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
         const DepthImage depth = backend->renderDepth(sceneIn, proj);
         const ShadeInputs allIn = makeShadeInputs(depth, proj, nullptr);
         const std::vector<float> allImage = backend->shade(allIn, lights, nullptr);
+        if (!shaderDepth || backend->name() == "vulkan") {
+            shaderDepth = std::make_shared<const DepthImage>(depth);
+            shaderAll = std::make_shared<const std::vector<float>>(allImage);
+            shaderShade = backend.get();
+        }
         for (const ReportConfig& cfg : cfgs) {
             if (cancelled(cancel)) throw Cancelled();
             const TileGrid grid = TileGrid::make(sceneIn.camera.width, sceneIn.camera.height, cfg.tileSize);
@@ -247,6 +259,55 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             ++done;
             if (progress) progress(done, total, cfg.backend + " " + cfg.label());
         }
+    }
+    for (const CustomShaderOptions& so : options.shaders) {
+        if (cancelled(cancel)) throw Cancelled();
+        if (!shaderDepth) throw Error("custom shaders need a backend for the depth pre-pass");
+        const TileGrid grid = TileGrid::make(sceneIn.camera.width, sceneIn.camera.height, sceneIn.camera.tileSize);
+        ReportRow row;
+        row.config.backend = "vulkan"; // it runs on a Vulkan device: judged beside the vulkan rows
+        row.config.tileSize = grid.tileSize;
+        const std::string file = std::filesystem::path(so.path).filename().string();
+        row.config.params["algorithm"] = "custom:" + file;
+        row.config.params["tile"] = std::to_string(grid.tileSize);
+        row.config.customLabel = "custom:" + file + " " + toString(so.layout) + " " + toString(so.lists);
+        std::vector<double> cullMs, shadeMs;
+        CullResult result;
+        CustomCullReport crep;
+        for (int r = 0; r < options.warmup + options.repeat; ++r) {
+            crep = CustomCullReport{};
+            result = runCustomShader(so, *shaderDepth, proj, grid, lights, crep);
+            if (r >= options.warmup) cullMs.push_back(crep.passMs);
+        }
+        row.device = crep.device;
+        GroundTruthOptions gto;
+        gto.imageError = false;
+        const GroundTruth truth = computeGroundTruth(*shaderDepth, proj, lights, result, gto, cancel);
+        const ShadeInputs in = makeShadeInputs(*shaderDepth, proj, &result);
+        std::vector<float> image;
+        for (int r = 0; r < options.warmup + options.repeat; ++r) {
+            image = shaderShade->shade(in, lights, &result);
+            if (r >= options.warmup) shadeMs.push_back(shaderShade->lastShadeMs());
+        }
+        const ImageError err = compareShadedImages(*shaderDepth, image, *shaderAll);
+        row.cullMs = median(cullMs);
+        row.shadeMs = median(shadeMs);
+        row.totalMs = row.cullMs + row.shadeMs;
+        const Metrics& m = truth.metrics;
+        row.efficiency = m.efficiency;
+        row.falseNegatives = m.falseNegatives;
+        row.meanList = m.meanList;
+        row.maxList = m.maxList;
+        row.resultBytes = m.resultBytes;
+        row.imageRmse = err.rmse;
+        row.imageMaxError = err.maxAbs;
+        if (crep.overflowLists || crep.invalidIndices || !crep.validationMessages.empty())
+            rep.notes.push_back(row.config.customLabel + ": " + std::to_string(crep.overflowLists) + " overflowed lists, " +
+                                std::to_string(crep.invalidIndices) + " invalid indices, " +
+                                std::to_string(crep.validationMessages.size()) + " validation messages");
+        rep.rows.push_back(std::move(row));
+        ++done;
+        if (progress) progress(done, total, "custom " + file);
     }
     markPareto(rep.rows);
     return rep;
@@ -508,9 +569,25 @@ void drawPanel(Plot& p, int x0, int y0, int w, int h, const Report& rep, const s
             p.line(px(front[i - 1]->totalMs), py(yOf(*front[i - 1])), px(front[i]->totalMs), py(yOf(*front[i])),
                    glm::dvec3(0.85, 0.1, 0.1), 2);
     }
+    std::size_t customDrawn = 0;
     for (const ReportRow& r : rep.rows) {
         if (!(r.totalMs > 0) || !std::isfinite(yOf(r))) continue;
         const int x = px(r.totalMs), y = py(yOf(r));
+        if (!r.config.customLabel.empty()) {
+            // A custom shader: a cross in its own colour, named beside it
+            // (and its false negatives, which keep it off the front).
+            const glm::dvec3 c(0.55, 0.0, 0.6);
+            if (onFront(r)) p.fill(x - 6, y - 6, x + 7, y + 7, glm::dvec3(0.85, 0.1, 0.1));
+            p.line(x - 5, y - 5, x + 5, y + 5, c, 2);
+            p.line(x - 5, y + 5, x + 5, y - 5, c, 2);
+            std::string name = r.config.params.count("algorithm") ? r.config.params.at("algorithm").substr(7) : "custom";
+            if (r.falseNegatives) name += " FN " + std::to_string(r.falseNegatives);
+            // Labels of nearby shaders would overlap: each one its own line.
+            const int line = int(customDrawn++ % 3) - 1;
+            p.line(x + 5, y, x + 8, y - 3 + 11 * line + 3, c, 1);
+            p.text(x + 9, y - 3 + 11 * line, name, 1, c);
+            continue;
+        }
         const glm::dvec3 c = algorithmColour(r.config.settings.algorithm);
         const bool second = !rep.backendDevices.empty() && r.config.backend != rep.backendDevices.front().first;
         if (onFront(r)) p.fill(x - 5, y - 5, x + 6, y + 6, glm::dvec3(0.85, 0.1, 0.1));
@@ -543,6 +620,12 @@ RgbImage paretoImage(const Report& rep) {
         p.fill(x, y, x + 9, y + 9, algorithmColour(algorithmFromString(a)));
         p.text(x + 14, y + 1, a, 1, ink);
         x += 14 + Plot::textWidth(a, 1) + 24;
+    }
+    if (std::any_of(rep.rows.begin(), rep.rows.end(), [](const ReportRow& r) { return !r.config.customLabel.empty(); })) {
+        p.line(x, y, x + 9, y + 9, glm::dvec3(0.55, 0.0, 0.6), 2);
+        p.line(x, y + 9, x + 9, y, glm::dvec3(0.55, 0.0, 0.6), 2);
+        p.text(x + 14, y + 1, "CUSTOM SHADER", 1, ink);
+        x += 14 + Plot::textWidth("CUSTOM SHADER", 1) + 24;
     }
     p.fill(x, y - 1, x + 11, y + 10, glm::dvec3(0.85, 0.1, 0.1));
     p.fill(x + 2, y + 1, x + 9, y + 8, glm::dvec3(0.3));

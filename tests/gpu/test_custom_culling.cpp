@@ -10,6 +10,7 @@
 #include "culling/custom_cull.hpp"
 #include "culling/errors.hpp"
 #include "culling/export.hpp"
+#include "culling/report.hpp"
 #include "culling/scene_io.hpp"
 
 #include <nlohmann/json.hpp>
@@ -414,4 +415,32 @@ TEST(CustomDecode, EveryLayoutDecodesCountsOverflowAndBadIndices) {
     EXPECT_EQ(c.overflowEntries, 2u);
     // Too few words for the layout is an error, not a read past the end.
     EXPECT_THROW(decodeLists({1, 2}, parseLayout("fixed:2"), 5, r, c), Error);
+}
+
+TEST_F(GpuTest, ReportPutsCustomShadersBesideTheBuiltinRows) {
+    Scene s = atrium(160, 96);
+    ReportOptions o;
+    o.backends = {"vulkan"};
+    o.tileSizes = {16};
+    o.cellCounts = {1};
+    o.fixed["test"] = "planes";
+    o.fixed["spot-test"] = "apex-sphere";
+    o.repeat = 1;
+    o.warmup = 0;
+    o.shaders = {optionsFor(kExamples + "tiled_fixed.comp"), optionsFor(kExamples + "flawed_tile_edges.comp")};
+    setenv("LIGHTCULL_VALIDATION", "1", 1);
+    const Report rep = runReport(s, o);
+    const ReportRow* good = nullptr;
+    const ReportRow* flawed = nullptr;
+    for (const ReportRow& r : rep.rows) {
+        if (r.config.customLabel.rfind("custom:tiled_fixed.comp", 0) == 0) good = &r;
+        if (r.config.customLabel.rfind("custom:flawed_tile_edges.comp", 0) == 0) flawed = &r;
+    }
+    ASSERT_TRUE(good && flawed);
+    EXPECT_EQ(good->config.backend, "vulkan");
+    EXPECT_EQ(good->falseNegatives, 0u);
+    EXPECT_GT(good->cullMs, 0.0);
+    EXPECT_FALSE(flawed->paretoEfficiency); // false negatives keep it off the front
+    const std::string csv = reportCsv(rep);
+    EXPECT_NE(csv.find(",custom:tiled_fixed.comp,"), std::string::npos);
 }

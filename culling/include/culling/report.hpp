@@ -11,6 +11,7 @@
 // paramAppliesTo() says it matters; Int parameters other than tile and cells
 // keep their value.
 
+#include "culling/custom_cull.hpp"
 #include "culling/export.hpp"
 #include "culling/params.hpp"
 #include "culling/scene.hpp"
@@ -33,6 +34,8 @@ struct ReportConfig {
     // Every parameter of the table except width/height, by name: its value
     // as text, or empty when it does not apply to the algorithm.
     std::map<std::string, std::string> params;
+    // A custom shader's row: "custom:my_cull.comp fixed:64 tile" (then label() is this).
+    std::string customLabel;
     // "2.5d tile=16 test=planes cells=32 slicing=log" (applicable ones only).
     std::string label() const;
 };
@@ -62,6 +65,10 @@ struct ReportOptions {
     std::map<std::string, std::string> fixed;
     int repeat = 3; // timed runs of cull and of shade per configuration
     int warmup = 1; // untimed runs before them (first-use pipeline compiles)
+    // Custom culling shaders (docs/CUSTOM_CULLING.md), one row each at the
+    // scene camera's tile size, beside the vulkan rows: on the vulkan
+    // backend's depth when it ran, else the first backend's.
+    std::vector<CustomShaderOptions> shaders;
 };
 
 struct Report {
