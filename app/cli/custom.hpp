@@ -50,7 +50,7 @@ struct CustomFlags {
                         ->type_name("LAYOUT")
                         ->needs(s);
         optLists = cmd->add_option("--lists", lists,
-                                   "Custom shader: which list a pixel loops over: tile, halfz or froxel:N[:log|linear] "
+                                   "Custom shader: which list a pixel loops over: tile, halfz, froxel:N[:log|linear] or cells:N[:log|linear] "
                                    "(default: the shader's first line, else tile)")
                        ->type_name("RULE")
                        ->needs(s);

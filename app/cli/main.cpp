@@ -388,7 +388,7 @@ int main(int argc, char** argv) {
         ->required();
     check->add_option("--layout", checkLayout, "Layout of a raw dump: fixed:N, compact[:N] or bitmask (default fixed:64)")
         ->type_name("LAYOUT");
-    check->add_option("--rule", checkRule, "Which list a pixel loops over: tile, halfz or froxel:N[:log|linear] (default tile)")
+    check->add_option("--rule", checkRule, "Which list a pixel loops over: tile, halfz, froxel:N[:log|linear] or cells:N[:log|linear] (default tile)")
         ->type_name("RULE");
     lcli::CustomFlags checkDepth;
     checkDepth.addDepth(check);

@@ -27,6 +27,10 @@ std::uint32_t CullResult::listOfPixel(std::uint32_t px, std::uint32_t py, double
     case Algorithm::Clustered:
         return tile * listsPerTile +
                sliceOfDepth(settings.slicing, clusterNear, clusterFar, listsPerTile, viewDepth);
+    case Algorithm::TwoPointFiveD:
+        if (!cellLists) return tile;
+        return tile * listsPerTile +
+               sliceOfDepth(settings.slicing, tileDepthMin[tile], tileDepthMax[tile], listsPerTile, viewDepth);
     default: return tile;
     }
 }
@@ -36,6 +40,7 @@ std::string CullResult::validate(std::size_t lightCount) const {
     std::uint32_t expectPerTile = 1;
     if (algorithm == Algorithm::HalfZ) expectPerTile = 2;
     if (algorithm == Algorithm::Clustered) expectPerTile = settings.cells;
+    if (algorithm == Algorithm::TwoPointFiveD && cellLists) expectPerTile = settings.cells;
     if (algorithm != Algorithm::All && listsPerTile != expectPerTile)
         return "listsPerTile is " + std::to_string(listsPerTile) + ", expected " +
                std::to_string(expectPerTile);

@@ -61,6 +61,7 @@ Algorithm ruleAlgorithm(const ListSpec& l) {
     case ListKind::Tile: return Algorithm::MinMax;
     case ListKind::HalfZ: return Algorithm::HalfZ;
     case ListKind::Froxel: return Algorithm::Clustered;
+    case ListKind::Cells: return Algorithm::TwoPointFiveD;
     }
     return Algorithm::MinMax;
 }
@@ -94,14 +95,28 @@ CullResult ruleSkeleton(const DepthImage& depth, const Projection& proj, const T
                         const ListSpec& lists) {
     CullSettings s;
     s.algorithm = ruleAlgorithm(lists);
-    s.cells = lists.kind == ListKind::Froxel ? lists.slices : 1;
+    s.cells = lists.kind == ListKind::Froxel || lists.kind == ListKind::Cells ? lists.slices : 1;
     s.slicing = lists.slicing;
     s.skipEmpty = false; // a custom froxel list may hold lights in empty froxels
     if (const std::string bad = s.validate(); !bad.empty()) throw SettingsError("lists", bad);
-    return makeCpuBackend()->cull(depth, proj, grid, lights, s);
+    CullResult r = makeCpuBackend()->cull(depth, proj, grid, lights, s);
+    if (lists.kind == ListKind::Cells) {
+        // 2.5d's tile bounds and cell masks, with a list per cell; no
+        // built-in algorithm makes such lists, so none to compare with.
+        r.cellLists = true;
+        r.listsPerTile = lists.slices;
+        r.listOffset.assign(std::size_t(grid.tileCount()) * lists.slices, 0);
+        r.listCount.assign(r.listOffset.size(), 0);
+        r.lightIndices.clear();
+    }
+    return r;
 }
 
 void compareWithBuiltin(const CullResult& custom, const CullResult& builtin, CustomCullReport& report) {
+    if (builtin.cellLists) {
+        report.builtinAlgorithm = "none (no built-in algorithm has a list per cell)";
+        return;
+    }
     report.builtinAlgorithm = toString(builtin.algorithm);
     report.builtinEntries = builtin.entries();
     report.listsDifferingFromBuiltin = 0;
@@ -157,13 +172,14 @@ ListSpec parseListSpec(const std::string& text) {
         l.kind = ListKind::Tile;
     } else if (parts[0] == "halfz" && parts.size() == 1) {
         l.kind = ListKind::HalfZ;
-    } else if (parts[0] == "froxel" && (parts.size() == 2 || parts.size() == 3) && parseUint(parts[1], n) && n >= 1 &&
-               n <= 32 && (parts.size() == 2 || parts[2] == "log" || parts[2] == "linear")) {
-        l.kind = ListKind::Froxel;
+    } else if ((parts[0] == "froxel" || parts[0] == "cells") && (parts.size() == 2 || parts.size() == 3) &&
+               parseUint(parts[1], n) && n >= 1 && n <= 32 &&
+               (parts.size() == 2 || parts[2] == "log" || parts[2] == "linear")) {
+        l.kind = parts[0] == "froxel" ? ListKind::Froxel : ListKind::Cells;
         l.slices = std::uint32_t(n);
         l.slicing = parts.size() == 3 && parts[2] == "linear" ? Slicing::Linear : Slicing::Log;
     } else {
-        throw SettingsError("lists", "'" + text + "' is not tile, halfz or froxel:N[:log|linear] (N in 1..32)");
+        throw SettingsError("lists", "'" + text + "' is not tile, halfz, froxel:N[:log|linear] or cells:N[:log|linear] (N in 1..32)");
     }
     return l;
 }
@@ -173,6 +189,7 @@ std::string toString(const ListSpec& l) {
     case ListKind::Tile: return "tile";
     case ListKind::HalfZ: return "halfz";
     case ListKind::Froxel: return "froxel:" + std::to_string(l.slices) + ":" + toString(l.slicing);
+    case ListKind::Cells: return "cells:" + std::to_string(l.slices) + ":" + toString(l.slicing);
     }
     return "?";
 }

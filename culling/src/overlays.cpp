@@ -74,7 +74,7 @@ std::vector<DepthCell> tileCells(const CullResult& r, const Projection& proj, st
         for (std::uint32_t k = 0; k < n; ++k) {
             DepthCell c;
             c.cell = k;
-            c.list = tile;
+            c.list = r.cellLists ? tile * n + k : tile;
             c.occupied = (mask >> k) & 1u;
             c.chunk = makeFrustumChunk(proj, rect, sliceBoundary(s, lo, hi, n, k), sliceBoundary(s, lo, hi, n, k + 1));
             cells.push_back(c);

@@ -7,8 +7,8 @@
 //   TILE_SIZE             tile edge in pixels
 //   MAX_LIGHTS_PER_TILE   fixed:N -> N (0 for the other layouts)
 //   LC_LAYOUT             LC_LAYOUT_FIXED (0), LC_LAYOUT_COMPACT (1), LC_LAYOUT_BITMASK (2)
-//   LC_LISTS              LC_LISTS_TILE (0), LC_LISTS_HALFZ (1), LC_LISTS_FROXEL (2)
-//   LC_LISTS_PER_TILE     1 (tile), 2 (halfz), N (froxel:N)
+//   LC_LISTS              LC_LISTS_TILE (0), LC_LISTS_HALFZ (1), LC_LISTS_FROXEL (2), LC_LISTS_CELLS (3)
+//   LC_LISTS_PER_TILE     1 (tile), 2 (halfz), N (froxel:N, cells:N)
 //   LC_MASK_WORDS         bitmask: 32-bit words per list
 //   LC_COMPACT_ENTRIES    compact: capacity of the index array
 // Dispatch: one workgroup per tile, (tilesX, tilesY, 1); the local size is
@@ -22,6 +22,7 @@
 #define LC_LISTS_TILE 0
 #define LC_LISTS_HALFZ 1
 #define LC_LISTS_FROXEL 2
+#define LC_LISTS_CELLS 3
 #define LC_PROJ_PERSPECTIVE 0     // [0,1] depth, near -> 0
 #define LC_PROJ_PERSPECTIVE_GL 1  // [-1,1] NDC depth stored as (ndc + 1) / 2
 #define LC_PROJ_REVERSED_Z 2      // near -> 1, far -> 0 (far may be infinite)
@@ -34,7 +35,7 @@
 layout(set = 0, binding = 0, std140) uniform LcParamsBlock {
     uvec4 size;        // width, height, tilesX, tilesY
     uvec4 counts;      // lightCount, listsPerTile, listCount, capacity (fixed: N; compact: entries; bitmask: words per list)
-    uvec4 mode;        // x: LC_PROJ_*, y: LC_LAYOUT_*, z: LC_LISTS_*, w: froxel LC_SLICING_*
+    uvec4 mode;        // x: LC_PROJ_*, y: LC_LAYOUT_*, z: LC_LISTS_*, w: froxel / cells LC_SLICING_*
     vec4 depthParams;  // x: A, y: B, z: 1 orthographic / 0 perspective, w: clear depth (no geometry)
     vec4 planes;       // x: camera near, y: camera far (0: infinite), z: froxel near, w: froxel far (view depth)
     // The view-space point of NDC (u, v) (v down, [-1, 1]) at view depth z:
@@ -75,7 +76,8 @@ float lcViewDepth(float d) {
     return lc.depthParams.z > 0.5 ? (d - lc.depthParams.x) / lc.depthParams.y : lc.depthParams.y / (d - lc.depthParams.x);
 }
 bool lcHasGeometry(float d) { return d != lc.depthParams.w; }
-// The list of tile `tile`, sub-list `sub` (halfz: 0 near, 1 far; froxel: slice).
+// The list of tile `tile`, sub-list `sub` (halfz: 0 near, 1 far; froxel:
+// slice; cells: cell of the tile's min/max view depth).
 uint lcListIndex(uint tile, uint sub) { return tile * LC_LISTS_PER_TILE + sub; }
 
 // Appends `light` to list `list` in the fixed or bitmask layout (atomic; any

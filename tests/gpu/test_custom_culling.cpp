@@ -10,6 +10,7 @@
 #include "culling/custom_cull.hpp"
 #include "culling/errors.hpp"
 #include "culling/export.hpp"
+#include "culling/overlays.hpp"
 #include "culling/report.hpp"
 #include "culling/scene_io.hpp"
 
@@ -163,6 +164,27 @@ TEST_F(GpuTest, ClusteredCompactExampleMatchesClustered) {
     const RunOutput outLin = runShader(s, optionsFor(kExamples + "clustered_compact.comp", "", "froxel:8:linear"), lin);
     expectCorrect(outLin, lin, cpuReference(s, outLin.depth, Algorithm::Clustered, 8, Slicing::Linear),
                   "clustered_compact.comp froxel:8:linear");
+}
+
+TEST_F(GpuTest, CellListsOverTheTileDepthRange) {
+    const Scene s = atrium();
+    for (const char* rule : {"cells:8:linear", "cells:4:log"}) {
+        CustomCullReport rep;
+        const RunOutput out = runShader(s, optionsFor(kData + "cells_bitmask.comp", "", rule), rep);
+        EXPECT_EQ(rep.lists, std::string(rule));
+        EXPECT_TRUE(out.result.cellLists);
+        EXPECT_EQ(out.result.listsPerTile, std::string(rule) == "cells:8:linear" ? 8u : 4u);
+        EXPECT_EQ(out.truth.metrics.falseNegatives, 0u) << rule;
+        EXPECT_TRUE(rep.validationMessages.empty()) << rule;
+        // A pixel's list is its cell's: the shading work can only shrink
+        // against one list per tile (minmax).
+        const CullResult minmax = cpuReference(s, out.depth, Algorithm::MinMax);
+        const GroundTruth mt = computeGroundTruth(out.depth, Projection(s.camera), out.lights, minmax);
+        EXPECT_LE(out.truth.metrics.shadingWork, mt.metrics.shadingWork) << rule;
+        // The overlays draw the cells with their own lists.
+        const auto cells = tileCells(out.result, Projection(s.camera), 30);
+        for (const DepthCell& c : cells) EXPECT_EQ(c.list, 30 * out.result.listsPerTile + c.cell);
+    }
 }
 
 TEST_F(GpuTest, FlawedExampleMissesLightsWhereItsFrustumsDrift) {
@@ -373,6 +395,8 @@ TEST(CustomSpecs, LayoutsListsAndFirstLineSettings) {
     EXPECT_EQ(toString(parseListSpec("froxel:8:linear")), "froxel:8:linear");
     EXPECT_THROW(parseListSpec("froxel:33"), SettingsError);
     EXPECT_THROW(parseListSpec("cells"), SettingsError);
+    EXPECT_EQ(toString(parseListSpec("cells:6")), "cells:6:log");
+    EXPECT_THROW(parseListSpec("cells:0"), SettingsError);
     EXPECT_EQ(layoutWords(parseLayout("fixed:4"), 10, 100), 50u);
     EXPECT_EQ(layoutWords(parseLayout("bitmask"), 10, 33), 20u);
     EXPECT_EQ(layoutWords(parseLayout("compact:7"), 10, 100), 1u + 20u + 7u);

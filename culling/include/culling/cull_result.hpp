@@ -22,7 +22,7 @@ struct Timings {
 // List numbering: `all` has exactly one list. Every other algorithm has
 // listsPerTile lists per tile, list = tileIndex * listsPerTile + sub, where sub
 // is 0 (naive, minmax, 2.5d), 0 near / 1 far (halfz), or the depth slice
-// (clustered).
+// (clustered; 2.5d with cellLists: the cell of the tile's depth range).
 struct CullResult {
     Algorithm algorithm = Algorithm::All;
     CullSettings settings;
@@ -38,6 +38,10 @@ struct CullResult {
     std::vector<std::uint32_t> cellMask;
     // Clustered depth range: slices are `settings.slicing` over [clusterNear, clusterFar].
     double clusterNear = 0, clusterFar = 0;
+    // 2.5d only (custom culling's `cells:N` rule, docs/CUSTOM_CULLING.md):
+    // one list per cell, settings.cells cells (settings.slicing) of the
+    // tile's [depthMin, depthMax], instead of one list per tile.
+    bool cellLists = false;
 
     std::vector<std::uint32_t> listOffset, listCount, lightIndices;
 

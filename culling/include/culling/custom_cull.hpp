@@ -31,15 +31,16 @@ struct LayoutSpec {
 LayoutSpec parseLayout(const std::string& text);
 std::string toString(const LayoutSpec& l);
 
-// Which list a pixel loops over (`--lists`), the rule of a built-in algorithm:
-// tile = one list per tile (as minmax), halfz = two per tile split at the
-// middle of the tile's min/max view depth (as halfz), froxel:N[:log|linear] =
-// N slices of the camera's near..far per tile (as clustered).
-enum class ListKind { Tile, HalfZ, Froxel };
+// Which list a pixel loops over (`--lists`): tile = one list per tile (as
+// minmax), halfz = two per tile split at the middle of the tile's min/max
+// view depth (as halfz), froxel:N[:log|linear] = N slices of the froxel
+// range per tile (as clustered), cells:N[:log|linear] = N cells of the
+// tile's own min/max view depth per tile (2.5d's cells, each with a list).
+enum class ListKind { Tile, HalfZ, Froxel, Cells };
 struct ListSpec {
     ListKind kind = ListKind::Tile;
-    std::uint32_t slices = 16;       // froxel: 1..32
-    Slicing slicing = Slicing::Log;  // froxel
+    std::uint32_t slices = 16;       // froxel, cells: 1..32
+    Slicing slicing = Slicing::Log;  // froxel, cells
 };
 ListSpec parseListSpec(const std::string& text); // throws SettingsError("lists", ...)
 std::string toString(const ListSpec& l);
