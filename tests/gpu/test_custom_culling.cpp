@@ -7,6 +7,8 @@
 // a dump or CSV are judged the same way.
 #include "gpu_test_env.hpp"
 
+#include "../unit/cli_support.hpp"
+
 #include "culling/custom_cull.hpp"
 #include "culling/errors.hpp"
 #include "culling/export.hpp"
@@ -467,4 +469,53 @@ TEST_F(GpuTest, ReportPutsCustomShadersBesideTheBuiltinRows) {
     EXPECT_FALSE(flawed->paretoEfficiency); // false negatives keep it off the front
     const std::string csv = reportCsv(rep);
     EXPECT_NE(csv.find(",custom:tiled_fixed.comp,"), std::string::npos);
+}
+
+TEST_F(GpuTest, CliRunShaderAndCheckWriteTheDiagnostics) {
+    lc_test::ScratchDir d;
+    const fs::path out = d.path / "mine";
+    auto r = lc_test::runCli({"run", "--builtin", "atrium", "--width", "330", "--height", "190", "--lights", "150",
+                              "--no-image-error", "--shader", kExamples + "flawed_tile_edges.comp", "--layout", "bitmask",
+                              "--out", out.string()},
+                             d.path);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("algorithm custom"), std::string::npos) << r.out;
+    const auto j = nlohmann::json::parse(lc_test::slurp(out / "summary.json"));
+    EXPECT_EQ(j["algorithm"], "custom");
+    EXPECT_EQ(j["custom"]["layout"], "bitmask"); // the flag beat the first line's fixed:256
+    EXPECT_EQ(j["custom"]["lists"], "tile");
+    EXPECT_TRUE(j["custom"]["validation_messages"].empty());
+    const auto fn = j["metrics"]["false_negatives"].get<std::uint64_t>();
+    std::uint64_t located = 0;
+    for (const auto& m : j["custom"]["missed"]) located += m["pixels"].get<std::uint64_t>();
+    EXPECT_EQ(located, fn); // every missed pixel-light is located
+    if (fn > 0) {
+        EXPECT_NE(r.out.find("MISSING light"), std::string::npos) << r.out;
+    }
+    EXPECT_TRUE(fs::exists(out / "tiles.csv") && fs::exists(out / "heatmap.png") && fs::exists(out / "overlays.vtm"));
+
+    // A compile error: one line with file and line, exit 1, nothing written.
+    r = lc_test::runCli({"run", "--builtin", "atrium", "--shader", kData + "syntax_error.comp", "--out",
+                         (d.path / "bad").string()},
+                        d.path);
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("syntax_error.comp:6: compile error"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(d.path / "bad"));
+
+    // check: an engine's CSV lists, here every light in every tile (no misses).
+    {
+        std::ofstream csv(d.path / "all.csv");
+        for (int t = 0; t < 21 * 12; ++t) {
+            csv << t;
+            for (int l = 0; l < 150; ++l) csv << "," << l;
+            csv << "\n";
+        }
+    }
+    r = lc_test::runCli({"check", "--builtin", "atrium", "--width", "330", "--height", "190", "--lights", "150", "--lists",
+                         (d.path / "all.csv").string(), "--rule", "tile", "--out", (d.path / "engine").string()},
+                        d.path);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto c = nlohmann::json::parse(lc_test::slurp(d.path / "engine" / "summary.json"));
+    EXPECT_EQ(c["metrics"]["false_negatives"], 0);
+    EXPECT_EQ(c["backend"], "dump");
 }
