@@ -1,5 +1,7 @@
 #include "camera_view.hpp"
 
+#include "culling/custom_cull.hpp"
+
 #include "document.hpp"
 #include "vtk_adapters.hpp"
 
@@ -36,6 +38,7 @@
 #include <QVTKInteractor.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <cstring>
 
@@ -478,7 +481,10 @@ void CameraView::updateOverlay() {
     const double tilePx = g.tileSize * (vp[2] - vp[0]) * width() / std::max(1u, cam.width);
     gridActor_->SetVisibility(tilePx >= 6.0);
 
-    heatCaption_ = std::string(lc::toString(run->result.algorithm)) + "  " + std::to_string(g.tilesX) + "x" +
+    const std::string what = run->custom ? "custom " + std::filesystem::path(run->custom->source).filename().string() +
+                                               " (" + run->custom->lists + ")"
+                                         : std::string(lc::toString(run->result.algorithm));
+    heatCaption_ = what + "  " + std::to_string(g.tilesX) + "x" +
                    std::to_string(g.tilesY) + " tiles of " + std::to_string(g.tileSize) + " px";
     updateImage();
     updateLegendAndCaption();

@@ -74,7 +74,11 @@ int main(int argc, char** argv) {
                                "Benchmark: drag one light with Live on for SECONDS, print the rate of results "
                                "shown and their latency, then quit.",
                                "SECONDS");
-    parser.addOptions({sceneOpt, builtinOpt, lightsOpt, seedOpt, runOpt, shotOpt, quitOpt, dragOpt});
+    QCommandLineOption shaderOpt("shader",
+                                 "Cull with this custom culling shader (as Culling > Custom shader...; "
+                                 "docs/CUSTOM_CULLING.md).",
+                                 "FILE");
+    parser.addOptions({sceneOpt, builtinOpt, lightsOpt, seedOpt, shaderOpt, runOpt, shotOpt, quitOpt, dragOpt});
     parser.process(app);
     if (parser.isSet(sceneOpt) && parser.isSet(builtinOpt)) {
         std::fprintf(stderr, "lightcull-studio: --scene and --builtin are exclusive\n");
@@ -133,6 +137,7 @@ int main(int argc, char** argv) {
         window.document()->resetScene(std::move(scene), window.document()->filePath());
         window.runCulling();
     }
+    if (ok && parser.isSet(shaderOpt) && !window.setCustomShader(parser.value(shaderOpt)) && scripted) return 1;
     const quint64 generation = window.cullService()->lastGeneration();
     const bool wantRun = generation > 0 || parser.isSet(runOpt);
     if (wantRun && generation == 0) window.runCulling();
