@@ -7,6 +7,8 @@ set -euo pipefail
 PACKAGES=(
   # toolchain
   cmake ninja-build g++ pkg-config git
+  # packaging: cpack -G DEB computes Depends with dpkg-shlibdeps and file(1)
+  dpkg-dev file
   # culling core
   libglm-dev libopenmesh-dev nlohmann-json3-dev libcli11-dev libpng-dev
   # glTF 2.0 scenes (tinygltf's header, compiled into the library)

@@ -7,11 +7,15 @@
 #      `hardcase` tests, with third-party (Mesa/LLVM/validation layer) leak
 #      reports suppressed by scripts/lsan.supp and nothing else.
 #   3. the bounded libFuzzer runs (scripts/fuzz.sh, build-fuzz/).
-# LIGHTCULL_TEST_STAGES selects stages; the default is "1 2 3", or only "1"
+#   4. the install: `cmake --install` of build/ into a temporary prefix, the
+#      installed lightcull on a built-in and an installed example scene, the
+#      installed studio's --screenshot, and `cpack -G DEB` with its Depends
+#      checked and its payload run.
+# LIGHTCULL_TEST_STAGES selects stages; the default is "1 2 3 4", or only "1"
 # when ctest arguments are given (`scripts/test.sh -L unit` runs a subset).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-if [ $# -gt 0 ]; then default_stages="1"; else default_stages="1 2 3"; fi
+if [ $# -gt 0 ]; then default_stages="1"; else default_stages="1 2 3 4"; fi
 stages="${LIGHTCULL_TEST_STAGES:-$default_stages}"
 jobs="$(nproc)"
 
@@ -66,4 +70,32 @@ if [[ " $stages " == *" 3 "* ]]; then
   t0=$(date +%s)
   scripts/fuzz.sh
   stage_time "stage 3 fuzzing (build + runs)" "$t0"
+fi
+
+if [[ " $stages " == *" 4 "* ]]; then
+  t0=$(date +%s)
+  [ -x build/app/cli/lightcull ] || scripts/build.sh
+  prefix="$(mktemp -d "${TMPDIR:-/tmp}/lightcull-install.XXXXXX")"
+  trap 'rm -rf "$prefix"' EXIT
+  cmake --install build --prefix "$prefix" >/dev/null
+  "$prefix/bin/lightcull" run --builtin atrium --width 320 --height 180 --out "$prefix/out-atrium"
+  "$prefix/bin/lightcull" run --scene "$prefix/share/lightcull/scenes/stele_courtyard.json" --width 320 \
+    --height 180 --out "$prefix/out-stele"
+  "$prefix/bin/lightcull" run --builtin atrium --width 320 --height 180 --no-image-error \
+    --shader "$prefix/share/lightcull/culling-examples/tiled_fixed.comp" --out "$prefix/out-custom"
+  grep -q '"false_negatives": 0' "$prefix/out-custom/summary.json"
+  with_display "$prefix/bin/lightcull-studio" --screenshot "$prefix/studio.png" --quit
+  test -s "$prefix/studio.png"
+  test -f "$prefix/share/applications/lightcull-studio.desktop"
+  test -f "$prefix/share/icons/hicolor/scalable/apps/lightcull-studio.svg"
+  (cd build && cpack -G DEB >/dev/null)
+  deb="$(ls build/lightcull_*_*.deb | head -n1)"
+  dpkg-deb -f "$deb" Depends | tee "$prefix/depends.txt"
+  for need in mesa-vulkan-drivers libvulkan1 libqt5widgets5 libvtk9.1; do
+    grep -q "$need" "$prefix/depends.txt" || { echo "test.sh: $deb does not depend on $need" >&2; exit 1; }
+  done
+  dpkg-deb -x "$deb" "$prefix/deb"
+  "$prefix/deb/usr/bin/lightcull" run --builtin atrium --width 160 --height 90 --out "$prefix/out-deb"
+  echo "test.sh: install: $prefix/bin and $deb ran"
+  stage_time "stage 4 install and package" "$t0"
 fi
