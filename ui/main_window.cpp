@@ -563,7 +563,13 @@ void MainWindow::updateStatus() {
     statusFn_->setText(tr("FN %1").arg(m.falseNegatives));
     statusFn_->setStyleSheet(m.falseNegatives > 0 ? "color: white; background: #c0392b; padding: 0 4px"
                                                   : "color: #2e7d32");
-    statusEfficiency_->setText(tr("efficiency %1").arg(m.efficiency, 0, 'f', 4));
+    statusEfficiency_->setText(tr("efficiency %1 (%2% of this grid's optimum)")
+                                   .arg(m.efficiency, 0, 'f', 4)
+                                   .arg(100.0 * m.efficiencyVsOptimal, 0, 'f', 1));
+    statusEfficiency_->setToolTip(tr("Exact work / shading work. The optimum is the shading work of lists holding "
+                                     "exactly the lights their pixels need together (optimal work %1): no culling "
+                                     "with these tiles, cells or froxels can do better.")
+                                      .arg(m.optimalWork));
     statusLists_->setText(tr("mean/max list %1 / %2").arg(m.meanList, 0, 'f', 2).arg(m.maxList));
 }
 

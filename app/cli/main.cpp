@@ -86,6 +86,8 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
               << lc::toString(settings.slicing) << ", backend " << r.backend << " (" << r.device << ")\n"
               << "false negatives " << m.falseNegatives << ", efficiency " << fmt("%.4f", m.efficiency)
               << " (exact work " << m.exactWork << " / shading work " << m.shadingWork << ")\n"
+              << "optimum of this grid: " << fmt("%.1f", 100.0 * m.efficiencyVsOptimal)
+              << "% (optimal work " << m.optimalWork << " / shading work " << m.shadingWork << ")\n"
               << "lists " << r.listCountTotal() << ", entries " << r.entries() << ", mean list "
               << fmt("%.2f", m.meanList) << ", max list " << m.maxList << ", " << m.resultBytes
               << " bytes\n";

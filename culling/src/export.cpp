@@ -165,6 +165,8 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     mj["shading_work"] = m.shadingWork;
     mj["exact_work"] = m.exactWork;
     mj["efficiency"] = m.efficiency;
+    mj["optimal_work"] = m.optimalWork;
+    mj["efficiency_vs_optimal"] = m.efficiencyVsOptimal;
     mj["mean_list"] = m.meanList;
     mj["max_list"] = m.maxList;
     mj["result_bytes"] = m.resultBytes;

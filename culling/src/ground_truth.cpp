@@ -140,23 +140,34 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
         struct Acc {
             std::vector<std::uint64_t> w, e, fn;
             std::vector<std::uint32_t> tilePixels;
+            std::uint64_t optimal = 0;
+            std::vector<char> neededAnywhere; // `all`: its one list spans every band
         };
         std::vector<Acc> acc(workers);
+        const bool oneList = result.algorithm == Algorithm::All;
         for (auto& a : acc) {
             a.w.assign(lists, 0), a.e.assign(lists, 0), a.fn.assign(lists, 0);
             a.tilePixels.assign(tiles, 0);
+            if (oneList) a.neededAnywhere.assign(lights.size(), 0);
         }
+        // Bands of whole tile rows: every list but `all`'s belongs to one tile,
+        // so its pixels, and the union of the lights they need, lie in one band.
+        const std::uint32_t bandRows = oneList ? 16u : result.grid.tileSize;
         // Membership of a needed light in the pixel's list: stamp[i] == the
         // current stamp when light i is listed. Neighbouring pixels mostly share
         // a list, so re-stamping on a change costs less than a binary search
         // per needed light.
         std::vector<std::vector<std::uint32_t>> stamps(workers, std::vector<std::uint32_t>(lights.size(), 0));
         std::vector<std::uint32_t> stampNow(workers, 0);
-        forEachRowBand(depth.height, 16, workers, cancel, [&](unsigned w, std::uint32_t y0, std::uint32_t y1) {
+        forEachRowBand(depth.height, bandRows, workers, cancel, [&](unsigned w, std::uint32_t y0, std::uint32_t y1) {
             Acc& a = acc[w];
             std::vector<std::uint32_t>& stamp = stamps[w];
             std::uint32_t& now = stampNow[w];
             std::uint32_t stampedList = std::numeric_limits<std::uint32_t>::max();
+            // (list, light) of every needed light in the band, and the pixels
+            // of each list: the band's lists' unions, for the optimum.
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> needs;
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> listPixels; // (list, 1) per pixel, summed below
             for (std::uint32_t y = y0; y < y1; ++y)
                 for (std::uint32_t x = 0; x < depth.width; ++x) {
                     if (!depth.hasGeometry(x, y)) continue;
@@ -179,12 +190,42 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
                     grid.forEachContaining(p, [&](std::uint32_t i) {
                         ++needed;
                         missed += stamp[i] != now;
+                        if (oneList) a.neededAnywhere[i] = 1;
+                        else needs.emplace_back(l, i);
                     });
                     a.e[l] += needed;
                     a.fn[l] += missed;
+                    if (!oneList) listPixels.emplace_back(l, 1u);
                 }
+            if (oneList) return;
+            std::sort(needs.begin(), needs.end());
+            needs.erase(std::unique(needs.begin(), needs.end()), needs.end());
+            std::sort(listPixels.begin(), listPixels.end());
+            // optimal += pixels of the list x lights its pixels need together.
+            std::size_t k = 0;
+            for (std::size_t i = 0; i < listPixels.size();) {
+                const std::uint32_t l = listPixels[i].first;
+                std::uint64_t pixels = 0;
+                while (i < listPixels.size() && listPixels[i].first == l) ++pixels, ++i;
+                while (k < needs.size() && needs[k].first < l) ++k;
+                std::uint64_t unionSize = 0;
+                while (k < needs.size() && needs[k].first == l) ++unionSize, ++k;
+                a.optimal += pixels * unionSize;
+            }
         });
+        if (oneList) {
+            std::uint64_t anywhere = 0, pixels = 0;
+            for (std::size_t i = 0; i < lights.size(); ++i) {
+                bool any = false;
+                for (const Acc& a : acc) any = any || a.neededAnywhere[i];
+                anywhere += any;
+            }
+            for (const Acc& a : acc)
+                for (std::uint32_t c : a.tilePixels) pixels += c;
+            m.optimalWork = anywhere * pixels;
+        }
         for (const Acc& a : acc) {
+            m.optimalWork += a.optimal;
             for (std::size_t l = 0; l < lists; ++l) {
                 gt.listShadingWork[l] += a.w[l];
                 gt.listExactWork[l] += a.e[l];
@@ -202,6 +243,7 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
     }
     for (std::uint32_t c : gt.tileGeometryPixels) m.geometryPixels += c;
     m.efficiency = m.shadingWork == 0 ? 1.0 : double(m.exactWork) / double(m.shadingWork);
+    m.efficiencyVsOptimal = m.shadingWork == 0 ? 1.0 : double(m.optimalWork) / double(m.shadingWork);
     m.meanList = lists == 0 ? 0.0 : double(result.entries()) / double(lists);
     m.resultBytes = result.bytes();
 

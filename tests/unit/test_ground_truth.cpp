@@ -3,12 +3,15 @@
 // hand-computed values.
 #include "culling/errors.hpp"
 #include "culling/ground_truth.hpp"
+#include "culling/scene_io.hpp"
 #include "light_grid.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
+#include <map>
+#include <set>
 #include <random>
 
 using namespace lc;
@@ -429,4 +432,50 @@ TEST(Lambert, ImageErrorIsTheContributionOfUnlistedLights) {
     EXPECT_NEAR(part.imageRmse, rmse, 1e-5 * rmse);
     EXPECT_NEAR(part.imageMaxError, mx, 1e-5 * mx);
     EXPECT_GT(part.falseNegatives, 0u);
+}
+
+// The optimum of a granularity (DESIGN.md): for each list, the pixels that use
+// it times the lights they need together, against brute force over every
+// light and pixel, for every list rule; and E <= optimal <= W without misses.
+TEST(GroundTruthOptimum, MatchesBruteForceForEveryListRule) {
+    Scene s = makeBuiltinScene("atrium");
+    LightGenSettings g = defaultLightGen(s, 60, 9);
+    g.spotFraction = 0.3;
+    s.lights = generateLights(g);
+    s.camera.width = 100;
+    s.camera.height = 60;
+    s.camera.tileSize = 8; // bands of 8 rows, not the 16 the other metrics used
+    const Projection proj(s.camera);
+    const DepthImage depth = rasterizeDepthCpu(s, proj);
+    const ViewLights lights = makeViewLights(s);
+    const TileGrid grid = TileGrid::make(s.camera.width, s.camera.height, s.camera.tileSize);
+    auto backend = makeCpuBackend();
+    for (const Algorithm a : {Algorithm::All, Algorithm::MinMax, Algorithm::HalfZ, Algorithm::TwoPointFiveD,
+                              Algorithm::Clustered}) {
+        CullSettings cs;
+        cs.algorithm = a;
+        cs.cells = 8;
+        const CullResult r = backend->cull(depth, proj, grid, lights, cs);
+        const GroundTruth gt = computeGroundTruth(depth, proj, lights, r, {false});
+        std::map<std::uint32_t, std::set<std::uint32_t>> unions;
+        std::map<std::uint32_t, std::uint64_t> pixels;
+        for (std::uint32_t y = 0; y < depth.height; ++y)
+            for (std::uint32_t x = 0; x < depth.width; ++x) {
+                if (!depth.hasGeometry(x, y)) continue;
+                const glm::dvec3 p = proj.viewPositionFromDepth(x, y, depth.at(x, y));
+                const std::uint32_t l = r.listOfPixel(x, y, -p.z);
+                ++pixels[l];
+                for (std::uint32_t i = 0; i < lights.size(); ++i)
+                    if (detail::lightNeeds(lights, i, p)) unions[l].insert(i);
+            }
+        std::uint64_t optimal = 0;
+        for (const auto& [l, n] : pixels) optimal += n * unions[l].size();
+        const Metrics& m = gt.metrics;
+        EXPECT_EQ(m.optimalWork, optimal) << toString(a);
+        EXPECT_EQ(m.falseNegatives, 0u) << toString(a);
+        EXPECT_LE(m.exactWork, m.optimalWork) << toString(a);
+        EXPECT_LE(m.optimalWork, m.shadingWork) << toString(a);
+        EXPECT_DOUBLE_EQ(m.efficiencyVsOptimal, double(m.optimalWork) / double(m.shadingWork)) << toString(a);
+        EXPECT_GT(m.optimalWork, 0u) << toString(a);
+    }
 }

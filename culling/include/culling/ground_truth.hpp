@@ -21,6 +21,11 @@ struct Metrics {
     std::uint32_t maxList = 0;
     std::uint64_t resultBytes = 0;
     std::uint64_t geometryPixels = 0;
+    // The best any culling of this result's granularity could do: with U(p)
+    // the union of needed(q) over the pixels q sharing p's list (its tile,
+    // cell or froxel), optimal_work = sum_p |U(p)| (DESIGN.md).
+    std::uint64_t optimalWork = 0;
+    double efficiencyVsOptimal = 1.0; // optimalWork / W (1 when W == 0)
     double imageRmse = 0, imageMaxError = 0; // Lambert, culled vs all lights
     bool imageErrorComputed = false;
 };
