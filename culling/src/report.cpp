@@ -249,6 +249,8 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             row.totalMs = row.cullMs + row.shadeMs;
             const Metrics& m = truth.metrics;
             row.efficiency = m.efficiency;
+            row.optimalWork = m.optimalWork;
+            row.efficiencyVsOptimal = m.efficiencyVsOptimal;
             row.falseNegatives = m.falseNegatives;
             row.meanList = m.meanList;
             row.maxList = m.maxList;
@@ -295,6 +297,8 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
         row.totalMs = row.cullMs + row.shadeMs;
         const Metrics& m = truth.metrics;
         row.efficiency = m.efficiency;
+        row.optimalWork = m.optimalWork;
+        row.efficiencyVsOptimal = m.efficiencyVsOptimal;
         row.falseNegatives = m.falseNegatives;
         row.meanList = m.meanList;
         row.maxList = m.maxList;
@@ -323,7 +327,7 @@ std::string reportCsv(const Report& rep) {
         out += "," + col;
     }
     out += ",cull_ms,shade_ms,total_ms,efficiency,false_negatives,mean_list,max_list,result_bytes,"
-           "image_rmse,image_max_error,pareto_efficiency,pareto_error\n";
+           "image_rmse,image_max_error,pareto_efficiency,pareto_error,optimal_work,efficiency_vs_optimal\n";
     auto quoted = [](const std::string& s) {
         if (s.find_first_of(",\"\n") == std::string::npos) return s;
         std::string q = "\"";
@@ -340,7 +344,8 @@ std::string reportCsv(const Report& rep) {
                roundTrip(r.efficiency) + "," + std::to_string(r.falseNegatives) + "," + roundTrip(r.meanList) + "," +
                std::to_string(r.maxList) + "," + std::to_string(r.resultBytes) + "," + roundTrip(r.imageRmse) + "," +
                roundTrip(r.imageMaxError) + "," + (r.paretoEfficiency ? "1" : "0") + "," +
-               (r.paretoError ? "1" : "0") + "\n";
+               (r.paretoError ? "1" : "0") + "," + std::to_string(r.optimalWork) + "," +
+               roundTrip(r.efficiencyVsOptimal) + "\n";
     }
     return out;
 }
@@ -393,7 +398,9 @@ std::string reportMarkdown(const Report& rep) {
             });
             md += "- On " + backend + ", the fastest configuration is " + describe(*fastest) + "; the slowest takes " +
                   fmt("%.1f", fastest->totalMs > 0 ? slowest->totalMs / fastest->totalMs : 0.0) +
-                  "x as long. The most efficient is " + describe(*tightest) + ".\n";
+                  "x as long. The most efficient is " + describe(*tightest) + ", at " +
+                  fmt("%.1f", 100.0 * tightest->efficiencyVsOptimal) +
+                  "% of the best lists its own tiles, cells or froxels allow (efficiency_vs_optimal).\n";
             std::vector<const ReportRow*> front;
             for (const ReportRow* r : rows)
                 if (r->paretoEfficiency) front.push_back(r);
@@ -432,15 +439,15 @@ std::string reportMarkdown(const Report& rep) {
             md += ".\n";
         }
     }
-    md += "\n## Table\n\n| backend | configuration | cull ms | shade ms | total ms | efficiency | FN | mean list | "
-          "max list | bytes | image RMSE | image max | Pareto |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
-          "---:|---|\n";
+    md += "\n## Table\n\n| backend | configuration | cull ms | shade ms | total ms | efficiency | of optimum | FN | "
+          "mean list | max list | bytes | image RMSE | image max | Pareto |\n|---|---|---:|---:|---:|---:|---:|---:|---:|"
+          "---:|---:|---:|---:|---|\n";
     for (const ReportRow& r : rep.rows) {
         std::string pareto = r.paretoEfficiency ? "E" : "";
         if (r.paretoError) pareto += pareto.empty() ? "I" : " I";
         md += "| " + r.config.backend + " | " + r.config.label() + " | " + fmt("%.3f", r.cullMs) + " | " +
               fmt("%.3f", r.shadeMs) + " | " + fmt("%.3f", r.totalMs) + " | " + fmt("%.4f", r.efficiency) + " | " +
-              std::to_string(r.falseNegatives) + " | " + fmt("%.2f", r.meanList) + " | " + std::to_string(r.maxList) +
+              fmt("%.3f", r.efficiencyVsOptimal) + " | " + std::to_string(r.falseNegatives) + " | " + fmt("%.2f", r.meanList) + " | " + std::to_string(r.maxList) +
               " | " + std::to_string(r.resultBytes) + " | " + fmt("%.4g", r.imageRmse) + " | " +
               fmt("%.4g", r.imageMaxError) + " | " + pareto + " |\n";
     }

@@ -45,6 +45,9 @@ struct ReportRow {
     std::string device;
     double cullMs = -1, shadeMs = -1, totalMs = -1; // medians over the repeats; total = cull + shade
     double efficiency = 1.0;
+    // Against the best lists of the row's own grid (Metrics::optimalWork).
+    std::uint64_t optimalWork = 0;
+    double efficiencyVsOptimal = 1.0;
     std::uint64_t falseNegatives = 0;
     double meanList = 0;
     std::uint32_t maxList = 0;
