@@ -3,6 +3,7 @@
 #include "camera_view.hpp"
 #include "cull_worker.hpp"
 #include "document.hpp"
+#include "explain_panel.hpp"
 #include "generate_dialog.hpp"
 #include "inspector_view.hpp"
 #include "progress_task.hpp"
@@ -28,6 +29,8 @@
 #include <QFileSystemWatcher>
 #include <QFile>
 #include <QFileDialog>
+#include <QScrollArea>
+#include <QTimer>
 #include <QInputDialog>
 #include <QFileInfo>
 #include <QLabel>
@@ -139,9 +142,13 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     connect(doc_, &Document::runOutputChanged, this, &MainWindow::updateStatus);
 
     resize(1600, 900);
-    // First start: views get the room, the log stays a strip at the bottom.
+    // First start: views get the room, the log stays a strip at the bottom,
+    // the scene tree is tall and the tile inspector and Explain are wide
+    // enough for their columns (a saved layout wins from then on).
     resizeDocks({findChild<QDockWidget*>("logDock")}, {110}, Qt::Vertical);
-    resizeDocks({findChild<QDockWidget*>("sceneDock"), findChild<QDockWidget*>("tileDock")}, {260, 220},
+    resizeDocks({findChild<QDockWidget*>("sceneDock"), findChild<QDockWidget*>("propertiesDock")}, {420, 300},
+                Qt::Vertical);
+    resizeDocks({findChild<QDockWidget*>("sceneDock"), findChild<QDockWidget*>("tileDock")}, {260, 330},
                 Qt::Horizontal);
     restoreSettings();
     syncParamWidgets();
@@ -175,10 +182,20 @@ void MainWindow::buildDocks() {
     log_->setMaximumBlockCount(5000);
     dock(tr("Scene"), "sceneDock", tree_, Qt::LeftDockWidgetArea);
     dock(tr("Properties"), "propertiesDock", properties_, Qt::LeftDockWidgetArea);
-    dock(tr("Tile inspector"), "tileDock", tileInspector_, Qt::RightDockWidgetArea);
+    auto* tileDock = dock(tr("Tile inspector"), "tileDock", tileInspector_, Qt::RightDockWidgetArea);
+    explain_ = new ExplainPanel(doc_);
+    explain_->setObjectName("explainPanel");
+    auto* explainDock = dock(tr("Explain"), "explainDock", explain_, Qt::RightDockWidgetArea);
+    splitDockWidget(tileDock, explainDock, Qt::Vertical);
     dock(tr("Message log"), "logDock", log_, Qt::BottomDockWidgetArea);
     auto* logDock = findChild<QDockWidget*>("logDock");
-    tabifyDockWidget(logDock, dock(tr("Report"), "reportDock", new ReportDock(doc_), Qt::BottomDockWidgetArea));
+    // The Report's chart and table scroll inside their dock, so that the
+    // bottom area can be a strip of a few log lines.
+    auto* reportScroll = new QScrollArea;
+    reportScroll->setWidget(new ReportDock(doc_));
+    reportScroll->setWidgetResizable(true);
+    reportScroll->setFrameShape(QFrame::NoFrame);
+    tabifyDockWidget(logDock, dock(tr("Report"), "reportDock", reportScroll, Qt::BottomDockWidgetArea));
     // A first start shows the log; the Report tab is one click away (a saved
     // layout wins).
     logDock->raise();

@@ -39,6 +39,7 @@ namespace lcui {
 
 class CameraView;
 class CullService;
+class ExplainPanel;
 class Document;
 class InspectorView;
 class PropertyPanel;
@@ -70,6 +71,7 @@ public:
     SceneTree* sceneTree() const { return tree_; }
     PropertyPanel* propertyPanel() const { return properties_; }
     TileInspector* tileInspector() const { return tileInspector_; }
+    ExplainPanel* explainPanel() const { return explain_; }
     QPlainTextEdit* messageLog() const { return log_; }
     QAction* action(const QString& objectName) const; // e.g. "actionRun"
     Prompts prompts;
@@ -188,6 +190,7 @@ private:
     QLabel* statusLists_;
     QLabel* statusShading_ = nullptr; // "shading..." while the worker shades
     QString lastBackendName_, lastDeviceName_;
+    ExplainPanel* explain_ = nullptr;
     std::shared_ptr<const lc::CustomShaderOptions> customShader_;
     QFileSystemWatcher* shaderWatcher_ = nullptr;
     quint64 pendingRuns_ = 0;

@@ -14,6 +14,7 @@
 // 2 for a bad command line, 1 for anything that failed while running.
 
 #include "culling/errors.hpp"
+#include "culling/explain.hpp"
 #include "culling/export.hpp"
 #include "culling/file_io.hpp"
 #include "culling/params.hpp"
@@ -28,6 +29,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -114,11 +116,13 @@ struct SceneFlags {
     std::vector<std::pair<std::string, CLI::Option*>> paramOptions;
     CLI::Option* optLights = nullptr;
 
-    void addTo(CLI::App* cmd) {
+    // `tileSizeFlag`: the tile-size parameter's flag (explain's --tile names a tile).
+    void addTo(CLI::App* cmd, const std::string& tileSizeFlag = "tile") {
         source.addTo(cmd);
         // One flag per culling parameter, straight from the parameter table.
         for (const lc::ParamSpec& p : lc::cullParams()) {
-            CLI::Option* o = cmd->add_option("--" + p.name, paramValues[p.name], paramDescription(p));
+            CLI::Option* o = cmd->add_option("--" + (p.name == "tile" ? tileSizeFlag : p.name), paramValues[p.name],
+                                             paramDescription(p));
             o->type_name(p.type == lc::ParamType::Int ? "INT" : p.type == lc::ParamType::Bool ? "BOOL" : "CHOICE");
             paramOptions.emplace_back(p.name, o);
         }
@@ -407,6 +411,19 @@ int main(int argc, char** argv) {
     lcli::ReportCommand report;
     report.add(app);
 
+    CLI::App* explain = app.add_subcommand(
+        "explain", "Why is a light in a tile's list, or why not: the algorithm's tests with their numbers and the "
+                   "ground truth of the list's pixels");
+    SceneFlags explainFlags;
+    explainFlags.addTo(explain, "tile-size");
+    std::string explainTile, explainLightText;
+    int explainCell = -1;
+    explain->add_option("--tile", explainTile, "The tile, as X,Y (0,0 is the top-left tile)")->type_name("X,Y")->required();
+    explain->add_option("--cell", explainCell,
+                        "The tile's sub-list: halfz 0 near / 1 far, clustered slice, cells:N cell (default: the tile's list)")
+        ->type_name("C");
+    explain->add_option("--light", explainLightText, "The light: its index or its name")->type_name("I|NAME")->required();
+
     CLI::App* convert = app.add_subcommand(
         "convert", "Convert a scene between scene JSON, glTF 2.0 (.gltf) and binary glTF (.glb), by extension; "
                    "the output is written atomically");
@@ -418,9 +435,10 @@ int main(int argc, char** argv) {
     // CLI11 reports a missing subcommand before an unknown word; name the word.
     if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "scenes" && std::string(argv[1]) != "run" &&
         std::string(argv[1]) != "bench" && std::string(argv[1]) != "report" &&
-        std::string(argv[1]) != "convert" && std::string(argv[1]) != "check")
+        std::string(argv[1]) != "convert" && std::string(argv[1]) != "check" &&
+        std::string(argv[1]) != "explain")
         return fail(2, std::string("unknown command '") + argv[1] +
-                           "' (commands: scenes, run, bench, report, convert, check; see --help)");
+                           "' (commands: scenes, run, bench, report, convert, check, explain; see --help)");
 
     try {
         app.parse(argc, argv);
@@ -452,6 +470,47 @@ int main(int argc, char** argv) {
             std::cout << "wrote " << convertOut << ": " << scene.triangleCount() << " triangles, " << scene.lights.size()
                       << " lights, camera " << lc::toString(scene.camera.projection) << " " << scene.camera.width << "x"
                       << scene.camera.height << "\n";
+            return 0;
+        }
+
+        if (app.got_subcommand("explain")) {
+            if (!explainFlags.hasScene()) return fail(2, "explain: give --scene FILE or --builtin NAME");
+            lc::Scene scene = explainFlags.loadScene();
+            lc::CullSettings settings;
+            explainFlags.applyParams(settings, scene.camera);
+            unsigned tx = 0, ty = 0;
+            char tail = 0;
+            if (std::sscanf(explainTile.c_str(), "%u,%u%c", &tx, &ty, &tail) != 2)
+                return fail(2, "--tile: expected X,Y, got '" + explainTile + "'");
+            std::uint32_t light = 0;
+            bool byName = false;
+            for (std::size_t i = 0; i < scene.lights.size(); ++i)
+                if (scene.lights[i].name == explainLightText) {
+                    light = std::uint32_t(i);
+                    byName = true;
+                    break;
+                }
+            if (!byName) {
+                char* end = nullptr;
+                const unsigned long v = std::strtoul(explainLightText.c_str(), &end, 10);
+                if (explainLightText.empty() || *end != '\0')
+                    return fail(2, "--light: no light named '" + explainLightText + "' and not an index");
+                light = std::uint32_t(v);
+            }
+            std::unique_ptr<lc::CullBackend> backend = explainFlags.openBackend();
+            lc::RunOptions options;
+            options.truthOptions.imageError = false;
+            const lc::RunOutput run = lc::runPipeline(scene, settings, *backend, options);
+            const lc::CullResult& r = run.result;
+            if (tx >= r.grid.tilesX || ty >= r.grid.tilesY)
+                return fail(2, "--tile: " + explainTile + " is outside the " + std::to_string(r.grid.tilesX) + "x" +
+                                   std::to_string(r.grid.tilesY) + " tiles");
+            const lc::Projection proj(scene.camera);
+            const std::uint32_t list = lc::listOf(r, r.grid.tileIndex(tx, ty), explainCell);
+            const lc::Explanation e = lc::explainLight(run, proj, list, light);
+            std::cout << "scene " << scene.name << ", " << r.grid.width << "x" << r.grid.height << ", backend "
+                      << r.backend << ", tile " << tx << "," << ty << "\n"
+                      << e.text(light < scene.lights.size() ? scene.lights[light].name : std::string());
             return 0;
         }
 

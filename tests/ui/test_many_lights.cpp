@@ -124,7 +124,9 @@ class ManyLightsTest : public QObject {
 
   private slots:
     void init() {
-        w_ = lctest::makeTestWindow();
+        // Wide enough that both views keep ~450 px beside the docks: the outline
+        // test below needs spheres large against the fixed-size drag handle.
+        w_ = lctest::makeTestWindow(QSize(1800, 950));
         QVERIFY(QTest::qWaitForWindowExposed(w_.get()));
     }
 

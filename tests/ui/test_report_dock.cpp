@@ -59,7 +59,9 @@ private slots:
         dock_ = w_->findChild<ReportDock*>();
         QVERIFY(dock_);
         // Tabbed behind the log by default: float it at a readable size.
-        auto* frame = qobject_cast<QDockWidget*>(dock_->parentWidget());
+        // (inside a scroll area inside the dock)
+        QDockWidget* frame = nullptr;
+        for (QWidget* p = dock_->parentWidget(); p && !frame; p = p->parentWidget()) frame = qobject_cast<QDockWidget*>(p);
         QVERIFY(frame);
         frame->setFloating(true);
         frame->resize(1000, 460);
