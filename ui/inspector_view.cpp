@@ -10,6 +10,10 @@
 #include "culling/projection.hpp"
 
 #include <QTimer>
+
+#include "culling/overlays.hpp"
+
+#include <optional>
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkCameraPass.h>
@@ -317,6 +321,129 @@ void InspectorView::resetCamera() {
     }
     renderer_->ResetCameraClippingRange();
     cameraFramed_ = true;
+    renderNow();
+}
+
+bool InspectorView::frameSelected(int ms) {
+    const auto run = doc_->runOutput();
+    const int tile = doc_->selectedTile();
+    if (run && tile >= 0 && std::uint32_t(tile) < run->result.grid.tileCount()) {
+        const lc::Projection proj(doc_->scene().camera);
+        std::optional<lc::FrustumChunk> chunk;
+        const int cell = doc_->selectedCell();
+        if (cell >= 0)
+            for (const lc::DepthCell& c : lc::tileCells(run->result, proj, std::uint32_t(tile)))
+                if (int(c.cell) == cell) chunk = c.chunk;
+        if (!chunk) chunk = lc::tileFrustum(run->result, proj, run->lights, std::uint32_t(tile));
+        if (chunk) {
+            const glm::dmat4 world = lc::worldFromView(doc_->scene().camera);
+            std::vector<glm::dvec3> corners;
+            for (const glm::dvec3& v : chunk->corners) corners.push_back(glm::dvec3(world * glm::dvec4(v, 1.0)));
+            flyToPoints(corners, ms);
+            return true;
+        }
+    }
+    const int light = doc_->currentLight();
+    if (light >= 0 && std::size_t(light) < doc_->scene().lights.size()) {
+        const lc::PointLight& l = doc_->scene().lights[std::size_t(light)];
+        flyTo(l.position, std::max(l.radius(), 1e-3), ms);
+        return true;
+    }
+    return false;
+}
+
+void InspectorView::flyTo(const glm::dvec3& center, double radius, int ms) {
+    // The sphere's six extreme points along the view axes bound it well enough.
+    vtkCamera* vc = renderer_->GetActiveCamera();
+    double vu[3];
+    vc->GetViewUp(vu);
+    double p0[3], f0[3];
+    vc->GetPosition(p0);
+    vc->GetFocalPoint(f0);
+    glm::dvec3 dir = glm::dvec3(f0[0], f0[1], f0[2]) - glm::dvec3(p0[0], p0[1], p0[2]);
+    if (glm::length(dir) < 1e-12) dir = {0, 0, -1};
+    dir = glm::normalize(dir);
+    glm::dvec3 up(vu[0], vu[1], vu[2]);
+    glm::dvec3 right = glm::cross(dir, up);
+    if (glm::length(right) < 1e-12) right = glm::dvec3(1, 0, 0);
+    right = glm::normalize(right);
+    up = glm::cross(right, dir);
+    flyToPoints({center + radius * right, center - radius * right, center + radius * up, center - radius * up,
+                 center + radius * dir, center - radius * dir},
+                ms);
+}
+
+void InspectorView::flyToPoints(const std::vector<glm::dvec3>& points, int ms) {
+    if (points.empty()) return;
+    vtkCamera* vc = renderer_->GetActiveCamera();
+    double p0[3], f0[3], vu[3];
+    vc->GetPosition(p0);
+    vc->GetFocalPoint(f0);
+    vc->GetViewUp(vu);
+    const glm::dvec3 fromEye(p0[0], p0[1], p0[2]), fromFocal(f0[0], f0[1], f0[2]);
+    glm::dvec3 dir = fromFocal - fromEye;
+    if (glm::length(dir) < 1e-12) dir = {0, 0, -1};
+    dir = glm::normalize(dir);
+    glm::dvec3 up(vu[0], vu[1], vu[2]);
+    glm::dvec3 right = glm::cross(dir, up);
+    if (glm::length(right) < 1e-12) right = glm::dvec3(1, 0, 0);
+    right = glm::normalize(right);
+    up = glm::cross(right, dir);
+    glm::dvec3 center(0.0);
+    for (const glm::dvec3& p : points) center += p;
+    center /= double(points.size());
+    // Keep the direction; the nearest eye distance from `center` at which every
+    // point projects inside the view, with a 10% margin: x / (d + z) <= tan.
+    const double halfY = 0.5 * vc->GetViewAngle() * 3.14159265358979323846 / 180.0;
+    const double aspect = height() > 0 ? double(width()) / double(height()) : 1.0;
+    const double tanY = std::tan(halfY) / 1.1, tanX = std::tan(halfY) * aspect / 1.1;
+    double distance = 1e-6, extentX = 1e-6, extentY = 1e-6;
+    for (const glm::dvec3& p : points) {
+        const glm::dvec3 q = p - center;
+        const double x = std::abs(glm::dot(q, right)), y = std::abs(glm::dot(q, up)), z = glm::dot(q, dir);
+        distance = std::max({distance, x / tanX - z, y / tanY - z});
+        extentX = std::max(extentX, x);
+        extentY = std::max(extentY, y);
+    }
+    if (vc->GetParallelProjection()) vc->SetParallelScale(1.1 * std::max(extentY, extentX / aspect));
+    const glm::dvec3 toEye = center - dir * distance;
+    const int steps = std::max(1, ms / 25);
+    auto apply = [this, vc, fromEye, fromFocal, toEye, center](double t) {
+        const double s = t * t * (3.0 - 2.0 * t); // ease in and out
+        const glm::dvec3 e = glm::mix(fromEye, toEye, s), f = glm::mix(fromFocal, center, s);
+        vc->SetFocalPoint(f.x, f.y, f.z);
+        vc->SetPosition(e.x, e.y, e.z);
+        renderer_->ResetCameraClippingRange();
+        renderNow();
+    };
+    if (ms <= 0) {
+        apply(1.0);
+        return;
+    }
+    ++flight_;
+    const int flight = flight_;
+    for (int i = 1; i <= steps; ++i)
+        QTimer::singleShot(i * ms / steps, this, [apply, i, steps, flight, this] {
+            if (flight == flight_) apply(double(i) / steps); // a newer flight takes over
+        });
+}
+
+void InspectorView::lookThroughCullingCamera() {
+    ++flight_; // stops a flight in progress
+    const lc::Camera& c = doc_->scene().camera;
+    vtkCamera* vc = renderer_->GetActiveCamera();
+    vc->SetPosition(c.position.x, c.position.y, c.position.z);
+    vc->SetFocalPoint(c.target.x, c.target.y, c.target.z);
+    vc->SetViewUp(c.up.x, c.up.y, c.up.z);
+    if (lc::isOrthographic(c.projection)) {
+        vc->ParallelProjectionOn();
+        vc->SetParallelScale(0.5 * c.orthoHeight);
+    } else {
+        vc->ParallelProjectionOff();
+        vc->SetViewAngle(c.fovYDeg);
+    }
+    vc->OrthogonalizeViewUp();
+    renderer_->ResetCameraClippingRange();
     renderNow();
 }
 

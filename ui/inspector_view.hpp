@@ -58,6 +58,20 @@ public:
     vtkRenderer* renderer() const;
     // Frames the whole scene (meshes, lights and the culling camera).
     void resetCamera();
+    // Flies (animated, `ms` milliseconds) to the selection so it fills the
+    // view, keeping the viewing direction: the selected cell's or tile's
+    // frustum chunk of the latest run, else the current light's sphere.
+    // False when nothing is selected.
+    bool frameSelected(int ms = 300);
+    // The view becomes the culling camera (position, direction, up, field of
+    // view or orthographic height): tile frustums line up with the camera
+    // view's grid. Orbiting starts from there.
+    void lookThroughCullingCamera();
+    // Flies to the world-space sphere (centre, radius), keeping the direction.
+    void flyTo(const glm::dvec3& center, double radius, int ms = 300);
+    // Flies, keeping the direction, to where every world-space point fits the
+    // view with a 10% margin.
+    void flyToPoints(const std::vector<glm::dvec3>& points, int ms = 300);
     // Light whose sphere is under the widget position (logical px), or -1;
     // `hit` receives the picked point on its sphere.
     int pickLight(const QPoint& pos, glm::dvec3* hit = nullptr);
@@ -136,6 +150,7 @@ private:
     bool handleActive_ = false;
     int pressX_ = 0, pressY_ = 0;
     bool cameraFramed_ = false;
+    int flight_ = 0; // frameSelected's animation: a newer one supersedes it
     std::unique_ptr<InspectorOverlays> overlays_;
     std::unique_ptr<SpotConesActor> spotCones_; // spot lights' cones (ui/spot_actor.hpp)
     std::unique_ptr<SpotHandles> spotHandles_;  // after the handles above: destroyed first

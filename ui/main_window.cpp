@@ -262,6 +262,13 @@ void MainWindow::buildActions() {
             &MainWindow::setCullingCameraFromInspector);
     connect(make(tr("Reset inspector camera"), "actionResetView"), &QAction::triggered, this,
             [this] { inspectorView_->resetCamera(); });
+    connect(make(tr("&Frame selected"), "actionFrameSelected", QKeySequence(Qt::Key_F)), &QAction::triggered, this,
+            [this] {
+                if (!inspectorView_->frameSelected())
+                    statusBar()->showMessage(tr("Nothing selected to frame: click a tile or pick a light"), 4000);
+            });
+    connect(make(tr("&Look through the culling camera"), "actionLookThrough", QKeySequence(Qt::Key_C)),
+            &QAction::triggered, this, [this] { inspectorView_->lookThroughCullingCamera(); });
     QAction* tabbed = make(tr("Tabbed views"), "actionTabbedViews");
     tabbed->setCheckable(true);
     connect(tabbed, &QAction::toggled, this, &MainWindow::setTabbedViews);
@@ -321,6 +328,8 @@ void MainWindow::buildMenus() {
     QMenu* view = menuBar()->addMenu(tr("&View"));
     view->addAction(action("actionTabbedViews"));
     view->addAction(action("actionResetView"));
+    view->addAction(action("actionFrameSelected"));
+    view->addAction(action("actionLookThrough"));
     view->addSeparator();
     for (auto* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());
     buildOverlayMenus(overlayFileMenu, view);

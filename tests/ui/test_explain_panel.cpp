@@ -8,11 +8,17 @@
 #include "document.hpp"
 #include "explain_panel.hpp"
 #include "main_window.hpp"
+#include "inspector_view.hpp"
 #include "scene_tree.hpp"
 
 #include "culling/explain.hpp"
 #include "culling/ground_truth.hpp"
+#include "culling/overlays.hpp"
 
+#include <vtkCamera.h>
+#include <vtkRenderer.h>
+
+#include <QAction>
 #include <QDir>
 #include <QElapsedTimer>
 #include <QLabel>
@@ -93,6 +99,62 @@ private slots:
         w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(light)));
         QDir().mkpath(LC_RENDER_OUT_DIR);
         QVERIFY(w_->grabWindow().save(LC_RENDER_OUT_DIR "/explain_panel.png"));
+    }
+
+    // F flies the inspector to the selected tile's frustum: afterwards all its
+    // corners project inside the view. C looks through the culling camera.
+    void frameSelectedAndLookThrough() {
+        auto run = doc()->runOutput();
+        const lc::Projection proj(doc()->scene().camera);
+        std::uint32_t tile = run->result.grid.tileIndex(7, 5);
+        auto chunk = lc::tileFrustum(run->result, proj, run->lights, tile);
+        for (std::uint32_t t = 0; !chunk && t < run->result.grid.tileCount(); ++t)
+            if ((chunk = lc::tileFrustum(run->result, proj, run->lights, t))) tile = t;
+        QVERIFY(chunk);
+        doc()->setSelectedTile(int(tile));
+        InspectorView* iv = w_->inspectorView();
+        vtkRenderer* ren = iv->renderer();
+        const glm::dmat4 world = lc::worldFromView(doc()->scene().camera);
+        auto cornersInside = [&] {
+            int inside = 0;
+            for (const glm::dvec3& v : chunk->corners) {
+                const glm::dvec3 wpt = glm::dvec3(world * glm::dvec4(v, 1.0));
+                ren->SetWorldPoint(wpt.x, wpt.y, wpt.z, 1.0);
+                ren->WorldToDisplay();
+                double d[3];
+                ren->GetDisplayPoint(d);
+                const int* size = ren->GetSize();
+                inside += d[0] >= 0 && d[0] <= size[0] && d[1] >= 0 && d[1] <= size[1] && d[2] >= 0 && d[2] <= 1;
+            }
+            return inside;
+        };
+        // Start from a view where the tile is a sliver far away.
+        iv->flyTo({0, 1000, 0}, 1.0, 0);
+        QVERIFY(cornersInside() < 8);
+        QSignalSpy none(w_.get(), &MainWindow::runFinished);
+        w_->action("actionFrameSelected")->trigger();
+        QTest::qWait(500); // the flight takes 300 ms
+        QCOMPARE(cornersInside(), 8);
+        // The frustum fills the view: its projected extent spans a good part of it.
+        double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};
+        for (const glm::dvec3& v : chunk->corners) {
+            const glm::dvec3 wpt = glm::dvec3(world * glm::dvec4(v, 1.0));
+            ren->SetWorldPoint(wpt.x, wpt.y, wpt.z, 1.0);
+            ren->WorldToDisplay();
+            double d[3];
+            ren->GetDisplayPoint(d);
+            for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], d[k]), hi[k] = std::max(hi[k], d[k]);
+        }
+        const int* size = ren->GetSize();
+        QVERIFY2(std::max((hi[0] - lo[0]) / size[0], (hi[1] - lo[1]) / size[1]) > 0.5, "the frustum does not fill the view");
+        QVERIFY(w_->grabWindow().save(LC_RENDER_OUT_DIR "/framed_tile.png")); // to look at
+
+        w_->action("actionLookThrough")->trigger();
+        double pos[3];
+        ren->GetActiveCamera()->GetPosition(pos);
+        const glm::dvec3 cp = doc()->scene().camera.position;
+        QVERIFY(glm::length(glm::dvec3(pos[0], pos[1], pos[2]) - cp) < 1e-9);
+        QCOMPARE(ren->GetActiveCamera()->GetViewAngle(), doc()->scene().camera.fovYDeg);
     }
 };
 
