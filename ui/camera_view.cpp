@@ -8,7 +8,9 @@
 #include "culling/export.hpp"
 #include "culling/overlays.hpp"
 
+#include <QHelpEvent>
 #include <QTimer>
+#include <QToolTip>
 #include <vtkActor.h>
 #include <vtkActor2D.h>
 #include <vtkCamera.h>
@@ -629,6 +631,49 @@ void CameraView::updateSelectedTile() {
     loop->InsertNextCell(5, ids);
     selData_->SetPoints(pts);
     selData_->SetLines(loop);
+}
+
+QString CameraView::tileTooltip(int tile) const {
+    const auto run = doc_->runOutput();
+    if (!run || tile < 0 || std::uint32_t(tile) >= run->result.grid.tileCount()) return {};
+    const lc::CullResult& r = run->result;
+    const std::uint32_t per = r.algorithm == lc::Algorithm::All ? 0 : std::max(r.listsPerTile, 1u);
+    QString lists;
+    std::uint64_t w = 0, e = 0, fn = 0;
+    for (std::uint32_t k = 0; k < std::max(per, 1u); ++k) {
+        const std::uint32_t l = per ? std::uint32_t(tile) * per + k : 0;
+        lists += (k ? ", " : "") + QString::number(r.listCount[l]);
+        if (run->truthComputed && per) {
+            w += run->truth.listShadingWork[l];
+            e += run->truth.listExactWork[l];
+            fn += run->truth.listFalseNegatives[l];
+        }
+    }
+    const lc::TileGrid& g = r.grid;
+    QString text = tr("tile %1,%2: %3 %4").arg(tile % g.tilesX).arg(tile / g.tilesX).arg(per > 1 ? tr("lists of") : tr("list of"), lists) +
+                   tr(" lights");
+    if (r.tileDepthMin[std::size_t(tile)] <= r.tileDepthMax[std::size_t(tile)])
+        text += tr("\nview depth %1 .. %2").arg(r.tileDepthMin[std::size_t(tile)], 0, 'g', 5).arg(r.tileDepthMax[std::size_t(tile)], 0, 'g', 5);
+    else
+        text += tr("\nno geometry");
+    if (run->truthComputed && per) {
+        text += tr("\n%1 geometry pixels, efficiency %2")
+                    .arg(run->truth.tileGeometryPixels[std::size_t(tile)])
+                    .arg(w ? QString::number(double(e) / double(w), 'f', 3) : QStringLiteral("-"));
+        if (fn) text += tr("\nMISSING: %1 pixel-lights").arg(fn);
+    }
+    return text;
+}
+
+bool CameraView::event(QEvent* e) {
+    if (e->type() == QEvent::ToolTip) {
+        auto* help = static_cast<QHelpEvent*>(e);
+        const QString text = tileTooltip(tileAtWidgetPos(help->pos()));
+        if (text.isEmpty()) QToolTip::hideText();
+        else QToolTip::showText(help->globalPos(), text, this);
+        return true;
+    }
+    return QVTKOpenGLNativeWidget::event(e);
 }
 
 int CameraView::tileAtWidgetPos(const QPoint& pos) const {

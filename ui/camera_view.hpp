@@ -62,9 +62,13 @@ public:
 
     explicit CameraView(Document* doc, QWidget* parent = nullptr);
     ~CameraView() override;
+    bool event(QEvent* e) override; // hover tooltips
 
     // Tile under a widget position (logical pixels, y down), -1 outside the image.
     int tileAtWidgetPos(const QPoint& pos) const;
+    // The hover tooltip of a tile of the latest run: its list lengths, view
+    // depth range, geometry pixels, efficiency and misses; empty without a run.
+    QString tileTooltip(int tile) const;
     // The heat value of every tile (what the map colours): for `all` the one
     // list's length everywhere; otherwise the longest of the tile's lists (the
     // longest loop a pixel of the tile can run). Tiles without geometry: -1.

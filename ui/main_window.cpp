@@ -29,6 +29,7 @@
 #include <QFileSystemWatcher>
 #include <QFile>
 #include <QFileDialog>
+#include <QHBoxLayout>
 #include <QScrollArea>
 #include <QTimer>
 #include <QInputDialog>
@@ -180,7 +181,32 @@ void MainWindow::buildDocks() {
     log_->setObjectName("messageLog");
     log_->setReadOnly(true);
     log_->setMaximumBlockCount(5000);
-    dock(tr("Scene"), "sceneDock", tree_, Qt::LeftDockWidgetArea);
+    // The scene tree with a filter box and the light order above it.
+    auto* scenePane = new QWidget;
+    {
+        auto* filter = new QLineEdit;
+        filter->setObjectName("sceneFilter");
+        filter->setPlaceholderText(tr("Filter lights by name or index"));
+        filter->setClearButtonEnabled(true);
+        connect(filter, &QLineEdit::textChanged, tree_, &SceneTree::setLightFilter);
+        auto* sort = new QComboBox;
+        sort->setObjectName("sceneSort");
+        sort->addItem(tr("by index"), int(SceneTree::LightSort::Index));
+        sort->addItem(tr("by name"), int(SceneTree::LightSort::Name));
+        sort->addItem(tr("by radius"), int(SceneTree::LightSort::Radius));
+        sort->addItem(tr("by tiles reached"), int(SceneTree::LightSort::TilesReached));
+        connect(sort, qOverload<int>(&QComboBox::currentIndexChanged), this, [this, sort] {
+            tree_->setLightSort(SceneTree::LightSort(sort->currentData().toInt()));
+        });
+        auto* row = new QHBoxLayout;
+        row->addWidget(filter, 1);
+        row->addWidget(sort);
+        auto* col = new QVBoxLayout(scenePane);
+        col->setContentsMargins(0, 0, 0, 0);
+        col->addLayout(row);
+        col->addWidget(tree_, 1);
+    }
+    dock(tr("Scene"), "sceneDock", scenePane, Qt::LeftDockWidgetArea);
     dock(tr("Properties"), "propertiesDock", properties_, Qt::LeftDockWidgetArea);
     auto* tileDock = dock(tr("Tile inspector"), "tileDock", tileInspector_, Qt::RightDockWidgetArea);
     explain_ = new ExplainPanel(doc_);

@@ -4,6 +4,10 @@
 
 #include <QItemSelectionModel>
 
+#include <algorithm>
+#include <climits>
+#include <cstdint>
+
 namespace lcui {
 
 SceneTree::SceneTree(Document* doc, QWidget* parent) : QTreeView(parent), doc_(doc) {
@@ -22,10 +26,33 @@ SceneTree::SceneTree(Document* doc, QWidget* parent) : QTreeView(parent), doc_(d
     });
     connect(doc_, &Document::lightChanged, this, &SceneTree::updateLightRow);
     connect(doc_, &Document::selectionChanged, this, &SceneTree::syncFromDocument);
+    connect(doc_, &Document::runOutputChanged, this, [this] {
+        if (sort_ == LightSort::TilesReached) setLightSort(sort_); // the counts changed
+    });
 }
 
 QModelIndex SceneTree::lightIndex(int i) const {
-    return lights_ && i >= 0 && i < lights_->rowCount() ? lights_->child(i)->index() : QModelIndex();
+    if (!lights_ || i < 0 || std::size_t(i) >= rowOfLight_.size()) return {};
+    const int row = rowOfLight_[std::size_t(i)];
+    return row < lights_->rowCount() ? lights_->child(row)->index() : QModelIndex();
+}
+
+void SceneTree::setLightFilter(const QString& text) {
+    filter_ = text.trimmed();
+    applyFilter();
+}
+
+void SceneTree::applyFilter() {
+    if (!lights_) return;
+    for (int row = 0; row < lights_->rowCount(); ++row)
+        setRowHidden(row, lights_->index(),
+                     !filter_.isEmpty() && !lights_->child(row)->text().contains(filter_, Qt::CaseInsensitive));
+}
+
+void SceneTree::setLightSort(LightSort sort) {
+    sort_ = sort;
+    rebuildLights();
+    syncFromDocument();
 }
 
 void SceneTree::rebuild() {
@@ -59,26 +86,55 @@ void SceneTree::rebuildLights() {
     syncing_ = true;
     const auto& lights = doc_->scene().lights;
     lights_->removeRows(0, lights_->rowCount());
+    order_.resize(lights.size());
+    for (std::size_t i = 0; i < lights.size(); ++i) order_[i] = int(i);
+    if (sort_ == LightSort::Name) {
+        std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) { return lights[std::size_t(a)].name < lights[std::size_t(b)].name; });
+    } else if (sort_ == LightSort::Radius) {
+        std::vector<double> r(lights.size());
+        for (std::size_t i = 0; i < lights.size(); ++i) r[i] = lights[i].validate().empty() ? lights[i].radius() : 0.0;
+        std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) { return r[std::size_t(a)] > r[std::size_t(b)]; });
+    } else if (sort_ == LightSort::TilesReached) {
+        std::vector<std::size_t> tiles(lights.size(), 0);
+        if (const auto run = doc_->runOutput(); run && run->result.algorithm != lc::Algorithm::All) {
+            // One pass over the lists: each light's distinct tiles.
+            const auto& res = run->result;
+            const std::uint32_t per = std::max(res.listsPerTile, 1u);
+            std::vector<std::uint32_t> lastTile(lights.size(), UINT32_MAX);
+            for (std::uint32_t l = 0; l < res.listCount.size(); ++l)
+                for (std::uint32_t k = 0; k < res.listCount[l]; ++k) {
+                    const std::uint32_t light = res.lightIndices[res.listOffset[l] + k];
+                    if (light < lights.size() && lastTile[light] != l / per) {
+                        lastTile[light] = l / per;
+                        ++tiles[light];
+                    }
+                }
+        }
+        std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) { return tiles[std::size_t(a)] > tiles[std::size_t(b)]; });
+    }
+    rowOfLight_.assign(lights.size(), 0);
     QList<QStandardItem*> rows;
     rows.reserve(int(lights.size()));
-    for (std::size_t i = 0; i < lights.size(); ++i) {
+    for (std::size_t row = 0; row < order_.size(); ++row) {
         auto* it = new QStandardItem;
         it->setData(KindLight, kKindRole);
-        it->setData(int(i), kIndexRole);
+        it->setData(order_[row], kIndexRole);
+        rowOfLight_[std::size_t(order_[row])] = int(row);
         rows.append(it);
     }
     for (auto* r : rows) lights_->appendRow(r);
     for (std::size_t i = 0; i < lights.size(); ++i) updateLightRow(int(i));
     lights_->setText(tr("Lights (%1)").arg(lights.size()));
+    applyFilter();
     syncing_ = false;
 }
 
 void SceneTree::updateLightRow(int i) {
     const auto& lights = doc_->scene().lights;
-    if (!lights_ || i < 0 || i >= lights_->rowCount() || i >= int(lights.size())) return;
+    if (!lights_ || i < 0 || std::size_t(i) >= rowOfLight_.size() || i >= int(lights.size())) return;
     const auto& l = lights[std::size_t(i)];
     const QString name = l.name.empty() ? tr("light") : QString::fromStdString(l.name);
-    lights_->child(i)->setText(QStringLiteral("%1  %2").arg(i).arg(name));
+    lights_->child(rowOfLight_[std::size_t(i)])->setText(QStringLiteral("%1  %2").arg(i).arg(name));
 }
 
 void SceneTree::syncFromDocument() {

@@ -6,6 +6,8 @@
 #include <QStandardItemModel>
 #include <QTreeView>
 
+#include <vector>
+
 namespace lcui {
 
 class Document;
@@ -24,9 +26,20 @@ public:
     // The model index of light i (for tests and scrolling).
     QModelIndex lightIndex(int i) const;
 
+    // Light rows whose text (index and name) holds `text`, case-insensitive;
+    // the others are hidden. Empty: every row.
+    void setLightFilter(const QString& text);
+    // Order of the light rows: by index, by name, by radius (largest first) or
+    // by the tiles whose lists hold the light in the latest run (most first).
+    enum class LightSort { Index, Name, Radius, TilesReached };
+    void setLightSort(LightSort sort);
+    // Light indices in row order (for tests).
+    std::vector<int> lightOrder() const { return order_; }
+
 private:
     void rebuild();
     void rebuildLights();
+    void applyFilter();
     void updateLightRow(int i);
     void syncFromDocument();
     void syncToDocument();
@@ -37,6 +50,10 @@ private:
     QStandardItem* lights_ = nullptr;
     QStandardItem* camera_ = nullptr;
     bool syncing_ = false;
+    QString filter_;
+    LightSort sort_ = LightSort::Index;
+    std::vector<int> order_;      // row -> light index
+    std::vector<int> rowOfLight_; // light index -> row
 };
 
 } // namespace lcui

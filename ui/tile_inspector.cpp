@@ -6,6 +6,9 @@
 #include <QColor>
 #include <QHeaderView>
 #include <QLabel>
+#include <QSortFilterProxyModel>
+#include <QRegularExpression>
+#include <QComboBox>
 #include <QTableView>
 #include <QVBoxLayout>
 
@@ -62,9 +65,28 @@ QVariant TileLightsModel::data(const QModelIndex& index, int role) const {
 
 TileInspector::TileInspector(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
     model_ = new TileLightsModel(doc_, this);
+    // Rows sort by any column (click its header) and filter by verdict.
+    proxy_ = new QSortFilterProxyModel(this);
+    proxy_->setObjectName("tileLightsProxy");
+    proxy_->setSourceModel(model_);
+    proxy_->setFilterKeyColumn(TileLightsModel::ColVerdict);
+    proxy_->setSortRole(Qt::DisplayRole);
+    verdictFilter_ = new QComboBox;
+    verdictFilter_->setObjectName("tileVerdictFilter");
+    verdictFilter_->addItem(tr("All rows"), QString());
+    verdictFilter_->addItem(tr("Needed"), QStringLiteral("needed"));
+    verdictFilter_->addItem(tr("False positives"), QStringLiteral("false positive"));
+    verdictFilter_->addItem(tr("MISSING"), QStringLiteral("MISSING"));
+    connect(verdictFilter_, qOverload<int>(&QComboBox::currentIndexChanged), this, [this] {
+        const QString v = verdictFilter_->currentData().toString();
+        proxy_->setFilterRegularExpression(v.isEmpty() ? QRegularExpression()
+                                                       : QRegularExpression("^" + QRegularExpression::escape(v) + "$"));
+    });
     table_ = new QTableView;
     table_->setObjectName("tileLightsTable");
-    table_->setModel(model_);
+    table_->setModel(proxy_);
+    table_->setSortingEnabled(true);
+    table_->sortByColumn(-1, Qt::AscendingOrder); // the model's order until a header is clicked
     table_->horizontalHeader()->setStretchLastSection(true);
     table_->verticalHeader()->hide();
     table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
@@ -75,11 +97,14 @@ TileInspector::TileInspector(Document* doc, QWidget* parent) : QWidget(parent), 
     auto* l = new QVBoxLayout(this);
     l->setContentsMargins(2, 2, 2, 2);
     l->addWidget(summary_);
+    l->addWidget(verdictFilter_);
     l->addWidget(table_, 1);
     connect(doc_, &Document::tileSelectionChanged, this, &TileInspector::refresh);
     connect(doc_, &Document::runOutputChanged, this, &TileInspector::refresh);
-    connect(table_, &QTableView::doubleClicked, this, [this](const QModelIndex& i) {
-        if (i.row() < int(model_->rows().size())) doc_->setSelectedLights({int(model_->rows()[std::size_t(i.row())].light)});
+    connect(table_, &QTableView::doubleClicked, this, [this](const QModelIndex& shown) {
+        const QModelIndex i = proxy_->mapToSource(shown);
+        if (i.isValid() && i.row() < int(model_->rows().size()))
+            doc_->setSelectedLights({int(model_->rows()[std::size_t(i.row())].light)});
     });
     refresh();
 }

@@ -12,7 +12,9 @@
 #include <memory>
 #include <vector>
 
+class QComboBox;
 class QLabel;
+class QSortFilterProxyModel;
 class QTableView;
 
 namespace lcui {
@@ -47,6 +49,9 @@ public:
     std::vector<int> listedLights() const;
     const std::vector<lc::TileLightRow>& rows() const { return model_->rows(); }
     TileLightsModel* model() const { return model_; }
+    // What the table shows: the model sorted and filtered by verdict.
+    QSortFilterProxyModel* proxy() const { return proxy_; }
+    QComboBox* verdictFilter() const { return verdictFilter_; }
     QTableView* table() const { return table_; }
     QString summaryText() const;
 
@@ -54,6 +59,8 @@ private:
     void refresh();
     Document* doc_;
     TileLightsModel* model_;
+    QSortFilterProxyModel* proxy_;
+    QComboBox* verdictFilter_;
     QTableView* table_;
     QLabel* summary_;
 };

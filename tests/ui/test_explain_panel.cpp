@@ -8,7 +8,9 @@
 #include "document.hpp"
 #include "explain_panel.hpp"
 #include "main_window.hpp"
+#include "camera_view.hpp"
 #include "inspector_view.hpp"
+#include "tile_inspector.hpp"
 #include "scene_tree.hpp"
 
 #include "culling/explain.hpp"
@@ -21,7 +23,10 @@
 #include <QAction>
 #include <QDir>
 #include <QElapsedTimer>
+#include <QComboBox>
 #include <QLabel>
+#include <QLineEdit>
+#include <QSortFilterProxyModel>
 #include <QPlainTextEdit>
 #include <QUndoStack>
 
@@ -155,6 +160,70 @@ private slots:
         const glm::dvec3 cp = doc()->scene().camera.position;
         QVERIFY(glm::length(glm::dvec3(pos[0], pos[1], pos[2]) - cp) < 1e-9);
         QCOMPARE(ren->GetActiveCamera()->GetViewAngle(), doc()->scene().camera.fovYDeg);
+    }
+
+    // Readable at a glance: a tile's hover tooltip, the tile inspector's
+    // verdict filter and column sort, the scene tree's filter and orders.
+    void tooltipsFiltersAndSorting() {
+        auto run = doc()->runOutput();
+        std::uint32_t tile = 0;
+        for (std::uint32_t t = 0; t < run->result.grid.tileCount(); ++t)
+            if (run->result.listCount[t] > run->result.listCount[tile]) tile = t;
+        CameraView* cv = w_->cameraView();
+        const QString tip = cv->tileTooltip(int(tile));
+        const std::uint32_t tx = tile % run->result.grid.tilesX, ty = tile / run->result.grid.tilesX;
+        QVERIFY2(tip.startsWith(QString("tile %1,%2: list of %3 lights").arg(tx).arg(ty).arg(run->result.listCount[tile])),
+                 qPrintable(tip));
+        QVERIFY2(tip.contains("view depth") && tip.contains("efficiency"), qPrintable(tip));
+        // The tooltip of the tile under a widget position is that tile's.
+        const QPoint centre = cv->rect().center();
+        QCOMPARE(cv->tileTooltip(cv->tileAtWidgetPos(centre)).isEmpty(), cv->tileAtWidgetPos(centre) < 0);
+
+        doc()->setSelectedTile(int(tile));
+        TileInspector* ti = w_->tileInspector();
+        const int all = ti->proxy()->rowCount();
+        int fp = 0;
+        for (const auto& r : ti->model()->rows()) fp += r.verdict == lc::Verdict::FalsePositive;
+        QVERIFY(fp > 0 && fp < all);
+        ti->verdictFilter()->setCurrentIndex(ti->verdictFilter()->findData(QStringLiteral("false positive")));
+        QCOMPARE(ti->proxy()->rowCount(), fp);
+        for (int r = 0; r < ti->proxy()->rowCount(); ++r)
+            QCOMPARE(ti->proxy()->index(r, TileLightsModel::ColVerdict).data().toString(), QString("false positive"));
+        ti->verdictFilter()->setCurrentIndex(0);
+        QCOMPARE(ti->proxy()->rowCount(), all);
+        // Sorting by pixels needing the light, most first (a header click).
+        ti->proxy()->sort(TileLightsModel::ColPixels, Qt::DescendingOrder);
+        for (int r = 1; r < ti->proxy()->rowCount(); ++r)
+            QVERIFY(ti->proxy()->index(r - 1, TileLightsModel::ColPixels).data().toInt() >=
+                    ti->proxy()->index(r, TileLightsModel::ColPixels).data().toInt());
+
+        // The scene tree: filter by name, then order by radius.
+        auto* filter = w_->findChild<QLineEdit*>("sceneFilter");
+        QVERIFY(filter);
+        QTest::keyClicks(filter, "light_12");
+        SceneTree* tree = w_->sceneTree();
+        int shown = 0;
+        const QModelIndex lightsGroup = tree->lightIndex(0).parent();
+        for (int row = 0; row < int(doc()->scene().lights.size()); ++row)
+            if (!tree->isRowHidden(row, lightsGroup)) {
+                ++shown;
+                QVERIFY(tree->sceneModel()->itemFromIndex(tree->sceneModel()->index(row, 0, lightsGroup))->text().contains("light_12"));
+            }
+        QCOMPARE(shown, 11); // light_12 and light_120..light_129
+        filter->clear();
+        auto* sort = w_->findChild<QComboBox*>("sceneSort");
+        sort->setCurrentIndex(sort->findData(int(SceneTree::LightSort::Radius)));
+        const std::vector<int> order = tree->lightOrder();
+        QCOMPARE(order.size(), doc()->scene().lights.size());
+        for (std::size_t k = 1; k < order.size(); ++k)
+            QVERIFY(doc()->scene().lights[std::size_t(order[k - 1])].radius() >= doc()->scene().lights[std::size_t(order[k])].radius());
+        // Selection still maps rows to lights after sorting.
+        tree->setCurrentIndex(tree->lightIndex(order[0]));
+        QCOMPARE(doc()->currentLight(), order[0]);
+        sort->setCurrentIndex(sort->findData(int(SceneTree::LightSort::TilesReached)));
+        const std::vector<int> byTiles = tree->lightOrder();
+        auto tilesOf = [&](int light) { return lc::tilesHoldingLight(run->result, std::uint32_t(light)).size(); };
+        for (std::size_t k = 1; k < byTiles.size(); k += 37) QVERIFY(tilesOf(byTiles[k - 1]) >= tilesOf(byTiles[k]));
     }
 };
 
