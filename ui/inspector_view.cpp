@@ -704,7 +704,70 @@ void InspectorView::onLeftRelease() {
         std::vector<int> sel = add ? doc_->selectedLights() : std::vector<int>{};
         sel.push_back(light);
         doc_->setSelectedLights(sel);
+        return;
     }
+    int tile = -1, cell = -1;
+    if (pickChunk(pos, &tile, &cell)) {
+        doc_->setSelectedTile(tile);
+        doc_->setSelectedCell(cell);
+    }
+}
+
+bool InspectorView::pickChunk(const QPoint& pos, int* tileOut, int* cellOut) {
+    const auto run = doc_->runOutput();
+    if (!run) return false;
+    const auto& ov = doc_->overlays();
+    const double dpr = devicePixelRatioF();
+    const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
+    auto worldAt = [&](double z) {
+        renderer_->SetDisplayPoint(x, y, z);
+        renderer_->DisplayToWorld();
+        double w[4];
+        renderer_->GetWorldPoint(w);
+        return glm::dvec3(w[0], w[1], w[2]) / (w[3] != 0.0 ? w[3] : 1.0);
+    };
+    // The click ray in the culling camera's view space, where chunks live.
+    const glm::dmat4 view = doc_->scene().camera.viewFromWorld();
+    const glm::dvec3 o = glm::dvec3(view * glm::dvec4(worldAt(0.0), 1.0));
+    glm::dvec3 d = glm::dvec3(view * glm::dvec4(worldAt(1.0), 1.0)) - o;
+    if (!(glm::length(d) > 0)) return false;
+    d = glm::normalize(d);
+    // Entry distance of the ray into a convex chunk (inside: n.p + w >= 0), or -1.
+    auto enter = [&](const lc::FrustumChunk& c) {
+        double t0 = 0, t1 = 1e300;
+        for (const lc::Plane& pl : c.planes) {
+            const double denom = pl.x * d.x + pl.y * d.y + pl.z * d.z, dist = lc::signedDistance(pl, o);
+            if (denom == 0.0) {
+                if (dist < 0) return -1.0;
+                continue;
+            }
+            const double t = -dist / denom;
+            if (denom > 0) t0 = std::max(t0, t);
+            else t1 = std::min(t1, t);
+        }
+        return t0 <= t1 ? t0 : -1.0;
+    };
+    const lc::Projection proj(doc_->scene().camera);
+    const lc::CullResult& r = run->result;
+    double best = 1e300;
+    // The selected tile's cells (drawn with the cells overlay) first: they are
+    // inside its frustum, so a click on one must select the cell.
+    const int sel = doc_->selectedTile();
+    if (ov.cells && sel >= 0 && std::uint32_t(sel) < r.grid.tileCount())
+        for (const lc::DepthCell& c : lc::tileCells(r, proj, std::uint32_t(sel))) {
+            const double t = enter(c.chunk);
+            if (t >= 0 && t < best) best = t, *tileOut = sel, *cellOut = int(c.cell);
+        }
+    if (best < 1e300) return true;
+    // Then every tile's frustum, when they are drawn; else the selected one.
+    for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t) {
+        if (!ov.allTileFrustums && !(ov.tileFrustum && int(t) == sel)) continue;
+        const auto chunk = lc::tileFrustum(r, proj, run->lights, t);
+        if (!chunk) continue;
+        const double h = enter(*chunk);
+        if (h >= 0 && h < best) best = h, *tileOut = int(t), *cellOut = -1;
+    }
+    return best < 1e300;
 }
 
 } // namespace lcui

@@ -75,6 +75,11 @@ public:
     // Light whose sphere is under the widget position (logical px), or -1;
     // `hit` receives the picked point on its sphere.
     int pickLight(const QPoint& pos, glm::dvec3* hit = nullptr);
+    // The cell of the selected tile (cells overlay on), else the tile frustum
+    // (every tile's with the all-frustums overlay, else the selected one's)
+    // that the ray under the widget position enters first; false when none.
+    // A click that hits no light selects what this finds.
+    bool pickChunk(const QPoint& pos, int* tile, int* cell);
     // Mesh surface point under the widget position; false when none. `normal`
     // is the surface normal facing the viewer.
     bool pickSurface(const QPoint& pos, glm::dvec3* point, glm::dvec3* normal = nullptr);

@@ -21,6 +21,7 @@
 #include <vtkRenderer.h>
 
 #include <QAction>
+#include <optional>
 #include <QDir>
 #include <QElapsedTimer>
 #include <QComboBox>
@@ -155,6 +156,40 @@ private slots:
         QVERIFY(w_->grabWindow().save(LC_RENDER_OUT_DIR "/framed_tile.png")); // to look at
 
         w_->action("actionLookThrough")->trigger();
+        // Pick in 3D: through the culling camera, a click inside the selected
+        // tile enters its nearest cell first; with every tile's frustum drawn
+        // and no cells, a click on another tile selects that tile.
+        auto displayOf = [&](const glm::dvec3& viewPoint) {
+            const glm::dvec3 wpt = glm::dvec3(world * glm::dvec4(viewPoint, 1.0));
+            ren->SetWorldPoint(wpt.x, wpt.y, wpt.z, 1.0);
+            ren->WorldToDisplay();
+            double d[3];
+            ren->GetDisplayPoint(d);
+            const double dpr = iv->devicePixelRatioF();
+            return QPoint(int(d[0] / dpr), int(iv->height() - 1 - d[1] / dpr));
+        };
+        auto centreOf = [](const lc::FrustumChunk& c) {
+            glm::dvec3 m(0.0);
+            for (const glm::dvec3& v : c.corners) m += v;
+            return m / 8.0;
+        };
+        int pickedTile = -1, pickedCell = -1;
+        QVERIFY(iv->pickChunk(displayOf(centreOf(*chunk)), &pickedTile, &pickedCell));
+        QCOMPARE(pickedTile, int(tile));
+        QCOMPARE(pickedCell, 0);
+        Document::OverlayOptions ov = doc()->overlays();
+        ov.cells = false;
+        ov.allTileFrustums = true;
+        doc()->setOverlays(ov);
+        std::uint32_t other = tile;
+        std::optional<lc::FrustumChunk> otherChunk;
+        for (std::uint32_t t = 0; t < run->result.grid.tileCount() && !otherChunk; ++t)
+            if (t != tile && t % run->result.grid.tilesX > 2 && t / run->result.grid.tilesX > 2)
+                if ((otherChunk = lc::tileFrustum(run->result, proj, run->lights, t))) other = t;
+        QVERIFY(otherChunk);
+        QVERIFY(iv->pickChunk(displayOf(centreOf(*otherChunk)), &pickedTile, &pickedCell));
+        QCOMPARE(pickedTile, int(other));
+        QCOMPARE(pickedCell, -1);
         double pos[3];
         ren->GetActiveCamera()->GetPosition(pos);
         const glm::dvec3 cp = doc()->scene().camera.position;
