@@ -324,6 +324,19 @@ void InspectorView::resetCamera() {
     renderNow();
 }
 
+std::pair<glm::dvec3, glm::dvec3> InspectorView::viewRay(const QPoint& pos) const {
+    const double dpr = devicePixelRatioF();
+    const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
+    auto worldAt = [&](double z) {
+        renderer_->SetDisplayPoint(x, y, z);
+        renderer_->DisplayToWorld();
+        double w[4];
+        renderer_->GetWorldPoint(w);
+        return glm::dvec3(w[0], w[1], w[2]) / (w[3] != 0.0 ? w[3] : 1.0);
+    };
+    return {worldAt(0.0), worldAt(1.0)};
+}
+
 bool InspectorView::frameSelected(int ms) {
     const auto run = doc_->runOutput();
     const int tile = doc_->selectedTile();
@@ -630,15 +643,7 @@ void InspectorView::onRadiusEnd() {
 int InspectorView::pickLight(const QPoint& pos, glm::dvec3* hit) {
     const double dpr = devicePixelRatioF();
     const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
-    // The view ray through the pixel, from the near to the far clipping plane.
-    auto worldAt = [&](double z) {
-        renderer_->SetDisplayPoint(x, y, z);
-        renderer_->DisplayToWorld();
-        double w[4];
-        renderer_->GetWorldPoint(w);
-        return glm::dvec3(w[0], w[1], w[2]) / (w[3] != 0.0 ? w[3] : 1.0);
-    };
-    const glm::dvec3 origin = worldAt(0.0), farPoint = worldAt(1.0);
+    const auto [origin, farPoint] = viewRay(pos);
     double nearest = glm::length(farPoint - origin);
     if (!(nearest > 0)) return -1;
     const glm::dvec3 dir = (farPoint - origin) / nearest;
@@ -717,19 +722,11 @@ bool InspectorView::pickChunk(const QPoint& pos, int* tileOut, int* cellOut) {
     const auto run = doc_->runOutput();
     if (!run) return false;
     const auto& ov = doc_->overlays();
-    const double dpr = devicePixelRatioF();
-    const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
-    auto worldAt = [&](double z) {
-        renderer_->SetDisplayPoint(x, y, z);
-        renderer_->DisplayToWorld();
-        double w[4];
-        renderer_->GetWorldPoint(w);
-        return glm::dvec3(w[0], w[1], w[2]) / (w[3] != 0.0 ? w[3] : 1.0);
-    };
+    const auto [nearPoint, farPoint] = viewRay(pos);
     // The click ray in the culling camera's view space, where chunks live.
     const glm::dmat4 view = doc_->scene().camera.viewFromWorld();
-    const glm::dvec3 o = glm::dvec3(view * glm::dvec4(worldAt(0.0), 1.0));
-    glm::dvec3 d = glm::dvec3(view * glm::dvec4(worldAt(1.0), 1.0)) - o;
+    const glm::dvec3 o = glm::dvec3(view * glm::dvec4(nearPoint, 1.0));
+    glm::dvec3 d = glm::dvec3(view * glm::dvec4(farPoint, 1.0)) - o;
     if (!(glm::length(d) > 0)) return false;
     d = glm::normalize(d);
     // Entry distance of the ray into a convex chunk (inside: n.p + w >= 0), or -1.

@@ -21,6 +21,7 @@
 #include <vtkSmartPointer.h>
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 class vtkActor;
@@ -108,6 +109,9 @@ public:
 
 private:
     bool renderPending_ = false;
+    // The world-space points under a widget position (logical px) on the
+    // near and the far clipping plane: the view ray through that pixel.
+    std::pair<glm::dvec3, glm::dvec3> viewRay(const QPoint& pos) const;
     void rebuildMeshes();
     void rebuildLights();
     void updateLight(int index);

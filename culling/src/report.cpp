@@ -160,6 +160,41 @@ void markPareto(std::vector<ReportRow>& rows) {
     }
 }
 
+namespace {
+
+// A row after its timed culls: ground truth, `repeat` timed shades of the
+// culled lists on `shader`, and the image error against `allImage`.
+void judgeRow(ReportRow& row, const std::vector<double>& cullMs, const CullResult& result, const DepthImage& depth,
+              const Projection& proj, const ViewLights& lights, CullBackend& shader, const std::vector<float>& allImage,
+              const ReportOptions& options, const CancelToken* cancel) {
+    GroundTruthOptions gto;
+    gto.imageError = false;
+    const GroundTruth truth = computeGroundTruth(depth, proj, lights, result, gto, cancel);
+    const ShadeInputs in = makeShadeInputs(depth, proj, &result);
+    std::vector<float> image;
+    std::vector<double> shadeMs;
+    for (int r = 0; r < options.warmup + options.repeat; ++r) {
+        image = shader.shade(in, lights, &result);
+        if (r >= options.warmup) shadeMs.push_back(shader.lastShadeMs());
+    }
+    const ImageError err = compareShadedImages(depth, image, allImage);
+    row.cullMs = median(cullMs);
+    row.shadeMs = median(shadeMs);
+    row.totalMs = row.cullMs + row.shadeMs;
+    const Metrics& m = truth.metrics;
+    row.efficiency = m.efficiency;
+    row.optimalWork = m.optimalWork;
+    row.efficiencyVsOptimal = m.efficiencyVsOptimal;
+    row.falseNegatives = m.falseNegatives;
+    row.meanList = m.meanList;
+    row.maxList = m.maxList;
+    row.resultBytes = m.resultBytes;
+    row.imageRmse = err.rmse;
+    row.imageMaxError = err.maxAbs;
+}
+
+} // namespace
+
 Report runReport(const Scene& sceneIn, const ReportOptions& options, const ReportProgress& progress,
                  const CancelToken* cancel) {
     sceneIn.validate();
@@ -225,7 +260,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             ReportRow row;
             row.config = cfg;
             row.device = backend->deviceName();
-            std::vector<double> cullMs, shadeMs;
+            std::vector<double> cullMs;
             CullResult result;
             for (int r = 0; r < options.warmup + options.repeat; ++r) {
                 result = backend->cull(depth, proj, grid, lights, cfg.settings);
@@ -234,29 +269,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             if (const std::string bad = result.validate(lights.size()); !bad.empty())
                 throw Error("backend '" + backend->name() + "' produced an inconsistent result for " + cfg.label() +
                             ": " + bad);
-            GroundTruthOptions gto;
-            gto.imageError = false;
-            const GroundTruth truth = computeGroundTruth(depth, proj, lights, result, gto, cancel);
-            const ShadeInputs in = makeShadeInputs(depth, proj, &result);
-            std::vector<float> image;
-            for (int r = 0; r < options.warmup + options.repeat; ++r) {
-                image = backend->shade(in, lights, &result);
-                if (r >= options.warmup) shadeMs.push_back(backend->lastShadeMs());
-            }
-            const ImageError err = compareShadedImages(depth, image, allImage);
-            row.cullMs = median(cullMs);
-            row.shadeMs = median(shadeMs);
-            row.totalMs = row.cullMs + row.shadeMs;
-            const Metrics& m = truth.metrics;
-            row.efficiency = m.efficiency;
-            row.optimalWork = m.optimalWork;
-            row.efficiencyVsOptimal = m.efficiencyVsOptimal;
-            row.falseNegatives = m.falseNegatives;
-            row.meanList = m.meanList;
-            row.maxList = m.maxList;
-            row.resultBytes = m.resultBytes;
-            row.imageRmse = err.rmse;
-            row.imageMaxError = err.maxAbs;
+            judgeRow(row, cullMs, result, depth, proj, lights, *backend, allImage, options, cancel);
             rep.rows.push_back(std::move(row));
             ++done;
             if (progress) progress(done, total, cfg.backend + " " + cfg.label());
@@ -273,7 +286,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
         row.config.params["algorithm"] = "custom:" + file;
         row.config.params["tile"] = std::to_string(grid.tileSize);
         row.config.customLabel = "custom:" + file + " " + toString(so.layout) + " " + toString(so.lists);
-        std::vector<double> cullMs, shadeMs;
+        std::vector<double> cullMs;
         CullResult result;
         CustomCullReport crep;
         for (int r = 0; r < options.warmup + options.repeat; ++r) {
@@ -282,29 +295,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             if (r >= options.warmup) cullMs.push_back(crep.passMs);
         }
         row.device = crep.device;
-        GroundTruthOptions gto;
-        gto.imageError = false;
-        const GroundTruth truth = computeGroundTruth(*shaderDepth, proj, lights, result, gto, cancel);
-        const ShadeInputs in = makeShadeInputs(*shaderDepth, proj, &result);
-        std::vector<float> image;
-        for (int r = 0; r < options.warmup + options.repeat; ++r) {
-            image = shaderShade->shade(in, lights, &result);
-            if (r >= options.warmup) shadeMs.push_back(shaderShade->lastShadeMs());
-        }
-        const ImageError err = compareShadedImages(*shaderDepth, image, *shaderAll);
-        row.cullMs = median(cullMs);
-        row.shadeMs = median(shadeMs);
-        row.totalMs = row.cullMs + row.shadeMs;
-        const Metrics& m = truth.metrics;
-        row.efficiency = m.efficiency;
-        row.optimalWork = m.optimalWork;
-        row.efficiencyVsOptimal = m.efficiencyVsOptimal;
-        row.falseNegatives = m.falseNegatives;
-        row.meanList = m.meanList;
-        row.maxList = m.maxList;
-        row.resultBytes = m.resultBytes;
-        row.imageRmse = err.rmse;
-        row.imageMaxError = err.maxAbs;
+        judgeRow(row, cullMs, result, *shaderDepth, proj, lights, *shaderShade, *shaderAll, options, cancel);
         if (crep.overflowLists || crep.invalidIndices || !crep.validationMessages.empty())
             rep.notes.push_back(row.config.customLabel + ": " + std::to_string(crep.overflowLists) + " overflowed lists, " +
                                 std::to_string(crep.invalidIndices) + " invalid indices, " +

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <cstdlib>
 #include <cstring>
 
@@ -562,40 +564,16 @@ bool Context::submitAndWaitFor(const std::function<void(VkCommandBuffer)>& recor
     ai.commandBufferCount = 1;
     VkCommandBuffer cmd;
     LC_VK(vkAllocateCommandBuffers(device_, &ai, &cmd));
-    name(VK_OBJECT_TYPE_COMMAND_BUFFER, cmd, n);
-    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    LC_VK(vkBeginCommandBuffer(cmd, &bi));
-    record(cmd);
-    LC_VK(vkEndCommandBuffer(cmd));
-    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    si.commandBufferCount = 1;
-    si.pCommandBuffers = &cmd;
-    VkFence f = fence_;
-    LC_VK(vkResetFences(device_, 1, &f));
-    const auto t0 = std::chrono::steady_clock::now();
-    LC_VK(vkQueueSubmit(queue_, 1, &si, f));
-    const VkResult r = vkWaitForFences(device_, 1, &f, VK_TRUE, std::uint64_t(std::max(timeoutMs, 1.0) * 1e6));
-    wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (r == VK_TIMEOUT) return false; // the command buffer is still pending: left to the abandoned pool
-    if (r != VK_SUCCESS) throwVkError("vkWaitForFences", r, __FILE__, __LINE__);
-    vkFreeCommandBuffers(device_, commandPool_, 1, &cmd);
-    return true;
-}
-
-double Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record, const std::string& n) {
-    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    ai.commandPool = commandPool_;
-    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    ai.commandBufferCount = 1;
-    VkCommandBuffer cmd;
-    LC_VK(vkAllocateCommandBuffers(device_, &ai, &cmd));
-    // Freed on every exit path (the pool owns it; this returns it early).
+    // Freed on every exit path (the pool owns it; this returns it early),
+    // except after a timeout: the device may still be executing it.
     struct FreeCmd {
         VkDevice d;
         VkCommandPool p;
         VkCommandBuffer c;
-        ~FreeCmd() { vkFreeCommandBuffers(d, p, 1, &c); }
+        bool keep = false;
+        ~FreeCmd() {
+            if (!keep) vkFreeCommandBuffers(d, p, 1, &c);
+        }
     } freeCmd{device_, commandPool_, cmd};
     name(VK_OBJECT_TYPE_COMMAND_BUFFER, cmd, n);
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
@@ -608,11 +586,26 @@ double Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record
     si.pCommandBuffers = &cmd;
     VkFence f = fence_;
     LC_VK(vkResetFences(device_, 1, &f));
-    auto t0 = std::chrono::steady_clock::now();
+    // No limit (submitAndWait) or a finite one in nanoseconds.
+    const std::uint64_t timeoutNs = std::isfinite(timeoutMs) && timeoutMs > 0
+                                        ? std::uint64_t(std::min(timeoutMs, 1e9) * 1e6)
+                                        : UINT64_MAX;
+    const auto t0 = std::chrono::steady_clock::now();
     LC_VK(vkQueueSubmit(queue_, 1, &si, f));
-    LC_VK(vkWaitForFences(device_, 1, &f, VK_TRUE, UINT64_MAX));
-    auto t1 = std::chrono::steady_clock::now();
-    return std::chrono::duration<double, std::milli>(t1 - t0).count();
+    const VkResult r = vkWaitForFences(device_, 1, &f, VK_TRUE, timeoutNs);
+    wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (r == VK_TIMEOUT) {
+        freeCmd.keep = true; // still pending: left to the context the caller abandons
+        return false;
+    }
+    if (r != VK_SUCCESS) throwVkError("vkWaitForFences", r, __FILE__, __LINE__);
+    return true;
+}
+
+double Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record, const std::string& n) {
+    double wallMs = 0;
+    submitAndWaitFor(record, n, std::numeric_limits<double>::infinity(), wallMs); // never times out
+    return wallMs;
 }
 
 } // namespace lc::vk
