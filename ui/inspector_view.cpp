@@ -367,41 +367,36 @@ bool InspectorView::frameSelected(int ms) {
 
 void InspectorView::flyTo(const glm::dvec3& center, double radius, int ms) {
     // The sphere's six extreme points along the view axes bound it well enough.
-    vtkCamera* vc = renderer_->GetActiveCamera();
-    double vu[3];
-    vc->GetViewUp(vu);
-    double p0[3], f0[3];
-    vc->GetPosition(p0);
-    vc->GetFocalPoint(f0);
-    glm::dvec3 dir = glm::dvec3(f0[0], f0[1], f0[2]) - glm::dvec3(p0[0], p0[1], p0[2]);
-    if (glm::length(dir) < 1e-12) dir = {0, 0, -1};
-    dir = glm::normalize(dir);
-    glm::dvec3 up(vu[0], vu[1], vu[2]);
-    glm::dvec3 right = glm::cross(dir, up);
-    if (glm::length(right) < 1e-12) right = glm::dvec3(1, 0, 0);
-    right = glm::normalize(right);
-    up = glm::cross(right, dir);
-    flyToPoints({center + radius * right, center - radius * right, center + radius * up, center - radius * up,
-                 center + radius * dir, center - radius * dir},
+    const ViewBasis b = viewBasis();
+    flyToPoints({center + radius * b.right, center - radius * b.right, center + radius * b.up, center - radius * b.up,
+                 center + radius * b.dir, center - radius * b.dir},
                 ms);
 }
 
-void InspectorView::flyToPoints(const std::vector<glm::dvec3>& points, int ms) {
-    if (points.empty()) return;
+InspectorView::ViewBasis InspectorView::viewBasis() const {
     vtkCamera* vc = renderer_->GetActiveCamera();
     double p0[3], f0[3], vu[3];
     vc->GetPosition(p0);
     vc->GetFocalPoint(f0);
     vc->GetViewUp(vu);
-    const glm::dvec3 fromEye(p0[0], p0[1], p0[2]), fromFocal(f0[0], f0[1], f0[2]);
-    glm::dvec3 dir = fromFocal - fromEye;
-    if (glm::length(dir) < 1e-12) dir = {0, 0, -1};
-    dir = glm::normalize(dir);
-    glm::dvec3 up(vu[0], vu[1], vu[2]);
-    glm::dvec3 right = glm::cross(dir, up);
-    if (glm::length(right) < 1e-12) right = glm::dvec3(1, 0, 0);
-    right = glm::normalize(right);
-    up = glm::cross(right, dir);
+    ViewBasis b;
+    b.eye = {p0[0], p0[1], p0[2]};
+    b.focal = {f0[0], f0[1], f0[2]};
+    b.dir = b.focal - b.eye;
+    if (glm::length(b.dir) < 1e-12) b.dir = {0, 0, -1};
+    b.dir = glm::normalize(b.dir);
+    b.right = glm::cross(b.dir, glm::dvec3(vu[0], vu[1], vu[2]));
+    if (glm::length(b.right) < 1e-12) b.right = glm::dvec3(1, 0, 0);
+    b.right = glm::normalize(b.right);
+    b.up = glm::cross(b.right, b.dir);
+    return b;
+}
+
+void InspectorView::flyToPoints(const std::vector<glm::dvec3>& points, int ms) {
+    if (points.empty()) return;
+    vtkCamera* vc = renderer_->GetActiveCamera();
+    const ViewBasis b = viewBasis();
+    const glm::dvec3 fromEye = b.eye, fromFocal = b.focal, dir = b.dir, up = b.up, right = b.right;
     glm::dvec3 center(0.0);
     for (const glm::dvec3& p : points) center += p;
     center /= double(points.size());

@@ -112,6 +112,11 @@ private:
     // The world-space points under a widget position (logical px) on the
     // near and the far clipping plane: the view ray through that pixel.
     std::pair<glm::dvec3, glm::dvec3> viewRay(const QPoint& pos) const;
+    // The inspector camera's eye, focal point and orthonormal view axes.
+    struct ViewBasis {
+        glm::dvec3 eye, focal, dir, up, right;
+    };
+    ViewBasis viewBasis() const;
     void rebuildMeshes();
     void rebuildLights();
     void updateLight(int index);
