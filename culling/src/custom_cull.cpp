@@ -13,7 +13,6 @@
 #include <png.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -303,28 +302,17 @@ std::vector<MissedLight> locateFalseNegatives(const RunOutput& run, const Projec
 
 namespace {
 
-// Ground truth and the image error over a finished custom result, as
-// runPipeline does after its cull.
+// Ground truth and the image error over decoded custom lists: runPipeline's
+// own last phases. Lists read from a dump are shaded on the CPU reference.
 void judge(RunOutput& out, const Projection& proj, CullBackend* shadeBackend, const RunOptions& runOptions) {
     if (const std::string bad = out.result.validate(out.lights.size()); !bad.empty())
         throw Error("custom lists are inconsistent after decoding: " + bad);
-    if (runOptions.groundTruth) {
-        GroundTruthOptions t = runOptions.truthOptions;
-        t.imageError = false;
-        const auto t0 = std::chrono::steady_clock::now();
-        out.truth = computeGroundTruth(out.depth, proj, out.lights, out.result, t);
-        out.truthComputed = true;
-        out.result.timings.groundTruthMs =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    std::unique_ptr<CullBackend> cpu;
+    if (!shadeBackend) {
+        cpu = makeCpuBackend();
+        shadeBackend = cpu.get();
     }
-    if (runOptions.truthOptions.imageError) {
-        std::unique_ptr<CullBackend> cpu;
-        if (!shadeBackend) {
-            cpu = makeCpuBackend();
-            shadeBackend = cpu.get();
-        }
-        shadeAndCompare(*shadeBackend, out, proj, runOptions.keepShadedImages);
-    }
+    judgeRun(out, proj, *shadeBackend, runOptions);
 }
 
 } // namespace

@@ -161,21 +161,25 @@ RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBack
     if (out.result.device.empty()) out.result.device = backend.deviceName();
     if (out.result.timingMethod.empty()) out.result.timingMethod = backend.timingMethod();
     throwIfCancelled(cancel);
+    judgeRun(out, proj, backend, options, cancel);
+    return out;
+}
 
+void judgeRun(RunOutput& out, const Projection& proj, CullBackend& shadeBackend, const RunOptions& options,
+              const CancelToken* cancel) {
+    using Clock = std::chrono::steady_clock;
     if (options.groundTruth) {
         GroundTruthOptions truthOptions = options.truthOptions;
         truthOptions.imageError = false; // from the backend's shading pass below
-        const auto t2 = Clock::now();
+        const auto t0 = Clock::now();
         out.truth = computeGroundTruth(out.depth, proj, out.lights, out.result, truthOptions, cancel);
         out.truthComputed = true;
-        out.result.timings.groundTruthMs =
-            std::chrono::duration<double, std::milli>(Clock::now() - t2).count();
+        out.result.timings.groundTruthMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     }
     if (options.truthOptions.imageError) {
         throwIfCancelled(cancel);
-        shadeAndCompare(backend, out, proj, options.keepShadedImages, cancel);
+        shadeAndCompare(shadeBackend, out, proj, options.keepShadedImages, cancel);
     }
-    return out;
 }
 
 } // namespace lc

@@ -47,6 +47,14 @@ struct RunOptions {
 RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBackend& backend,
                       const RunOptions& options = {}, const CancelToken* cancel = nullptr);
 
+// The phases of runPipeline after its cull, for lists made elsewhere (custom
+// culling): ground truth when options.groundTruth (timed into
+// out.result.timings), then, when options.truthOptions.imageError, the
+// shading pass on `shadeBackend` and the image error (shadeAndCompare).
+// out.result must be valid for out.lights.
+void judgeRun(RunOutput& out, const Projection& proj, CullBackend& shadeBackend, const RunOptions& options,
+              const CancelToken* cancel = nullptr);
+
 // The shading phase of runPipeline on its own: shades `out.result`'s lists and
 // every light on `backend` over out.depth, sets timings.shadeMs (the culled
 // image) and the image error in out.truth.metrics; keeps the images in `out`
