@@ -10,6 +10,9 @@
 #include "vk/validation.hpp"
 #include "vk/vk_context.hpp"
 
+// Vulkan create-info structs are filled field by field (as in vk_context.cpp).
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+
 #include <glslang/Public/ResourceLimits.h>
 #include <glslang/Public/ShaderLang.h>
 #include <glslang/SPIRV/GlslangToSpv.h>
@@ -133,7 +136,7 @@ std::vector<std::uint32_t> compileSource(const std::string& path, const std::str
         shader.setEntryPoint(entry.c_str());
         shader.setSourceEntryPoint(entry.c_str());
     }
-    auto messages = EShMessages(EShMsgSpvRules | EShMsgVulkanRules | (hlsl ? EShMsgReadHlsl : 0));
+    auto messages = EShMessages(EShMsgSpvRules | EShMsgVulkanRules | (hlsl ? int(EShMsgReadHlsl) : 0));
     Includer includer(fs::path(path).parent_path());
     if (!shader.parse(GetDefaultResources(), hlsl ? 100 : 450, false, messages, includer))
         throwCompileError(path, shader.getInfoLog(), "compile error");
@@ -186,49 +189,6 @@ struct RunState {
     vk::DescriptorPoolHandle pool;
     // Members die in reverse order: the context, declared first, goes last.
 };
-
-vk::Image createSampledImage(const vk::Context& ctx, std::uint32_t w, std::uint32_t h) {
-    vk::Image img;
-    const VkDevice dev = ctx.device();
-    VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-    ici.imageType = VK_IMAGE_TYPE_2D;
-    ici.format = VK_FORMAT_R32_SFLOAT;
-    ici.extent = {w, h, 1};
-    ici.mipLevels = 1;
-    ici.arrayLayers = 1;
-    ici.samples = VK_SAMPLE_COUNT_1_BIT;
-    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
-    ici.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-    VkImage im;
-    LC_VK(vkCreateImage(dev, &ici, nullptr, &im));
-    img.image = vk::ImageHandle(dev, im);
-    ctx.name(VK_OBJECT_TYPE_IMAGE, im, "custom.depthTexture");
-    VkMemoryRequirements req;
-    vkGetImageMemoryRequirements(dev, im, &req);
-    VkPhysicalDeviceMemoryProperties mp;
-    vkGetPhysicalDeviceMemoryProperties(ctx.physicalDevice(), &mp);
-    std::uint32_t type = UINT32_MAX;
-    for (std::uint32_t i = 0; i < mp.memoryTypeCount && type == UINT32_MAX; ++i)
-        if ((req.memoryTypeBits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
-            type = i;
-    if (type == UINT32_MAX) throw DeviceError("no device-local memory for the depth texture");
-    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    ai.allocationSize = req.size;
-    ai.memoryTypeIndex = type;
-    VkDeviceMemory mem;
-    LC_VK(vkAllocateMemory(dev, &ai, nullptr, &mem));
-    img.memory = vk::MemoryHandle(dev, mem);
-    LC_VK(vkBindImageMemory(dev, im, mem, 0));
-    VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-    vci.image = im;
-    vci.viewType = VK_IMAGE_VIEW_TYPE_2D;
-    vci.format = VK_FORMAT_R32_SFLOAT;
-    vci.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    VkImageView view;
-    LC_VK(vkCreateImageView(dev, &vci, nullptr, &view));
-    img.view = vk::ImageViewHandle(dev, view);
-    return img;
-}
 
 } // namespace
 
@@ -323,7 +283,9 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
                                "custom.lists");
 
     // The depth texture, from the depth buffer through a copy.
-    st->depthImage = createSampledImage(ctx, depth.width, depth.height);
+    st->depthImage = ctx.createImage(depth.width, depth.height, VK_FORMAT_R32_SFLOAT,
+                                     VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                                     VK_IMAGE_ASPECT_COLOR_BIT, "custom.depthTexture");
     VkSamplerCreateInfo sci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
     sci.magFilter = sci.minFilter = VK_FILTER_NEAREST;
     sci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;

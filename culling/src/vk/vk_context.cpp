@@ -481,6 +481,12 @@ double TimestampPool::milliseconds(std::uint32_t span) const {
 }
 
 Image Context::createDepthImage(std::uint32_t w, std::uint32_t h, VkFormat format, const std::string& n) const {
+    return createImage(w, h, format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                       VK_IMAGE_ASPECT_DEPTH_BIT, n);
+}
+
+Image Context::createImage(std::uint32_t w, std::uint32_t h, VkFormat format, VkImageUsageFlags usage,
+                           VkImageAspectFlags aspect, const std::string& n) const {
     Image img;
     VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     ici.imageType = VK_IMAGE_TYPE_2D;
@@ -490,7 +496,7 @@ Image Context::createDepthImage(std::uint32_t w, std::uint32_t h, VkFormat forma
     ici.arrayLayers = 1;
     ici.samples = VK_SAMPLE_COUNT_1_BIT;
     ici.tiling = VK_IMAGE_TILING_OPTIMAL;
-    ici.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    ici.usage = usage;
     ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
     VkImage im;
     LC_VK(vkCreateImage(device_, &ici, nullptr, &im));
@@ -511,7 +517,7 @@ Image Context::createDepthImage(std::uint32_t w, std::uint32_t h, VkFormat forma
     vci.image = im;
     vci.viewType = VK_IMAGE_VIEW_TYPE_2D;
     vci.format = format;
-    vci.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+    vci.subresourceRange = {aspect, 0, 1, 0, 1};
     VkImageView view;
     LC_VK(vkCreateImageView(device_, &vci, nullptr, &view));
     img.view = ImageViewHandle(device_, view);

@@ -196,6 +196,11 @@ public:
     // (usage gets TRANSFER_SRC | TRANSFER_DST for that): host reads of mapped
     // video memory (resizable BAR) are uncached and slow.
     Buffer createDeviceBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name) const;
+    // A 2D image in device-local memory with a view of `aspect`, named `name`
+    // (memory "name.memory", view "name.view").
+    Image createImage(std::uint32_t w, std::uint32_t h, VkFormat format, VkImageUsageFlags usage,
+                      VkImageAspectFlags aspect, const std::string& name) const;
+    // createImage for a depth attachment the host reads back (transfer source).
     Image createDepthImage(std::uint32_t w, std::uint32_t h, VkFormat format, const std::string& name) const;
     ShaderModuleHandle createShader(const std::uint32_t* words, std::size_t wordCount,
                                     const std::string& name) const;
