@@ -24,11 +24,6 @@ std::string num(double v) {
     return b;
 }
 
-// The same slack the reference adds to a radius (tile_math.cpp).
-double slack(const glm::dvec3& c, double r) {
-    return 1e-9 * (r + std::abs(c.x) + std::abs(c.y) + std::abs(c.z)) + 1e-12;
-}
-
 bool tileEmpty(const CullResult& r, std::uint32_t t) { return !(r.tileDepthMin[t] <= r.tileDepthMax[t]); }
 
 } // namespace
@@ -71,7 +66,7 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
     const BoundingSphere sphere = lights.cullSphere(light, s.spotTest);
     e.sphereCenter = sphere.center;
     e.sphereRadius = sphere.radius;
-    const double rr = sphere.radius + slack(sphere.center, sphere.radius);
+    const double rr = sphere.radius + sphereTestSlack(sphere.center, sphere.radius);
     auto step = [&](std::string test, std::string numbers, bool passed) {
         e.steps.push_back({std::move(test), std::move(numbers), passed});
         return passed;

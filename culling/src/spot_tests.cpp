@@ -6,16 +6,6 @@
 
 namespace lc {
 
-namespace {
-
-// Keeps every rejection conservative under rounding, as tile_math's tests do:
-// relative to the magnitudes involved, far above double rounding and far
-// below any distance a scene cares about.
-double slack(const glm::dvec3& c, double r) {
-    return 1e-9 * (r + std::abs(c.x) + std::abs(c.y) + std::abs(c.z)) + 1e-12;
-}
-
-} // namespace
 
 const char* toString(SpotTest t) {
     switch (t) {
@@ -67,7 +57,7 @@ BoundingSphere chunkBoundingSphere(const FrustumChunk& chunk) {
 
 bool coneIntersectsSphere(const SpotCone& cone, const glm::dvec3& c, double r) {
     const glm::dvec3 v = c - cone.apex;
-    const double rr = r + slack(c, r + cone.range) + slack(cone.apex, 0.0);
+    const double rr = r + sphereTestSlack(c, r + cone.range) + sphereTestSlack(cone.apex, 0.0);
     const double vLen2 = glm::dot(v, v);
     if (vLen2 > (cone.range + rr) * (cone.range + rr)) return false; // outside the range sphere
     const double vAxial = glm::dot(v, cone.axis);
@@ -95,7 +85,7 @@ double coneMaxSignedDistance(const SpotCone& cone, const Plane& plane) {
 }
 
 bool coneIntersectsChunkPlanes(const SpotCone& cone, const FrustumChunk& chunk) {
-    const double tol = slack(cone.apex, cone.range);
+    const double tol = sphereTestSlack(cone.apex, cone.range);
     for (const Plane& p : chunk.planes)
         if (coneMaxSignedDistance(cone, p) < -tol) return false;
     return true;

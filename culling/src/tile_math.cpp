@@ -94,14 +94,11 @@ const char* toString(Slicing s) {
     return "?";
 }
 
-namespace {
-
-// Slack that keeps every test conservative under rounding: relative to the
-// magnitudes involved (1e-9 is far above double rounding, far below any
-// distance a scene cares about).
-double slack(const glm::dvec3& c, double r) {
+double sphereTestSlack(const glm::dvec3& c, double r) {
     return 1e-9 * (r + std::abs(c.x) + std::abs(c.y) + std::abs(c.z)) + 1e-12;
 }
+
+namespace {
 
 bool planesPass(const FrustumChunk& chunk, const glm::dvec3& c, double r) {
     for (const Plane& p : chunk.planes)
@@ -162,7 +159,7 @@ double distanceToChunk(const FrustumChunk& chunk, const glm::dvec3& p) {
 // one runs the cheaper tests first (they are conservative, so this loses
 // nothing) and then refines.
 bool sphereIntersectsChunk(SphereTest test, const FrustumChunk& chunk, const glm::dvec3& c, double r) {
-    const double rr = r + slack(c, r);
+    const double rr = r + sphereTestSlack(c, r);
     if (!planesPass(chunk, c, rr)) return false;
     if (test == SphereTest::Planes) return true;
     if (!aabbPass(chunk, c, rr)) return false;

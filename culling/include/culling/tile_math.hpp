@@ -55,6 +55,11 @@ const char* toString(SphereTest t);
 // space) and the chunk share a point; Planes and PlanesAabb may also say true
 // when they don't (false positives), Exact only within rounding.
 bool sphereIntersectsChunk(SphereTest test, const FrustumChunk& chunk, const glm::dvec3& c, double r);
+// The distance the conservative tests add to a sphere's radius (c, r in view
+// space) so that rounding never rejects what touches: 1e-9 of the magnitudes
+// involved (far above double rounding, far below any distance a scene cares
+// about) plus 1e-12. Shared by the chunk tests, the spot tests and explain.
+double sphereTestSlack(const glm::dvec3& c, double r);
 // Exact Euclidean distance from p to the chunk (0 inside).
 double distanceToChunk(const FrustumChunk& chunk, const glm::dvec3& p);
 
