@@ -881,14 +881,9 @@ bool MainWindow::setCustomShader(const QString& path) {
         runCulling();
         return true;
     }
-    auto o = std::make_shared<lc::CustomShaderOptions>();
-    o->path = path.toStdString();
+    std::shared_ptr<const lc::CustomShaderOptions> o;
     try {
-        if (!path.endsWith(".spv", Qt::CaseInsensitive)) {
-            QFile f(path);
-            if (!f.open(QIODevice::ReadOnly)) throw lc::InputError(o->path, "", 0, "cannot open shader for reading");
-            lc::applyShaderHeader(f.readLine().toStdString(), o->path, *o, false, false, false);
-        }
+        o = std::make_shared<const lc::CustomShaderOptions>(lc::shaderOptionsFromFile(path.toStdString()));
     } catch (const std::exception& e) {
         log(tr("cannot use %1: %2").arg(path, describe(e)), true);
         prompts.showError(this, tr("Custom shader"), describe(e));
@@ -913,22 +908,13 @@ void MainWindow::reloadCustomShader() {
     if (QFileInfo::exists(path) && !shaderWatcher_->files().contains(path)) shaderWatcher_->addPath(path);
     if (!QFileInfo::exists(path)) return; // mid-save; the new file's change follows
     log(tr("%1 changed: culling again").arg(path));
-    auto o = std::make_shared<lc::CustomShaderOptions>(*customShader_);
     try {
-        if (!path.endsWith(".spv", Qt::CaseInsensitive)) {
-            QFile f(path);
-            if (f.open(QIODevice::ReadOnly)) {
-                lc::CustomShaderOptions fresh;
-                fresh.path = o->path;
-                lc::applyShaderHeader(f.readLine().toStdString(), o->path, fresh, false, false, false);
-                o = std::make_shared<lc::CustomShaderOptions>(fresh);
-            }
-        }
+        // The first line may have changed its settings.
+        customShader_ = std::make_shared<const lc::CustomShaderOptions>(lc::shaderOptionsFromFile(path.toStdString()));
     } catch (const std::exception& e) {
         log(tr("cannot use %1: %2").arg(path, describe(e)), true);
         return;
     }
-    customShader_ = o;
     runCulling();
 }
 

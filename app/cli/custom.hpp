@@ -13,25 +13,6 @@
 
 namespace lcli {
 
-// A shader file's options: its first-line settings, then what the caller set
-// (non-empty `layout`/`lists`/`entry` win).
-inline lc::CustomShaderOptions shaderFromFile(const std::string& path, const std::string& layout = {},
-                                              const std::string& lists = {}, const std::string& entry = {}) {
-    lc::CustomShaderOptions o;
-    o.path = path;
-    if (!layout.empty()) o.layout = lc::parseLayout(layout);
-    if (!lists.empty()) o.lists = lc::parseListSpec(lists);
-    if (!entry.empty()) o.entry = entry;
-    if (path.size() < 4 || path.substr(path.size() - 4) != ".spv") {
-        std::ifstream in(path, std::ios::binary);
-        if (!in) throw lc::InputError(path, "", 0, "cannot open shader for reading");
-        std::string first;
-        std::getline(in, first);
-        lc::applyShaderHeader(first, path, o, !layout.empty(), !lists.empty(), !entry.empty());
-    }
-    return o;
-}
-
 struct CustomFlags {
     std::string shader, layout, lists, entry, depthFile;
     bool noValidation = false;
@@ -75,7 +56,7 @@ struct CustomFlags {
     }
 
     lc::CustomShaderOptions shaderOptions(const std::string& device) const {
-        lc::CustomShaderOptions o = shaderFromFile(shader, layout, lists, entry);
+        lc::CustomShaderOptions o = lc::shaderOptionsFromFile(shader, layout, lists, entry);
         o.device = device;
         o.validation = !noValidation;
         o.timeoutMs = timeoutMs;

@@ -99,7 +99,7 @@ int ReportCommand::run() {
     lc::ReportOptions options;
     options.device = device_;
     for (const std::string& sh : shaders_) {
-        lc::CustomShaderOptions so = shaderFromFile(sh);
+        lc::CustomShaderOptions so = lc::shaderOptionsFromFile(sh);
         so.device = device_;
         options.shaders.push_back(std::move(so));
     }

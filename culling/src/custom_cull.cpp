@@ -46,14 +46,6 @@ bool parseUint(const std::string& s, std::uint64_t& v) {
     return true;
 }
 
-std::string readText(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, "", 0, "cannot open file for reading");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 // The built-in algorithm whose list rule a ListSpec names.
 Algorithm ruleAlgorithm(const ListSpec& l) {
     switch (l.kind) {
@@ -89,6 +81,14 @@ void assignLists(std::vector<std::vector<std::uint32_t>>& lists, std::uint32_t l
 } // namespace
 
 namespace detail {
+
+std::string readWholeFile(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, "", 0, "cannot open file for reading");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
 
 CullResult ruleSkeleton(const DepthImage& depth, const Projection& proj, const TileGrid& grid, const ViewLights& lights,
                         const ListSpec& lists) {
@@ -231,6 +231,23 @@ void applyShaderHeader(const std::string& text, const std::string& path, CustomS
     }
 }
 
+CustomShaderOptions shaderOptionsFromFile(const std::string& path, const std::string& layout, const std::string& lists,
+                                          const std::string& entry) {
+    CustomShaderOptions o;
+    o.path = path;
+    if (!layout.empty()) o.layout = parseLayout(layout);
+    if (!lists.empty()) o.lists = parseListSpec(lists);
+    if (!entry.empty()) o.entry = entry;
+    if (fs::path(path).extension() != ".spv") {
+        std::ifstream in(path, std::ios::binary);
+        if (!in) throw InputError(path, "", 0, "cannot open shader for reading");
+        std::string first;
+        std::getline(in, first);
+        applyShaderHeader(first, path, o, !layout.empty(), !lists.empty(), !entry.empty());
+    }
+    return o;
+}
+
 void decodeLists(const std::vector<std::uint32_t>& words, const LayoutSpec& layout, std::uint32_t lightCount,
                  CullResult& result, CustomCullReport& report) {
     const std::size_t lists = result.listOffset.size();
@@ -354,7 +371,7 @@ RunOutput checkListDump(const Scene& scene, const std::string& listsPath, const 
     report.lists = toString(lists);
     const auto lightCount = std::uint32_t(out.lights.size());
     const std::string ext = fs::path(listsPath).extension().string();
-    const std::string bytes = readText(listsPath);
+    const std::string bytes = detail::readWholeFile(listsPath);
     if (ext == ".csv") {
         // One line per list: "list,light,light,...". Lists not named are empty.
         std::vector<std::vector<std::uint32_t>> perList(r.listOffset.size());

@@ -9,6 +9,8 @@ namespace lc::detail {
 // shares, and the reference lists it is compared with.
 CullResult ruleSkeleton(const DepthImage& depth, const Projection& proj, const TileGrid& grid, const ViewLights& lights,
                         const ListSpec& lists);
+// The whole file, bytes as they are; InputError naming it when it cannot be opened.
+std::string readWholeFile(const std::string& path);
 // Fills report.builtin*: how the custom lists differ from the built-in ones.
 void compareWithBuiltin(const CullResult& custom, const CullResult& builtin, CustomCullReport& report);
 

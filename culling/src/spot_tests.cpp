@@ -6,7 +6,6 @@
 
 namespace lc {
 
-
 const char* toString(SpotTest t) {
     switch (t) {
     case SpotTest::ApexSphere: return "apex-sphere";

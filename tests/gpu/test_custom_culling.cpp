@@ -45,15 +45,7 @@ Scene atrium(std::uint32_t w = 330, std::uint32_t h = 190, std::uint32_t lights 
 }
 
 CustomShaderOptions optionsFor(const std::string& path, const std::string& layout = {}, const std::string& lists = {}) {
-    CustomShaderOptions o;
-    o.path = path;
-    std::ifstream in(path);
-    std::string first;
-    std::getline(in, first);
-    if (!layout.empty()) o.layout = parseLayout(layout);
-    if (!lists.empty()) o.lists = parseListSpec(lists);
-    applyShaderHeader(first, path, o, !layout.empty(), !lists.empty(), false);
-    return o;
+    return shaderOptionsFromFile(path, layout, lists);
 }
 
 RunOutput runShader(const Scene& s, const CustomShaderOptions& o, CustomCullReport& rep) {

@@ -64,6 +64,13 @@ struct CustomShaderOptions {
 void applyShaderHeader(const std::string& shaderText, const std::string& path, CustomShaderOptions& options,
                        bool layoutGiven, bool listsGiven, bool entryGiven);
 
+// A shader file's options: its first-line settings (none for .spv), under
+// what the caller sets (a non-empty `layout`, `lists` or `entry` wins, as a
+// command-line flag does). Throws InputError naming the file when it cannot
+// be read or its first line is bad, SettingsError for a bad `layout`/`lists`.
+CustomShaderOptions shaderOptionsFromFile(const std::string& path, const std::string& layout = {},
+                                          const std::string& lists = {}, const std::string& entry = {});
+
 // What a custom culling (shader or dump) did beside its lists.
 struct CustomCullReport {
     std::string source;                  // the shader or dump file

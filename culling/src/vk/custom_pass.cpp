@@ -58,14 +58,6 @@ struct CustomLight {
 };
 static_assert(sizeof(CustomLight) == 32, "CustomLight must match LcLight (std430)");
 
-std::string readFile(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, "", 0, "cannot open shader for reading");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 void initGlslang() {
     static std::once_flag once;
     std::call_once(once, [] { glslang::InitializeProcess(); });
@@ -166,7 +158,7 @@ std::string definesFor(const CustomShaderOptions& o, const TileGrid& grid, std::
 }
 
 std::vector<std::uint32_t> loadSpirv(const std::string& path) {
-    const std::string bytes = readFile(path);
+    const std::string bytes = detail::readWholeFile(path);
     if (bytes.size() < 20 || bytes.size() % 4 != 0)
         throw InputError(path, "", 0, "not SPIR-V: " + std::to_string(bytes.size()) + " bytes is not a whole module");
     std::vector<std::uint32_t> words(bytes.size() / 4);
@@ -219,7 +211,7 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
     } else {
         const bool hlsl = ext == ".hlsl";
         if (!hlsl) entry = "main";
-        spirv = compileSource(o.path, readFile(o.path), hlsl, o.entry,
+        spirv = compileSource(o.path, detail::readWholeFile(o.path), hlsl, o.entry,
                               definesFor(o, grid, skeleton.listsPerTile, lightCount, compactEntries));
     }
 
