@@ -140,78 +140,81 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
         struct Acc {
             std::vector<std::uint64_t> w, e, fn;
             std::vector<std::uint32_t> tilePixels;
-            std::uint64_t optimal = 0;
-            std::vector<char> neededAnywhere; // `all`: its one list spans every band
+            // The optimum: per list its pixels and the lights they need
+            // together; `all`'s one list spans every band, so it keeps a flag
+            // per light instead.
+            std::vector<std::uint64_t> listPixels, listUnion;
+            std::vector<std::uint32_t> unionTile, unionSubs; // per light: the tile counted, its sub-lists counted
+            std::vector<char> neededAnywhere;
         };
         std::vector<Acc> acc(workers);
         const bool oneList = result.algorithm == Algorithm::All;
+        const std::uint32_t per = std::max(result.listsPerTile, 1u); // <= 32: one bit per sub-list
         for (auto& a : acc) {
             a.w.assign(lists, 0), a.e.assign(lists, 0), a.fn.assign(lists, 0);
             a.tilePixels.assign(tiles, 0);
-            if (oneList) a.neededAnywhere.assign(lights.size(), 0);
+            if (oneList) {
+                a.neededAnywhere.assign(lights.size(), 0);
+            } else {
+                a.listPixels.assign(lists, 0), a.listUnion.assign(lists, 0);
+                a.unionTile.assign(lights.size(), std::numeric_limits<std::uint32_t>::max());
+                a.unionSubs.assign(lights.size(), 0);
+            }
         }
-        // Bands of whole tile rows: every list but `all`'s belongs to one tile,
-        // so its pixels, and the union of the lights they need, lie in one band.
-        const std::uint32_t bandRows = oneList ? 16u : result.grid.tileSize;
         // Membership of a needed light in the pixel's list: stamp[i] == the
         // current stamp when light i is listed. Neighbouring pixels mostly share
         // a list, so re-stamping on a change costs less than a binary search
         // per needed light.
         std::vector<std::vector<std::uint32_t>> stamps(workers, std::vector<std::uint32_t>(lights.size(), 0));
         std::vector<std::uint32_t> stampNow(workers, 0);
-        forEachRowBand(depth.height, bandRows, workers, cancel, [&](unsigned w, std::uint32_t y0, std::uint32_t y1) {
+        const std::uint32_t ts = result.grid.tileSize;
+        // Bands of one tile row, walked tile by tile: a tile's pixels come one
+        // after another, so the lights its lists need together are counted
+        // with one tile number and one bit per sub-list per light.
+        forEachRowBand(depth.height, ts, workers, cancel, [&](unsigned w, std::uint32_t y0, std::uint32_t y1) {
             Acc& a = acc[w];
             std::vector<std::uint32_t>& stamp = stamps[w];
             std::uint32_t& now = stampNow[w];
             std::uint32_t stampedList = std::numeric_limits<std::uint32_t>::max();
-            // (list, light) of every needed light in the band, and the pixels
-            // of each list: the band's lists' unions, for the optimum.
-            std::vector<std::pair<std::uint32_t, std::uint32_t>> needs;
-            std::vector<std::pair<std::uint32_t, std::uint32_t>> listPixels; // (list, 1) per pixel, summed below
-            for (std::uint32_t y = y0; y < y1; ++y)
-                for (std::uint32_t x = 0; x < depth.width; ++x) {
-                    if (!depth.hasGeometry(x, y)) continue;
-                    const double d = depth.at(x, y);
-                    const glm::dvec3 p = proj.viewPositionFromDepth(x, y, d);
-                    const std::uint32_t l = result.listOfPixel(x, y, proj.viewDepthFromWindowDepth(d));
-                    if (l >= lists) throw Error("ground truth: listOfPixel gave list " + std::to_string(l));
-                    ++a.tilePixels[result.grid.tileOfPixel(x, y)];
-                    if (l != stampedList) {
-                        if (++now == 0) { // wrapped: clear old stamps
-                            std::fill(stamp.begin(), stamp.end(), 0);
-                            now = 1;
+            for (std::uint32_t tx0 = 0; tx0 < depth.width; tx0 += ts)
+                for (std::uint32_t y = y0; y < y1; ++y)
+                    for (std::uint32_t x = tx0; x < std::min(depth.width, tx0 + ts); ++x) {
+                        if (!depth.hasGeometry(x, y)) continue;
+                        const double d = depth.at(x, y);
+                        const glm::dvec3 p = proj.viewPositionFromDepth(x, y, d);
+                        const std::uint32_t l = result.listOfPixel(x, y, proj.viewDepthFromWindowDepth(d));
+                        if (l >= lists) throw Error("ground truth: listOfPixel gave list " + std::to_string(l));
+                        const std::uint32_t t = result.grid.tileOfPixel(x, y);
+                        ++a.tilePixels[t];
+                        if (l != stampedList) {
+                            if (++now == 0) { // wrapped: clear old stamps
+                                std::fill(stamp.begin(), stamp.end(), 0);
+                                now = 1;
+                            }
+                            const std::uint32_t* first = result.lightIndices.data() + result.listOffset[l];
+                            for (std::uint32_t k = 0; k < result.listCount[l]; ++k) stamp[first[k]] = now;
+                            stampedList = l;
                         }
-                        const std::uint32_t* first = result.lightIndices.data() + result.listOffset[l];
-                        for (std::uint32_t k = 0; k < result.listCount[l]; ++k) stamp[first[k]] = now;
-                        stampedList = l;
+                        a.w[l] += result.listCount[l];
+                        const std::uint32_t subBit = oneList ? 0u : 1u << (l - t * per);
+                        std::uint64_t needed = 0, missed = 0;
+                        grid.forEachContaining(p, [&](std::uint32_t i) {
+                            ++needed;
+                            missed += stamp[i] != now;
+                            if (oneList) {
+                                a.neededAnywhere[i] = 1;
+                                return;
+                            }
+                            if (a.unionTile[i] != t) a.unionTile[i] = t, a.unionSubs[i] = 0;
+                            if (!(a.unionSubs[i] & subBit)) {
+                                a.unionSubs[i] |= subBit;
+                                ++a.listUnion[l];
+                            }
+                        });
+                        a.e[l] += needed;
+                        a.fn[l] += missed;
+                        if (!oneList) ++a.listPixels[l];
                     }
-                    a.w[l] += result.listCount[l];
-                    std::uint64_t needed = 0, missed = 0;
-                    grid.forEachContaining(p, [&](std::uint32_t i) {
-                        ++needed;
-                        missed += stamp[i] != now;
-                        if (oneList) a.neededAnywhere[i] = 1;
-                        else needs.emplace_back(l, i);
-                    });
-                    a.e[l] += needed;
-                    a.fn[l] += missed;
-                    if (!oneList) listPixels.emplace_back(l, 1u);
-                }
-            if (oneList) return;
-            std::sort(needs.begin(), needs.end());
-            needs.erase(std::unique(needs.begin(), needs.end()), needs.end());
-            std::sort(listPixels.begin(), listPixels.end());
-            // optimal += pixels of the list x lights its pixels need together.
-            std::size_t k = 0;
-            for (std::size_t i = 0; i < listPixels.size();) {
-                const std::uint32_t l = listPixels[i].first;
-                std::uint64_t pixels = 0;
-                while (i < listPixels.size() && listPixels[i].first == l) ++pixels, ++i;
-                while (k < needs.size() && needs[k].first < l) ++k;
-                std::uint64_t unionSize = 0;
-                while (k < needs.size() && needs[k].first == l) ++unionSize, ++k;
-                a.optimal += pixels * unionSize;
-            }
         });
         if (oneList) {
             std::uint64_t anywhere = 0, pixels = 0;
@@ -223,9 +226,13 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
             for (const Acc& a : acc)
                 for (std::uint32_t c : a.tilePixels) pixels += c;
             m.optimalWork = anywhere * pixels;
+        } else {
+            // optimal += pixels of the list x lights its pixels need together
+            // (each list lies in one band: one worker has all of it).
+            for (const Acc& a : acc)
+                for (std::size_t l = 0; l < lists; ++l) m.optimalWork += a.listPixels[l] * a.listUnion[l];
         }
         for (const Acc& a : acc) {
-            m.optimalWork += a.optimal;
             for (std::size_t l = 0; l < lists; ++l) {
                 gt.listShadingWork[l] += a.w[l];
                 gt.listExactWork[l] += a.e[l];
