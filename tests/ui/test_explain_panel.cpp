@@ -121,34 +121,35 @@ private slots:
         InspectorView* iv = w_->inspectorView();
         vtkRenderer* ren = iv->renderer();
         const glm::dmat4 world = lc::worldFromView(doc()->scene().camera);
+        // A view-space point in the inspector's display coordinates (device
+        // pixels, y up; z the depth in [0, 1]).
+        auto display = [&](const glm::dvec3& viewPoint) {
+            const glm::dvec3 wpt = glm::dvec3(world * glm::dvec4(viewPoint, 1.0));
+            ren->SetWorldPoint(wpt.x, wpt.y, wpt.z, 1.0);
+            ren->WorldToDisplay();
+            double d[3];
+            ren->GetDisplayPoint(d);
+            return glm::dvec3(d[0], d[1], d[2]);
+        };
         auto cornersInside = [&] {
             int inside = 0;
+            const int* size = ren->GetSize();
             for (const glm::dvec3& v : chunk->corners) {
-                const glm::dvec3 wpt = glm::dvec3(world * glm::dvec4(v, 1.0));
-                ren->SetWorldPoint(wpt.x, wpt.y, wpt.z, 1.0);
-                ren->WorldToDisplay();
-                double d[3];
-                ren->GetDisplayPoint(d);
-                const int* size = ren->GetSize();
-                inside += d[0] >= 0 && d[0] <= size[0] && d[1] >= 0 && d[1] <= size[1] && d[2] >= 0 && d[2] <= 1;
+                const glm::dvec3 d = display(v);
+                inside += d.x >= 0 && d.x <= size[0] && d.y >= 0 && d.y <= size[1] && d.z >= 0 && d.z <= 1;
             }
             return inside;
         };
         // Start from a view where the tile is a sliver far away.
         iv->flyTo({0, 1000, 0}, 1.0, 0);
         QVERIFY(cornersInside() < 8);
-        QSignalSpy none(w_.get(), &MainWindow::runFinished);
         w_->action("actionFrameSelected")->trigger();
         QTest::qWait(500); // the flight takes 300 ms
         QCOMPARE(cornersInside(), 8);
         // The frustum fills the view: its projected extent spans a good part of it.
         double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};
         for (const glm::dvec3& v : chunk->corners) {
-            const glm::dvec3 wpt = glm::dvec3(world * glm::dvec4(v, 1.0));
-            ren->SetWorldPoint(wpt.x, wpt.y, wpt.z, 1.0);
-            ren->WorldToDisplay();
-            double d[3];
-            ren->GetDisplayPoint(d);
+            const glm::dvec3 d = display(v);
             for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], d[k]), hi[k] = std::max(hi[k], d[k]);
         }
         const int* size = ren->GetSize();
@@ -159,14 +160,10 @@ private slots:
         // Pick in 3D: through the culling camera, a click inside the selected
         // tile enters its nearest cell first; with every tile's frustum drawn
         // and no cells, a click on another tile selects that tile.
-        auto displayOf = [&](const glm::dvec3& viewPoint) {
-            const glm::dvec3 wpt = glm::dvec3(world * glm::dvec4(viewPoint, 1.0));
-            ren->SetWorldPoint(wpt.x, wpt.y, wpt.z, 1.0);
-            ren->WorldToDisplay();
-            double d[3];
-            ren->GetDisplayPoint(d);
+        auto displayOf = [&](const glm::dvec3& viewPoint) { // as a widget position (logical px, y down)
+            const glm::dvec3 d = display(viewPoint);
             const double dpr = iv->devicePixelRatioF();
-            return QPoint(int(d[0] / dpr), int(iv->height() - 1 - d[1] / dpr));
+            return QPoint(int(d.x / dpr), int(iv->height() - 1 - d.y / dpr));
         };
         auto centreOf = [](const lc::FrustumChunk& c) {
             glm::dvec3 m(0.0);
