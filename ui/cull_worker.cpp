@@ -99,6 +99,12 @@ void CullWorker::cancelCurrent() {
     shadeWanted_ = 0;
 }
 
+void CullWorker::cancelShading() {
+    std::lock_guard lock(mutex_);
+    if (shadeCancel_) shadeCancel_->cancelled = true;
+    shadeWanted_ = 0;
+}
+
 quint64 CullWorker::droppedRequests() const {
     std::lock_guard lock(mutex_);
     return dropped_;
@@ -163,7 +169,8 @@ bool CullWorker::shadeLast() {
         if (cancel->cancelled) throw lc::Cancelled();
         auto full = std::make_shared<lc::RunOutput>(*last_);
         lc::shadeAndCompare(*backend_, *full, lc::Projection(lastScene_->camera), true, cancel.get(),
-                            kShadeSliceMs);
+                            kShadeSliceMs,
+                            [this, generation](double f) { emit shadingProgress(generation, f); });
         last_ = full;
         shaded = true;
         emit finished(generation, last_);
@@ -308,6 +315,7 @@ CullService::CullService(QObject* parent) : QObject(parent), worker_(new CullWor
     connect(worker_, &CullWorker::backendReady, this, &CullService::backendReady,
             Qt::QueuedConnection);
     connect(worker_, &CullWorker::shadingStarted, this, &CullService::shadingStarted, Qt::QueuedConnection);
+    connect(worker_, &CullWorker::shadingProgress, this, &CullService::shadingProgress, Qt::QueuedConnection);
     connect(worker_, &CullWorker::shadingEnded, this, &CullService::shadingEnded, Qt::QueuedConnection);
     thread_.start();
 }

@@ -67,6 +67,10 @@ public:
     // is shaded now (or, already shaded, sent again). Any other generation
     // ends at once with shadingEnded(generation, false).
     void requestShading(quint64 generation);
+    // Thread-safe: stops the shading pass in progress (the status bar's
+    // Cancel); it ends with shadingEnded(generation, false) and the run keeps
+    // its lists and ground truth.
+    void cancelShading();
 
 signals:
     void started(quint64 generation);
@@ -76,6 +80,7 @@ signals:
     // The shading pass of `generation` starts / ends (`shaded`: its images
     // were sent with finished(); false: cancelled, failed or not possible).
     void shadingStarted(quint64 generation);
+    void shadingProgress(quint64 generation, double fraction);
     void shadingEnded(quint64 generation, bool shaded);
 
 private slots:
@@ -145,6 +150,7 @@ signals:
     void failed(quint64 generation, QString message);
     void backendReady(QString name, QString device);
     void shadingStarted(quint64 generation);
+    void shadingProgress(quint64 generation, double fraction);
     void shadingEnded(quint64 generation, bool shaded);
 
 private:

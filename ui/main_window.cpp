@@ -7,6 +7,7 @@
 #include "generate_dialog.hpp"
 #include "inspector_view.hpp"
 #include "progress_task.hpp"
+#include "status_progress.hpp"
 #include "property_panel.hpp"
 #include "scene_tree.hpp"
 #include "tile_inspector.hpp"
@@ -218,7 +219,17 @@ void MainWindow::buildDocks() {
     // The Report's chart and table scroll inside their dock, so that the
     // bottom area can be a strip of a few log lines.
     auto* reportScroll = new QScrollArea;
-    reportScroll->setWidget(new ReportDock(doc_));
+    auto* report = new ReportDock(doc_);
+    reportScroll->setWidget(report);
+    // The sweep's progress also in the status bar, with its Cancel.
+    connect(report, &ReportDock::started, this, [this, report] {
+        statusProgress_->begin("report", tr("report..."), [report] { report->cancel(); }, 0);
+    });
+    connect(report, &ReportDock::progressed, this, [this](int done, int total, const QString& label) {
+        statusProgress_->setProgress("report", double(done) / std::max(total, 1),
+                                     tr("report %1/%2 %3").arg(done).arg(total).arg(label));
+    });
+    connect(report, &ReportDock::finished, this, [this] { statusProgress_->end("report"); });
     reportScroll->setWidgetResizable(true);
     reportScroll->setFrameShape(QFrame::NoFrame);
     tabifyDockWidget(logDock, dock(tr("Report"), "reportDock", reportScroll, Qt::BottomDockWidgetArea));
@@ -448,6 +459,8 @@ void MainWindow::buildToolbar() {
 }
 
 void MainWindow::buildStatusBar() {
+    statusProgress_ = new StatusProgress;
+    statusBar()->addPermanentWidget(statusProgress_);
     auto label = [this](const char* name) {
         auto* l = new QLabel;
         l->setObjectName(name);
@@ -677,7 +690,7 @@ bool MainWindow::openSceneFile(const QString& path) {
     loadTimer.start();
     try {
         lc::Scene s = runWithProgressResult<lc::Scene>(
-            this, tr("Loading %1...").arg(QFileInfo(path).fileName()),
+            statusProgress_, tr("Loading %1...").arg(QFileInfo(path).fileName()),
             [p, o = gltfOptions, &gltfReport](const lc::CancelToken& c, const lc::Progress& pr) {
                 return lc::loadSceneAny(p, o, &gltfReport, &c, pr);
             });
@@ -708,7 +721,7 @@ bool MainWindow::importMeshFile(const QString& path) {
     lc::MeshLoadReport report;
     try {
         lc::Mesh m = runWithProgressResult<lc::Mesh>(
-            this, tr("Importing %1...").arg(QFileInfo(path).fileName()),
+            statusProgress_, tr("Importing %1...").arg(QFileInfo(path).fileName()),
             [p, &report](const lc::CancelToken& c, const lc::Progress& pr) {
                 return lc::loadMesh(p, &report, &c, pr);
             });
@@ -808,7 +821,7 @@ bool MainWindow::generateLights(const lc::LightGenSettings& g) {
     std::vector<lc::PointLight> lights;
     try {
         lights = runWithProgressResult<std::vector<lc::PointLight>>(
-            this, tr("Generating %1 lights...").arg(g.count),
+            statusProgress_, tr("Generating %1 lights...").arg(g.count),
             [g](const lc::CancelToken& c, const lc::Progress& p) { return lc::generateLights(g, &c, p); });
     } catch (const lc::Cancelled&) {
         log(tr("light generation cancelled"));

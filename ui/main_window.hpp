@@ -44,6 +44,7 @@ class Document;
 class InspectorView;
 class PropertyPanel;
 class SceneTree;
+class StatusProgress;
 class TileInspector;
 
 struct Prompts {
@@ -188,7 +189,7 @@ private:
     QLabel* statusFn_;
     QLabel* statusEfficiency_;
     QLabel* statusLists_;
-    QLabel* statusShading_ = nullptr; // "shading..." while the worker shades
+    StatusProgress* statusProgress_ = nullptr; // loads, shading and reports, with Cancel
     QString lastBackendName_, lastDeviceName_;
     ExplainPanel* explain_ = nullptr;
     std::shared_ptr<const lc::CustomShaderOptions> customShader_;

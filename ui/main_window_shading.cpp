@@ -6,14 +6,13 @@
 #include "camera_view.hpp"
 #include "cull_worker.hpp"
 #include "document.hpp"
+#include "status_progress.hpp"
 
 #include <QAction>
 #include <QActionGroup>
 #include <QEventLoop>
-#include <QLabel>
 #include <QMenu>
 #include <QSettings>
-#include <QStatusBar>
 
 namespace lcui {
 
@@ -40,17 +39,16 @@ void MainWindow::buildImageModes(QMenu* view) {
         connect(a, &QAction::triggered, this, [this, m] { cameraView_->setImageMode(m); });
     }
 
-    statusShading_ = new QLabel;
-    statusShading_->setObjectName("statusShading");
-    statusBar()->addPermanentWidget(statusShading_);
-    connect(service_, &CullService::shadingStarted, this, [this](quint64 generation) {
-        statusShading_->setText(tr("shading..."));
-        statusShading_->setToolTip(tr("shading the culled and the all-lights image of run %1").arg(generation));
+    // "shading..." with its progress and a Cancel in the status bar: shown
+    // at once, as the images are what the user switched the view for.
+    connect(service_, &CullService::shadingStarted, this, [this] {
+        statusProgress_->begin("shading", tr("shading..."), [this] { service_->worker()->cancelShading(); }, 0);
+        statusProgress_->setProgress("shading", 0.0);
     });
-    connect(service_, &CullService::shadingEnded, this, [this] {
-        statusShading_->clear();
-        statusShading_->setToolTip({});
+    connect(service_, &CullService::shadingProgress, this, [this](quint64, double fraction) {
+        statusProgress_->setProgress("shading", fraction);
     });
+    connect(service_, &CullService::shadingEnded, this, [this] { statusProgress_->end("shading"); });
 
     connect(cameraView_, &CameraView::imageModeChanged, this, [this](Mode mode) {
         if (QAction* a = action(QString("actionImage_%1").arg(CameraView::toString(mode)))) a->setChecked(true);
@@ -90,7 +88,6 @@ std::shared_ptr<const lc::RunOutput> MainWindow::shadedRunOutput() {
         ended = true;
         loop.quit();
     });
-    statusShading_->setText(tr("shading..."));
     service_->requestShading(generation);
     if (!ended) loop.exec(QEventLoop::ExcludeUserInputEvents);
     disconnect(c1);

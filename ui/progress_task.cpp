@@ -1,9 +1,10 @@
 #include "progress_task.hpp"
 
+#include "status_progress.hpp"
+
 #include "culling/errors.hpp"
 
 #include <QEventLoop>
-#include <QProgressDialog>
 #include <QThread>
 #include <QTimer>
 
@@ -11,21 +12,17 @@
 
 namespace lcui {
 
-void runWithProgress(QWidget* parent, const QString& label,
+void runWithProgress(StatusProgress* status, const QString& label,
                      const std::function<void(const lc::CancelToken&, const lc::Progress&)>& work,
                      int showAfterMs) {
     lc::CancelToken cancel;
-    std::atomic<double> fraction{0.0};
+    std::atomic<double> fraction{-1.0};
     std::exception_ptr error;
     const lc::Progress progress = [&fraction](double f) { fraction = f; };
 
-    QProgressDialog dialog(label, QObject::tr("Cancel"), 0, 1000, parent);
-    dialog.setWindowModality(Qt::WindowModal);
-    dialog.setMinimumDuration(showAfterMs);
-    dialog.setAutoClose(false);
-    dialog.setAutoReset(false);
-    dialog.setValue(0);
-    QObject::connect(&dialog, &QProgressDialog::canceled, [&cancel] { cancel.cancelled = true; });
+    const QString key = "load";
+    status->begin(key, label, [&cancel] { cancel.cancelled = true; }, showAfterMs);
+    status->blockInput(true);
 
     QThread* thread = QThread::create([&] {
         try {
@@ -37,18 +34,15 @@ void runWithProgress(QWidget* parent, const QString& label,
     QEventLoop loop;
     QObject::connect(thread, &QThread::finished, &loop, &QEventLoop::quit);
     QTimer poll;
-    QObject::connect(&poll, &QTimer::timeout, [&] {
-        if (dialog.wasCanceled()) cancel.cancelled = true; // also when cancel() is called directly
-        else dialog.setValue(int(fraction.load() * 1000));
-    });
+    QObject::connect(&poll, &QTimer::timeout, [&] { status->setProgress(key, fraction.load()); });
     poll.start(50);
     thread->start();
     loop.exec(); // "finished" is queued to this thread, so it cannot be missed
     thread->wait();
     delete thread;
     poll.stop();
-    if (dialog.wasCanceled()) cancel.cancelled = true;
-    dialog.reset();
+    status->blockInput(false);
+    status->end(key);
     if (error) std::rethrow_exception(error);
     if (cancel.cancelled) throw lc::Cancelled();
 }

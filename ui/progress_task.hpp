@@ -1,7 +1,8 @@
 #pragma once
 // Long operations (loading a 400k-triangle mesh or a scene, generating tens of
-// thousands of lights) run on a background thread while a progress dialog
-// shows how far they got and offers Cancel. The UI keeps processing events.
+// thousands of lights) run on a background thread while the status bar
+// (StatusProgress) shows how far they got and offers Cancel. The UI keeps
+// processing events (views repaint) but takes no input besides Cancel.
 
 #include "culling/depth.hpp"
 #include "culling/scene_io.hpp"
@@ -12,26 +13,28 @@
 #include <functional>
 #include <optional>
 
-class QWidget;
 
 namespace lcui {
 
+class StatusProgress;
+
 // Runs `work` on a new thread and waits (processing events) until it returns.
-// The dialog appears only when the work takes longer than `showAfterMs`.
+// Its status row ("load": statusCancel_load, ...) shows at once by default:
+// the window ignores clicks meanwhile, and the row says why.
 // Cancel sets the token; work that does not check it still runs to its end,
 // and its result is then discarded. Rethrows the work's exception; throws
 // lc::Cancelled when cancelled.
-void runWithProgress(QWidget* parent, const QString& label,
+void runWithProgress(StatusProgress* status, const QString& label,
                      const std::function<void(const lc::CancelToken&, const lc::Progress&)>& work,
-                     int showAfterMs = 300);
+                     int showAfterMs = 0);
 
 template <class T>
-T runWithProgressResult(QWidget* parent, const QString& label,
+T runWithProgressResult(StatusProgress* status, const QString& label,
                         const std::function<T(const lc::CancelToken&, const lc::Progress&)>& work,
-                        int showAfterMs = 300) {
+                        int showAfterMs = 0) {
     std::optional<T> result;
     runWithProgress(
-        parent, label,
+        status, label,
         [&](const lc::CancelToken& c, const lc::Progress& p) { result.emplace(work(c, p)); },
         showAfterMs);
     return std::move(*result);

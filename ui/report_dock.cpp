@@ -131,6 +131,7 @@ bool ReportDock::start() {
     cancelButton_->setEnabled(true);
     progress_->setRange(0, 0); // busy until the first progress report
     status_->setText(tr("Opening backends..."));
+    emit started();
     const lc::Scene scene = doc_->scene();
     const lc::ReportOptions options = options_;
     thread_ = std::thread([this, scene, options] {
@@ -165,6 +166,7 @@ void ReportDock::onProgress(int done, int total, const QString& label) {
     progress_->setRange(0, std::max(total, 1));
     progress_->setValue(done);
     status_->setText(tr("%1/%2 %3").arg(done).arg(total).arg(label));
+    emit progressed(done, total, label);
 }
 
 void ReportDock::onDone(std::shared_ptr<lc::Report> report, const QString& error, bool cancelled) {

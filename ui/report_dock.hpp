@@ -60,6 +60,9 @@ public:
     std::optional<QPoint> chartPositionOf(std::size_t row) const;
 
 signals:
+    void started();
+    // A configuration of the sweep finished (the status bar mirrors the dock's bar).
+    void progressed(int done, int total, const QString& label);
     void finished(bool ok); // ok: a report was made (false: cancelled or failed)
     void configurationLoaded(int row);
 

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <numeric>
 
 namespace lc {
@@ -52,7 +53,8 @@ ShadeInputs rowsOf(const ShadeInputs& in, std::uint32_t y0, std::uint32_t y1) {
 // backend's shading time (the sum of the slices').
 std::vector<float> shadeImage(CullBackend& backend, const ShadeInputs& in, const ViewLights& lights,
                               const CullResult* culled, std::uint32_t align, double sliceMs,
-                              const CancelToken* cancel, double& shadeMs) {
+                              const CancelToken* cancel, double& shadeMs,
+                              const std::function<void(double)>& rowsDone) {
     if (sliceMs <= 0) {
         std::vector<float> rgb = backend.shade(in, lights, culled);
         shadeMs = backend.lastShadeMs();
@@ -70,6 +72,7 @@ std::vector<float> shadeImage(CullBackend& backend, const ShadeInputs& in, const
         shadeMs += backend.lastShadeMs() >= 0 ? backend.lastShadeMs() : wallMs;
         std::copy(part.begin(), part.end(), rgb.begin() + std::ptrdiff_t(std::size_t(in.width) * y0 * 3));
         throwIfCancelled(cancel);
+        if (rowsDone) rowsDone(double(y1) / double(in.height));
         // The next slice: as many aligned rows as fit sliceMs at this rate.
         const double perRowMs = std::max(wallMs, 1e-3) / double(y1 - y0);
         rows = std::max(align, std::uint32_t(sliceMs / perRowMs) / align * align);
@@ -81,14 +84,20 @@ std::vector<float> shadeImage(CullBackend& backend, const ShadeInputs& in, const
 } // namespace
 
 void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
-                     const CancelToken* cancel, double sliceMs) {
+                     const CancelToken* cancel, double sliceMs, const Progress& progress) {
     const ShadeInputs culledIn = makeShadeInputs(out.depth, proj, &out.result);
     const CullResult& r = out.result;
     // shadeCpu's row bands: a tile row (at least 4) for lists, 16 rows for all lights.
     const std::uint32_t align = std::lcm(std::max(r.grid.tileSize, 4u), 16u);
     double culledMs = 0, allMs = 0;
+    // The all-lights image costs more (every light at every pixel), but the
+    // split by images is what a user can follow: half each.
+    auto part = [&progress](double base) -> std::function<void(double)> {
+        if (!progress) return {};
+        return [&progress, base](double f) { progress(base + 0.5 * f); };
+    };
     std::vector<float> culled =
-        shadeImage(backend, culledIn, out.lights, &r, align, sliceMs, cancel, culledMs);
+        shadeImage(backend, culledIn, out.lights, &r, align, sliceMs, cancel, culledMs, part(0.0));
     out.result.timings.shadeMs = culledMs;
     throwIfCancelled(cancel);
     // `all` with one list of every light in order shades exactly the reference.
@@ -102,7 +111,7 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
         ShadeInputs allIn = culledIn;
         for (std::uint32_t& l : allIn.list)
             if (l != ShadeInputs::kNoList) l = 0;
-        all = shadeImage(backend, allIn, out.lights, nullptr, align, sliceMs, cancel, allMs);
+        all = shadeImage(backend, allIn, out.lights, nullptr, align, sliceMs, cancel, allMs, part(0.5));
         throwIfCancelled(cancel);
     }
     const ImageError e = compareShadedImages(out.depth, culled, all);

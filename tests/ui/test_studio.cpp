@@ -53,7 +53,8 @@
 #include <QElapsedTimer>
 #include <QFileInfo>
 #include <QMimeData>
-#include <QProgressDialog>
+#include <QToolBar>
+#include <QToolButton>
 #include <QUrl>
 
 #include <fstream>
@@ -597,16 +598,33 @@ private slots:
     void cancelledImportLeavesSceneIntact() {
         openSmall();
         const std::string before = sceneText(doc());
-        // Press Cancel on the progress dialog as soon as it exists.
+        // While the import runs the window takes no input but Cancel (a
+        // click on the toolbar's Add light is dropped: the scene compares
+        // equal below); Cancel is pressed as soon as the status bar shows it.
+        auto* fileBar = w_->findChild<QToolBar*>("fileToolbar");
+        QWidget* addLight = fileBar ? fileBar->widgetForAction(w_->action("actionAddLight")) : nullptr;
+        QVERIFY(addLight && addLight->isVisible());
+        bool blockedClickSent = false, clicked = false;
         QTimer poll;
         connect(&poll, &QTimer::timeout, [&] {
-            if (auto* dlg = w_->findChild<QProgressDialog*>()) dlg->cancel();
+            auto* cancel = w_->findChild<QToolButton*>("statusCancel_load");
+            if (!cancel || !cancel->isVisible() || clicked) return;
+            QTest::mouseClick(addLight, Qt::LeftButton);
+            blockedClickSent = true;
+            QTest::mouseClick(cancel, Qt::LeftButton);
+            clicked = true;
         });
         poll.start(10);
         QVERIFY(!w_->importMeshFile(LC_ASSETS_DIR "/buildings/buildings.obj"));
         poll.stop();
+        QVERIFY(clicked && blockedClickSent);
         QCOMPARE(sceneText(doc()), before);
         QVERIFY(w_->messageLog()->toPlainText().contains("cancelled"));
+        QTRY_VERIFY(!w_->findChild<QToolButton*>("statusCancel_load"));
+        // Input is back: the same click adds a light.
+        const std::size_t lights = doc()->scene().lights.size();
+        QTest::mouseClick(addLight, Qt::LeftButton);
+        QCOMPARE(doc()->scene().lights.size(), lights + 1);
     }
 
     void dropImportsMesh() {

@@ -5,6 +5,7 @@
 #include "culling/backend.hpp"
 #include "culling/ground_truth.hpp"
 #include "culling/scene.hpp"
+#include "culling/scene_io.hpp"
 
 #include <memory>
 
@@ -61,8 +62,10 @@ void judgeRun(RunOutput& out, const Projection& proj, CullBackend& shadeBackend,
 // when asked. sliceMs > 0 shades each image in row slices of about that wall
 // time and checks `cancel` between them (the studio: a newer edit waits one
 // slice, not a whole image), with the same pixels as whole images; shadeMs is
-// then the sum of the slices'.
+// then the sum of the slices'. `progress` gets the fraction of rows shaded
+// over both images after each slice.
 void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
-                     const CancelToken* cancel = nullptr, double sliceMs = 0);
+                     const CancelToken* cancel = nullptr, double sliceMs = 0,
+                     const Progress& progress = {});
 
 } // namespace lc
