@@ -14,6 +14,7 @@
 #include <QProgressBar>
 #include <QPushButton>
 #include <QSpinBox>
+#include <QToolButton>
 #include <QUndoStack>
 
 #include <vtkRenderWindow.h>
@@ -107,7 +108,12 @@ private slots:
         QTRY_VERIFY_WITH_TIMEOUT(dock_->progressBar()->value() >= 2, kTimeoutMs);
         const int total = dock_->progressBar()->maximum();
         QVERIFY(total > 500);
-        QTest::mouseClick(dock_->findChild<QPushButton*>("reportCancel"), Qt::LeftButton);
+        // The status bar mirrors the sweep; its Cancel stops it as the dock's does.
+        auto* statusBar = w_->findChild<QProgressBar*>("statusProgress_report");
+        QVERIFY(statusBar && statusBar->isVisible());
+        QTRY_VERIFY(statusBar->value() > 0 && statusBar->value() < statusBar->maximum());
+        QVERIFY(w_->findChild<QLabel*>("statusTask_report")->text().contains(QString("/%1").arg(total)));
+        QTest::mouseClick(w_->findChild<QToolButton*>("statusCancel_report"), Qt::LeftButton);
         QVERIFY(done.wait(kTimeoutMs));
         QCOMPARE(done.first().at(0).toBool(), false);
         QVERIFY(!dock_->isRunning());
@@ -115,6 +121,7 @@ private slots:
         QCOMPARE(dock_->report()->rows.size(), std::size_t(3)); // the previous report
         QVERIFY(dock_->findChild<QLabel*>("reportStatus")->text().contains("Cancelled"));
         QVERIFY(dock_->findChild<QPushButton*>("reportRun")->isEnabled());
+        QTRY_VERIFY(!w_->findChild<QProgressBar*>("statusProgress_report"));
     }
 
     void clickingAPointLoadsItsConfiguration() {
