@@ -71,6 +71,7 @@ public:
         bool lightCellRange = true;   // cells the current light's sphere spans
         bool listHighlight = true;    // listed lights highlighted, others dimmed, missing red
         bool reverseLookup = true;    // tiles whose lists hold the current light
+        bool explainMarkers = true;   // Explain in 3D: the deciding plane, the nearest or needing pixel
         lc::HeatMode heat = lc::HeatMode::ListLength;
         bool operator==(const OverlayOptions&) const = default;
     };

@@ -31,34 +31,45 @@ ExplainPanel::ExplainPanel(Document* doc, QWidget* parent) : QWidget(parent), do
     refresh();
 }
 
+std::optional<lc::Explanation> explainSelection(const Document& doc) {
+    const auto run = doc.runOutput();
+    const int tile = doc.selectedTile();
+    const int light = doc.currentLight();
+    if (!run || !run->truthComputed || tile < 0 || light < 0 || std::size_t(light) >= run->lights.size())
+        return std::nullopt;
+    const lc::CullResult& r = run->result;
+    int sub = doc.selectedCell();
+    if (r.listsPerTile <= 1) sub = -1;
+    else if (sub < 0) sub = 0; // a tile of several lists without a cell: its first
+    const std::uint32_t list = lc::listOf(r, std::uint32_t(tile), sub);
+    return lc::explainLight(*run, lc::Projection(doc.scene().camera), list, std::uint32_t(light));
+}
+
 void ExplainPanel::refresh() {
     explanation_.reset();
-    const auto run = doc_->runOutput();
-    const int tile = doc_->selectedTile();
-    const int light = doc_->currentLight();
-    if (!run || !run->truthComputed || tile < 0 || light < 0 || std::size_t(light) >= run->lights.size()) {
-        verdict_->setText(tr("Select a tile (click the camera view) and a light (the scene tree or a row of the tile "
-                             "inspector) to see why the light is, or is not, in that tile's list."));
+    std::optional<lc::Explanation> e;
+    QString error;
+    try {
+        e = explainSelection(*doc_);
+    } catch (const std::exception& ex) {
+        error = QString::fromStdString(ex.what());
+    }
+    if (!e) {
+        verdict_->setText(!error.isEmpty() ? error
+                                           : tr("Select a tile (click the camera view) and a light (the scene tree or "
+                                                "a row of the tile inspector) to see why the light is, or is not, in "
+                                                "that tile's list."));
         verdict_->setStyleSheet({});
         text_->clear();
         return;
     }
-    try {
-        const lc::CullResult& r = run->result;
-        int sub = doc_->selectedCell();
-        if (r.listsPerTile <= 1) sub = -1;
-        else if (sub < 0) sub = 0; // a tile of several lists without a cell: its first
-        const std::uint32_t list = lc::listOf(r, std::uint32_t(tile), sub);
-        explanation_ = lc::explainLight(*run, lc::Projection(doc_->scene().camera), list, std::uint32_t(light));
-        const std::string name = std::size_t(light) < doc_->scene().lights.size() ? doc_->scene().lights[light].name : "";
-        text_->setPlainText(QString::fromStdString(explanation_->text(name)));
-        verdict_->setText(QString::fromStdString(explanation_->verdict));
-        const bool missing = !explanation_->listed && explanation_->pixelsNeeding > 0;
-        verdict_->setStyleSheet(missing ? "QLabel { color: white; background: rgb(200,40,40); padding: 2px; }" : "");
-    } catch (const std::exception& e) {
-        verdict_->setText(QString::fromStdString(e.what()));
-        text_->clear();
-    }
+    explanation_ = std::move(e);
+    const std::size_t light = explanation_->light;
+    const std::string name = light < doc_->scene().lights.size() ? doc_->scene().lights[light].name : "";
+    text_->setPlainText(QString::fromStdString(explanation_->text(name)));
+    verdict_->setText(QString::fromStdString(explanation_->verdict));
+    const bool missing = !explanation_->listed && explanation_->pixelsNeeding > 0;
+    verdict_->setStyleSheet(missing ? "QLabel { color: white; background: rgb(200,40,40); padding: 2px; }" : "");
 }
 
 } // namespace lcui

@@ -17,6 +17,12 @@ namespace lcui {
 
 class Document;
 
+// The explanation of the document's selection: the selected tile (its
+// selected cell, or its first list when it has several and none is
+// selected) and the current light, in the latest run once its ground truth
+// is in. nullopt when something is missing; throws what lc::explainLight throws.
+std::optional<lc::Explanation> explainSelection(const Document& doc);
+
 class ExplainPanel : public QWidget {
     Q_OBJECT
 public:

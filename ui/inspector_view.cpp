@@ -352,6 +352,14 @@ bool InspectorView::frameSelected(int ms) {
             const glm::dmat4 world = lc::worldFromView(doc_->scene().camera);
             std::vector<glm::dvec3> corners;
             for (const glm::dvec3& v : chunk->corners) corners.push_back(glm::dvec3(world * glm::dvec4(v, 1.0)));
+            // With Explain's markers shown: the pixel that matters (and the
+            // nearest point of the light's sphere) come into view too.
+            vtkPolyData* marker = overlays_->explainPixel();
+            for (vtkIdType i = 0; marker->GetNumberOfCells() > 0 && i < marker->GetNumberOfPoints(); ++i) {
+                double p[3];
+                marker->GetPoint(i, p);
+                corners.push_back({p[0], p[1], p[2]});
+            }
             flyToPoints(corners, ms);
             return true;
         }

@@ -64,6 +64,7 @@ void MainWindow::buildOverlayMenus(QMenu* file, QMenu* view) {
     toggle(tr("Light's cell range"), "actionOverlayLightRange", &Options::lightCellRange);
     toggle(tr("Highlight listed lights"), "actionOverlayListHighlight", &Options::listHighlight);
     toggle(tr("Tiles holding the selected light"), "actionOverlayReverse", &Options::reverseLookup);
+    toggle(tr("Explain: deciding plane and pixel"), "actionOverlayExplain", &Options::explainMarkers);
     // A view toggle of the inspector (not a document option): the culling
     // sphere, chunk spheres or chunk planes the run's spot test evaluated for
     // the current spot light and the selected tile (overlay_actors.hpp).

@@ -1,6 +1,7 @@
 #include "overlay_actors.hpp"
 
 #include "document.hpp"
+#include "explain_panel.hpp"
 #include "vtk_adapters.hpp"
 
 #include <vtkActor.h>
@@ -114,6 +115,8 @@ struct InspectorOverlays::Impl {
     vtkNew<vtkPolyData> spotSphere, spotPassed, spotRejected;
     vtkSmartPointer<vtkActor> spotSphereA, spotPassedA, spotRejectedA;
     vtkNew<vtkTextActor> spotCaption;
+    vtkNew<vtkPolyData> explainPlane, explainPixel;
+    vtkSmartPointer<vtkActor> explainPlaneA, explainEdgeA, explainPixelA;
     vtkNew<vtkPolyData> tileSolid, tileOutline, cellFill, cellOutline, cellSelected, splitQuad, lightRange,
         allTiles, reverse;
     vtkSmartPointer<vtkActor> tileSolidA, tileOutlineA, cellFillA, cellOutlineA, cellSelectedA, splitA, rangeA,
@@ -137,7 +140,16 @@ InspectorOverlays::InspectorOverlays(vtkRenderer* renderer, vtkSphereSource* sph
     d_->spotSphereA = makeActor(d_->spotSphere, 1.0, 0.5, 0.7, 1.0, 2.0); // pink: a spot is often white
     d_->spotPassedA = makeActor(d_->spotPassed, 0.25, 0.55, 1.0, 1.0, 2.0); // not the cell range's green
     d_->spotRejectedA = makeActor(d_->spotRejected, 1.0, 0.25, 0.2, 1.0, 2.0);
-    for (vtkActor* a : {d_->spotSphereA.Get(), d_->spotPassedA.Get(), d_->spotRejectedA.Get()}) {
+    // Colours no other overlay uses: violet (red when it rejected), white.
+    d_->explainPlaneA = makeActor(d_->explainPlane, 0.55, 0.35, 1.0, 0.45);
+    // Its outline opaque and thick: visible through the translucent cells.
+    d_->explainEdgeA = makeActor(d_->explainPlane, 0.55, 0.35, 1.0, 1.0, 4.0);
+    d_->explainEdgeA->GetProperty()->SetRepresentationToWireframe();
+    d_->explainPixelA = makeActor(d_->explainPixel, 1.0, 1.0, 1.0, 1.0, 2.5);
+    d_->explainPixelA->GetProperty()->SetPointSize(12);
+    d_->explainPixelA->GetProperty()->SetRenderPointsAsSpheres(true);
+    for (vtkActor* a : {d_->spotSphereA.Get(), d_->spotPassedA.Get(), d_->spotRejectedA.Get(),
+                        d_->explainPlaneA.Get(), d_->explainEdgeA.Get(), d_->explainPixelA.Get()}) {
         a->SetVisibility(false);
         renderer->AddActor(a);
     }
@@ -220,6 +232,8 @@ vtkPolyData* InspectorOverlays::spotCullSphere() const { return d_->spotSphere; 
 vtkPolyData* InspectorOverlays::spotChunksPassed() const { return d_->spotPassed; }
 vtkPolyData* InspectorOverlays::spotChunksRejected() const { return d_->spotRejected; }
 vtkTextActor* InspectorOverlays::spotCaption() const { return d_->spotCaption; }
+vtkPolyData* InspectorOverlays::explainPlane() const { return d_->explainPlane; }
+vtkPolyData* InspectorOverlays::explainPixel() const { return d_->explainPixel; }
 
 void InspectorOverlays::update(const Document& doc) {
     for (vtkPolyData* pd : {d_->tileSolid.Get(), d_->tileOutline.Get(), d_->cellFill.Get(), d_->cellOutline.Get(),
@@ -245,6 +259,7 @@ void InspectorOverlays::update(const Document& doc) {
         d_->allTiles->Initialize();
         allTilesRun_ = nullptr;
         updateSpotPrimitive(doc, nullptr, -1);
+        updateExplainMarkers(doc);
         return;
     }
     const lc::CullResult& r = run->result;
@@ -381,6 +396,83 @@ void InspectorOverlays::update(const Document& doc) {
     show(d_->allTilesA, d_->allTiles->GetNumberOfCells() > 0);
 
     updateSpotPrimitive(doc, run.get(), tileOk ? tile : -1);
+    updateExplainMarkers(doc);
+}
+
+const double InspectorOverlays::kExplainPlaneScale = 1.5;
+
+void InspectorOverlays::updateExplainMarkers(const Document& doc) {
+    d_->explainPlane->Initialize();
+    d_->explainPixel->Initialize();
+    explanation_.reset();
+    if (doc.overlays().explainMarkers) {
+        try {
+            explanation_ = explainSelection(doc);
+        } catch (const std::exception&) {
+            // The Explain panel shows the message; nothing to draw.
+        }
+    }
+    const glm::dmat4 w = lc::worldFromView(doc.scene().camera);
+    auto world = [&w](const glm::dvec3& v) {
+        const glm::dvec4 p = w * glm::dvec4(v, 1.0);
+        return glm::dvec3(p);
+    };
+    if (explanation_ && explanation_->hasChunk && explanation_->decisivePlane >= 0) {
+        const lc::Explanation& e = *explanation_;
+        vtkNew<vtkPoints> pts;
+        vtkNew<vtkCellArray> polys, lines;
+        vtkIdType ids[5];
+        // The plane is unbounded: its piece around the chunk's face, half as
+        // large again, so that it shows beside the face's cells and edges.
+        const auto face = lc::chunkFace(e.chunkCorners, e.decisivePlane);
+        const glm::dvec3 mid = 0.25 * (face[0] + face[1] + face[2] + face[3]);
+        for (int i = 0; i < 4; ++i) {
+            const glm::dvec3 p = world(mid + kExplainPlaneScale * (face[std::size_t(i)] - mid));
+            ids[i] = pts->InsertNextPoint(p.x, p.y, p.z);
+        }
+        ids[4] = ids[0];
+        polys->InsertNextCell(4, ids);
+        lines->InsertNextCell(5, ids);
+        d_->explainPlane->SetPoints(pts);
+        d_->explainPlane->SetPolys(polys);
+        d_->explainPlane->SetLines(lines);
+        for (vtkActor* a : {d_->explainPlaneA.Get(), d_->explainEdgeA.Get()}) {
+            if (e.decisiveMargin < 0) a->GetProperty()->SetColor(1.0, 0.15, 0.1);
+            else a->GetProperty()->SetColor(0.55, 0.35, 1.0);
+        }
+    }
+    if (explanation_) {
+        const lc::Explanation& e = *explanation_;
+        vtkNew<vtkPoints> pts;
+        vtkNew<vtkCellArray> verts, lines;
+        if (e.nearestDistance >= 0) {
+            // The nearest pixel of a false positive, and the nearest point of
+            // the light's range sphere: the gap the tests did not see.
+            const glm::dvec3 p = world(e.nearestPosition);
+            const auto& lights = doc.runOutput()->lights;
+            const glm::dvec3 c = lights.centers[e.light];
+            const glm::dvec3 dir = e.nearestPosition - c;
+            const double len = glm::length(dir);
+            const glm::dvec3 q = world(len > 0 ? c + dir * (lights.radii[e.light] / len) : c);
+            const vtkIdType a = pts->InsertNextPoint(p.x, p.y, p.z);
+            const vtkIdType b = pts->InsertNextPoint(q.x, q.y, q.z);
+            verts->InsertNextCell(1, &a);
+            const vtkIdType seg[2] = {a, b};
+            lines->InsertNextCell(2, seg);
+            d_->explainPixelA->GetProperty()->SetColor(1.0, 1.0, 1.0);
+        } else if (e.hasNeededPixel) {
+            const glm::dvec3 p = world(e.neededPosition);
+            const vtkIdType a = pts->InsertNextPoint(p.x, p.y, p.z);
+            verts->InsertNextCell(1, &a);
+            d_->explainPixelA->GetProperty()->SetColor(0.2, 1.0, 0.3);
+        }
+        d_->explainPixel->SetPoints(pts);
+        if (verts->GetNumberOfCells()) d_->explainPixel->SetVerts(verts);
+        if (lines->GetNumberOfCells()) d_->explainPixel->SetLines(lines);
+    }
+    d_->explainPlaneA->SetVisibility(d_->explainPlane->GetNumberOfCells() > 0);
+    d_->explainEdgeA->SetVisibility(d_->explainPlane->GetNumberOfCells() > 0);
+    d_->explainPixelA->SetVisibility(d_->explainPixel->GetNumberOfCells() > 0);
 }
 
 void InspectorOverlays::updateSpotPrimitive(const Document& doc, const lc::RunOutput* run, int tile) {

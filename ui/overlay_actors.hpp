@@ -17,9 +17,16 @@
 //   tile under cone-sphere the bounding sphere of every chunk the cone was
 //   tested against, under cone-planes those chunks' outlines (blue: passed,
 //   red: rejected), with a caption saying which test and what was tested.
+// - Explain in 3D (explainSelection: the selected list and the current
+//   light): the chunk plane that decided (red: it rejected the light; violet:
+//   every plane kept it and this one came closest to rejecting it), and the
+//   pixel that matters: for a false positive the nearest pixel of the list
+//   with a white line to the light's sphere (the gap the tests could not
+//   see), for a needed light the needing pixel nearest its centre (green).
 // Each part follows its Document::OverlayOptions toggle. Translucent parts
 // rely on the renderer's depth peeling (set up by InspectorView).
 
+#include "culling/explain.hpp"
 #include "culling/overlays.hpp"
 
 #include <vtkNew.h>
@@ -72,6 +79,14 @@ public:
     vtkPolyData* spotChunksPassed() const;   // cone-sphere: circles; cone-planes: chunk edges
     vtkPolyData* spotChunksRejected() const;
     vtkTextActor* spotCaption() const;
+    // Explain in 3D (world space): the deciding plane (one quad and its
+    // outline: the chunk's face scaled by kExplainPlaneScale about its
+    // centre) and the pixel marker (point 0; for a false positive point 1 on
+    // the light's sphere, joined by a line).
+    static const double kExplainPlaneScale;
+    vtkPolyData* explainPlane() const;
+    vtkPolyData* explainPixel() const;
+    const std::optional<lc::Explanation>& explanation() const { return explanation_; }
 
 private:
     struct Impl;
@@ -82,7 +97,9 @@ private:
     const void* allTilesRun_ = nullptr; // run the all-tiles wireframe was built for
     bool showSpotPrimitive_ = false;
     std::optional<lc::SpotTestPrimitive> spotPrimitive_;
+    std::optional<lc::Explanation> explanation_;
     void updateSpotPrimitive(const Document& doc, const lc::RunOutput* run, int tile);
+    void updateExplainMarkers(const Document& doc);
 };
 
 } // namespace lcui

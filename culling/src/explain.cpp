@@ -8,6 +8,7 @@
 #include "culling/tile_math.hpp"
 #include "light_grid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -27,6 +28,22 @@ std::string num(double v) {
 bool tileEmpty(const CullResult& r, std::uint32_t t) { return !(r.tileDepthMin[t] <= r.tileDepthMax[t]); }
 
 } // namespace
+
+const char* chunkPlaneName(int plane) {
+    static const char* kPlane[6] = {"side plane left", "side plane right", "side plane top",
+                                    "side plane bottom", "depth min (chunk's near plane)",
+                                    "depth max (chunk's far plane)"};
+    return plane >= 0 && plane < 6 ? kPlane[plane] : "";
+}
+
+std::array<glm::dvec3, 4> chunkFace(const std::array<glm::dvec3, 8>& c, int plane) {
+    // Corners: near tl, tr, br, bl (0..3), far tl, tr, br, bl (4..7).
+    static const int kFace[6][4] = {{0, 3, 7, 4}, {1, 2, 6, 5}, {0, 1, 5, 4},
+                                    {3, 2, 6, 7}, {0, 1, 2, 3}, {4, 5, 6, 7}};
+    const int p = std::clamp(plane, 0, 5);
+    return {c[std::size_t(kFace[p][0])], c[std::size_t(kFace[p][1])], c[std::size_t(kFace[p][2])],
+            c[std::size_t(kFace[p][3])]};
+}
 
 std::uint32_t listOf(const CullResult& r, std::uint32_t tile, int sub) {
     if (r.algorithm == Algorithm::All) return 0;
@@ -142,13 +159,13 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
                 }
             }
             const FrustumChunk chunk = makeFrustumChunk(proj, rect, lo, hi);
-            static const char* kPlane[6] = {"side plane left", "side plane right", "side plane top",
-                                            "side plane bottom", "depth min (chunk's near plane)",
-                                            "depth max (chunk's far plane)"};
+            e.hasChunk = true;
+            e.chunkCorners = chunk.corners;
             for (int k = 0; k < 6; ++k) {
                 const double d = signedDistance(chunk.planes[std::size_t(k)], sphere.center);
-                ok = step(kPlane[k], "signed distance " + num(d) + (d >= -rr ? " >= " : " < ") + "-r = " + num(-rr),
+                ok = step(chunkPlaneName(k), "signed distance " + num(d) + (d >= -rr ? " >= " : " < ") + "-r = " + num(-rr),
                           d >= -rr) && ok;
+                if (e.decisivePlane < 0 || d + rr < e.decisiveMargin) e.decisivePlane = k, e.decisiveMargin = d + rr;
             }
             if (s.test != SphereTest::Planes) {
                 glm::dvec3 blo = chunk.corners[0], bhi = chunk.corners[0];
@@ -175,6 +192,7 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
 
     // Ground truth over the list's pixels.
     e.nearestDistance = kInf;
+    double neededToCentre = kInf;
     std::uint32_t x0 = 0, y0 = 0, x1 = r.grid.width, y1 = r.grid.height;
     if (r.algorithm != Algorithm::All) {
         const TileGrid::Rect rect = r.grid.tileRect(e.tile % r.grid.tilesX, e.tile / r.grid.tilesX);
@@ -188,6 +206,12 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
             ++e.listPixels;
             if (detail::lightNeeds(lights, light, p)) {
                 ++e.pixelsNeeding;
+                const double toCentre = glm::length(p - lights.centers[light]);
+                if (!e.hasNeededPixel || toCentre < neededToCentre) {
+                    e.hasNeededPixel = true;
+                    e.neededPosition = p;
+                    neededToCentre = toCentre;
+                }
                 continue;
             }
             const double d = std::max(0.0, glm::length(p - lights.centers[light]) - lights.radii[light]);
@@ -234,6 +258,9 @@ std::string Explanation::text(const std::string& lightName) const {
            ".." + num(-sphereCenter.z + sphereRadius) + "\n";
     if (chunkDepthMax > 0) out += "  tested chunk: view depth " + num(chunkDepthMin) + ".." + num(chunkDepthMax) + "\n";
     for (const ExplainStep& s : steps) out += std::string("  ") + (s.passed ? "pass  " : "FAIL  ") + s.test + ": " + s.numbers + "\n";
+    if (decisivePlane >= 0)
+        out += std::string("  ") + (decisiveMargin < 0 ? "rejected by the " : "closest to rejecting it: the ") +
+               chunkPlaneName(decisivePlane) + " (signed distance + r = " + num(decisiveMargin) + ")\n";
     out += "  tests: " + std::string(testsPass ? "keep it" : "reject it") + "; the list " +
            (listed ? "holds it" : "does not hold it") + "\n";
     out += "  verdict: " + verdict + "\n";

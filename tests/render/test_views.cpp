@@ -248,6 +248,58 @@ private slots:
         qInfo("%s", qPrintable(c.message));
     }
 
+    // Frame selected (F) on a tile with its 8 depth cells, and Explain in 3D
+    // for a light listed there that no pixel of the tile needs: the plane
+    // closest to rejecting it (violet quad) and the tile's pixel nearest the
+    // light's sphere joined to it (white); F brings both into view. The inspector's camera is the
+    // one frameSelected flies to (no animation) orbited by a fixed angle, so a
+    // change in the framing shows here too.
+    void framedTileWithExplain() {
+        Document doc;
+        doc.resetScene(fixedScene(), {});
+        lc::CullSettings s = doc.settings();
+        s.algorithm = lc::Algorithm::TwoPointFiveD;
+        s.cells = 8;
+        doc.setSettings(s);
+        auto backend = lc::makeBackend("cpu");
+        lc::RunOptions opt;
+        opt.truthOptions.imageError = false;
+        auto run = std::make_shared<lc::RunOutput>(lc::runPipeline(doc.scene(), doc.settings(), *backend, opt));
+        QVERIFY(doc.setRunOutput(run, 1));
+        // The first tile (in tile order: a fixed choice, the scene is fixed)
+        // with a false positive.
+        const lc::Projection proj(doc.scene().camera);
+        int tile = -1, light = -1;
+        for (std::uint32_t t = 0; t < run->result.grid.tileCount() && tile < 0; ++t)
+            for (const auto& row : lc::tileLightRows(*run, proj, t, -1))
+                if (row.verdict == lc::Verdict::FalsePositive) {
+                    tile = int(t), light = int(row.light);
+                    break;
+                }
+        QVERIFY(tile >= 0);
+        doc.setSelectedTile(tile);
+        doc.setSelectedLights({light});
+
+        InspectorView iv(&doc);
+        iv.resize(640, 480);
+        iv.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&iv));
+        QVERIFY(iv.frameSelected(0));
+        QVERIFY(iv.overlays()->explainPlane()->GetNumberOfCells() > 0);
+        QCOMPARE(iv.overlays()->explainPixel()->GetNumberOfPoints(), vtkIdType(2));
+        // The deciding plane here is the frustum's right side, seen edge-on
+        // from where F looks: orbit a little to see it face-on, as a user would.
+        QCOMPARE(iv.overlays()->explanation()->decisivePlane, 1);
+        iv.renderer()->GetActiveCamera()->Azimuth(50);
+        iv.renderer()->ResetCameraClippingRange();
+        iv.renderNow();
+        QTest::qWait(50);
+        iv.renderNow();
+        const Comparison c = compareWithBaseline(iv.grabFramebuffer(), "inspector_framed_tile_explain");
+        QVERIFY2(c.ok, qPrintable(c.message));
+        qInfo("%s", qPrintable(c.message));
+    }
+
     // Difference mode (issue 7): |culled - all| of the shading pass drawn 1:1
     // in the letterboxed viewport (the largest error white), the grey legend
     // from 0 to that error, the caption with the image error, and the tile

@@ -10,6 +10,7 @@
 #include "main_window.hpp"
 #include "camera_view.hpp"
 #include "inspector_view.hpp"
+#include "overlay_actors.hpp"
 #include "tile_inspector.hpp"
 #include "scene_tree.hpp"
 
@@ -18,6 +19,7 @@
 #include "culling/overlays.hpp"
 
 #include <vtkCamera.h>
+#include <vtkPolyData.h>
 #include <vtkRenderer.h>
 
 #include <QAction>
@@ -105,6 +107,86 @@ private slots:
         w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(light)));
         QDir().mkpath(LC_RENDER_OUT_DIR);
         QVERIFY(w_->grabWindow().save(LC_RENDER_OUT_DIR "/explain_panel.png"));
+    }
+
+    // Explain in 3D: the plane that decided and the pixel that matters, drawn
+    // where the explanation puts them.
+    void explainMarkersIn3D() {
+        auto run = doc()->runOutput();
+        const lc::Projection proj(doc()->scene().camera);
+        const glm::dmat4 world = lc::worldFromView(doc()->scene().camera);
+        auto toWorld = [&](const glm::dvec3& v) { return glm::dvec3(world * glm::dvec4(v, 1.0)); };
+        auto point = [](vtkPolyData* pd, vtkIdType i) {
+            double p[3];
+            pd->GetPoint(i, p);
+            return glm::dvec3(p[0], p[1], p[2]);
+        };
+        auto near = [](const glm::dvec3& a, const glm::dvec3& b) { return glm::length(a - b) <= 1e-6 * (1 + glm::length(a)); };
+        // A tile with a false positive (listed, no pixel needs it) and a needed light.
+        std::uint32_t tile = 0, fpLight = 0, neededLight = 0;
+        bool found = false;
+        for (std::uint32_t t = 0; t < run->result.grid.tileCount() && !found; ++t) {
+            int fp = -1, needed = -1;
+            for (const auto& row : lc::tileLightRows(*run, proj, t, -1)) {
+                if (row.verdict == lc::Verdict::FalsePositive && fp < 0) fp = int(row.light);
+                if (row.verdict == lc::Verdict::Needed && needed < 0) needed = int(row.light);
+            }
+            if (fp >= 0 && needed >= 0) tile = t, fpLight = std::uint32_t(fp), neededLight = std::uint32_t(needed), found = true;
+        }
+        QVERIFY(found);
+        doc()->setSelectedTile(int(tile));
+        w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(fpLight)));
+        InspectorOverlays* ov = w_->inspectorView()->overlays();
+        QVERIFY(ov->explanation());
+        QCOMPARE(ov->explanation()->text(), w_->explainPanel()->explanation()->text());
+        const lc::Explanation& e = *ov->explanation();
+        QVERIFY(e.listed && e.pixelsNeeding == 0 && e.nearestDistance >= 0);
+        // Every plane kept it: the one drawn is the closest to rejecting it.
+        QVERIFY(e.decisivePlane >= 0 && e.decisiveMargin >= 0);
+        const auto face = lc::chunkFace(e.chunkCorners, e.decisivePlane);
+        const glm::dvec3 mid = 0.25 * (face[0] + face[1] + face[2] + face[3]);
+        QCOMPARE(ov->explainPlane()->GetNumberOfPoints(), vtkIdType(4));
+        for (int i = 0; i < 4; ++i)
+            QVERIFY(near(point(ov->explainPlane(), i),
+                         toWorld(mid + InspectorOverlays::kExplainPlaneScale * (face[std::size_t(i)] - mid))));
+        // The nearest pixel and the nearest point of the light's sphere,
+        // nearestDistance apart.
+        QCOMPARE(ov->explainPixel()->GetNumberOfPoints(), vtkIdType(2));
+        QCOMPARE(ov->explainPixel()->GetNumberOfLines(), vtkIdType(1));
+        const glm::dvec3 px = point(ov->explainPixel(), 0), onSphere = point(ov->explainPixel(), 1);
+        QVERIFY(near(px, toWorld(e.nearestPosition)));
+        const double r = run->lights.radii[fpLight];
+        QVERIFY(std::abs(glm::length(onSphere - toWorld(run->lights.centers[fpLight])) - r) <= 1e-6 * r);
+        QVERIFY(std::abs(glm::length(px - onSphere) - e.nearestDistance) <= 1e-6 * (1 + r));
+        w_->action("actionFrameSelected")->trigger();
+        QTest::qWait(500);
+        QDir().mkpath(LC_RENDER_OUT_DIR);
+        QVERIFY(w_->grabWindow().save(LC_RENDER_OUT_DIR "/explain_markers.png")); // to look at
+
+        // A needed light: one marker, at a pixel inside its sphere.
+        w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(neededLight)));
+        QVERIFY(ov->explanation() && ov->explanation()->pixelsNeeding > 0);
+        QCOMPARE(ov->explainPixel()->GetNumberOfPoints(), vtkIdType(1));
+        QVERIFY(glm::length(point(ov->explainPixel(), 0) - toWorld(run->lights.centers[neededLight])) <=
+                run->lights.radii[neededLight] * (1 + 1e-9));
+
+        // A light the tile's planes reject: the plane drawn is one that failed.
+        for (std::uint32_t i = 0; i < run->lights.size(); ++i) {
+            const auto ex = lc::explainLight(*run, proj, tile, i);
+            if (ex.testsPass || ex.decisiveMargin >= 0) continue;
+            w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(i)));
+            QVERIFY(ov->explanation());
+            const std::string failed = lc::chunkPlaneName(ov->explanation()->decisivePlane);
+            bool stepFailed = false;
+            for (const auto& st : ov->explanation()->steps) stepFailed = stepFailed || (st.test == failed && !st.passed);
+            QVERIFY2(stepFailed, failed.c_str());
+            break;
+        }
+
+        // The View > Overlays toggle removes both.
+        w_->action("actionOverlayExplain")->trigger();
+        QCOMPARE(ov->explainPlane()->GetNumberOfCells(), vtkIdType(0));
+        QCOMPARE(ov->explainPixel()->GetNumberOfCells(), vtkIdType(0));
     }
 
     // F flies the inspector to the selected tile's frustum: afterwards all its

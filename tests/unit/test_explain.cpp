@@ -6,6 +6,8 @@
 
 #include "culling/explain.hpp"
 #include "culling/ground_truth.hpp"
+#include "culling/overlays.hpp"
+#include "culling/tile_math.hpp"
 #include "culling/scene_io.hpp"
 
 #include <gtest/gtest.h>
@@ -64,6 +66,44 @@ TEST(Explain, TestsAgreeWithTheReferenceListsForEveryAlgorithm) {
             }
         }
     }
+}
+
+// The deciding plane: chunkFace's corners lie on the plane it names, and it
+// is the plane of least margin (a failed one when a plane rejects).
+TEST(Explain, TheDecidingPlaneIsTheOneOfLeastMargin) {
+    const Scene s = smallAtrium();
+    const Projection proj(s.camera);
+    CullSettings cs;
+    cs.algorithm = Algorithm::MinMax;
+    const RunOutput run = cpuRun(s, cs);
+    std::uint32_t rejectedByPlane = 0, kept = 0;
+    for (std::uint32_t t = 0; t < run.result.grid.tileCount(); t += 7) {
+        const auto chunk = tileFrustum(run.result, proj, run.lights, t);
+        if (!chunk) continue;
+        for (int k = 0; k < 6; ++k)
+            for (const glm::dvec3& c : chunkFace(chunk->corners, k))
+                EXPECT_NEAR(signedDistance(chunk->planes[std::size_t(k)], c), 0.0, 1e-9 * (1 + glm::length(c)))
+                    << chunkPlaneName(k);
+        for (std::uint32_t i = 0; i < run.lights.size(); ++i) {
+            const Explanation e = explainLight(run, proj, t, i);
+            ASSERT_TRUE(e.hasChunk);
+            ASSERT_GE(e.decisivePlane, 0);
+            double least = 1e300;
+            bool planeFailed = false;
+            for (const ExplainStep& st : e.steps)
+                for (int k = 0; k < 6; ++k)
+                    if (st.test == chunkPlaneName(k)) planeFailed = planeFailed || !st.passed;
+            const double rr = e.sphereRadius + sphereTestSlack(e.sphereCenter, e.sphereRadius);
+            for (int k = 0; k < 6; ++k)
+                least = std::min(least, signedDistance(chunk->planes[std::size_t(k)], e.sphereCenter) + rr);
+            EXPECT_DOUBLE_EQ(e.decisiveMargin, least);
+            EXPECT_EQ(e.decisiveMargin < 0, planeFailed) << e.text();
+            rejectedByPlane += planeFailed;
+            kept += !planeFailed;
+        }
+    }
+    EXPECT_GT(rejectedByPlane, 0u);
+    EXPECT_GT(kept, 0u);
 }
 
 TEST(Explain, GroundTruthCountsMatchTheTileInspector) {

@@ -9,6 +9,7 @@
 #include "culling/pipeline.hpp"
 #include "culling/projection.hpp"
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -28,6 +29,15 @@ struct Explanation {
     glm::dvec3 sphereCenter{0.0}; // the culling sphere the tests use (view space)
     double sphereRadius = 0;
     double chunkDepthMin = 0, chunkDepthMax = 0; // the view-depth range of the tested chunk
+    // The tested chunk (view space, FrustumChunk's corner order) and the
+    // plane of its six (FrustumChunk's order: left, right, top, bottom, near,
+    // far) that decided: the one that rejected the light by the widest margin,
+    // or, when all six keep it, the one that came closest to rejecting it
+    // (smallest signed distance + r). The studio draws both in 3D.
+    bool hasChunk = false;
+    std::array<glm::dvec3, 8> chunkCorners{};
+    int decisivePlane = -1;
+    double decisiveMargin = 0; // signed distance + r of that plane (< 0: rejected)
     std::vector<ExplainStep> steps;
     bool testsPass = false;    // the reference's tests keep the light in this list
     bool listed = false;       // the run's list holds it
@@ -38,6 +48,10 @@ struct Explanation {
     double nearestDistance = -1;
     glm::dvec3 nearestPosition{0.0};
     std::uint32_t nearestX = 0, nearestY = 0;
+    // When pixels need it: the needing pixel nearest the light's centre (view
+    // space), where a miss would show first.
+    bool hasNeededPixel = false;
+    glm::dvec3 neededPosition{0.0};
     std::string verdict;       // one line: needed / false positive (why) / MISSING / not listed, rightly
     // The whole explanation, one step a line, as the CLI prints it.
     std::string text(const std::string& lightName = {}) const;
@@ -50,5 +64,11 @@ std::uint32_t listOf(const CullResult& r, std::uint32_t tile, int sub);
 // Explains light `light` in list `list` of run.result. Needs run.depth and
 // run.lights; throws SettingsError for an index out of range.
 Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint32_t list, std::uint32_t light);
+
+// The four corners (view space, in order around it) of plane `plane` (0..5,
+// FrustumChunk's plane order) of a chunk with corners `c`.
+std::array<glm::dvec3, 4> chunkFace(const std::array<glm::dvec3, 8>& c, int plane);
+// The names explain's steps give the six planes.
+const char* chunkPlaneName(int plane);
 
 } // namespace lc
