@@ -2,6 +2,7 @@
 
 #include "cull_lists_comp.spv.h"
 #include "depth_vert.spv.h"
+#include "fine_prune_comp.spv.h"
 #include "light_bins_comp.spv.h"
 #include "prefix_sum_comp.spv.h"
 #include "shade_comp.spv.h"
@@ -17,6 +18,7 @@ LC_SPV(tileBoundsWide, lc_spv_tile_bounds_wide_comp)
 LC_SPV(lightBins, lc_spv_light_bins_comp)
 LC_SPV(cullLists, lc_spv_cull_lists_comp)
 LC_SPV(prefixSum, lc_spv_prefix_sum_comp)
+LC_SPV(finePrune, lc_spv_fine_prune_comp)
 LC_SPV(shade, lc_spv_shade_comp)
 #undef LC_SPV
 } // namespace lc::spirv

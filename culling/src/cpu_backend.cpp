@@ -9,6 +9,7 @@
 #include "culling/backend.hpp"
 
 #include "culling/errors.hpp"
+#include "culling/fine_prune.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -215,6 +216,18 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
             }
         }
         const SphereTest test = settings.test;
+        // fptl's fine test: any geometry pixel of the tile inside the light's
+        // volume (fine_prune.hpp), from the same per-pixel positions.
+        auto tilePixelKeeps = [&](const TileGrid::Rect& rect, std::uint32_t l) {
+            for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
+                for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
+                    const double v = viewDepth[std::size_t(y) * depth.width + x];
+                    if (std::isnan(v)) continue;
+                    if (fptlPixelKeeps(lights, l, proj.viewPositionFromDepth(x, y, double(depth.at(x, y)))))
+                        return true;
+                }
+            return false;
+        };
         // The one per-chunk test: the culling sphere, then for a spot light
         // under a cone test the cone refinement (spot_tests.hpp).
         auto intersects = [&](const FrustumChunk& chunk, std::uint32_t l) {
@@ -239,6 +252,7 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
                 FrustumChunk chunkA, chunkB;
                 switch (algo) {
                 case Algorithm::Naive: chunkA = makeFrustumChunk(proj, rect, camNear, naiveFar); break;
+                case Algorithm::Fptl:
                 case Algorithm::MinMax:
                 case Algorithm::TwoPointFiveD: chunkA = makeFrustumChunk(proj, rect, tmin, tmax); break;
                 case Algorithm::HalfZ:
@@ -256,6 +270,10 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
                     case Algorithm::Naive:
                     case Algorithm::MinMax:
                         if (intersects(chunkA, l)) lists[t].push_back(l);
+                        break;
+                    case Algorithm::Fptl:
+                        // Coarse: minmax's test; fine: a pixel of the tile the light could reach.
+                        if (intersects(chunkA, l) && tilePixelKeeps(rect, l)) lists[t].push_back(l);
                         break;
                     case Algorithm::HalfZ:
                         if (intersects(chunkA, l)) lists[2 * t].push_back(l);

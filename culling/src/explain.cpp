@@ -4,6 +4,7 @@
 #include "culling/explain.hpp"
 
 #include "culling/errors.hpp"
+#include "culling/fine_prune.hpp"
 #include "culling/spot_tests.hpp"
 #include "culling/tile_math.hpp"
 #include "light_grid.hpp"
@@ -117,6 +118,7 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
                 hi = std::isfinite(proj.farPlane()) ? proj.farPlane() : std::max(lightFar, lo);
                 break;
             }
+            case Algorithm::Fptl:
             case Algorithm::MinMax: lo = tmin, hi = tmax; break;
             case Algorithm::TwoPointFiveD:
                 if (r.cellLists && e.sub >= 0) {
@@ -184,6 +186,21 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
                 const bool pass = spotIntersectsChunk(s.spotTest, s.test, lights.spotCone(light), chunk);
                 ok = step(std::string("spot cone (") + toString(s.spotTest) + ")",
                           pass ? "the cone meets the chunk" : "the cone misses the chunk", pass) && ok;
+            }
+            if (r.algorithm == Algorithm::Fptl) {
+                // The fine prune, as the reference runs it (fine_prune.hpp):
+                // the tile's geometry pixels inside the light's volume.
+                std::uint32_t inside = 0, pixels = 0;
+                for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
+                    for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
+                        if (!run.depth.hasGeometry(x, y)) continue;
+                        ++pixels;
+                        inside += fptlPixelKeeps(lights, light, proj.viewPositionFromDepth(x, y, run.depth.at(x, y)));
+                    }
+                ok = step("fine prune (the tile's pixels)",
+                          std::to_string(inside) + " of the tile's " + std::to_string(pixels) +
+                              " geometry pixels lie inside the light's volume (+slack)",
+                          inside > 0) && ok;
             }
         }
         e.testsPass = ok;

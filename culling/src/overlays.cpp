@@ -173,6 +173,7 @@ std::optional<SpotTestPrimitive> spotTestPrimitive(const RunOutput& run, const P
     switch (r.algorithm) {
     case Algorithm::Naive:
     case Algorithm::MinMax:
+    case Algorithm::Fptl:
     case Algorithm::TwoPointFiveD:
         if (const auto chunk = tileFrustum(r, proj, run.lights, t)) add(t, 0, *chunk);
         break;

@@ -12,7 +12,8 @@ namespace {
 constexpr std::pair<Algorithm, const char*> kAlgorithms[] = {
     {Algorithm::All, "all"},          {Algorithm::Naive, "naive"},
     {Algorithm::MinMax, "minmax"},    {Algorithm::HalfZ, "halfz"},
-    {Algorithm::TwoPointFiveD, "2.5d"}, {Algorithm::Clustered, "clustered"}};
+    {Algorithm::TwoPointFiveD, "2.5d"}, {Algorithm::Clustered, "clustered"},
+    {Algorithm::Fptl, "fptl"}};
 constexpr SphereTest kTests[] = {SphereTest::Planes, SphereTest::PlanesAabb, SphereTest::Exact};
 constexpr Slicing kSlicings[] = {Slicing::Log, Slicing::Linear};
 constexpr SpotTest kSpotTests[] = {SpotTest::ApexSphere, SpotTest::TightSphere, SpotTest::ConeSphere,
@@ -36,7 +37,8 @@ std::vector<ParamSpec> buildTable() {
     t.push_back({"algorithm", ParamType::Choice, "2.5d", algos, 0, 0,
                  "culling algorithm: all (no culling), naive (tile planes + camera near/far), "
                  "minmax (tile min/max depth), halfz (two lists split at mid depth), 2.5d "
-                 "(depth-cell occupancy mask), clustered (3D froxel grid)",
+                 "(depth-cell occupancy mask), clustered (3D froxel grid), fptl (fine-pruned tiles: "
+                 "minmax, then each light tested against the tile's pixels)",
                  "Algorithm"});
     t.push_back({"test", ParamType::Choice, "planes", tests, 0, 0,
                  "sphere-vs-volume test: planes (6 planes), planes+aabb (planes and the chunk's "

@@ -25,6 +25,9 @@ inline CullBackend& vulkan() {
     return *backend;
 }
 
+// Mesa's lavapipe (a CPU device, with its loop cap; vulkan_backend.cpp).
+inline bool vulkanIsCpuDevice() { return vulkan().deviceName().rfind("llvmpipe", 0) == 0; }
+
 inline std::string joinedMessages() {
     std::string s;
     for (const auto& m : vk::validationMessages()) s += m + "\n";

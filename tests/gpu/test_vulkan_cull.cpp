@@ -9,6 +9,7 @@
 
 #include "culling/depth.hpp"
 #include "culling/ground_truth.hpp"
+#include "culling/pipeline.hpp"
 #include "culling/scene_io.hpp"
 
 #include <algorithm>
@@ -21,7 +22,7 @@ using lc::gputest::GpuTest;
 namespace {
 
 const Algorithm kAlgorithms[] = {Algorithm::All,    Algorithm::Naive,         Algorithm::MinMax,
-                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered};
+                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl};
 const SphereTest kTests[] = {SphereTest::Planes, SphereTest::PlanesAabb, SphereTest::Exact};
 
 struct Comparison {
@@ -614,3 +615,36 @@ TEST_F(GpuTest, DepthBinsSpareTheCountPassMostCandidates) {
 }
 
 } // namespace
+
+// fptl (fine-pruned tiles): the CPU reference's lists are the per-tile
+// optimum itself (optimal work = shading work), a subset of minmax's per
+// tile; the Vulkan lists hold them and stay within float widening of them,
+// with spot lights among the point lights (the prune tests the cones).
+TEST_F(GpuTest, FinePrunedTilesReachThePerTileOptimum) {
+    Scene scene = sized("atrium", 320, 180);
+    LightGenSettings g = defaultLightGen(scene, 400, 21);
+    g.spotFraction = 0.4;
+    scene.lights = generateLights(g);
+    auto cpuBackend = makeCpuBackend();
+    CullSettings st;
+    st.algorithm = Algorithm::MinMax;
+    const RunOutput minmax = runPipeline(scene, st, *cpuBackend);
+    st.algorithm = Algorithm::Fptl;
+    const RunOutput cpu = runPipeline(scene, st, *cpuBackend);
+    ASSERT_GT(cpu.truth.metrics.shadingWork, 0u);
+    EXPECT_EQ(cpu.truth.metrics.falseNegatives, 0u);
+    EXPECT_EQ(cpu.truth.metrics.optimalWork, cpu.truth.metrics.shadingWork);
+    EXPECT_LT(cpu.result.entries(), minmax.result.entries());
+    for (std::uint32_t t = 0; t < cpu.result.grid.tileCount(); ++t) {
+        const auto fb = cpu.result.lightIndices.begin() + cpu.result.listOffset[t];
+        const auto mb = minmax.result.lightIndices.begin() + minmax.result.listOffset[t];
+        EXPECT_TRUE(std::includes(mb, mb + minmax.result.listCount[t], fb, fb + cpu.result.listCount[t])) << "tile " << t;
+    }
+    const RunOutput gpu = runPipeline(scene, st, gputest::vulkan());
+    EXPECT_EQ(gpu.truth.metrics.falseNegatives, 0u);
+    EXPECT_GE(gpu.truth.metrics.efficiencyVsOptimal, 0.99);
+    EXPECT_LE(gpu.truth.metrics.efficiencyVsOptimal, 1.0);
+    const Comparison cmp = compareLists(cpu.result, gpu.result);
+    EXPECT_EQ(cmp.missing, 0u) << cmp.firstMissing;
+    EXPECT_LE(cmp.extra, 8 + cmp.cpuEntries / 200);
+}

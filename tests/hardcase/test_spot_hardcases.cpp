@@ -21,7 +21,7 @@ using namespace lc;
 namespace {
 
 const Algorithm kAlgorithms[] = {Algorithm::All,    Algorithm::Naive,         Algorithm::MinMax,
-                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered};
+                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl};
 const SpotTest kSpotTests[] = {SpotTest::ApexSphere, SpotTest::TightSphere, SpotTest::ConeSphere,
                                SpotTest::ConePlanes};
 
@@ -149,6 +149,14 @@ TEST_P(SpotHardCase, EveryAlgorithmAndSpotTest) {
         // The cone refinements never list more than the tight sphere.
         EXPECT_LE(entries(byTest[SpotTest::ConeSphere]), entries(byTest[SpotTest::TightSphere]));
         EXPECT_LE(entries(byTest[SpotTest::ConePlanes]), entries(byTest[SpotTest::TightSphere]));
+        if (algo == Algorithm::Fptl) {
+            // The fine prune tests the cone itself at the tile's pixels,
+            // whatever the spot test: one list for all four.
+            for (SpotTest t : kSpotTests)
+                EXPECT_EQ(byTest[t].lightIndices, byTest[SpotTest::ApexSphere].lightIndices) << toString(t);
+            if (c.name == "pointing_away") EXPECT_EQ(entries(byTest[SpotTest::ApexSphere]), 0u);
+            continue;
+        }
         if (c.name == "pointing_away" && algo != Algorithm::Naive) {
             // Every tile's chunk lies in front of the camera, the whole cone
             // behind it: both cone tests reject it everywhere, while the apex
@@ -194,7 +202,8 @@ TEST_F(SpotVulkan, ManySpotsEveryTestIsASupersetOfTheCpu) {
     const ViewLights lights = makeViewLights(scene);
     GroundTruthOptions o;
     o.imageError = false;
-    for (Algorithm algo : {Algorithm::MinMax, Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Naive})
+    for (Algorithm algo : {Algorithm::MinMax, Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Naive,
+                           Algorithm::Fptl})
         for (SpotTest t : kSpotTests) {
             SCOPED_TRACE(std::string(toString(algo)) + " " + toString(t));
             CullSettings st;

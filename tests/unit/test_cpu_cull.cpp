@@ -164,6 +164,19 @@ std::vector<std::vector<std::uint32_t>> bruteForceLists(const CullRun& r) {
             case Algorithm::MinMax:
                 if (!empty && hit(mn, mx)) out[t].push_back(std::uint32_t(i));
                 break;
+            case Algorithm::Fptl: {
+                // minmax's test, then a geometry pixel of the tile within the
+                // sphere (with the reference's rounding slack).
+                if (empty || !hit(mn, mx)) break;
+                bool reached = false;
+                for (std::uint32_t y = rect.y0; y < rect.y1 && !reached; ++y)
+                    for (std::uint32_t x = rect.x0; x < rect.x1 && !reached; ++x)
+                        reached = r.depth.hasGeometry(x, y) &&
+                                  glm::length(proj.viewPositionFromDepth(x, y, r.depth.at(x, y)) - c) <=
+                                      rad + sphereTestSlack(c, rad);
+                if (reached) out[t].push_back(std::uint32_t(i));
+                break;
+            }
             case Algorithm::HalfZ:
                 if (empty) break;
                 if (hit(mn, (mn + mx) / 2)) out[2 * t].push_back(std::uint32_t(i));
@@ -214,7 +227,7 @@ const ProjectionKind kKinds[] = {ProjectionKind::Perspective, ProjectionKind::Pe
                                  ProjectionKind::ReversedZ, ProjectionKind::Orthographic,
                                  ProjectionKind::OrthographicGL};
 const Algorithm kAlgorithms[] = {Algorithm::All,   Algorithm::Naive,         Algorithm::MinMax,
-                                 Algorithm::HalfZ, Algorithm::TwoPointFiveD, Algorithm::Clustered};
+                                 Algorithm::HalfZ, Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl};
 const SphereTest kTests[] = {SphereTest::Planes, SphereTest::PlanesAabb, SphereTest::Exact};
 
 } // namespace

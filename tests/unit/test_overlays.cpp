@@ -124,7 +124,7 @@ TEST(Overlays, TileFrustumCornersLieOnTheCullingPlanes) {
 // list of the run, for every algorithm with tile volumes.
 TEST(Overlays, OverlayVolumesReproduceEveryList) {
     for (Algorithm alg : {Algorithm::Naive, Algorithm::MinMax, Algorithm::HalfZ, Algorithm::TwoPointFiveD,
-                          Algorithm::Clustered}) {
+                          Algorithm::Clustered, Algorithm::Fptl}) {
         for (Slicing slicing : {Slicing::Log, Slicing::Linear}) {
             SCOPED_TRACE(std::string(toString(alg)) + " " + toString(slicing));
             const CulledScene run = runBuiltin("atrium", alg, ProjectionKind::Perspective, slicing);
@@ -137,6 +137,12 @@ TEST(Overlays, OverlayVolumesReproduceEveryList) {
                 std::vector<std::vector<std::uint32_t>> expect(count);
                 const auto frustum = tileFrustum(r, proj, L, t);
                 const auto cells = tileCells(r, proj, t);
+                // fptl: the frustum's lights that a pixel of the tile needs
+                // (the ground truth's rule; the fine prune's slack is 1e-9).
+                std::vector<char> needed(L.size(), 0);
+                if (alg == Algorithm::Fptl)
+                    for (const auto& [light, pixels] : pixelsNeedingLights(run.out.depth, proj, L, r.grid, t))
+                        needed[light] = pixels > 0;
                 for (std::uint32_t l = 0; l < L.size(); ++l) {
                     const glm::dvec3& c = L.centers[l];
                     const double rad = L.radii[l];
@@ -145,6 +151,10 @@ TEST(Overlays, OverlayVolumesReproduceEveryList) {
                     case Algorithm::Naive:
                     case Algorithm::MinMax:
                         if (frustum && sphereIntersectsChunk(r.settings.test, *frustum, c, rad)) expect[0].push_back(l);
+                        break;
+                    case Algorithm::Fptl:
+                        if (frustum && needed[l] && sphereIntersectsChunk(r.settings.test, *frustum, c, rad))
+                            expect[0].push_back(l);
                         break;
                     case Algorithm::TwoPointFiveD: {
                         std::uint32_t occupied = 0;
@@ -316,7 +326,7 @@ TEST(Overlays, ReverseLookupMatchesTilesCsv) {
 // there is no geometry.
 TEST(Overlays, TileHeatAddsUpToTheRunsMetrics) {
     for (Algorithm alg : {Algorithm::Naive, Algorithm::MinMax, Algorithm::HalfZ, Algorithm::TwoPointFiveD,
-                          Algorithm::Clustered}) {
+                          Algorithm::Clustered, Algorithm::Fptl}) {
         SCOPED_TRACE(toString(alg));
         const CulledScene run = runBuiltin("sky", alg); // sky: most tiles hold no geometry
         const CullResult& r = run.out.result;

@@ -21,7 +21,7 @@ TEST(Params, TableOrderAndDefaultsMatchTheStructs) {
         EXPECT_FALSE(p.label.empty()) << p.name;
     }
     EXPECT_EQ(cullParam("algorithm").choices,
-              (std::vector<std::string>{"all", "naive", "minmax", "halfz", "2.5d", "clustered"}));
+              (std::vector<std::string>{"all", "naive", "minmax", "halfz", "2.5d", "clustered", "fptl"}));
     EXPECT_EQ(cullParam("test").choices, (std::vector<std::string>{"planes", "planes+aabb", "exact"}));
     EXPECT_EQ(cullParam("cells").minValue, 1);
     EXPECT_EQ(cullParam("cells").maxValue, 32);
@@ -91,7 +91,7 @@ TEST(Params, BadValuesNameTheParameterAndTheValue) {
 
 TEST(Params, AlgorithmNamesAndSettingsValidate) {
     for (Algorithm a : {Algorithm::All, Algorithm::Naive, Algorithm::MinMax, Algorithm::HalfZ,
-                        Algorithm::TwoPointFiveD, Algorithm::Clustered})
+                        Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl})
         EXPECT_EQ(algorithmFromString(toString(a)), a);
     EXPECT_STREQ(toString(Algorithm::TwoPointFiveD), "2.5d");
     try {

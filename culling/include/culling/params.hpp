@@ -12,8 +12,8 @@
 
 namespace lc {
 
-enum class Algorithm { All, Naive, MinMax, HalfZ, TwoPointFiveD, Clustered };
-const char* toString(Algorithm a);  // "all", "naive", "minmax", "halfz", "2.5d", "clustered"
+enum class Algorithm { All, Naive, MinMax, HalfZ, TwoPointFiveD, Clustered, Fptl };
+const char* toString(Algorithm a);  // "all", "naive", "minmax", "halfz", "2.5d", "clustered", "fptl"
 Algorithm algorithmFromString(const std::string& s); // throws SettingsError("algorithm", ...)
 
 // Settings of one culling run. Resolution and tile size live on the Camera

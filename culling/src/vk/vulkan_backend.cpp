@@ -12,6 +12,11 @@
 //      takes the entries from there and stops (no second submission) --
 //   4. cull_lists write pass: stashed lists copied, the longer ones tested
 //      again, indices written ascending into an index array sized exactly.
+//   fptl adds (always with the write pass, its lists being minmax's so far):
+//   5. fine_prune, an invocation per entry: the light against its tile's
+//      geometry pixels, pruned entries marked;
+//   6. fine_prune pack, an invocation per list: kept entries to the front
+//      of the list's range, the new count; the host packs the ranges.
 // So memory is the entries the scene produces, with no per-list cap and no
 // tiles x lights x cells allocation.
 #include "vk/vulkan_backend.hpp"
@@ -259,7 +264,8 @@ private:
     Context ctx_;
     DescriptorSetLayoutHandle setLayout_;
     PipelineLayoutHandle computeLayout_;
-    ShaderModuleHandle boundsShader_, boundsWideShader_, binsShader_, cullShader_, scanShader_, vertShader_;
+    ShaderModuleHandle boundsShader_, boundsWideShader_, binsShader_, cullShader_, scanShader_, pruneShader_,
+        vertShader_;
     double lastCullWallMs_ = -1;
     std::uint32_t lastLongestList_ = 0; // of the previous cull: sizes a CPU device's stash
     std::map<std::string, PipelineHandle> computePipelines_;
@@ -280,6 +286,7 @@ void VulkanBackend::createComputeObjects() {
     binsShader_ = mk(spirv::lightBins(), "shader.light_bins");
     cullShader_ = mk(spirv::cullLists(), "shader.cull_lists");
     scanShader_ = mk(spirv::prefixSum(), "shader.prefix_sum");
+    pruneShader_ = mk(spirv::finePrune(), "shader.fine_prune");
     vertShader_ = mk(spirv::depthVert(), "shader.depth_vert");
 }
 
@@ -589,8 +596,10 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     if (lights.centers.size() != lights.size()) throw Error("view lights: centres and radii differ in count");
     // Spot lights: the sphere tests need only the chosen sphere (below); the
     // cone tests also upload each spot's cone (binding 9).
-    const bool spotCones = !lights.spotAngles.empty() &&
-                           (settings.spotTest == SpotTest::ConeSphere || settings.spotTest == SpotTest::ConePlanes);
+    const bool coneTests = settings.spotTest == SpotTest::ConeSphere || settings.spotTest == SpotTest::ConePlanes;
+    const bool fptl = settings.algorithm == Algorithm::Fptl;
+    // fptl's fine prune tests every spot's cone at the pixels, whatever the spot test.
+    const bool spotCones = !lights.spotAngles.empty() && (coneTests || fptl);
 
     const Algorithm algo = settings.algorithm;
     const std::uint32_t tiles = grid.tileCount(), cells = settings.cells;
@@ -654,7 +663,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         if (isReversed(proj.kind())) flags |= LC_FLAG_REVERSED;
         if (farInfinite) flags |= LC_FLAG_FAR_INFINITE;
         if (settings.skipEmpty) flags |= LC_FLAG_SKIP_EMPTY;
-        if (spotCones)
+        if (spotCones && coneTests)
             flags |= settings.spotTest == SpotTest::ConeSphere ? LC_FLAG_SPOT_CONE_SPHERE : LC_FLAG_SPOT_CONE_PLANES;
         p.size = glm::uvec4(grid.width, grid.height, grid.tilesX, grid.tilesY);
         p.counts = glm::uvec4(n, res.listsPerTile, listTotal, flags);
@@ -776,6 +785,13 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     std::uint32_t lanes = sg;
     if (kLocal % sg != 0) lanes = 1;
     else if (ctx_.isCpuDevice()) lanes = itersPerList <= kLoopLimit ? 1 : sg;
+    // fptl's passes: a tile's pixels plus a 32-step search per entry, a
+    // list's entries (at most the lights) per list.
+    if (fptl && ctx_.isCpuDevice() &&
+        (std::uint64_t(grid.tileSize) * grid.tileSize + 32 > kLoopLimit || n > kLoopLimit))
+        throw SettingsError("tile", "fptl on '" + ctx_.deviceName() + "' takes tiles of at most 255 pixels and at most " +
+                                        std::to_string(kLoopLimit) +
+                                        " lights (the driver caps a shader invocation at 65,535 loop iterations)");
     if (ctx_.isCpuDevice() && itersPerList / lanes > kLoopLimit)
         throw SettingsError("lights", std::to_string(n) + " lights is more than the culling passes can take on '" +
                                           ctx_.deviceName() + "' (at most " +
@@ -796,6 +812,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     VkPipeline binsPipe = computePipeline("light_bins", binsShader_, spec(kLocal, 0), false);
     VkPipeline countPipe = computePipeline("cull_lists.count", cullShader_, spec(kLocal, 0, lanes), subgroupLanes);
     VkPipeline writePipe = computePipeline("cull_lists.write", cullShader_, spec(kLocal, 1, lanes), subgroupLanes);
+    VkPipeline prunePipe = fptl ? computePipeline("fine_prune", pruneShader_, spec(kLocal, 0), false) : VK_NULL_HANDLE;
+    VkPipeline packPipe = fptl ? computePipeline("fine_prune.pack", pruneShader_, spec(kLocal, 1), false) : VK_NULL_HANDLE;
     // Scan: one subgroup on a CPU device while each lane's run (read and
     // write: 2 loop iterations per list) fits the loop cap, else wide.
     const bool wideScan = !ctx_.isCpuDevice() || 2 * (std::uint64_t(listTotal) / sg + 1) > kLoopLimit / 2;
@@ -807,6 +825,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const Grid binGroups = groupsFor(planeBinWords + depthBinWords, lim);
     const Grid countGroups = groupsFor(all ? 1 : std::uint64_t(listTotal) * lanes, lim);
     const Grid writeGroups = groupsFor(all ? n : std::uint64_t(listTotal) * lanes, lim);
+    const Grid packGroups = groupsFor(listTotal, lim);
 
     const bool gpuClock = useGpuTimestamps();
     TimestampPool stamps = gpuClock ? TimestampPool(ctx_, 2, "cull.timestamps") : TimestampPool();
@@ -860,7 +879,13 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                           " list entries, more than one storage buffer of this device holds (" +
                           std::to_string(lim.maxStorageBufferRange / 4) + ")");
 
-    if (total > 0 && longest <= stashSlots) {
+    // The coarse counts and offsets, before fptl's pack rewrites the counts
+    // (in place when the buffer is mapped).
+    const std::vector<std::uint32_t> counts0 = fptl ? std::vector<std::uint32_t>(counts, counts + listTotal)
+                                                    : std::vector<std::uint32_t>();
+    const std::vector<std::uint32_t> offs0 = fptl ? std::vector<std::uint32_t>(offs, offs + listTotal)
+                                                  : std::vector<std::uint32_t>();
+    if (total > 0 && longest <= stashSlots && !fptl) {
         // The stash holds every list whole: the entries are in, no write pass.
         res.lightIndices.resize(total);
         for (std::uint32_t l = 0; l < listTotal; ++l)
@@ -872,6 +897,10 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         Staging back(ctx_);
         idx = static_cast<const std::uint32_t*>(back.download(indexBuf, std::size_t(total) * 4));
         const auto* status2 = static_cast<const std::uint32_t*>(back.download(statusBuf, 4));
+        // fptl: the packed counts (mapped: the same memory as `counts`).
+        const auto* packed =
+            fptl ? static_cast<const std::uint32_t*>(back.download(countBuf, std::size_t(listTotal) * 4)) : nullptr;
+        const Grid pruneGroups = groupsFor(total, lim);
         wallMs += ctx_.submitAndWait(
             [&](VkCommandBuffer cmd) {
                 // The write pass reads counts/offsets/bounds written by the previous submission.
@@ -882,6 +911,18 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                                         nullptr);
                 vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, writePipe);
                 vkCmdDispatch(cmd, writeGroups.x, writeGroups.y, 1);
+                if (fptl) {
+                    // The prune reads the entries the write pass wrote, and
+                    // the pack the marks the prune wrote over them.
+                    computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+                    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, prunePipe);
+                    vkCmdDispatch(cmd, pruneGroups.x, pruneGroups.y, 1);
+                    computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+                    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, packPipe);
+                    vkCmdDispatch(cmd, packGroups.x, packGroups.y, 1);
+                }
                 if (gpuClock) stamps.end(cmd, 1);
                 back.recordDownloads(cmd);
             },
@@ -890,7 +931,21 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         if (*status2 & 8u) throw DeviceError(loopLimitError);
         if (*status2 & 2u)
             throw DeviceError("Vulkan write pass found a different entry count than the count pass");
-        res.lightIndices.assign(idx, idx + total);
+        if (fptl) {
+            // Each list's kept entries lead its range: pack the ranges.
+            std::uint32_t at = 0;
+            res.listOffset.resize(listTotal);
+            res.listCount.assign(packed, packed + listTotal);
+            for (std::uint32_t l = 0; l < listTotal; ++l) {
+                if (res.listCount[l] > counts0[l])
+                    throw DeviceError("Vulkan fine prune kept more entries than the list had");
+                res.listOffset[l] = at;
+                res.lightIndices.insert(res.lightIndices.end(), idx + offs0[l], idx + offs0[l] + res.listCount[l]);
+                at += res.listCount[l];
+            }
+        } else {
+            res.lightIndices.assign(idx, idx + total);
+        }
     }
 
     // Results out of the mapped (or staged) buffers.
@@ -905,8 +960,10 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         if (algo == Algorithm::HalfZ) res.halfzSplit[t] = empty ? kInf : double(tb[t].split);
         if (!res.cellMask.empty()) res.cellMask[t] = tb[t].cellMask;
     }
-    res.listCount.assign(counts, counts + listTotal);
-    res.listOffset.assign(offs, offs + listTotal);
+    if (!fptl || total == 0) {
+        res.listCount.assign(counts, counts + listTotal);
+        res.listOffset.assign(offs, offs + listTotal);
+    }
 
     res.backend = name();
     res.device = deviceName();

@@ -1,0 +1,86 @@
+#version 450
+// fptl's fine prune (culling/fine_prune.hpp), run after cull_lists wrote the
+// coarse (minmax) lists into the index array:
+//   WRITE_PASS 0: an invocation per entry of the index array. It finds its
+//     list (a binary search of the offsets), walks the geometry pixels of
+//     that list's tile and overwrites the entry with PRUNED when no pixel lies
+//     inside the light's volume: its range sphere and, for a spot light, its
+//     cone (binding 9 holds every spot's cone for fptl), both widened by the
+//     backend's float margin (cull_common.glsl) so that every light the
+//     double-precision reference keeps stays.
+//   WRITE_PASS 1: an invocation per list moves its kept entries, in order, to
+//     the front of its range and writes the new count. Offsets stay: a list
+//     keeps its slot, its tail unused (the host packs them on read-back).
+// Loops per invocation: at most a tile's pixels plus the search (pass 0),
+// a list's entries (pass 1); the host keeps both under lavapipe's cap.
+#extension GL_GOOGLE_include_directive : require
+#include "cull_common.glsl"
+
+const uint PRUNED = 0xffffffffu;
+
+bool pixelMayNeed(vec3 p, uint l) {
+    vec4 L = lights[l].centerRadius;
+    vec3 c = L.xyz;
+    float r = L.w;
+    bool spot = false;
+    vec3 axis = vec3(0.0);
+    float cosAngle = 0.0;
+    if (uint(spots.length()) > l && spots[l].apexRange.w > 0.0) {
+        // A spot light: its range sphere is centred on the apex.
+        c = spots[l].apexRange.xyz;
+        r = spots[l].apexRange.w;
+        axis = spots[l].axisCos.xyz;
+        cosAngle = spots[l].axisCos.w;
+        spot = true;
+    }
+    float eps = (length(c) + r) * P.cluster.z + P.cluster.w;
+    vec3 d = p - c;
+    float len = length(d);
+    if (len > r + eps) return false;
+    return !spot || dot(d, axis) >= len * cosAngle - eps;
+}
+
+void main() {
+    loadParams();
+    uint id = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
+              gl_LocalInvocationIndex;
+    uint lists = P.counts.z;
+    if (WRITE_PASS == 0u) {
+        if (id >= listOffset[lists]) return;
+        // offset[lo] <= id < offset[hi]: ends on the one non-empty list holding id.
+        uint lo = 0u, hi = lists;
+        while (hi - lo > 1u) {
+            uint mid = (lo + hi) >> 1u;
+            if (listOffset[mid] <= id) lo = mid; else hi = mid;
+        }
+        uint l = lightIndices[id];
+        uint tx = lo % P.size.z, ty = lo / P.size.z;
+        uint x0 = tx * TILE_SIZE, y0 = ty * TILE_SIZE;
+        uint w = min(x0 + TILE_SIZE, P.size.x) - x0, h = min(y0 + TILE_SIZE, P.size.y) - y0;
+        float W = float(P.size.x), H = float(P.size.y);
+        bool keep = false;
+        // One flat loop over the tile's pixels (one loop, so its iterations
+        // are the only ones lavapipe counts here).
+        for (uint i = 0u; i < w * h && !keep; ++i) {
+            uint x = x0 + i % w, y = y0 + i / w;
+            float depth = depthBuf[y * P.size.x + x];
+            if (depth == P.depth.w) continue; // clear depth: no geometry
+            float v = viewDepthOf(depth);
+            if (isnan(v) || isinf(v)) continue;
+            vec3 p = viewAt(2.0 * (float(x) + 0.5) / W - 1.0, 2.0 * (float(y) + 0.5) / H - 1.0, v);
+            keep = pixelMayNeed(p, l);
+        }
+        if (!keep) lightIndices[id] = PRUNED;
+    } else {
+        if (id >= lists) return;
+        uint base = listOffset[id], count = listCount[id], n = 0u;
+        for (uint i = 0u; i < count; ++i) {
+            uint l = lightIndices[base + i];
+            if (l != PRUNED) {
+                lightIndices[base + n] = l;
+                ++n;
+            }
+        }
+        listCount[id] = n;
+    }
+}
