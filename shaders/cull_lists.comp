@@ -111,13 +111,16 @@ void main() {
     // A tile without geometry gets no lights, except for the two volumes that
     // do not come from the depth buffer (as the CPU reference): naive, and
     // clustered without skip-empty.
-    bool depthDriven = ALGORITHM != LC_ALG_NAIVE &&
+    // zbin's tile masks are naive's test (the lights arrive depth-sorted,
+    // so a list holds sorted positions; zbin.comp bins them in depth).
+    bool screenSpace = ALGORITHM == LC_ALG_NAIVE || ALGORITHM == LC_ALG_ZBIN;
+    bool depthDriven = !screenSpace &&
                        !(ALGORITHM == LC_ALG_CLUSTERED && (P.counts.w & LC_FLAG_SKIP_EMPTY) == 0u);
     bool listLive = !depthDriven || tb.depthMin <= tb.depthMax;
     uint geomMask = 0u;
     float maskLo = 0.0, maskHi = 0.0; // 2.5d: the cells' range, the tile's own bounds
     float zlo = tb.depthMin, zhi = tb.depthMax;
-    if (ALGORITHM == LC_ALG_NAIVE) {
+    if (screenSpace) {
         zlo = P.lens.z;
         zhi = P.lens.w;
     } else if (ALGORITHM == LC_ALG_HALFZ) {
@@ -167,7 +170,7 @@ void main() {
         // The depth bins (light_bins.comp): lights that reach no deeper than
         // the chunk's far end and no nearer than its near end. naive's chunk
         // spans every light's depth.
-        bool depthBins = DEPTH_BINS != 0u && ALGORITHM != LC_ALG_NAIVE;
+        bool depthBins = DEPTH_BINS != 0u && !screenSpace;
         uint nearBase = P.bins.w + depthBinOf(chunkHi) * words;
         uint farBase = P.bins.w + (LC_DEPTH_BINS + depthBinOf(chunkLo)) * words;
         bool cut = false;

@@ -8,6 +8,7 @@
 #include "shade_comp.spv.h"
 #include "tile_bounds_comp.spv.h"
 #include "tile_bounds_wide_comp.spv.h"
+#include "zbin_comp.spv.h"
 
 namespace lc::spirv {
 #define LC_SPV(fn, arr) \
@@ -19,6 +20,7 @@ LC_SPV(lightBins, lc_spv_light_bins_comp)
 LC_SPV(cullLists, lc_spv_cull_lists_comp)
 LC_SPV(prefixSum, lc_spv_prefix_sum_comp)
 LC_SPV(finePrune, lc_spv_fine_prune_comp)
+LC_SPV(zbin, lc_spv_zbin_comp)
 LC_SPV(shade, lc_spv_shade_comp)
 #undef LC_SPV
 } // namespace lc::spirv

@@ -18,6 +18,7 @@ Code tileBoundsWide();  // the same, depth read 2 or 8 pixels a load (needs shad
 Code lightBins();  // per tile column / row bitmask of the lights not outside its side planes
 Code cullLists();   // per-list light tests: count pass and write pass
 Code prefixSum();   // exclusive scan of the list counts into offsets
+Code zbin();        // zbin: the depth bins of the depth-sorted lights
 Code finePrune();   // fptl: prune the coarse lists against the tile's pixels, then pack them
 Code shade();       // Lambert shading pass, one invocation per pixel
 

@@ -246,11 +246,14 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
                 const std::uint32_t t = grid.tileIndex(tx, ty);
                 const TileGrid::Rect rect = grid.tileRect(tx, ty);
                 const bool empty = tileEmpty(t);
-                if (empty && algo != Algorithm::Naive && !(algo == Algorithm::Clustered && !settings.skipEmpty))
+                // naive's and zbin's screen-space volumes do not depend on the depth.
+                if (empty && algo != Algorithm::Naive && algo != Algorithm::ZBin &&
+                    !(algo == Algorithm::Clustered && !settings.skipEmpty))
                     continue;
                 const double tmin = res.tileDepthMin[t], tmax = res.tileDepthMax[t];
                 FrustumChunk chunkA, chunkB;
                 switch (algo) {
+                case Algorithm::ZBin:
                 case Algorithm::Naive: chunkA = makeFrustumChunk(proj, rect, camNear, naiveFar); break;
                 case Algorithm::Fptl:
                 case Algorithm::MinMax:
@@ -268,6 +271,7 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
                     const double r = sphereRadius[l];
                     switch (algo) {
                     case Algorithm::Naive:
+                    case Algorithm::ZBin: // the tile's mask: the screen-space test
                     case Algorithm::MinMax:
                         if (intersects(chunkA, l)) lists[t].push_back(l);
                         break;
@@ -309,6 +313,29 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
                 }
             }
         });
+    }
+
+    if (algo == Algorithm::ZBin) {
+        // The lights sorted by the view depth of their culling sphere's
+        // centre; per linear bin of [near, far] the range of sorted positions
+        // whose depth extent (with the tests' slack) reaches it.
+        res.zbinNear = camNear;
+        res.zbinFar = naiveFar;
+        std::vector<double> centreDepth(n);
+        for (std::size_t l = 0; l < n; ++l) centreDepth[l] = -sphereCenter[l].z;
+        zbinSortLights(centreDepth, res.zbinOrder, res.zbinRank);
+        res.zbinLo.assign(settings.bins, std::numeric_limits<std::uint32_t>::max());
+        res.zbinHi.assign(settings.bins, 0);
+        for (std::uint32_t k = 0; k < n; ++k) {
+            const std::uint32_t l = res.zbinOrder[k];
+            const double slack = sphereTestSlack(sphereCenter[l], sphereRadius[l]);
+            const double a = centreDepth[l] - sphereRadius[l] - slack, b = centreDepth[l] + sphereRadius[l] + slack;
+            if (b < res.zbinNear || a > res.zbinFar) continue;
+            for (std::uint32_t bin = res.zbinOf(a), last = res.zbinOf(b); bin <= last; ++bin) {
+                res.zbinLo[bin] = std::min(res.zbinLo[bin], k);
+                res.zbinHi[bin] = std::max(res.zbinHi[bin], k);
+            }
+        }
     }
 
     // Compact: offsets, counts and one index array.

@@ -100,12 +100,13 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
         const bool empty = tileEmpty(r, t);
         bool ok = true;
         double lo = 0, hi = 0;
-        const bool emptyListed = r.algorithm == Algorithm::Naive ||
+        const bool emptyListed = r.algorithm == Algorithm::Naive || r.algorithm == Algorithm::ZBin ||
                                  (r.algorithm == Algorithm::Clustered && !s.skipEmpty);
         if (empty && !emptyListed) {
             ok = step("tile holds geometry", "no geometry pixel: the tile gets an empty list", false);
         } else {
             switch (r.algorithm) {
+            case Algorithm::ZBin: // the tile's mask: naive's screen-space volume
             case Algorithm::Naive: {
                 // As the reference: the camera's near and far, an infinite far
                 // replaced by the farthest depth any light reaches.
@@ -186,6 +187,26 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
                 const bool pass = spotIntersectsChunk(s.spotTest, s.test, lights.spotCone(light), chunk);
                 ok = step(std::string("spot cone (") + toString(s.spotTest) + ")",
                           pass ? "the cone meets the chunk" : "the cone misses the chunk", pass) && ok;
+            }
+            if (r.algorithm == Algorithm::ZBin && light < r.zbinRank.size()) {
+                // After the mask, each pixel's bin: the light is looped over
+                // where its rank lies in the bin's range. Reported, not a test
+                // of the list (the mask is the list).
+                const std::uint32_t k = r.zbinRank[light];
+                std::uint32_t inRange = 0, pixels = 0;
+                for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
+                    for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
+                        if (!run.depth.hasGeometry(x, y)) continue;
+                        ++pixels;
+                        const std::uint32_t b = r.zbinOf(proj.viewDepthFromWindowDepth(run.depth.at(x, y)));
+                        inRange += r.zbinLo[b] <= k && k <= r.zbinHi[b];
+                    }
+                step("Z-bins (per pixel, after the mask)",
+                     "sorted position " + std::to_string(k) + " of " + std::to_string(lights.size()) + "; bins " +
+                         std::to_string(r.zbinOf(cd - sphere.radius)) + ".." + std::to_string(r.zbinOf(cd + sphere.radius)) +
+                         " of " + std::to_string(r.zbinLo.size()) + "; the pixels of " + std::to_string(inRange) + " of the tile's " +
+                         std::to_string(pixels) + " geometry pixels loop over it",
+                     inRange > 0);
             }
             if (r.algorithm == Algorithm::Fptl) {
                 // The fine prune, as the reference runs it (fine_prune.hpp):

@@ -152,6 +152,7 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     j["slicing"] = toString(settings.slicing);
     j["skip_empty"] = settings.skipEmpty;
     j["spot_test"] = toString(settings.spotTest);
+    j["bins"] = settings.bins;
     j["lights"] = run.lights.size();
     std::size_t spots = 0;
     for (std::size_t i = 0; i < run.lights.size(); ++i) spots += run.lights.isSpot(i);

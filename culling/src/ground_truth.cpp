@@ -122,6 +122,36 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
         throw Error("ground truth: inconsistent cull result: " + bad);
     if (result.grid.width != depth.width || result.grid.height != depth.height)
         throw Error("ground truth: cull result grid does not match the depth image");
+    if (result.algorithm == Algorithm::ZBin && result.pixelList.empty()) {
+        // A pixel loops over its tile's mask within its bin's range: judged
+        // through the per-(tile, bin) lists, then folded back to the tiles.
+        const CullResult perPixel = zbinPixelLists(result, depth, proj);
+        GroundTruth sub = computeGroundTruth(depth, proj, lights, perPixel, opt, cancel);
+        std::vector<std::uint32_t> tileOf(perPixel.listCount.size(), 0);
+        for (std::uint32_t y = 0; y < depth.height; ++y)
+            for (std::uint32_t x = 0; x < depth.width; ++x)
+                if (const std::uint32_t l = perPixel.pixelList[std::size_t(y) * depth.width + x]; l != 0xffffffffu)
+                    tileOf[l] = result.grid.tileOfPixel(x, y);
+        GroundTruth gt;
+        gt.metrics = sub.metrics;
+        gt.tileGeometryPixels = std::move(sub.tileGeometryPixels);
+        const std::size_t lists = result.listCount.size();
+        gt.listShadingWork.assign(lists, 0);
+        gt.listExactWork.assign(lists, 0);
+        gt.listFalseNegatives.assign(lists, 0);
+        for (std::size_t l = 0; l < tileOf.size(); ++l) {
+            gt.listShadingWork[tileOf[l]] += sub.listShadingWork[l];
+            gt.listExactWork[tileOf[l]] += sub.listExactWork[l];
+            gt.listFalseNegatives[tileOf[l]] += sub.listFalseNegatives[l];
+        }
+        // The masks are the lists the renderer keeps: their lengths and bytes.
+        Metrics& m = gt.metrics;
+        m.maxList = 0;
+        for (std::uint32_t c : result.listCount) m.maxList = std::max(m.maxList, c);
+        m.meanList = lists == 0 ? 0.0 : double(result.entries()) / double(lists);
+        m.resultBytes = result.bytes();
+        return gt;
+    }
 
     const std::size_t lists = result.listCount.size();
     const std::size_t tiles = result.grid.tileCount();
@@ -149,6 +179,10 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
         };
         std::vector<Acc> acc(workers);
         const bool oneList = result.algorithm == Algorithm::All;
+        // Per-pixel lists (zbin's): the optimum is the per-tile one, so the
+        // union is counted per tile (one "sub-list").
+        const bool perTileUnion = !result.pixelList.empty();
+        const std::size_t unions = perTileUnion ? std::max(lists, tiles) : lists;
         const std::uint32_t per = std::max(result.listsPerTile, 1u); // <= 32: one bit per sub-list
         for (auto& a : acc) {
             a.w.assign(lists, 0), a.e.assign(lists, 0), a.fn.assign(lists, 0);
@@ -156,7 +190,7 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
             if (oneList) {
                 a.neededAnywhere.assign(lights.size(), 0);
             } else {
-                a.listPixels.assign(lists, 0), a.listUnion.assign(lists, 0);
+                a.listPixels.assign(unions, 0), a.listUnion.assign(unions, 0);
                 a.unionTile.assign(lights.size(), std::numeric_limits<std::uint32_t>::max());
                 a.unionSubs.assign(lights.size(), 0);
             }
@@ -196,7 +230,8 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
                             stampedList = l;
                         }
                         a.w[l] += result.listCount[l];
-                        const std::uint32_t subBit = oneList ? 0u : 1u << (l - t * per);
+                        const std::uint32_t subBit = oneList || perTileUnion ? 1u : 1u << (l - t * per);
+                        const std::uint32_t u = perTileUnion ? t : l; // where the union counts
                         std::uint64_t needed = 0, missed = 0;
                         grid.forEachContaining(p, [&](std::uint32_t i) {
                             ++needed;
@@ -208,12 +243,12 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
                             if (a.unionTile[i] != t) a.unionTile[i] = t, a.unionSubs[i] = 0;
                             if (!(a.unionSubs[i] & subBit)) {
                                 a.unionSubs[i] |= subBit;
-                                ++a.listUnion[l];
+                                ++a.listUnion[u];
                             }
                         });
                         a.e[l] += needed;
                         a.fn[l] += missed;
-                        if (!oneList) ++a.listPixels[l];
+                        if (!oneList) ++a.listPixels[u];
                     }
         });
         if (oneList) {
@@ -230,7 +265,7 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
             // optimal += pixels of the list x lights its pixels need together
             // (each list lies in one band: one worker has all of it).
             for (const Acc& a : acc)
-                for (std::size_t l = 0; l < lists; ++l) m.optimalWork += a.listPixels[l] * a.listUnion[l];
+                for (std::size_t l = 0; l < a.listPixels.size(); ++l) m.optimalWork += a.listPixels[l] * a.listUnion[l];
         }
         for (const Acc& a : acc) {
             for (std::size_t l = 0; l < lists; ++l) {

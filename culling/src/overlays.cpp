@@ -54,10 +54,45 @@ std::optional<FrustumChunk> tileFrustum(const CullResult& r, const Projection& p
                                         const ViewLights& lights, std::uint32_t tile) {
     if (tile >= r.grid.tileCount()) return std::nullopt;
     const auto rect = r.grid.tileRect(tile % r.grid.tilesX, tile / r.grid.tilesX);
-    if (r.algorithm == Algorithm::Naive || r.algorithm == Algorithm::All)
+    if (r.algorithm == Algorithm::Naive || r.algorithm == Algorithm::All || r.algorithm == Algorithm::ZBin)
         return makeFrustumChunk(proj, rect, proj.nearPlane(), cameraFarDepth(proj, lights, r.settings.spotTest));
     if (!tileHasGeometry(r, tile)) return std::nullopt;
     return makeFrustumChunk(proj, rect, r.tileDepthMin[tile], r.tileDepthMax[tile]);
+}
+
+namespace {
+
+// zbin: the view depth where bin b starts (b == bins: the far end).
+double zbinBoundary(const CullResult& r, std::uint32_t b) {
+    return r.zbinNear + (r.zbinFar - r.zbinNear) * double(b) / double(std::max<std::size_t>(r.zbinLo.size(), 1));
+}
+
+// zbin: the bins of a tile's depth range in at most 32 groups of
+// consecutive bins: [first, last] of group g.
+struct BinGroups {
+    std::uint32_t b0 = 0, count = 0, groups = 0;
+    std::uint32_t first(std::uint32_t g) const { return b0 + std::uint32_t(std::uint64_t(g) * count / groups); }
+    std::uint32_t last(std::uint32_t g) const { return first(g + 1) - 1; }
+};
+BinGroups zbinGroups(const CullResult& r, std::uint32_t tile) {
+    BinGroups g;
+    if (r.zbinLo.empty() || !tileHasGeometry(r, tile)) return g;
+    g.b0 = r.zbinOf(r.tileDepthMin[tile]);
+    g.count = r.zbinOf(r.tileDepthMax[tile]) - g.b0 + 1;
+    g.groups = std::min(g.count, 32u);
+    return g;
+}
+
+} // namespace
+
+std::optional<FrustumChunk> zbinLightSlab(const CullResult& r, const Projection& proj, const ViewLights& lights,
+                                          std::uint32_t light) {
+    if (r.algorithm != Algorithm::ZBin || r.zbinLo.empty() || light >= lights.size()) return std::nullopt;
+    const BoundingSphere s = lights.cullSphere(light, r.settings.spotTest);
+    const double a = -s.center.z - s.radius, b = -s.center.z + s.radius;
+    if (b < r.zbinNear || a > r.zbinFar) return std::nullopt;
+    const TileGrid::Rect screen{0, 0, r.grid.width, r.grid.height};
+    return makeFrustumChunk(proj, screen, zbinBoundary(r, r.zbinOf(a)), zbinBoundary(r, r.zbinOf(b) + 1));
 }
 
 std::vector<DepthCell> tileCells(const CullResult& r, const Projection& proj, std::uint32_t tile) {
@@ -88,6 +123,13 @@ std::vector<DepthCell> tileCells(const CullResult& r, const Projection& proj, st
         cells.push_back({1, 2 * tile + 1, true, makeFrustumChunk(proj, rect, split, hi)});
         break;
     }
+    case Algorithm::ZBin: {
+        const BinGroups g = zbinGroups(r, tile);
+        for (std::uint32_t k = 0; k < g.groups; ++k)
+            cells.push_back({k, tile, true,
+                             makeFrustumChunk(proj, rect, zbinBoundary(r, g.first(k)), zbinBoundary(r, g.last(k) + 1))});
+        break;
+    }
     case Algorithm::Clustered: {
         const std::uint32_t n = r.listsPerTile;
         for (std::uint32_t k = 0; k < n; ++k) {
@@ -116,6 +158,15 @@ std::uint32_t lightCellRange(const CullResult& r, std::uint32_t tile, const glm:
         return sliceRangeMask(r.settings.slicing, r.tileDepthMin[tile], r.tileDepthMax[tile], r.settings.cells, a, b);
     case Algorithm::Clustered:
         return sliceRangeMask(r.settings.slicing, r.clusterNear, r.clusterFar, r.listsPerTile, a, b);
+    case Algorithm::ZBin: {
+        const BinGroups g = zbinGroups(r, tile);
+        if (g.groups == 0 || b < r.zbinNear || a > r.zbinFar) return 0;
+        const std::uint32_t la = r.zbinOf(a), lb = r.zbinOf(b);
+        std::uint32_t m = 0;
+        for (std::uint32_t k = 0; k < g.groups; ++k)
+            if (la <= g.last(k) && lb >= g.first(k)) m |= 1u << k;
+        return m;
+    }
     case Algorithm::HalfZ: {
         if (!tileHasGeometry(r, tile) || tile >= r.halfzSplit.size()) return 0;
         const double lo = r.tileDepthMin[tile], hi = r.tileDepthMax[tile], split = r.halfzSplit[tile];

@@ -13,7 +13,7 @@ constexpr std::pair<Algorithm, const char*> kAlgorithms[] = {
     {Algorithm::All, "all"},          {Algorithm::Naive, "naive"},
     {Algorithm::MinMax, "minmax"},    {Algorithm::HalfZ, "halfz"},
     {Algorithm::TwoPointFiveD, "2.5d"}, {Algorithm::Clustered, "clustered"},
-    {Algorithm::Fptl, "fptl"}};
+    {Algorithm::Fptl, "fptl"},        {Algorithm::ZBin, "zbin"}};
 constexpr SphereTest kTests[] = {SphereTest::Planes, SphereTest::PlanesAabb, SphereTest::Exact};
 constexpr Slicing kSlicings[] = {Slicing::Log, Slicing::Linear};
 constexpr SpotTest kSpotTests[] = {SpotTest::ApexSphere, SpotTest::TightSphere, SpotTest::ConeSphere,
@@ -38,7 +38,8 @@ std::vector<ParamSpec> buildTable() {
                  "culling algorithm: all (no culling), naive (tile planes + camera near/far), "
                  "minmax (tile min/max depth), halfz (two lists split at mid depth), 2.5d "
                  "(depth-cell occupancy mask), clustered (3D froxel grid), fptl (fine-pruned tiles: "
-                 "minmax, then each light tested against the tile's pixels)",
+                 "minmax, then each light tested against the tile's pixels), zbin (Z-binning: a "
+                 "screen-space light mask per tile and linear view-depth bins of the depth-sorted lights)",
                  "Algorithm"});
     t.push_back({"test", ParamType::Choice, "planes", tests, 0, 0,
                  "sphere-vs-volume test: planes (6 planes), planes+aabb (planes and the chunk's "
@@ -57,6 +58,9 @@ std::vector<ParamSpec> buildTable() {
                  "sphere around the cone), cone-sphere (tight sphere, then cone vs the cell's "
                  "bounding sphere), cone-planes (tight sphere, then cone vs each cell plane)",
                  "Spot test"});
+    t.push_back({"bins", ParamType::Int, "1024", {}, 1, 16384,
+                 "zbin: view-depth bins, linear from the near plane to the far plane (or the farthest "
+                 "light)", "Bins"});
     t.push_back({"tile", ParamType::Int, "16", {}, 1, 256, "tile size in pixels", "Tile"});
     t.push_back({"width", ParamType::Int, "1280", {}, 1, 16384, "render width in pixels", "Width"});
     t.push_back({"height", ParamType::Int, "720", {}, 1, 16384, "render height in pixels", "Height"});
@@ -103,6 +107,7 @@ Algorithm algorithmFromString(const std::string& s) {
 std::string CullSettings::validate() const {
     if (cells < 1 || cells > 32)
         return "cells: must be an integer in 1..32, got " + std::to_string(cells);
+    if (bins < 1 || bins > 16384) return "bins: must be an integer in 1..16384, got " + std::to_string(bins);
     bool knownAlgo = false;
     for (const auto& x : kAlgorithms) knownAlgo |= x.first == algorithm;
     if (!knownAlgo) return "algorithm: unknown value";
@@ -136,6 +141,7 @@ void setParam(CullSettings& s, Camera& camera, const std::string& name, const st
     else if (name == "slicing") s.slicing = kSlicings[parseChoice(p, value)];
     else if (name == "skip-empty") s.skipEmpty = parseBool(p, value);
     else if (name == "spot-test") s.spotTest = kSpotTests[parseChoice(p, value)];
+    else if (name == "bins") s.bins = std::uint32_t(parseInt(p, value));
     else if (name == "tile") camera.tileSize = std::uint32_t(parseInt(p, value));
     else if (name == "width") camera.width = std::uint32_t(parseInt(p, value));
     else if (name == "height") camera.height = std::uint32_t(parseInt(p, value));
@@ -149,6 +155,7 @@ std::string getParam(const CullSettings& s, const Camera& camera, const std::str
     if (name == "slicing") return toString(s.slicing);
     if (name == "skip-empty") return s.skipEmpty ? "true" : "false";
     if (name == "spot-test") return toString(s.spotTest);
+    if (name == "bins") return std::to_string(s.bins);
     if (name == "tile") return std::to_string(camera.tileSize);
     if (name == "width") return std::to_string(camera.width);
     return std::to_string(camera.height);

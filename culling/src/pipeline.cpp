@@ -85,8 +85,12 @@ std::vector<float> shadeImage(CullBackend& backend, const ShadeInputs& in, const
 
 void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
                      const CancelToken* cancel, double sliceMs, const Progress& progress) {
-    const ShadeInputs culledIn = makeShadeInputs(out.depth, proj, &out.result);
-    const CullResult& r = out.result;
+    // zbin: the lists its pixels loop over, a (tile, bin) each.
+    const bool zbin = out.result.algorithm == Algorithm::ZBin;
+    CullResult perPixel;
+    if (zbin) perPixel = zbinPixelLists(out.result, out.depth, proj);
+    const CullResult& r = zbin ? perPixel : out.result;
+    const ShadeInputs culledIn = makeShadeInputs(out.depth, proj, &r);
     // shadeCpu's row bands: a tile row (at least 4) for lists, 16 rows for all lights.
     const std::uint32_t align = std::lcm(std::max(r.grid.tileSize, 4u), 16u);
     double culledMs = 0, allMs = 0;

@@ -80,6 +80,7 @@ bool paramAppliesTo(const std::string& name, Algorithm a, std::uint32_t cells, b
     if (name == "cells") return a == Algorithm::TwoPointFiveD || a == Algorithm::Clustered;
     if (name == "slicing") return (a == Algorithm::TwoPointFiveD || a == Algorithm::Clustered) && cells > 1;
     if (name == "skip-empty") return a == Algorithm::Clustered;
+    if (name == "bins") return a == Algorithm::ZBin;
     return true; // tile, test, and parameters added later
 }
 

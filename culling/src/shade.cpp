@@ -304,6 +304,10 @@ std::vector<float> shadeCpu(const ShadeInputs& in, const ViewLights& lights, con
 
 std::vector<float> shadeLambertCpu(const DepthImage& depth, const Projection& proj, const ViewLights& lights,
                                    const CullResult* culled) {
+    if (culled && culled->algorithm == Algorithm::ZBin && culled->pixelList.empty()) {
+        const CullResult perPixel = zbinPixelLists(*culled, depth, proj); // what a zbin pixel loops over
+        return shadeCpu(makeShadeInputs(depth, proj, &perPixel), lights, &perPixel);
+    }
     return shadeCpu(makeShadeInputs(depth, proj, culled), lights, culled);
 }
 

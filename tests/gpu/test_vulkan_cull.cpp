@@ -22,7 +22,7 @@ using lc::gputest::GpuTest;
 namespace {
 
 const Algorithm kAlgorithms[] = {Algorithm::All,    Algorithm::Naive,         Algorithm::MinMax,
-                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl};
+                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin};
 const SphereTest kTests[] = {SphereTest::Planes, SphereTest::PlanesAabb, SphereTest::Exact};
 
 struct Comparison {
@@ -432,8 +432,15 @@ TEST_F(GpuTest, ResultBytesFollowTheEntries) {
                 const CullResult r = b->cull(depth, proj, grid, lights, st);
                 const std::string label = std::string(name) + " " + toString(a) + " " + r.backend;
                 const std::uint64_t lists = r.listCountTotal();
-                EXPECT_LE(r.bytes(), 4 * r.entries() + 8 * lists + 4096) << label;
-                EXPECT_GE(r.bytes(), 4 * r.entries() + 8 * lists) << label;
+                if (a == Algorithm::ZBin) {
+                    // The renderer's form: a 32-bit range per bin, a bit per light per tile.
+                    EXPECT_EQ(r.bytes(), 4 * std::uint64_t(st.bins) +
+                                             4 * std::uint64_t(grid.tileCount()) * ((lights.size() + 31) / 32))
+                        << label;
+                } else {
+                    EXPECT_LE(r.bytes(), 4 * r.entries() + 8 * lists + 4096) << label;
+                    EXPECT_GE(r.bytes(), 4 * r.entries() + 8 * lists) << label;
+                }
                 EXPECT_EQ(r.diagnosticBytes(), 8 * std::uint64_t(grid.tileCount()) + 4 * r.cellMask.size()) << label;
                 if (a == Algorithm::HalfZ)
                     for (std::uint32_t t = 0; t < grid.tileCount(); ++t)
@@ -647,4 +654,44 @@ TEST_F(GpuTest, FinePrunedTilesReachThePerTileOptimum) {
     const Comparison cmp = compareLists(cpu.result, gpu.result);
     EXPECT_EQ(cmp.missing, 0u) << cmp.firstMissing;
     EXPECT_LE(cmp.extra, 8 + cmp.cpuEntries / 200);
+}
+
+// zbin on the GPU: the same depth order, the same masks up to float
+// widening, and every bin's range holding the reference's (zbin.comp widens
+// each light's depth extent), at several bin counts.
+TEST_F(GpuTest, ZBinBinsHoldTheReferenceBins) {
+    Scene scene = sized("forest", 320, 180);
+    LightGenSettings g = defaultLightGen(scene, 700, 4);
+    g.spotFraction = 0.2;
+    scene.lights = generateLights(g);
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(320, 180, 16);
+    const ViewLights lights = makeViewLights(scene);
+    auto cpuBackend = makeCpuBackend();
+    const DepthImage depth = cpuBackend->renderDepth(scene, proj);
+    for (std::uint32_t bins : {1u, 100u, 4096u, 16384u}) {
+        SCOPED_TRACE(bins);
+        CullSettings st;
+        st.algorithm = Algorithm::ZBin;
+        st.bins = bins;
+        const CullResult cpu = cpuBackend->cull(depth, proj, grid, lights, st);
+        const CullResult gpu = gputest::vulkan().cull(depth, proj, grid, lights, st);
+        ASSERT_EQ(gpu.validate(lights.size()), "");
+        EXPECT_EQ(gpu.zbinOrder, cpu.zbinOrder);
+        EXPECT_EQ(gpu.zbinNear, cpu.zbinNear);
+        EXPECT_EQ(gpu.zbinFar, cpu.zbinFar);
+        std::size_t wider = 0, used = 0;
+        for (std::uint32_t b = 0; b < bins; ++b) {
+            if (cpu.zbinLo[b] > cpu.zbinHi[b]) continue;
+            ++used;
+            ASSERT_LE(gpu.zbinLo[b], cpu.zbinLo[b]) << "bin " << b;
+            ASSERT_GE(gpu.zbinHi[b], cpu.zbinHi[b]) << "bin " << b;
+            wider += gpu.zbinLo[b] != cpu.zbinLo[b] || gpu.zbinHi[b] != cpu.zbinHi[b];
+        }
+        EXPECT_GT(used, 0u);
+        EXPECT_LE(wider, 2 + used / 50) << "bins widened by more than rounding";
+        GroundTruthOptions o;
+        o.imageError = false;
+        EXPECT_EQ(computeGroundTruth(depth, proj, lights, gpu, o).metrics.falseNegatives, 0u);
+    }
 }

@@ -72,7 +72,7 @@ TEST_F(VulkanShade, MatchesTheCpuReferenceForEveryAlgorithmAndAllLights) {
         EXPECT_GE(gpu.lastShadeMs(), 0.0);
     }
     for (Algorithm algo : {Algorithm::All, Algorithm::Naive, Algorithm::MinMax, Algorithm::HalfZ,
-                           Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl}) {
+                           Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin}) {
         CullSettings settings;
         settings.algorithm = algo;
         settings.cells = 8;

@@ -30,7 +30,7 @@ using lc::hardcase::hardCases;
 namespace {
 
 const Algorithm kAlgorithms[] = {Algorithm::All,    Algorithm::Naive,         Algorithm::MinMax,
-                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl};
+                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin};
 
 const HardCase& caseNamed(const std::string& name) {
     for (const HardCase& c : hardCases())
@@ -62,6 +62,7 @@ void expectFiniteOutputs(const RunOutput& run) {
             EXPECT_EQ(lo, hardcase::kInf) << "empty tile " << t << " min";
             EXPECT_EQ(hi, -hardcase::kInf) << "empty tile " << t << " max";
             const bool depthFree = r.algorithm == Algorithm::All || r.algorithm == Algorithm::Naive ||
+                                   r.algorithm == Algorithm::ZBin ||
                                    (r.algorithm == Algorithm::Clustered && !r.settings.skipEmpty);
             if (!depthFree)
                 for (std::uint32_t k = 0; k < r.listsPerTile; ++k)

@@ -21,7 +21,7 @@ using namespace lc;
 namespace {
 
 const Algorithm kAlgorithms[] = {Algorithm::All,    Algorithm::Naive,         Algorithm::MinMax,
-                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl};
+                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin};
 const SpotTest kSpotTests[] = {SpotTest::ApexSphere, SpotTest::TightSphere, SpotTest::ConeSphere,
                                SpotTest::ConePlanes};
 
@@ -203,7 +203,7 @@ TEST_F(SpotVulkan, ManySpotsEveryTestIsASupersetOfTheCpu) {
     GroundTruthOptions o;
     o.imageError = false;
     for (Algorithm algo : {Algorithm::MinMax, Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Naive,
-                           Algorithm::Fptl})
+                           Algorithm::Fptl, Algorithm::ZBin})
         for (SpotTest t : kSpotTests) {
             SCOPED_TRACE(std::string(toString(algo)) + " " + toString(t));
             CullSettings st;

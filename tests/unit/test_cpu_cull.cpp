@@ -7,6 +7,7 @@
 //    per-light tile rectangles.
 #include "culling/backend.hpp"
 #include "culling/errors.hpp"
+#include "culling/ground_truth.hpp"
 
 #include <gtest/gtest.h>
 
@@ -111,10 +112,15 @@ std::uint64_t falseNegatives(const CullRun& r, std::uint64_t* exactWork = nullpt
             const std::uint32_t l = r.result.listOfPixel(x, y, -p.z);
             const auto* b = r.result.lightIndices.data() + r.result.listOffset[l];
             const auto* en = b + r.result.listCount[l];
+            // zbin: the pixel loops over the mask's lights within its bin's range.
+            const bool zbin = r.result.algorithm == Algorithm::ZBin;
+            const std::uint32_t bin = zbin ? r.result.zbinOf(-p.z) : 0;
             for (std::size_t i = 0; i < r.lights.size(); ++i) {
                 if (glm::length(p - r.lights.centers[i]) > r.lights.radii[i]) continue;
                 ++e;
-                fn += !std::binary_search(b, en, std::uint32_t(i));
+                const bool inBin = !zbin || (r.result.zbinLo[bin] <= r.result.zbinRank[i] &&
+                                             r.result.zbinRank[i] <= r.result.zbinHi[bin]);
+                fn += !std::binary_search(b, en, std::uint32_t(i)) || !inBin;
             }
         }
     if (exactWork) *exactWork = e;
@@ -156,6 +162,7 @@ std::vector<std::vector<std::uint32_t>> bruteForceLists(const CullRun& r) {
                 return sphereIntersectsChunk(st.test, makeFrustumChunk(proj, rect, a, b), c, rad);
             };
             switch (res.algorithm) {
+            case Algorithm::ZBin: // the tile masks: naive's screen-space test
             case Algorithm::Naive: {
                 const double f = std::isinf(proj.farPlane()) ? std::max(lightFar, proj.nearPlane()) : proj.farPlane();
                 if (hit(proj.nearPlane(), f)) out[t].push_back(std::uint32_t(i));
@@ -227,7 +234,7 @@ const ProjectionKind kKinds[] = {ProjectionKind::Perspective, ProjectionKind::Pe
                                  ProjectionKind::ReversedZ, ProjectionKind::Orthographic,
                                  ProjectionKind::OrthographicGL};
 const Algorithm kAlgorithms[] = {Algorithm::All,   Algorithm::Naive,         Algorithm::MinMax,
-                                 Algorithm::HalfZ, Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl};
+                                 Algorithm::HalfZ, Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin};
 const SphereTest kTests[] = {SphereTest::Planes, SphereTest::PlanesAabb, SphereTest::Exact};
 
 } // namespace
@@ -462,4 +469,68 @@ TEST(Backends, RegistryAndViewLights) {
         EXPECT_EQ(e.index(), 1u);
         EXPECT_EQ(e.lightName(), "bad");
     }
+}
+
+// zbin: the bins are the ranges of sorted positions whose depth extent
+// reaches them, no wider; a pixel's loop (mask within its bin's range) is what
+// the ground truth counts as shading work; and the bins cut the masks' work.
+TEST(CpuCull, ZBinBinsAreTightAndTheGroundTruthCountsThePixelsLoops) {
+    const Scene scene = syntheticScene(ProjectionKind::Perspective, 96, 64, 16, 120, 11);
+    CullSettings st;
+    st.algorithm = Algorithm::ZBin;
+    st.bins = 64;
+    const CullRun r = runCpu(scene, st);
+    const CullResult& z = r.result;
+    ASSERT_EQ(z.validate(r.lights.size()), "");
+    ASSERT_EQ(z.zbinLo.size(), 64u);
+    // Sorted by centre depth.
+    for (std::size_t k = 1; k < z.zbinOrder.size(); ++k)
+        EXPECT_LE(-r.lights.centers[z.zbinOrder[k - 1]].z, -r.lights.centers[z.zbinOrder[k]].z);
+    const double width = (z.zbinFar - z.zbinNear) / 64;
+    std::size_t nonEmpty = 0;
+    for (std::uint32_t b = 0; b < 64; ++b) {
+        const double lo = z.zbinNear + b * width, hi = lo + width;
+        // Brute force: the sorted positions whose extent overlaps [lo, hi].
+        std::uint32_t first = ~0u, last = 0;
+        for (std::uint32_t k = 0; k < z.zbinOrder.size(); ++k) {
+            const std::uint32_t l = z.zbinOrder[k];
+            const double d = -r.lights.centers[l].z, rad = r.lights.radii[l];
+            if (d + rad >= lo - 1e-9 * hi && d - rad < hi + 1e-9 * hi) first = std::min(first, k), last = std::max(last, k);
+        }
+        if (first == ~0u) {
+            EXPECT_GT(z.zbinLo[b], z.zbinHi[b]) << "bin " << b;
+            continue;
+        }
+        ++nonEmpty;
+        EXPECT_EQ(z.zbinLo[b], first) << "bin " << b;
+        EXPECT_EQ(z.zbinHi[b], last) << "bin " << b;
+    }
+    EXPECT_GT(nonEmpty, 10u);
+    // Shading work: per pixel, the mask's lights whose rank is in its bin's range.
+    const Projection proj(scene.camera);
+    std::uint64_t work = 0;
+    for (std::uint32_t y = 0; y < r.depth.height; ++y)
+        for (std::uint32_t x = 0; x < r.depth.width; ++x) {
+            if (!r.depth.hasGeometry(x, y)) continue;
+            const std::uint32_t t = z.grid.tileOfPixel(x, y), b = z.zbinOf(-proj.viewPositionFromDepth(x, y, r.depth.at(x, y)).z);
+            for (std::uint32_t i = 0; i < z.listCount[t]; ++i) {
+                const std::uint32_t k = z.zbinRank[z.lightIndices[z.listOffset[t] + i]];
+                work += z.zbinLo[b] <= k && k <= z.zbinHi[b];
+            }
+        }
+    GroundTruthOptions o;
+    o.imageError = false;
+    const GroundTruth gt = computeGroundTruth(r.depth, proj, r.lights, z, o);
+    EXPECT_EQ(gt.metrics.shadingWork, work);
+    EXPECT_EQ(gt.metrics.falseNegatives, 0u);
+    std::uint64_t perTile = 0;
+    for (std::uint64_t w : gt.listShadingWork) perTile += w;
+    EXPECT_EQ(perTile, work);
+    EXPECT_EQ(gt.listShadingWork.size(), z.listCount.size());
+    // The masks are naive's lists; the bins cut the work a pixel loops over.
+    st.algorithm = Algorithm::Naive;
+    const CullRun naive = runCpu(scene, st);
+    EXPECT_EQ(naive.result.lightIndices, z.lightIndices);
+    EXPECT_LT(work, computeGroundTruth(naive.depth, proj, naive.lights, naive.result, o).metrics.shadingWork);
+    EXPECT_EQ(z.bytes(), 4u * 64 + 4u * z.grid.tileCount() * ((r.lights.size() + 31) / 32));
 }

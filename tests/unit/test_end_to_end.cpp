@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const char* kAlgorithms[] = {"all", "naive", "minmax", "halfz", "2.5d", "clustered", "fptl"};
+const char* kAlgorithms[] = {"all", "naive", "minmax", "halfz", "2.5d", "clustered", "fptl", "zbin"};
 
 nlohmann::json runAndRead(const ScratchDir& s, const std::vector<std::string>& extra, const std::string& tag) {
     const fs::path out = s.path / tag;

@@ -39,7 +39,7 @@ TEST(Explain, TestsAgreeWithTheReferenceListsForEveryAlgorithm) {
     const Scene s = smallAtrium();
     const Projection proj(s.camera);
     for (const Algorithm a : {Algorithm::All, Algorithm::Naive, Algorithm::MinMax, Algorithm::HalfZ,
-                              Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl}) {
+                              Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin}) {
         for (const SphereTest t : {SphereTest::Planes, SphereTest::Exact}) {
             for (const SpotTest st : {SpotTest::ApexSphere, SpotTest::ConePlanes}) {
                 CullSettings cs;

@@ -144,7 +144,7 @@ TEST(Export, SummaryJsonHasEveryKeyConsistentWithTheRun) {
 
 TEST(Export, TilesCsvHasOneRowPerListMatchingTheResult) {
     for (Algorithm alg : {Algorithm::All, Algorithm::MinMax, Algorithm::HalfZ, Algorithm::TwoPointFiveD,
-                          Algorithm::Clustered, Algorithm::Fptl}) {
+                          Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin}) {
         const PipelineRun r = runBuiltin("sky", alg, 100, 70); // partial edge tiles, many empty tiles
         const CullResult& res = r.out.result;
         const std::string csv = tilesCsv(r.out);

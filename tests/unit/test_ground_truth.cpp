@@ -451,7 +451,7 @@ TEST(GroundTruthOptimum, MatchesBruteForceForEveryListRule) {
     const TileGrid grid = TileGrid::make(s.camera.width, s.camera.height, s.camera.tileSize);
     auto backend = makeCpuBackend();
     for (const Algorithm a : {Algorithm::All, Algorithm::MinMax, Algorithm::HalfZ, Algorithm::TwoPointFiveD,
-                              Algorithm::Clustered, Algorithm::Fptl}) {
+                              Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin}) {
         CullSettings cs;
         cs.algorithm = a;
         cs.cells = 8;

@@ -124,7 +124,7 @@ TEST(Overlays, TileFrustumCornersLieOnTheCullingPlanes) {
 // list of the run, for every algorithm with tile volumes.
 TEST(Overlays, OverlayVolumesReproduceEveryList) {
     for (Algorithm alg : {Algorithm::Naive, Algorithm::MinMax, Algorithm::HalfZ, Algorithm::TwoPointFiveD,
-                          Algorithm::Clustered, Algorithm::Fptl}) {
+                          Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin}) {
         for (Slicing slicing : {Slicing::Log, Slicing::Linear}) {
             SCOPED_TRACE(std::string(toString(alg)) + " " + toString(slicing));
             const CulledScene run = runBuiltin("atrium", alg, ProjectionKind::Perspective, slicing);
@@ -149,6 +149,7 @@ TEST(Overlays, OverlayVolumesReproduceEveryList) {
                     const std::uint32_t range = lightCellRange(r, t, c, rad);
                     switch (alg) {
                     case Algorithm::Naive:
+                    case Algorithm::ZBin: // its masks: the screen-space frustum
                     case Algorithm::MinMax:
                         if (frustum && sphereIntersectsChunk(r.settings.test, *frustum, c, rad)) expect[0].push_back(l);
                         break;
@@ -326,7 +327,7 @@ TEST(Overlays, ReverseLookupMatchesTilesCsv) {
 // there is no geometry.
 TEST(Overlays, TileHeatAddsUpToTheRunsMetrics) {
     for (Algorithm alg : {Algorithm::Naive, Algorithm::MinMax, Algorithm::HalfZ, Algorithm::TwoPointFiveD,
-                          Algorithm::Clustered, Algorithm::Fptl}) {
+                          Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin}) {
         SCOPED_TRACE(toString(alg));
         const CulledScene run = runBuiltin("sky", alg); // sky: most tiles hold no geometry
         const CullResult& r = run.out.result;

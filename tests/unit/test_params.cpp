@@ -10,8 +10,8 @@ TEST(Params, TableOrderAndDefaultsMatchTheStructs) {
     const auto& t = cullParams();
     std::vector<std::string> names;
     for (const auto& p : t) names.push_back(p.name);
-    EXPECT_EQ(names, (std::vector<std::string>{"algorithm", "test", "cells", "slicing", "skip-empty", "spot-test", "tile",
-                                               "width", "height"}));
+    EXPECT_EQ(names, (std::vector<std::string>{"algorithm", "test", "cells", "slicing", "skip-empty", "spot-test", "bins",
+                                               "tile", "width", "height"}));
     // The table's defaults are the structs' defaults.
     const CullSettings s;
     const Camera cam;
@@ -21,13 +21,15 @@ TEST(Params, TableOrderAndDefaultsMatchTheStructs) {
         EXPECT_FALSE(p.label.empty()) << p.name;
     }
     EXPECT_EQ(cullParam("algorithm").choices,
-              (std::vector<std::string>{"all", "naive", "minmax", "halfz", "2.5d", "clustered", "fptl"}));
+              (std::vector<std::string>{"all", "naive", "minmax", "halfz", "2.5d", "clustered", "fptl", "zbin"}));
     EXPECT_EQ(cullParam("test").choices, (std::vector<std::string>{"planes", "planes+aabb", "exact"}));
     EXPECT_EQ(cullParam("cells").minValue, 1);
     EXPECT_EQ(cullParam("cells").maxValue, 32);
     EXPECT_EQ(cullParam("tile").maxValue, 256);
     EXPECT_EQ(cullParam("width").maxValue, 16384);
     EXPECT_EQ(cullParam("skip-empty").type, ParamType::Bool);
+    EXPECT_EQ(cullParam("bins").minValue, 1);
+    EXPECT_EQ(cullParam("bins").maxValue, 16384);
     EXPECT_THROW(cullParam("colour"), SettingsError);
 }
 
@@ -91,7 +93,7 @@ TEST(Params, BadValuesNameTheParameterAndTheValue) {
 
 TEST(Params, AlgorithmNamesAndSettingsValidate) {
     for (Algorithm a : {Algorithm::All, Algorithm::Naive, Algorithm::MinMax, Algorithm::HalfZ,
-                        Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl})
+                        Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin})
         EXPECT_EQ(algorithmFromString(toString(a)), a);
     EXPECT_STREQ(toString(Algorithm::TwoPointFiveD), "2.5d");
     try {

@@ -45,6 +45,7 @@ const uint LC_ALG_HALFZ = 3u;
 const uint LC_ALG_25D = 4u;
 const uint LC_ALG_CLUSTERED = 5u;
 const uint LC_ALG_FPTL = 6u;
+const uint LC_ALG_ZBIN = 7u;
 const uint LC_TEST_PLANES = 0u;
 const uint LC_TEST_PLANES_AABB = 1u;
 const uint LC_TEST_EXACT = 2u;

@@ -35,7 +35,7 @@ double cameraFarDepth(const Projection& proj, const ViewLights& lights,
 std::pair<std::uint32_t, std::uint32_t> tileLists(const CullResult& r, std::uint32_t tile);
 
 // The frustum a tile's lists were culled against, truncated in depth:
-// naive and all: the camera's near..cameraFarDepth; minmax, halfz, 2.5d and
+// naive, zbin (its mask) and all: the camera's near..cameraFarDepth; minmax, halfz, 2.5d and
 // clustered: the tile's geometry min..max view depth. nullopt for a tile
 // without geometry (except naive/all, whose range does not depend on it).
 std::optional<FrustumChunk> tileFrustum(const CullResult& r, const Projection& proj,
@@ -56,8 +56,17 @@ struct DepthCell {
 // - clustered: the froxels of the tile's column: settings.cells slices of
 //   [clusterNear, clusterFar], occupancy from cellMask, list t*cells + k; also
 //   for a tile without geometry (all cells empty then).
-// - naive, minmax, all: no cells. 2.5d and halfz tiles without geometry: none.
+// - zbin: the Z-bins the tile's depth range spans, in at most 32 cells of
+//   consecutive bins (cell k: its bins' depth range), all serving the mask.
+// - naive, minmax, fptl, all: no cells. 2.5d, halfz and zbin tiles without
+//   geometry: none.
 std::vector<DepthCell> tileCells(const CullResult& r, const Projection& proj, std::uint32_t tile);
+
+// zbin: the slab of the whole camera frustum over the bins light `light`'s
+// culling sphere spans (from its first bin's near boundary to its last bin's
+// far one); nullopt for other algorithms or a light that reaches no bin.
+std::optional<FrustumChunk> zbinLightSlab(const CullResult& r, const Projection& proj, const ViewLights& lights,
+                                          std::uint32_t light);
 
 // The cells of `tile` (as bits in tileCells' order) whose depth interval a
 // light's sphere (view-space centre, radius) reaches: sliceRangeMask of the

@@ -12,8 +12,9 @@
 
 namespace lc {
 
-enum class Algorithm { All, Naive, MinMax, HalfZ, TwoPointFiveD, Clustered, Fptl };
-const char* toString(Algorithm a);  // "all", "naive", "minmax", "halfz", "2.5d", "clustered", "fptl"
+enum class Algorithm { All, Naive, MinMax, HalfZ, TwoPointFiveD, Clustered, Fptl, ZBin };
+// "all", "naive", "minmax", "halfz", "2.5d", "clustered", "fptl", "zbin"
+const char* toString(Algorithm a);
 Algorithm algorithmFromString(const std::string& s); // throws SettingsError("algorithm", ...)
 
 // Settings of one culling run. Resolution and tile size live on the Camera
@@ -25,6 +26,7 @@ struct CullSettings {
     Slicing slicing = Slicing::Log;
     bool skipEmpty = true;           // clustered: empty clusters (no geometry) get empty lists
     SpotTest spotTest = SpotTest::ApexSphere; // how spot lights are culled (point lights ignore it)
+    std::uint32_t bins = 1024;       // zbin: linear view-depth bins (1..16384)
 
     // Empty when valid, else names the field.
     std::string validate() const;
@@ -46,7 +48,7 @@ struct ParamSpec {
 };
 
 // Every culling parameter, in display order: algorithm, test, cells, slicing,
-// skip-empty, spot-test, tile, width, height.
+// skip-empty, spot-test, bins, tile, width, height.
 const std::vector<ParamSpec>& cullParams();
 const ParamSpec& cullParam(const std::string& name); // throws SettingsError
 

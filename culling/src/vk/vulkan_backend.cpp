@@ -17,6 +17,9 @@
 //      geometry pixels, pruned entries marked;
 //   6. fine_prune pack, an invocation per list: kept entries to the front
 //      of the list's range, the new count; the host packs the ranges.
+//   zbin uploads the lights sorted by depth and culls naive's screen-space
+//   volume (its tile masks, as sorted positions, mapped back by the host),
+//   and zbin.comp bins the sorted lights in depth after light_bins.
 // So memory is the entries the scene produces, with no per-list cap and no
 // tiles x lights x cells allocation.
 #include "vk/vulkan_backend.hpp"
@@ -265,7 +268,7 @@ private:
     DescriptorSetLayoutHandle setLayout_;
     PipelineLayoutHandle computeLayout_;
     ShaderModuleHandle boundsShader_, boundsWideShader_, binsShader_, cullShader_, scanShader_, pruneShader_,
-        vertShader_;
+        zbinShader_, vertShader_;
     double lastCullWallMs_ = -1;
     std::uint32_t lastLongestList_ = 0; // of the previous cull: sizes a CPU device's stash
     std::map<std::string, PipelineHandle> computePipelines_;
@@ -287,6 +290,7 @@ void VulkanBackend::createComputeObjects() {
     cullShader_ = mk(spirv::cullLists(), "shader.cull_lists");
     scanShader_ = mk(spirv::prefixSum(), "shader.prefix_sum");
     pruneShader_ = mk(spirv::finePrune(), "shader.fine_prune");
+    zbinShader_ = mk(spirv::zbin(), "shader.zbin");
     vertShader_ = mk(spirv::depthVert(), "shader.depth_vert");
 }
 
@@ -629,13 +633,15 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     // Light bins: one bit per light per tile column and per tile row, then
     // per depth bin twice (near ends, far ends; light_bins.comp). `naive`
     // spans every light's depth and `all` tests nothing: no depth bins.
-    const bool depthBins = algo != Algorithm::All && algo != Algorithm::Naive && n > 0;
+    const bool zbin = algo == Algorithm::ZBin;
+    const bool depthBins = algo != Algorithm::All && algo != Algorithm::Naive && !zbin && n > 0;
     // Words per column, row or depth bin: a bit per light, padded to whole
     // uvec4s (cull_lists.comp reads four words a load on a CPU device).
     const std::uint32_t binWords = (n + 127) / 128 * 4;
     const std::uint64_t planeBinWords = std::uint64_t(binWords) * (grid.tilesX + grid.tilesY);
     const std::uint64_t depthBinWords = depthBins ? std::uint64_t(binWords) * LC_DEPTH_BINS : 0;
-    const std::uint64_t binTotal64 = planeBinWords + 2 * depthBinWords;
+    // zbin: its bins' (lo, hi) after the plane bins.
+    const std::uint64_t binTotal64 = planeBinWords + 2 * depthBinWords + (zbin ? 2 * std::uint64_t(settings.bins) : 0);
     if (binTotal64 * 4 > lim.maxStorageBufferRange)
         throw SettingsError("lights", "too many lights for the light bins of this device");
 
@@ -653,6 +659,17 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     if (algo == Algorithm::Clustered) {
         res.clusterNear = camNear;
         res.clusterFar = farInfinite ? std::max(lightFar, 2.0 * camNear) : proj.farPlane();
+    }
+    // zbin: the lights go up sorted by depth (as the CPU reference sorts them).
+    std::vector<std::uint32_t> upOrder(n);
+    for (std::uint32_t l = 0; l < n; ++l) upOrder[l] = l;
+    if (zbin) {
+        std::vector<double> centreDepth(n);
+        for (std::uint32_t l = 0; l < n; ++l) centreDepth[l] = -cullSpheres[l].center.z;
+        zbinSortLights(centreDepth, res.zbinOrder, res.zbinRank);
+        upOrder = res.zbinOrder;
+        res.zbinNear = camNear;
+        res.zbinFar = naiveFar;
     }
 
     // Inputs, prepared on the host.
@@ -676,20 +693,26 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         p.cluster = glm::vec4(float(res.clusterNear), float(res.clusterFar), kRelEps, kAbsEps);
         p.bins = glm::uvec4(binWords, binWords * grid.tilesX, stashSlots, std::uint32_t(planeBinWords));
         p.depthBins = depthBinSlicing(proj, camNear, lightNear, lightFar);
+        if (zbin)
+            p.depthBins = glm::vec4(float(camNear), naiveFar > camNear ? float(settings.bins / (naiveFar - camNear)) : 0.0f,
+                                    float(settings.bins), 0.0f);
     }
     std::vector<GpuLight> gpuLights(n);
-    for (std::uint32_t l = 0; l < n; ++l)
-        gpuLights[l].centerRadius = glm::vec4(glm::vec3(cullSpheres[l].center), float(cullSpheres[l].radius));
+    for (std::uint32_t k = 0; k < n; ++k) {
+        const BoundingSphere& s = cullSpheres[upOrder[k]];
+        gpuLights[k].centerRadius = glm::vec4(glm::vec3(s.center), float(s.radius));
+    }
     // One cone per light under a cone test (range 0: a point light), else a
     // single unused element.
     std::vector<GpuSpotCone> gpuSpots(spotCones ? n : 1, GpuSpotCone{});
     if (spotCones)
-        for (std::uint32_t l = 0; l < n; ++l) {
+        for (std::uint32_t k = 0; k < n; ++k) {
+            const std::uint32_t l = upOrder[k];
             if (!lights.isSpot(l)) continue;
             const SpotCone c = lights.spotCone(l);
-            gpuSpots[l].apexRange = glm::vec4(glm::vec3(c.apex), float(c.range));
-            gpuSpots[l].axisCos = glm::vec4(glm::vec3(c.axis), float(c.cosAngle));
-            gpuSpots[l].sinAngle = glm::vec4(float(c.sinAngle), 0.0f, 0.0f, 0.0f);
+            gpuSpots[k].apexRange = glm::vec4(glm::vec3(c.apex), float(c.range));
+            gpuSpots[k].axisCos = glm::vec4(glm::vec3(c.axis), float(c.cosAngle));
+            gpuSpots[k].sinAngle = glm::vec4(float(c.sinAngle), 0.0f, 0.0f, 0.0f);
         }
     const std::uint32_t statusZero[2] = {0, 0};
 
@@ -720,6 +743,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const auto* status = static_cast<const std::uint32_t*>(staging.download(statusBuf, 8));
     const auto* stashed =
         stashBytes ? static_cast<const std::uint32_t*>(staging.download(stashBuf, stashBytes)) : nullptr;
+    const auto* binWordsOut =
+        zbin ? static_cast<const std::uint32_t*>(staging.download(binBuf, binTotal64 * 4)) : nullptr;
 
     // Descriptor sets: one for passes 1-3, one with the sized index array for pass 4.
     VkDevice dev = ctx_.device();
@@ -814,6 +839,9 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     VkPipeline writePipe = computePipeline("cull_lists.write", cullShader_, spec(kLocal, 1, lanes), subgroupLanes);
     VkPipeline prunePipe = fptl ? computePipeline("fine_prune", pruneShader_, spec(kLocal, 0), false) : VK_NULL_HANDLE;
     VkPipeline packPipe = fptl ? computePipeline("fine_prune.pack", pruneShader_, spec(kLocal, 1), false) : VK_NULL_HANDLE;
+    VkPipeline zbinInitPipe = zbin ? computePipeline("zbin.init", zbinShader_, spec(kLocal, 0), false) : VK_NULL_HANDLE;
+    VkPipeline zbinPipe = zbin ? computePipeline("zbin", zbinShader_, spec(kLocal, 1), false) : VK_NULL_HANDLE;
+    const Grid zbinInitGroups = groupsFor(settings.bins, lim), zbinGroups = groupsFor(n, lim);
     // Scan: one subgroup on a CPU device while each lane's run (read and
     // write: 2 loop iterations per list) fits the loop cap, else wide.
     const bool wideScan = !ctx_.isCpuDevice() || 2 * (std::uint64_t(listTotal) / sg + 1) > kLoopLimit / 2;
@@ -842,6 +870,20 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                 // writes only the bins, which the bounds pass never touches.
                 vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, binsPipe);
                 vkCmdDispatch(cmd, binGroups.x, binGroups.y, 1);
+            }
+            if (zbin) {
+                // The bins' words follow the plane bins' in one buffer: ordered
+                // after light_bins, then the empty ranges before the lights.
+                computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+                vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, zbinInitPipe);
+                vkCmdDispatch(cmd, zbinInitGroups.x, zbinInitGroups.y, 1);
+                if (n > 0) {
+                    computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+                    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, zbinPipe);
+                    vkCmdDispatch(cmd, zbinGroups.x, zbinGroups.y, 1);
+                }
             }
             // The count pass reads the tile bounds and bins the two passes above wrote
             // (and ORs status after the bounds pass did).
@@ -946,6 +988,22 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         } else {
             res.lightIndices.assign(idx, idx + total);
         }
+    }
+
+    if (zbin) {
+        // The masks hold sorted positions: back to light indices, ascending.
+        for (std::uint32_t l = 0; l < listTotal; ++l) {
+            auto b = res.lightIndices.begin() + offs[l], e = b + counts[l];
+            for (auto it = b; it != e; ++it) *it = res.zbinOrder[*it];
+            std::sort(b, e);
+        }
+        res.zbinLo.assign(binWordsOut + planeBinWords, binWordsOut + planeBinWords + 2 * std::size_t(settings.bins));
+        res.zbinHi.resize(settings.bins);
+        for (std::uint32_t b = 0; b < settings.bins; ++b) {
+            res.zbinHi[b] = res.zbinLo[2 * std::size_t(b) + 1];
+            res.zbinLo[b] = res.zbinLo[2 * std::size_t(b)];
+        }
+        res.zbinLo.resize(settings.bins);
     }
 
     // Results out of the mapped (or staged) buffers.
