@@ -115,7 +115,8 @@ struct InspectorOverlays::Impl {
     vtkNew<vtkPolyData> spotSphere, spotPassed, spotRejected;
     vtkSmartPointer<vtkActor> spotSphereA, spotPassedA, spotRejectedA;
     vtkNew<vtkTextActor> spotCaption;
-    vtkNew<vtkPolyData> explainPlane, explainPixel;
+    vtkNew<vtkPolyData> explainPlane, explainPixel, zbinSlab;
+    vtkSmartPointer<vtkActor> zbinSlabA;
     vtkSmartPointer<vtkActor> explainPlaneA, explainEdgeA, explainPixelA;
     vtkNew<vtkPolyData> tileSolid, tileOutline, cellFill, cellOutline, cellSelected, splitQuad, lightRange,
         allTiles, reverse;
@@ -136,6 +137,7 @@ InspectorOverlays::InspectorOverlays(vtkRenderer* renderer, vtkSphereSource* sph
     d_->cellSelectedA = makeActor(d_->cellSelected, 1.0, 0.95, 0.2, 0.45, 3.0);
     d_->splitA = makeActor(d_->splitQuad, 1.0, 0.3, 0.9, 0.4);
     d_->rangeA = makeActor(d_->lightRange, 0.3, 1.0, 0.35, 1.0, 3.0);
+    d_->zbinSlabA = makeActor(d_->zbinSlab, 0.3, 1.0, 0.35, 0.15, 2.0); // the light range's green, translucent
     d_->reverseA = makeActor(d_->reverse, 1.0, 0.3, 1.0, 0.8, 1.5);
     d_->spotSphereA = makeActor(d_->spotSphere, 1.0, 0.5, 0.7, 1.0, 2.0); // pink: a spot is often white
     d_->spotPassedA = makeActor(d_->spotPassed, 0.25, 0.55, 1.0, 1.0, 2.0); // not the cell range's green
@@ -212,7 +214,7 @@ InspectorOverlays::InspectorOverlays(vtkRenderer* renderer, vtkSphereSource* sph
     for (vtkActor* a : {d_->allTilesA.Get(), d_->tileSolidA.Get(), d_->tileOutlineA.Get(), d_->cellFillA.Get(),
                         d_->cellOutlineA.Get(), d_->cellSelectedA.Get(), d_->splitA.Get(), d_->rangeA.Get(),
                         d_->reverseA.Get(), static_cast<vtkActor*>(d_->listedA.Get()),
-                        static_cast<vtkActor*>(d_->missingA.Get())}) {
+                        static_cast<vtkActor*>(d_->missingA.Get()), d_->zbinSlabA.Get()}) {
         a->SetVisibility(false);
         renderer->AddActor(a);
     }
@@ -233,11 +235,13 @@ vtkPolyData* InspectorOverlays::spotChunksPassed() const { return d_->spotPassed
 vtkPolyData* InspectorOverlays::spotChunksRejected() const { return d_->spotRejected; }
 vtkTextActor* InspectorOverlays::spotCaption() const { return d_->spotCaption; }
 vtkPolyData* InspectorOverlays::explainPlane() const { return d_->explainPlane; }
+vtkPolyData* InspectorOverlays::zbinSlab() const { return d_->zbinSlab; }
 vtkPolyData* InspectorOverlays::explainPixel() const { return d_->explainPixel; }
 
 void InspectorOverlays::update(const Document& doc) {
     for (vtkPolyData* pd : {d_->tileSolid.Get(), d_->tileOutline.Get(), d_->cellFill.Get(), d_->cellOutline.Get(),
-                            d_->cellSelected.Get(), d_->splitQuad.Get(), d_->lightRange.Get(), d_->reverse.Get()})
+                            d_->cellSelected.Get(), d_->splitQuad.Get(), d_->lightRange.Get(), d_->reverse.Get(),
+                            d_->zbinSlab.Get()})
         pd->Initialize();
     listed_.clear();
     missing_.clear();
@@ -254,7 +258,7 @@ void InspectorOverlays::update(const Document& doc) {
         for (vtkActor* a : {d_->allTilesA.Get(), d_->tileSolidA.Get(), d_->tileOutlineA.Get(), d_->cellFillA.Get(),
                             d_->cellOutlineA.Get(), d_->cellSelectedA.Get(), d_->splitA.Get(), d_->rangeA.Get(),
                             d_->reverseA.Get(), static_cast<vtkActor*>(d_->listedA.Get()),
-                            static_cast<vtkActor*>(d_->missingA.Get())})
+                            static_cast<vtkActor*>(d_->missingA.Get()), d_->zbinSlabA.Get()})
             show(a, false);
         d_->allTiles->Initialize();
         allTilesRun_ = nullptr;
@@ -319,6 +323,17 @@ void InspectorOverlays::update(const Document& doc) {
         g.into(d_->lightRange);
     }
     show(d_->rangeA, d_->lightRange->GetNumberOfCells() > 0);
+
+    // zbin: the slab of the camera frustum over the current light's bins.
+    if (opt.lightCellRange && lightOk)
+        if (const auto slab = lc::zbinLightSlab(r, proj, run->lights, std::uint32_t(light))) {
+            ChunkGeometry g;
+            g.worldFromView = w;
+            g.faces(*slab);
+            g.edges(*slab);
+            g.into(d_->zbinSlab);
+        }
+    show(d_->zbinSlabA, d_->zbinSlab->GetNumberOfCells() > 0);
 
     // Reverse look-up: the volumes whose lists hold the current light.
     if (opt.reverseLookup && lightOk) {

@@ -5,6 +5,8 @@
 // - its depth cells: occupied cells filled, empty ones outlined, the selected
 //   cell highlighted; the halfz split as a filled quad; clustered froxels;
 // - the cells the current light's sphere spans in that tile (green outline);
+//   under zbin also the slab of the whole camera frustum over its Z-bins
+//   (translucent green), and the tile's bins as its cells;
 // - every tile's frustum as ONE wireframe poly-data actor coloured by list
 //   length (interactive at ~8,000 tiles: 12 lines per tile, one draw);
 // - reverse look-up: the frustums (halfz/clustered: the cells) whose lists
@@ -63,6 +65,7 @@ public:
     vtkPolyData* cellOutline() const; // every cell (12 lines each)
     vtkPolyData* splitQuad() const;   // halfz split
     vtkPolyData* lightRange() const;  // cells the current light spans
+    vtkPolyData* zbinSlab() const;    // zbin: the camera frustum over the current light's bins
     vtkPolyData* allTiles() const;    // every tile frustum, "list_length" cell data
     vtkPolyData* reverse() const;     // volumes whose list holds the current light
     vtkActor* allTilesActor() const;

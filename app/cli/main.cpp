@@ -84,8 +84,11 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
               << r.grid.tileSize << " (" << r.grid.tilesX << "x" << r.grid.tilesY << " tiles), "
               << run.lights.size() << " lights\n"
               << "algorithm " << (run.custom ? "custom" : lc::toString(settings.algorithm)) << ", test "
-              << lc::toString(settings.test) << ", cells " << settings.cells << ", slicing "
-              << lc::toString(settings.slicing) << ", backend " << r.backend << " (" << r.device << ")\n"
+              << lc::toString(settings.test)
+              << (settings.algorithm == lc::Algorithm::ZBin ? ", bins " + std::to_string(settings.bins)
+                                                            : ", cells " + std::to_string(settings.cells) + ", slicing " +
+                                                                  lc::toString(settings.slicing))
+              << ", backend " << r.backend << " (" << r.device << ")\n"
               << "false negatives " << m.falseNegatives << ", efficiency " << fmt("%.4f", m.efficiency)
               << " (exact work " << m.exactWork << " / shading work " << m.shadingWork << ")\n"
               << "optimum of this grid: " << fmt("%.1f", 100.0 * m.efficiencyVsOptimal)

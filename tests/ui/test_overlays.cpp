@@ -17,6 +17,7 @@
 #include "culling/overlays.hpp"
 #include "culling/scene_io.hpp"
 
+#include <QDir>
 #include <QAction>
 #include <QBrush>
 #include <QElapsedTimer>
@@ -331,6 +332,55 @@ private slots:
         QCOMPARE(int(ov->tileSolid()->GetNumberOfCells()), 0);
         w_->action("actionOverlayCells")->trigger();
         QCOMPARE(int(ov->cellFill()->GetNumberOfPolys()), 6 * std::popcount(mask));
+    }
+
+    // A Z-binned run: the toolbar's Bins sets the bin count; the selected
+    // tile shows the bins its depth range spans as cells, and the current
+    // light the slab of the camera frustum over its bins.
+    void zbinBinsAndLightSlab() {
+        openSmall("zbin");
+        QVERIFY(w_->setParamFromUi("bins", "256"));
+        QVERIFY(waitRun(w_->runCulling()));
+        const auto run = doc()->runOutput();
+        const lc::CullResult& r = run->result;
+        QVERIFY(r.algorithm == lc::Algorithm::ZBin);
+        QCOMPARE(r.zbinLo.size(), std::size_t(256));
+        const std::uint32_t t = busiestTile();
+        doc()->setSelectedTile(int(t));
+        InspectorOverlays* ov = w_->inspectorView()->overlays();
+        const lc::Projection proj(doc()->scene().camera);
+        const auto cells = lc::tileCells(r, proj, t);
+        const std::uint32_t span = r.zbinOf(r.tileDepthMax[t]) - r.zbinOf(r.tileDepthMin[t]) + 1;
+        QCOMPARE(cells.size(), std::size_t(std::min(span, 32u)));
+        QCOMPARE(int(ov->cellOutline()->GetNumberOfLines()), 12 * int(cells.size()));
+        // The cells cover the tile's depth range, near to far, without gaps.
+        QVERIFY(cells.front().chunk.depthMin <= r.tileDepthMin[t]);
+        QVERIFY(cells.back().chunk.depthMax >= r.tileDepthMax[t]);
+        for (std::size_t k = 1; k < cells.size(); ++k)
+            QCOMPARE(cells[k].chunk.depthMin, cells[k - 1].chunk.depthMax);
+
+        const int light = lightsOfList(r, t).front();
+        doc()->setSelectedLights({light});
+        const auto slab = lc::zbinLightSlab(r, proj, run->lights, std::uint32_t(light));
+        QVERIFY(slab);
+        const double d = -run->lights.centers[std::size_t(light)].z, rad = run->lights.radii[std::size_t(light)];
+        QVERIFY(slab->depthMin <= std::max(d - rad, r.zbinNear));
+        QVERIFY(slab->depthMax >= std::min(d + rad, r.zbinFar));
+        QVERIFY(slab->depthMax - slab->depthMin <= 2 * rad + 2 * (r.zbinFar - r.zbinNear) / 256 + 1e-9);
+        QCOMPARE(int(ov->zbinSlab()->GetNumberOfPolys()), 6);
+        QCOMPARE(int(ov->zbinSlab()->GetNumberOfLines()), 12);
+        const glm::dmat4 world = lc::worldFromView(doc()->scene().camera);
+        double p[3];
+        ov->zbinSlab()->GetPoint(0, p);
+        const glm::dvec3 c0 = glm::dvec3(world * glm::dvec4(slab->corners[0], 1.0));
+        QVERIFY(glm::length(glm::dvec3(p[0], p[1], p[2]) - c0) <= 1e-6 * (1 + glm::length(c0)));
+        w_->inspectorView()->renderNow();
+        QDir().mkpath(LC_RENDER_OUT_DIR);
+        QVERIFY(w_->grabWindow().save(LC_RENDER_OUT_DIR "/zbin_slab.png")); // to look at
+        // Another algorithm: no slab.
+        QVERIFY(w_->setParamFromUi("algorithm", "minmax"));
+        QVERIFY(waitRun(w_->runCulling()));
+        QCOMPARE(int(ov->zbinSlab()->GetNumberOfCells()), 0);
     }
 
     // Selecting a light outlines, in both views, exactly the tiles (and for
