@@ -38,6 +38,7 @@ ShadeInputs rowsOf(const ShadeInputs& in, std::uint32_t y0, std::uint32_t y1) {
     ShadeInputs s;
     s.width = in.width;
     s.height = y1 - y0;
+    s.perPixelLists = in.perPixelLists;
     const std::size_t a = std::size_t(in.width) * y0, b = std::size_t(in.width) * y1;
     s.position.assign(in.position.begin() + std::ptrdiff_t(3 * a),
                       in.position.begin() + std::ptrdiff_t(3 * b));
@@ -86,11 +87,8 @@ std::vector<float> shadeImage(CullBackend& backend, const ShadeInputs& in, const
 void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
                      const CancelToken* cancel, double sliceMs, const Progress& progress) {
     // zbin: the lists its pixels loop over, a (tile, bin) each.
-    const bool zbin = out.result.algorithm == Algorithm::ZBin;
-    CullResult perPixel;
-    if (zbin) perPixel = zbinPixelLists(out.result, out.depth, proj);
-    const CullResult& r = zbin ? perPixel : out.result;
-    const ShadeInputs culledIn = makeShadeInputs(out.depth, proj, &r);
+    const ShadeInputs culledIn = makeShadeInputs(out.depth, proj, &out.result);
+    const CullResult& r = out.result;
     // shadeCpu's row bands: a tile row (at least 4) for lists, 16 rows for all lights.
     const std::uint32_t align = std::lcm(std::max(r.grid.tileSize, 4u), 16u);
     double culledMs = 0, allMs = 0;
@@ -113,6 +111,7 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
         all = culled;
     } else {
         ShadeInputs allIn = culledIn;
+        allIn.perPixelLists.reset();
         for (std::uint32_t& l : allIn.list)
             if (l != ShadeInputs::kNoList) l = 0;
         all = shadeImage(backend, allIn, out.lights, nullptr, align, sliceMs, cancel, allMs, part(0.5));

@@ -223,6 +223,11 @@ ShadeInputs makeShadeInputs(const DepthImage& depth, const Projection& proj, con
                     std::to_string(culled->grid.height) + ", depth image " + std::to_string(depth.width) + "x" +
                     std::to_string(depth.height));
     ShadeInputs in;
+    if (culled && culled->algorithm == Algorithm::ZBin && culled->pixelList.empty()) {
+        // What a zbin pixel loops over: its tile's mask within its bin's range.
+        in.perPixelLists = std::make_shared<const CullResult>(zbinPixelLists(*culled, depth, proj));
+        culled = in.perPixelLists.get();
+    }
     in.width = depth.width;
     in.height = depth.height;
     const std::size_t n = std::size_t(depth.width) * depth.height;
@@ -248,6 +253,7 @@ ShadeInputs makeShadeInputs(const DepthImage& depth, const Projection& proj, con
 }
 
 std::vector<float> shadeCpu(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled) {
+    if (in.perPixelLists && culled) culled = in.perPixelLists.get();
     const std::uint32_t W = in.width;
     const std::size_t n = std::size_t(W) * in.height;
     if (in.position.size() != 3 * n || in.normal.size() != 3 * n || in.list.size() != n)
@@ -304,10 +310,6 @@ std::vector<float> shadeCpu(const ShadeInputs& in, const ViewLights& lights, con
 
 std::vector<float> shadeLambertCpu(const DepthImage& depth, const Projection& proj, const ViewLights& lights,
                                    const CullResult* culled) {
-    if (culled && culled->algorithm == Algorithm::ZBin && culled->pixelList.empty()) {
-        const CullResult perPixel = zbinPixelLists(*culled, depth, proj); // what a zbin pixel loops over
-        return shadeCpu(makeShadeInputs(depth, proj, &perPixel), lights, &perPixel);
-    }
     return shadeCpu(makeShadeInputs(depth, proj, culled), lights, culled);
 }
 

@@ -178,3 +178,23 @@ TEST(Shade, PicturesMapExposureAndDifference) {
     depth.width = 2, depth.height = 1, depth.clearDepth = 1.0f, depth.depth = {0.5f, 0.5f};
     EXPECT_NEAR(exposureFor(depth, ref), 0.9, 1e-12); // 99th percentile of {0.5, 1} is 1
 }
+
+// zbin: a pixel shades the lights of its tile's mask within its bin's range,
+// through every entry point (the G-buffer carries the per-pixel lists), not
+// the whole mask (naive's lists).
+TEST(Shade, ZBinPixelsShadeTheirBinsLightsOnly) {
+    const Scene scene = smallScene("forest", 128, 72, 16, 200);
+    const RunOutput zbin = cpuRun(scene, Algorithm::ZBin);
+    const RunOutput naive = cpuRun(scene, Algorithm::Naive);
+    ASSERT_EQ(zbin.result.lightIndices, naive.result.lightIndices); // the same masks
+    const Projection proj(scene.camera);
+    const CullResult perPixel = zbinPixelLists(zbin.result, zbin.depth, proj);
+    ASSERT_EQ(perPixel.validate(zbin.lights.size()), "");
+    ASSERT_LT(perPixel.entries(), zbin.result.entries() * 16); // few lists per tile
+    const ShadeInputs in = makeShadeInputs(zbin.depth, proj, &zbin.result);
+    ASSERT_TRUE(in.perPixelLists);
+    const std::vector<float> viaResult = shadeCpu(in, zbin.lights, &zbin.result);
+    EXPECT_EQ(viaResult, shadeCpu(makeShadeInputs(zbin.depth, proj, &perPixel), zbin.lights, &perPixel));
+    EXPECT_EQ(viaResult, shadeLambertCpu(zbin.depth, proj, zbin.lights, &zbin.result));
+    EXPECT_NE(viaResult, shadeLambertCpu(naive.depth, proj, naive.lights, &naive.result));
+}

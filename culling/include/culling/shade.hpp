@@ -15,6 +15,7 @@
 #include "culling/backend.hpp"
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -30,10 +31,14 @@ struct ShadeInputs {
     std::vector<float> position; // 3 per pixel
     std::vector<float> normal;   // 3 per pixel
     std::vector<std::uint32_t> list;
+    // zbin: the per-(tile, bin) lists `list` indexes (zbinPixelLists), which
+    // every shading pass uses instead of the (non-null) result it is handed.
+    std::shared_ptr<const CullResult> perPixelLists;
 };
 
 // Builds the G-buffer of `depth`. With `culled` null every geometry pixel uses
-// list 0 of "every light". Throws Error when sizes disagree.
+// list 0 of "every light"; a zbin result brings its per-pixel lists along.
+// Throws Error when sizes disagree.
 ShadeInputs makeShadeInputs(const DepthImage& depth, const Projection& proj, const CullResult* culled);
 
 // The CPU reference of the shading pass: RGB, 3 floats per pixel, background 0.

@@ -55,6 +55,7 @@ VkPipeline ShadePass::pipeline(bool allLights) {
 
 std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled,
                                   double& ms) {
+    if (in.perPixelLists && culled) culled = in.perPixelLists.get(); // zbin: the lists `in.list` indexes
     const std::size_t pixels = std::size_t(in.width) * in.height;
     if (in.position.size() != 3 * pixels || in.normal.size() != 3 * pixels || in.list.size() != pixels)
         throw Error("shading: inconsistent shading inputs");
