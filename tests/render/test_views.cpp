@@ -92,6 +92,24 @@ lc::Scene fixedScene() {
     return s;
 }
 
+// The render tier's fixture: `doc` holds the fixed scene culled on the CPU
+// reference with `algorithm` (and `cells`), the run set as its output.
+std::shared_ptr<const lc::RunOutput> cullFixedScene(Document& doc, lc::Algorithm algorithm, std::uint32_t cells = 32,
+                                                    bool shadedImages = false) {
+    doc.resetScene(fixedScene(), {});
+    lc::CullSettings s = doc.settings();
+    s.algorithm = algorithm;
+    s.cells = cells;
+    doc.setSettings(s);
+    auto backend = lc::makeBackend("cpu");
+    lc::RunOptions opt;
+    opt.truthOptions.imageError = shadedImages;
+    opt.keepShadedImages = shadedImages;
+    auto run = std::make_shared<lc::RunOutput>(lc::runPipeline(doc.scene(), doc.settings(), *backend, opt));
+    if (run->truth.metrics.falseNegatives != 0 || !doc.setRunOutput(run, 1)) return nullptr;
+    return run;
+}
+
 struct Comparison {
     bool ok = false;
     QString message;
@@ -146,13 +164,8 @@ class RenderTest : public QObject {
 private slots:
     void initTestCase() {
         doc_ = std::make_unique<Document>();
-        doc_->resetScene(fixedScene(), {});
-        auto backend = lc::makeBackend("cpu");
-        lc::RunOptions opt;
-        opt.truthOptions.imageError = false;
-        auto run = std::make_shared<lc::RunOutput>(lc::runPipeline(doc_->scene(), doc_->settings(), *backend, opt));
-        QCOMPARE(run->truth.metrics.falseNegatives, std::uint64_t(0));
-        QVERIFY(doc_->setRunOutput(run, 1));
+        const auto run = cullFixedScene(*doc_, doc_->settings().algorithm);
+        QVERIFY(run);
         doc_->setSelectedLights({1});
         doc_->setSelectedTile(int(run->result.grid.tileIndex(9, 6)));
     }
@@ -195,16 +208,8 @@ private slots:
     // the current light outlined in the camera view (efficiency heat map).
     void tileOverlays() {
         Document doc;
-        doc.resetScene(fixedScene(), {});
-        lc::CullSettings s = doc.settings();
-        s.algorithm = lc::Algorithm::TwoPointFiveD;
-        s.cells = 8;
-        doc.setSettings(s);
-        auto backend = lc::makeBackend("cpu");
-        lc::RunOptions opt;
-        opt.truthOptions.imageError = false;
-        auto run = std::make_shared<lc::RunOutput>(lc::runPipeline(doc.scene(), doc.settings(), *backend, opt));
-        QVERIFY(doc.setRunOutput(run, 1));
+        const auto run = cullFixedScene(doc, lc::Algorithm::TwoPointFiveD, 8);
+        QVERIFY(run);
         // The tile with the longest list (a fixed choice: the scene is fixed).
         std::uint32_t tile = 0;
         for (std::uint32_t t = 0; t < run->result.grid.tileCount(); ++t)
@@ -256,16 +261,8 @@ private slots:
     // change in the framing shows here too.
     void framedTileWithExplain() {
         Document doc;
-        doc.resetScene(fixedScene(), {});
-        lc::CullSettings s = doc.settings();
-        s.algorithm = lc::Algorithm::TwoPointFiveD;
-        s.cells = 8;
-        doc.setSettings(s);
-        auto backend = lc::makeBackend("cpu");
-        lc::RunOptions opt;
-        opt.truthOptions.imageError = false;
-        auto run = std::make_shared<lc::RunOutput>(lc::runPipeline(doc.scene(), doc.settings(), *backend, opt));
-        QVERIFY(doc.setRunOutput(run, 1));
+        const auto run = cullFixedScene(doc, lc::Algorithm::TwoPointFiveD, 8);
+        QVERIFY(run);
         // The first tile (in tile order: a fixed choice, the scene is fixed)
         // with a false positive.
         const lc::Projection proj(doc.scene().camera);
@@ -307,18 +304,9 @@ private slots:
     // the lights' cut-off leaves a visible error at the sphere edges.
     void differenceMode() {
         Document doc;
-        doc.resetScene(fixedScene(), {});
-        lc::CullSettings s = doc.settings();
-        s.algorithm = lc::Algorithm::TwoPointFiveD;
-        s.cells = 4;
-        doc.setSettings(s);
-        auto backend = lc::makeBackend("cpu");
-        lc::RunOptions opt;
-        opt.truthOptions.imageError = true;
-        opt.keepShadedImages = true;
-        auto run = std::make_shared<lc::RunOutput>(lc::runPipeline(doc.scene(), doc.settings(), *backend, opt));
+        const auto run = cullFixedScene(doc, lc::Algorithm::TwoPointFiveD, 4, true);
+        QVERIFY(run);
         QVERIFY(run->truth.metrics.imageMaxError > 0); // the picture is not black
-        QVERIFY(doc.setRunOutput(run, 1));
         doc.setSelectedTile(int(run->result.grid.tileIndex(9, 6)));
 
         CameraView cv(&doc);

@@ -855,6 +855,12 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const Grid writeGroups = groupsFor(all ? n : std::uint64_t(listTotal) * lanes, lim);
     const Grid packGroups = groupsFor(listTotal, lim);
 
+    // A dispatch that reads (or ORs into) what the dispatches before it wrote.
+    auto dispatchAfter = [](VkCommandBuffer cmd, VkPipeline pipe, Grid groups) {
+        computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
+        vkCmdDispatch(cmd, groups.x, groups.y, 1);
+    };
     const bool gpuClock = useGpuTimestamps();
     TimestampPool stamps = gpuClock ? TimestampPool(ctx_, 2, "cull.timestamps") : TimestampPool();
     double wallMs = ctx_.submitAndWait(
@@ -874,28 +880,14 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
             if (zbin) {
                 // The bins' words follow the plane bins' in one buffer: ordered
                 // after light_bins, then the empty ranges before the lights.
-                computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-                vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, zbinInitPipe);
-                vkCmdDispatch(cmd, zbinInitGroups.x, zbinInitGroups.y, 1);
-                if (n > 0) {
-                    computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-                    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, zbinPipe);
-                    vkCmdDispatch(cmd, zbinGroups.x, zbinGroups.y, 1);
-                }
+                dispatchAfter(cmd, zbinInitPipe, zbinInitGroups);
+                if (n > 0) dispatchAfter(cmd, zbinPipe, zbinGroups);
             }
             // The count pass reads the tile bounds and bins the two passes above wrote
             // (and ORs status after the bounds pass did).
-            computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, countPipe);
-            vkCmdDispatch(cmd, countGroups.x, countGroups.y, 1);
+            dispatchAfter(cmd, countPipe, countGroups);
             // The scan reads the counts the count pass wrote.
-            computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scanPipe);
-            vkCmdDispatch(cmd, 1, 1, 1);
+            dispatchAfter(cmd, scanPipe, Grid{1, 1});
             if (gpuClock) stamps.end(cmd, 0);
             staging.recordDownloads(cmd);
         },
@@ -956,14 +948,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                 if (fptl) {
                     // The prune reads the entries the write pass wrote, and
                     // the pack the marks the prune wrote over them.
-                    computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-                    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, prunePipe);
-                    vkCmdDispatch(cmd, pruneGroups.x, pruneGroups.y, 1);
-                    computeBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-                    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, packPipe);
-                    vkCmdDispatch(cmd, packGroups.x, packGroups.y, 1);
+                    dispatchAfter(cmd, prunePipe, pruneGroups);
+                    dispatchAfter(cmd, packPipe, packGroups);
                 }
                 if (gpuClock) stamps.end(cmd, 1);
                 back.recordDownloads(cmd);
