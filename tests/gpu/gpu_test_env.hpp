@@ -6,6 +6,7 @@
 // one backend is shared per test executable (instance creation with the layer
 // costs a few hundred milliseconds on lavapipe).
 #include "culling/backend.hpp"
+#include "culling/depth.hpp"
 #include "vk/validation.hpp"
 #include "vk/vulkan_backend.hpp"
 
@@ -33,6 +34,29 @@ inline std::string joinedMessages() {
     for (const auto& m : vk::validationMessages()) s += m + "\n";
     return s;
 }
+
+// The gpu tier's fixture: one frame's culling inputs from its scene (the
+// projection, the grid of its camera's tiles, the view lights and a depth
+// image: the shared Vulkan backend's by default, `depthFrom`'s, or the CPU
+// rasteriser's for nullptr). A test states its scene and culls f on both
+// backends: f.cull(*cpu, settings), f.cull(vulkan(), settings).
+struct Frame {
+    Scene scene;
+    Projection proj;
+    TileGrid grid;
+    ViewLights lights;
+    DepthImage depth;
+
+    explicit Frame(Scene s) : Frame(std::move(s), &vulkan()) {}
+    Frame(Scene s, CullBackend* depthFrom)
+        : scene(std::move(s)), proj(scene.camera),
+          grid(TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize)),
+          lights(makeViewLights(scene)),
+          depth(depthFrom ? depthFrom->renderDepth(scene, proj) : rasterizeDepthCpu(scene, proj)) {}
+    CullResult cull(CullBackend& backend, const CullSettings& settings) const {
+        return backend.cull(depth, proj, grid, lights, settings);
+    }
+};
 
 // Base fixture: asserts that the test left no validation message behind.
 class GpuTest : public ::testing::Test {

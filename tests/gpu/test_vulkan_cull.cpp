@@ -101,6 +101,11 @@ CaseReport checkCase(const std::string& label, const DepthImage& depth, const Pr
     return {cmp.extra, cmp.cpuEntries};
 }
 
+CaseReport checkCase(const std::string& label, const gputest::Frame& f, const CullSettings& settings,
+                     CullBackend& cpuBackend, CullBackend& gpuBackend = gputest::vulkan()) {
+    return checkCase(label, f.depth, f.proj, f.grid, f.lights, settings, cpuBackend, gpuBackend);
+}
+
 Scene sized(const std::string& name, std::uint32_t w, std::uint32_t h, std::uint32_t tile = 16) {
     Scene s = makeBuiltinScene(name);
     s.camera.width = w;
@@ -159,10 +164,7 @@ TEST_F(GpuTest, ProjectionKindsAndSlicing) {
         scene.camera.projection = k.kind;
         scene.camera.farPlane = k.far;
         if (isOrthographic(k.kind)) scene.camera.orthoHeight = 60.0;
-        const Projection proj(scene.camera);
-        const TileGrid grid = TileGrid::make(256, 144, 16);
-        const ViewLights lights = makeViewLights(scene);
-        const DepthImage depth = rasterizeDepthCpu(scene, proj);
+        const gputest::Frame f(scene, nullptr);
         for (Algorithm a : kAlgorithms) {
             for (Slicing sl : {Slicing::Log, Slicing::Linear}) {
                 if (sl == Slicing::Linear && a != Algorithm::TwoPointFiveD && a != Algorithm::Clustered) continue;
@@ -176,7 +178,7 @@ TEST_F(GpuTest, ProjectionKindsAndSlicing) {
                     s.cells = 32;
                     const std::string label = std::string(toString(k.kind)) + (std::isinf(k.far) ? "-inf " : " ") +
                                               toString(a) + " " + toString(sl) + (skip ? "" : " no-skip");
-                    const CaseReport r = checkCase(label, depth, proj, grid, lights, s, *cpuBackend);
+                    const CaseReport r = checkCase(label, f, s, *cpuBackend);
                     std::printf("[ cull     ] %-44s entries %8llu  extra on GPU %5llu\n", label.c_str(),
                                 (unsigned long long)r.entries, (unsigned long long)r.extra);
                 }
@@ -190,16 +192,13 @@ TEST_F(GpuTest, EdgeTilesOfNonMultipleResolutions) {
     auto cpuBackend = makeCpuBackend();
     for (auto [w, h] : {std::pair<std::uint32_t, std::uint32_t>{1366, 768}, {333, 187}}) {
         const Scene scene = sized("atrium", w, h);
-        const Projection proj(scene.camera);
-        const TileGrid grid = TileGrid::make(w, h, 16);
-        const ViewLights lights = makeViewLights(scene);
-        const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+        const gputest::Frame f(scene);
         for (Algorithm a : {Algorithm::MinMax, Algorithm::TwoPointFiveD, Algorithm::Clustered}) {
             CullSettings s;
             s.algorithm = a;
             s.test = SphereTest::PlanesAabb;
             const std::string label = std::to_string(w) + "x" + std::to_string(h) + " " + toString(a);
-            const CaseReport r = checkCase(label, depth, proj, grid, lights, s, *cpuBackend);
+            const CaseReport r = checkCase(label, f, s, *cpuBackend);
             std::printf("[ cull     ] %-44s entries %8llu  extra on GPU %5llu\n", label.c_str(),
                         (unsigned long long)r.entries, (unsigned long long)r.extra);
         }
@@ -258,19 +257,16 @@ TEST_F(GpuTest, LightsTouchingBoundsWithinRounding) {
 TEST_F(GpuTest, ZeroLightsGiveEmptyLists) {
     Scene scene = sized("wall", 200, 120);
     scene.lights.clear();
-    const Projection proj(scene.camera);
-    const TileGrid grid = TileGrid::make(200, 120, 16);
-    const ViewLights lights = makeViewLights(scene);
-    const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+    const gputest::Frame f(scene);
     for (Algorithm a : kAlgorithms) {
         CullSettings s;
         s.algorithm = a;
-        const CullResult r = gputest::vulkan().cull(depth, proj, grid, lights, s);
+        const CullResult r = f.cull(gputest::vulkan(), s);
         EXPECT_EQ(r.validate(0), "") << toString(a);
         EXPECT_EQ(r.entries(), 0u) << toString(a);
-        EXPECT_EQ(r.listCountTotal(), a == Algorithm::All ? 1u : grid.tileCount() * r.listsPerTile);
+        EXPECT_EQ(r.listCountTotal(), a == Algorithm::All ? 1u : f.grid.tileCount() * r.listsPerTile);
         // The wall fills the screen: every tile still gets its depth bounds.
-        for (std::uint32_t t = 0; t < grid.tileCount(); ++t) EXPECT_LE(r.tileDepthMin[t], r.tileDepthMax[t]);
+        for (std::uint32_t t = 0; t < f.grid.tileCount(); ++t) EXPECT_LE(r.tileDepthMin[t], r.tileDepthMax[t]);
     }
 }
 
@@ -280,18 +276,14 @@ TEST_F(GpuTest, OneLight) {
     scene.lights.resize(1);
     scene.lights[0].position = 0.5 * (scene.bounds().first + scene.bounds().second);
     scene.lights[0].explicitRadius = 4.0;
-    const Projection proj(scene.camera);
-    const TileGrid grid = TileGrid::make(320, 180, 16);
-    const ViewLights lights = makeViewLights(scene);
-    const DepthImage depth = rasterizeDepthCpu(scene, proj);
+    const gputest::Frame f(scene, nullptr);
     std::uint64_t entries = 0;
     for (Algorithm a : kAlgorithms)
         for (SphereTest t : kTests) {
             CullSettings s;
             s.algorithm = a;
             s.test = t;
-            entries += checkCase(std::string("one light ") + toString(a) + " " + toString(t), depth, proj, grid,
-                                 lights, s, *cpuBackend)
+            entries += checkCase(std::string("one light ") + toString(a) + " " + toString(t), f, s, *cpuBackend)
                            .entries;
         }
     EXPECT_GT(entries, 0u) << "the light should touch some tiles";
@@ -329,14 +321,11 @@ TEST_F(GpuTest, MoreLightsThanWorkgroupInvocations) {
         scene.lights[i].position = {0.001 * i, 0.0, 5.0};
         scene.lights[i].explicitRadius = 500.0;
     }
-    const Projection proj(scene.camera);
-    const TileGrid grid = TileGrid::make(96, 64, 16);
-    const ViewLights lights = makeViewLights(scene);
-    const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+    const gputest::Frame f(scene);
     for (Algorithm a : kAlgorithms) {
         CullSettings s;
         s.algorithm = a;
-        const CullResult r = gputest::vulkan().cull(depth, proj, grid, lights, s);
+        const CullResult r = f.cull(gputest::vulkan(), s);
         ASSERT_EQ(r.validate(n), "");
         std::size_t full = 0;
         for (std::size_t l = 0; l < r.listCount.size(); ++l) {
@@ -345,20 +334,17 @@ TEST_F(GpuTest, MoreLightsThanWorkgroupInvocations) {
             for (std::uint32_t i = 0; i < n; ++i) ASSERT_EQ(r.lightIndices[r.listOffset[l] + i], i);
             ++full;
         }
-        EXPECT_GE(full, a == Algorithm::All ? 1u : grid.tileCount()) << toString(a);
+        EXPECT_GE(full, a == Algorithm::All ? 1u : f.grid.tileCount()) << toString(a);
     }
 }
 
 TEST_F(GpuTest, ResultsAreDeterministic) {
     const Scene scene = sized("forest", 240, 136);
-    const Projection proj(scene.camera);
-    const TileGrid grid = TileGrid::make(240, 136, 16);
-    const ViewLights lights = makeViewLights(scene);
-    const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+    const gputest::Frame f(scene);
     CullSettings s;
     s.algorithm = Algorithm::Clustered;
-    const CullResult a = gputest::vulkan().cull(depth, proj, grid, lights, s);
-    const CullResult b = gputest::vulkan().cull(depth, proj, grid, lights, s);
+    const CullResult a = f.cull(gputest::vulkan(), s);
+    const CullResult b = f.cull(gputest::vulkan(), s);
     EXPECT_EQ(a.listOffset, b.listOffset);
     EXPECT_EQ(a.listCount, b.listCount);
     EXPECT_EQ(a.lightIndices, b.lightIndices);
@@ -421,29 +407,26 @@ TEST_F(GpuTest, ResultBytesFollowTheEntries) {
     for (const char* name : {"forest", "atrium"}) {
         Scene scene = sized(name, 640, 360);
         scene.lights = generateLights(defaultLightGen(scene, 2048, 3));
-        const Projection proj(scene.camera);
-        const TileGrid grid = TileGrid::make(640, 360, 16);
-        const ViewLights lights = makeViewLights(scene);
-        const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+        const gputest::Frame f(scene);
         for (Algorithm a : kAlgorithms) {
             CullSettings st;
             st.algorithm = a;
             for (CullBackend* b : {static_cast<CullBackend*>(cpuBackend.get()), &gputest::vulkan()}) {
-                const CullResult r = b->cull(depth, proj, grid, lights, st);
+                const CullResult r = f.cull(*b, st);
                 const std::string label = std::string(name) + " " + toString(a) + " " + r.backend;
                 const std::uint64_t lists = r.listCountTotal();
                 if (a == Algorithm::ZBin) {
                     // The renderer's form: a 32-bit range per bin, a bit per light per tile.
                     EXPECT_EQ(r.bytes(), 4 * std::uint64_t(st.bins) +
-                                             4 * std::uint64_t(grid.tileCount()) * ((lights.size() + 31) / 32))
+                                             4 * std::uint64_t(f.grid.tileCount()) * ((f.lights.size() + 31) / 32))
                         << label;
                 } else {
                     EXPECT_LE(r.bytes(), 4 * r.entries() + 8 * lists + 4096) << label;
                     EXPECT_GE(r.bytes(), 4 * r.entries() + 8 * lists) << label;
                 }
-                EXPECT_EQ(r.diagnosticBytes(), 8 * std::uint64_t(grid.tileCount()) + 4 * r.cellMask.size()) << label;
+                EXPECT_EQ(r.diagnosticBytes(), 8 * std::uint64_t(f.grid.tileCount()) + 4 * r.cellMask.size()) << label;
                 if (a == Algorithm::HalfZ)
-                    for (std::uint32_t t = 0; t < grid.tileCount(); ++t)
+                    for (std::uint32_t t = 0; t < f.grid.tileCount(); ++t)
                         ASSERT_EQ(r.listOffset[2 * t + 1], r.listOffset[2 * t] + r.listCount[2 * t]) << label;
             }
         }
@@ -459,24 +442,21 @@ TEST_F(GpuTest, DeviceMemoryPeakAndNoLeak) {
     for (std::uint32_t n : {64u, 65536u}) {
         Scene scene = sized("forest", 480, 270);
         scene.lights = generateLights(defaultLightGen(scene, n, 9));
-        const Projection proj(scene.camera);
-        const TileGrid grid = TileGrid::make(480, 270, 16);
-        const ViewLights lights = makeViewLights(scene);
-        const DepthImage depth = vk.renderDepth(scene, proj);
+        const gputest::Frame f(scene, &vk);
         CullSettings st;
         st.algorithm = Algorithm::TwoPointFiveD;
         vk.resetPeakDeviceBytes();
         const std::size_t liveBefore = vk.peakDeviceBytes(); // after a reset: what is alive now
-        const CullResult r = vk.cull(depth, proj, grid, lights, st);
+        const CullResult r = f.cull(vk, st);
         const std::size_t peak = vk.peakDeviceBytes();
         vk.resetPeakDeviceBytes();
         EXPECT_EQ(vk.peakDeviceBytes(), liveBefore) << "device memory leaked by cull()";
         const std::uint64_t words = (n + 31) / 32;
-        const std::uint64_t needed = 480ull * 270 * 4 + 4 * words * (grid.tilesX + grid.tilesY) +
+        const std::uint64_t needed = 480ull * 270 * 4 + 4 * words * (f.grid.tilesX + f.grid.tilesY) +
                                      8ull * r.listCountTotal() + 4 * r.entries();
-        EXPECT_GE(peak - liveBefore, needed) << n << " lights";
-        EXPECT_LT(peak - liveBefore, 4 * needed + (1u << 20)) << n << " lights";
-        if (n == 65536u) EXPECT_LT(peak - liveBefore, std::uint64_t(grid.tileCount()) * n * 4 / 8);
+        EXPECT_GE(peak - liveBefore, needed) << n << " f.lights";
+        EXPECT_LT(peak - liveBefore, 4 * needed + (1u << 20)) << n << " f.lights";
+        if (n == 65536u) EXPECT_LT(peak - liveBefore, std::uint64_t(f.grid.tileCount()) * n * 4 / 8);
         EXPECT_GT(r.volumeTests, 0u);
         EXPECT_GE(r.volumeTests, r.entries());
     }
@@ -499,22 +479,19 @@ TEST_F(GpuTest, StashedAndRecomputedListsMatchTheReference) {
     for (std::uint32_t n : {16u, 12000u}) {
         Scene scene = sized("forest", 640, 360);
         scene.lights = generateLights(defaultLightGen(scene, n, 11));
-        const Projection proj(scene.camera);
-        const TileGrid grid = TileGrid::make(640, 360, 16);
-        const ViewLights lights = makeViewLights(scene);
-        const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+        const gputest::Frame f(scene);
         for (Algorithm a : {Algorithm::MinMax, Algorithm::HalfZ, Algorithm::TwoPointFiveD, Algorithm::Clustered}) {
             CullSettings st;
             st.algorithm = a;
-            const std::string label = std::to_string(n) + " lights " + toString(a);
-            const CullResult gpu = gputest::vulkan().cull(depth, proj, grid, lights, st);
+            const std::string label = std::to_string(n) + " f.lights " + toString(a);
+            const CullResult gpu = f.cull(gputest::vulkan(), st);
             const std::uint32_t longest = *std::max_element(gpu.listCount.begin(), gpu.listCount.end());
             const bool anyShort = std::any_of(gpu.listCount.begin(), gpu.listCount.end(),
                                               [](std::uint32_t c) { return c > 0 && c <= 16; });
             ASSERT_TRUE(anyShort) << label;
             if (n == 16u) ASSERT_LE(longest, 16u) << label;
             else ASSERT_GT(longest, 128u) << label << ": no list needs the write pass";
-            checkCase(label, depth, proj, grid, lights, st, *cpuBackend);
+            checkCase(label, f, st, *cpuBackend);
         }
     }
 }
@@ -534,26 +511,23 @@ TEST_F(GpuTest, GrownStashHoldsListsOfUpTo128Entries) {
     auto cpuBackend = makeCpuBackend();
     Scene scene = sized("forest", 640, 360);
     scene.lights = generateLights(defaultLightGen(scene, 2500, 11));
-    const Projection proj(scene.camera);
-    const TileGrid grid = TileGrid::make(640, 360, 16);
-    const ViewLights lights = makeViewLights(scene);
-    const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+    const gputest::Frame f(scene);
     CullSettings st;
     st.algorithm = Algorithm::TwoPointFiveD;
     fresh->resetPeakDeviceBytes();
-    const CullResult first = fresh->cull(depth, proj, grid, lights, st);
+    const CullResult first = f.cull(*fresh, st);
     const std::size_t firstPeak = fresh->peakDeviceBytes();
     const std::uint32_t longest = *std::max_element(first.listCount.begin(), first.listCount.end());
     ASSERT_GT(longest, 32u) << "no list outgrows the first cull's stash";
     ASSERT_LE(longest, 128u) << "a list outgrows the grown stash";
     fresh->resetPeakDeviceBytes();
-    const CullResult second = fresh->cull(depth, proj, grid, lights, st);
+    const CullResult second = f.cull(*fresh, st);
     EXPECT_GT(fresh->peakDeviceBytes(), firstPeak) << "the stash did not grow";
     EXPECT_EQ(second.listCount, first.listCount);
     EXPECT_EQ(second.lightIndices, first.lightIndices);
     // A third cull (the grown stash again) against the CPU reference: the
     // first two are equal, so all three are checked.
-    checkCase("grown stash", depth, proj, grid, lights, st, *cpuBackend, *fresh);
+    checkCase("grown stash", f, st, *cpuBackend, *fresh);
 }
 
 // On lavapipe tile_bounds reads the depth 8 pixels a load where the width
@@ -603,17 +577,14 @@ TEST_F(GpuTest, WideDepthLoadsMatchSinglePixelLoads) {
 TEST_F(GpuTest, DepthBinsSpareTheCountPassMostCandidates) {
     Scene scene = sized("forest", 480, 270);
     scene.lights = generateLights(defaultLightGen(scene, 1024, 1));
-    const Projection proj(scene.camera);
-    const TileGrid grid = TileGrid::make(480, 270, 16);
-    const ViewLights lights = makeViewLights(scene);
-    const DepthImage depth = gputest::vulkan().renderDepth(scene, proj);
+    const gputest::Frame f(scene);
     auto cpuBackend = makeCpuBackend();
     for (Algorithm a : {Algorithm::MinMax, Algorithm::HalfZ, Algorithm::Clustered}) {
         CullSettings st;
         st.algorithm = a;
-        const std::string label = std::string("depth bins ") + toString(a);
-        checkCase(label, depth, proj, grid, lights, st, *cpuBackend);
-        const CullResult r = gputest::vulkan().cull(depth, proj, grid, lights, st);
+        const std::string label = std::string("f.depth bins ") + toString(a);
+        checkCase(label, f, st, *cpuBackend);
+        const CullResult r = f.cull(gputest::vulkan(), st);
         ASSERT_GT(r.entries(), 1000u) << label;
         EXPECT_LT(double(r.volumeTests), 2.0 * double(r.entries())) << label;
         std::printf("[ cull     ] %-44s entries %8llu  tests %8llu\n", label.c_str(),
@@ -664,19 +635,16 @@ TEST_F(GpuTest, ZBinBinsHoldTheReferenceBins) {
     LightGenSettings g = defaultLightGen(scene, 700, 4);
     g.spotFraction = 0.2;
     scene.lights = generateLights(g);
-    const Projection proj(scene.camera);
-    const TileGrid grid = TileGrid::make(320, 180, 16);
-    const ViewLights lights = makeViewLights(scene);
     auto cpuBackend = makeCpuBackend();
-    const DepthImage depth = cpuBackend->renderDepth(scene, proj);
+    const gputest::Frame f(scene, cpuBackend.get());
     for (std::uint32_t bins : {1u, 100u, 4096u, 16384u}) {
         SCOPED_TRACE(bins);
         CullSettings st;
         st.algorithm = Algorithm::ZBin;
         st.bins = bins;
-        const CullResult cpu = cpuBackend->cull(depth, proj, grid, lights, st);
-        const CullResult gpu = gputest::vulkan().cull(depth, proj, grid, lights, st);
-        ASSERT_EQ(gpu.validate(lights.size()), "");
+        const CullResult cpu = f.cull(*cpuBackend, st);
+        const CullResult gpu = f.cull(gputest::vulkan(), st);
+        ASSERT_EQ(gpu.validate(f.lights.size()), "");
         EXPECT_EQ(gpu.zbinOrder, cpu.zbinOrder);
         EXPECT_EQ(gpu.zbinNear, cpu.zbinNear);
         EXPECT_EQ(gpu.zbinFar, cpu.zbinFar);
@@ -692,6 +660,6 @@ TEST_F(GpuTest, ZBinBinsHoldTheReferenceBins) {
         EXPECT_LE(wider, 2 + used / 50) << "bins widened by more than rounding";
         GroundTruthOptions o;
         o.imageError = false;
-        EXPECT_EQ(computeGroundTruth(depth, proj, lights, gpu, o).metrics.falseNegatives, 0u);
+        EXPECT_EQ(computeGroundTruth(f.depth, f.proj, f.lights, gpu, o).metrics.falseNegatives, 0u);
     }
 }
