@@ -10,7 +10,7 @@ PACKAGES=(
   # packaging: cpack -G DEB computes Depends with dpkg-shlibdeps and file(1)
   dpkg-dev file
   # culling core
-  libglm-dev libopenmesh-dev nlohmann-json3-dev libcli11-dev libpng-dev
+  libglm-dev libopenmesh-dev nlohmann-json3-dev libcli11-dev libpng-dev zlib1g-dev
   # glTF 2.0 scenes (tinygltf's header, compiled into the library)
   libtinygltf-dev
   # Vulkan: headers, loader, lavapipe, shader compiler, validation in tests
