@@ -296,12 +296,12 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
         const lc::Projection proj(scene.camera);
         const lc::TileGrid grid = lc::TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
         const lc::ViewLights lights = lc::makeViewLights(scene);
-        std::vector<double> depthMs, cullMs, cullWallMs;
+        std::vector<double> depthMs, depthWallMs, cullMs, cullWallMs;
         std::size_t peakDeviceBytes = 0;
         lc::CullResult last;
         for (int i = 0; i < opt.warmup + opt.repeat; ++i) {
             const lc::DepthImage depth = backend->renderDepth(scene, proj);
-            const double d = backend->lastDepthMs();
+            const double d = backend->lastDepthMs(), dw = backend->lastDepthWallMs();
             // Peak device memory of the culling pass alone (its buffers, the
             // staging copies included; the depth image is the input).
             backend->resetPeakDeviceBytes();
@@ -309,13 +309,14 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
             peakDeviceBytes = std::max(peakDeviceBytes, backend->peakDeviceBytes());
             if (i >= opt.warmup) {
                 depthMs.push_back(d);
+                depthWallMs.push_back(dw);
                 cullMs.push_back(last.timings.cullMs);
                 cullWallMs.push_back(backend->lastCullWallMs());
             }
         }
-        const Stats ds = stats(depthMs), cs = stats(cullMs), ws = stats(cullWallMs);
+        const Stats ds = stats(depthMs), dws = stats(depthWallMs), cs = stats(cullMs), ws = stats(cullWallMs);
         std::cout << label << ": depth " << fmt("%.3f", ds.median) << " [" << fmt("%.3f", ds.min) << ".."
-                  << fmt("%.3f", ds.max) << "], cull " << fmt("%.3f", cs.median) << " [" << fmt("%.3f", cs.min)
+                  << fmt("%.3f", ds.max) << "] (wall " << fmt("%.3f", dws.median) << "), cull " << fmt("%.3f", cs.median) << " [" << fmt("%.3f", cs.min)
                   << ".." << fmt("%.3f", cs.max) << "] (wall " << fmt("%.3f", ws.median) << "), "
                   << last.entries() << " entries, " << last.listCountTotal() << " lists, " << last.bytes()
                   << " bytes (+" << last.diagnosticBytes() << " diagnostic), " << last.volumeTests
@@ -330,6 +331,7 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
                            {"tile_size", scene.camera.tileSize},
                            {"lights", lights.size()},
                            {"depth_ms", statsJson(ds)},
+                           {"depth_wall_ms", statsJson(dws)},
                            {"cull_ms", statsJson(cs)},
                            {"cull_wall_ms", statsJson(ws)},
                            {"list_entries", last.entries()},

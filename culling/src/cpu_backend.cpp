@@ -378,14 +378,18 @@ public:
         r.timings.cullMs =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         r.timings.depthMs = lastDepthMs_;
+        lastCullWallMs_ = r.timings.cullMs;
         r.backend = name();
         r.device = device_;
         r.timingMethod = timingMethod();
         return r;
     }
 
+    double lastCullWallMs() const override { return lastCullWallMs_; }
+
 private:
     std::string device_;
+    double lastCullWallMs_ = -1;
 };
 
 } // namespace

@@ -437,6 +437,31 @@ TEST_F(GpuTest, ResultBytesFollowTheEntries) {
 // hold (depth, light bins, counts, offsets, indices), and every byte is given
 // back afterwards (live memory before == after). Nothing per tile x light:
 // at 65,536 lights the peak stays far below tiles x lights x 4 bytes.
+// A rendered depth image whose pixels changed after the render, its id kept
+// (a caller that forgot to reset deviceCopy), and an older render's image:
+// the cull reads the pixels it is given, not the device's copy.
+TEST_F(GpuTest, TheCullReadsTheDepthItIsGiven) {
+    CullBackend& vk = gputest::vulkan();
+    Scene scene = sized("atrium", 320, 180);
+    scene.lights = generateLights(defaultLightGen(scene, 256, 4));
+    const gputest::Frame f(scene, &vk);
+    ASSERT_NE(f.depth.deviceCopy, 0u) << "the Vulkan depth is not kept on the device";
+    CullSettings st;
+    st.algorithm = Algorithm::MinMax;
+    DepthImage cleared = f.depth; // every pixel empty, the render's id kept
+    std::fill(cleared.depth.begin(), cleared.depth.end(), cleared.clearDepth);
+    const CullResult fromCleared = vk.cull(cleared, f.proj, f.grid, f.lights, st);
+    EXPECT_EQ(fromCleared.entries(), 0u) << "culled the device's copy instead of the pixels given";
+    const CullResult before = f.cull(vk, st);
+    ASSERT_GT(before.entries(), 0u);
+    Scene other = scene;
+    other.camera.position += glm::dvec3(0.0, 0.5, 0.0);
+    (void)vk.renderDepth(other, Projection(other.camera)); // replaces the device's copy
+    const CullResult after = f.cull(vk, st);
+    EXPECT_EQ(after.lightIndices, before.lightIndices);
+    EXPECT_EQ(after.tileDepthMax, before.tileDepthMax);
+}
+
 TEST_F(GpuTest, DeviceMemoryPeakAndNoLeak) {
     CullBackend& vk = gputest::vulkan();
     for (std::uint32_t n : {64u, 65536u}) {
@@ -445,15 +470,33 @@ TEST_F(GpuTest, DeviceMemoryPeakAndNoLeak) {
         const gputest::Frame f(scene, &vk);
         CullSettings st;
         st.algorithm = Algorithm::TwoPointFiveD;
+        // A depth image the backend did not render (this one's pixels, no
+        // device copy): the cull uploads it.
+        DepthImage uploaded = f.depth;
+        uploaded.deviceCopy = 0;
+        // A CPU device sizes its stash from the previous cull's longest list:
+        // one cull of these lights first, so both culls below size it alike.
+        (void)f.cull(vk, st);
         vk.resetPeakDeviceBytes();
         const std::size_t liveBefore = vk.peakDeviceBytes(); // after a reset: what is alive now
-        const CullResult r = f.cull(vk, st);
+        const CullResult r = vk.cull(uploaded, f.proj, f.grid, f.lights, st);
         const std::size_t peak = vk.peakDeviceBytes();
         vk.resetPeakDeviceBytes();
         EXPECT_EQ(vk.peakDeviceBytes(), liveBefore) << "device memory leaked by cull()";
         const std::uint64_t words = (n + 31) / 32;
-        const std::uint64_t needed = 480ull * 270 * 4 + 4 * words * (f.grid.tilesX + f.grid.tilesY) +
+        const std::uint64_t depthBytes = 480ull * 270 * 4;
+        const std::uint64_t needed = depthBytes + 4 * words * (f.grid.tilesX + f.grid.tilesY) +
                                      8ull * r.listCountTotal() + 4 * r.entries();
+        // The depth it rendered is on the device already: no depth buffer,
+        // no upload, the same lists.
+        const CullResult resident = f.cull(vk, st);
+        const std::size_t residentPeak = vk.peakDeviceBytes();
+        vk.resetPeakDeviceBytes();
+        EXPECT_EQ(vk.peakDeviceBytes(), liveBefore) << "device memory leaked by cull() on the resident depth";
+        EXPECT_LE(residentPeak - liveBefore + depthBytes, peak - liveBefore) << n << " lights";
+        EXPECT_EQ(resident.lightIndices, r.lightIndices);
+        EXPECT_EQ(resident.listCount, r.listCount);
+        EXPECT_EQ(resident.tileDepthMin, r.tileDepthMin);
         EXPECT_GE(peak - liveBefore, needed) << n << " f.lights";
         EXPECT_LT(peak - liveBefore, 4 * needed + (1u << 20)) << n << " f.lights";
         if (n == 65536u) EXPECT_LT(peak - liveBefore, std::uint64_t(f.grid.tileCount()) * n * 4 / 8);

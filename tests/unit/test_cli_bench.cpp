@@ -31,7 +31,8 @@ TEST(CliBench, SweepCrossProductWritesEveryConfiguration) {
         seen.insert({c["algorithm"].get<std::string>(), c["lights"].get<std::size_t>()});
         EXPECT_EQ(c["width"], 160);
         EXPECT_EQ(c["height"], 90);
-        for (const char* phase : {"depth_ms", "cull_ms"}) {
+        // The wall clocks too: on the CPU backend the same clock as the times.
+        for (const char* phase : {"depth_ms", "depth_wall_ms", "cull_ms", "cull_wall_ms"}) {
             const auto& st = c[phase];
             EXPECT_LE(st["min"].get<double>(), st["median"].get<double>()) << phase;
             EXPECT_LE(st["median"].get<double>(), st["max"].get<double>()) << phase;
@@ -41,6 +42,8 @@ TEST(CliBench, SweepCrossProductWritesEveryConfiguration) {
         EXPECT_GE(c["result_bytes"].get<std::uint64_t>(),
                   4 * c["list_entries"].get<std::uint64_t>() + 8 * c["lists"].get<std::uint64_t>());
         if (c["lights"] == 0) EXPECT_EQ(c["list_entries"], 0);
+        EXPECT_EQ(c["depth_wall_ms"], c["depth_ms"]);
+        EXPECT_EQ(c["cull_wall_ms"], c["cull_ms"]);
     }
     EXPECT_EQ(seen.size(), 6u);
     // One stdout line per configuration plus the header and the "wrote" line.

@@ -52,6 +52,10 @@ public:
     virtual CullResult cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
                             const ViewLights& lights, const CullSettings& settings) = 0;
     double lastDepthMs() const { return lastDepthMs_; }
+    // CPU wall-clock milliseconds of the last renderDepth() around its
+    // submission (its readback included); where the depth time is a wall
+    // clock already, that.
+    double lastDepthWallMs() const { return lastDepthWallMs_ >= 0 ? lastDepthWallMs_ : lastDepthMs_; }
     virtual std::string timingMethod() const = 0;
     // CPU wall-clock milliseconds of the last cull() around its submissions
     // (equal to its cullMs where that is the timing method; -1: not run).
@@ -70,6 +74,7 @@ public:
 
 protected:
     double lastDepthMs_ = -1;
+    double lastDepthWallMs_ = -1; // -1: the same as lastDepthMs_
     double lastShadeMs_ = -1;
 };
 

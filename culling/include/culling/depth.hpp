@@ -16,6 +16,11 @@ struct DepthImage {
     std::uint32_t width = 0, height = 0;
     float clearDepth = 1.0f;
     std::vector<float> depth;
+    // Non-zero when the Vulkan backend that rendered this image still holds
+    // it on the device under this id: its cull() then reads that copy and
+    // uploads nothing. Code that changes `depth` after a render sets it to 0
+    // (the backend also compares a sample of the pixels).
+    std::uint64_t deviceCopy = 0;
 
     float at(std::uint32_t x, std::uint32_t y) const { return depth[std::size_t(y) * width + x]; }
     bool hasGeometry(std::uint32_t x, std::uint32_t y) const { return at(x, y) != clearDepth; }

@@ -276,6 +276,23 @@ private:
     RenderPassHandle renderPass_[2];
     PipelineHandle depthPipeline_[2];
     std::unique_ptr<ShadePass> shadePass_;
+    // The last rendered depth image, kept on the device for the cull that
+    // follows (DepthImage::deviceCopy): its id, buffer and a sample of its
+    // pixels that a cull compares before trusting the id.
+    std::uint64_t residentId_ = 0, nextDepthId_ = 0;
+    Buffer residentDepth_;
+    std::vector<float> residentSample_;
+    static std::vector<float> depthSample(const DepthImage& d) {
+        std::vector<float> s;
+        const std::size_t n = d.depth.size(), step = std::max<std::size_t>(1, n / 256);
+        for (std::size_t i = 0; i < n; i += step) s.push_back(d.depth[i]);
+        if (n) s.push_back(d.depth[n - 1]);
+        return s;
+    }
+    bool isResident(const DepthImage& d) const {
+        return d.deviceCopy != 0 && d.deviceCopy == residentId_ && residentDepth_.buffer &&
+               residentSample_ == depthSample(d);
+    }
 };
 
 void VulkanBackend::createComputeObjects() {
@@ -511,7 +528,16 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
         staging.upload(ibuf, ix.data(), ix.size() * 4);
     }
     Image img = ctx_.createDepthImage(W, H, VK_FORMAT_D32_SFLOAT, "depth.image");
-    Buffer readback = ctx_.createBuffer(VkDeviceSize(W) * H * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "depth.readback");
+    // The depth goes into a storage buffer the cull reads in place (no
+    // readback and upload between the passes) and, from there, to the host.
+    // The previous one is released first: only one is kept.
+    residentDepth_ = Buffer();
+    residentId_ = 0;
+    Buffer resident = ctx_.createDeviceBuffer(VkDeviceSize(W) * H * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                                                          VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                              "depth.resident");
+    Staging back(ctx_);
+    const void* pixels = back.download(resident, std::size_t(W) * H * 4);
     VkRenderPass rp = depthRenderPass(reversed);
     VkPipeline pipe = depthPipeline(reversed);
     VkFramebufferCreateInfo fci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
@@ -565,25 +591,31 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
             VkBufferImageCopy region{};
             region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
             region.imageExtent = {W, H, 1};
-            vkCmdCopyImageToBuffer(cmd, img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1, &region);
-            // Host reads the readback buffer after the copy wrote it.
+            vkCmdCopyImageToBuffer(cmd, img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, resident.buffer, 1, &region);
+            // The readback copy (or, mapped, the host) reads what the image copy wrote.
             VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
             mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-            mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0,
-                                 nullptr, 0, nullptr);
+            mb.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_HOST_READ_BIT;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                 VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0, nullptr, 0,
+                                 nullptr);
+            back.recordDownloads(cmd);
         },
         "depth.commands");
     // GPU: the render pass alone; CPU device: the whole submission (the
     // readback copy included).
     lastDepthMs_ = gpuClock ? stamps.milliseconds(0) : wallMs;
+    lastDepthWallMs_ = wallMs;
 
     DepthImage out;
     out.width = W;
     out.height = H;
     out.clearDepth = clearDepth;
     out.depth.resize(std::size_t(W) * H);
-    std::memcpy(out.depth.data(), readback.mapped, out.depth.size() * 4);
+    std::memcpy(out.depth.data(), pixels, out.depth.size() * 4);
+    residentDepth_ = std::move(resident);
+    residentId_ = out.deviceCopy = ++nextDepthId_;
+    residentSample_ = depthSample(out);
     return out;
 }
 
@@ -719,7 +751,11 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     // Device buffers (sizes from the inputs; the index array comes after the count).
     const VkBufferUsageFlags ssbo = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     Buffer params = ctx_.createDeviceBuffer(sizeof(GpuCullParams), ssbo, "cull.params");
-    Buffer depthBuf = ctx_.createDeviceBuffer(depth.depth.size() * 4, ssbo, "cull.depth");
+    // The depth this backend rendered is on the device already.
+    const bool residentDepth = isResident(depth);
+    Buffer uploadedDepth =
+        residentDepth ? Buffer() : ctx_.createDeviceBuffer(depth.depth.size() * 4, ssbo, "cull.depth");
+    const Buffer& depthBuf = residentDepth ? residentDepth_ : uploadedDepth;
     Buffer tileBuf = ctx_.createDeviceBuffer(std::size_t(tiles) * sizeof(GpuTileBounds), ssbo, "cull.tiles");
     Buffer lightBuf = ctx_.createDeviceBuffer(std::size_t(n) * sizeof(GpuLight), ssbo, "cull.lights");
     Buffer binBuf = ctx_.createDeviceBuffer(binTotal64 * 4, ssbo, "cull.bins");
@@ -733,7 +769,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
 
     Staging staging(ctx_);
     staging.upload(params, &p, sizeof p);
-    staging.upload(depthBuf, depth.depth.data(), depth.depth.size() * 4);
+    if (!residentDepth) staging.upload(depthBuf, depth.depth.data(), depth.depth.size() * 4);
     staging.upload(lightBuf, gpuLights.data(), gpuLights.size() * sizeof(GpuLight));
     staging.upload(spotBuf, gpuSpots.data(), gpuSpots.size() * sizeof(GpuSpotCone));
     staging.upload(statusBuf, statusZero, 8);
@@ -867,6 +903,14 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         [&](VkCommandBuffer cmd) {
             if (gpuClock) stamps.reset(cmd);
             staging.recordUploads(cmd);
+            if (residentDepth) {
+                // The passes read the depth the depth submission's copy wrote.
+                VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+                mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+                mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+                vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
+                                     &mb, 0, nullptr, 0, nullptr);
+            }
             if (gpuClock) stamps.begin(cmd, 0);
             vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, computeLayout_, 0, 1, &set1, 0, nullptr);
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, boundsPipe);
