@@ -12,7 +12,8 @@
 // WRITE_PASS == 0 stores the count and stashes the list's first
 // P.bins.z entries (cull_common.glsl, binding 10); WRITE_PASS == 1 copies a
 // list the stash holds whole, else tests again and writes the indices at the
-// scanned offset and checks that the count matches. `all` has
+// scanned offset and checks that the count matches; a list that would end
+// beyond the index array is left out (the host sees the total and reruns). `all` has
 // one list of every light: its count pass is one invocation, its write pass
 // one invocation per light.
 #extension GL_GOOGLE_include_directive : require
@@ -82,7 +83,7 @@ void main() {
     if (ALGORITHM == LC_ALG_ALL) {
         if (WRITE_PASS == 0u) {
             if (id == 0u) listCount[0] = lightCount;
-        } else if (id < lightCount) {
+        } else if (id < lightCount && id < uint(lightIndices.length())) {
             lightIndices[id] = id;
         }
         return;
@@ -98,6 +99,9 @@ void main() {
     if (list >= P.counts.z) return;
     if (WRITE_PASS != 0u) {
         uint count = listCount[list];
+        // The index array may be smaller than the lists (a first submission
+        // sized from the previous cull): then the host writes them again.
+        if (listOffset[list] + count > uint(lightIndices.length())) return;
         if (count <= stashSlots) { // the count pass stashed the whole list
             uint base = listOffset[list];
             for (uint i = lane; i < count; i += LANES) lightIndices[base + i] = stash[list * stashSlots + i];

@@ -539,6 +539,39 @@ TEST_F(GpuTest, StashedAndRecomputedListsMatchTheReference) {
     }
 }
 
+// The write pass runs in the cull's one submission into an index array sized
+// from the previous cull of as many lists (on a CPU device: once the previous
+// cull's lists outgrew the stash). Lists that outgrow it are written again in
+// a second submission: 12,000 lights after 16, 24,000 after 12,000. Each
+// repeated cull (sized by its twin, in one submission) gives the same lists,
+// and the large ones hold the reference's.
+TEST_F(GpuTest, ListsThatOutgrowTheIndexArrayAreWrittenAgain) {
+    std::unique_ptr<CullBackend> fresh = makeVulkanBackend("");
+    auto cpuBackend = makeCpuBackend();
+    std::vector<gputest::Frame> frames;
+    for (std::uint32_t n : {16u, 12000u, 24000u}) {
+        Scene s = sized("forest", 640, 360);
+        s.lights = generateLights(defaultLightGen(s, n, 11));
+        frames.emplace_back(s, fresh.get());
+    }
+    for (Algorithm a : {Algorithm::All, Algorithm::MinMax, Algorithm::TwoPointFiveD, Algorithm::Clustered}) {
+        CullSettings st;
+        st.algorithm = a;
+        std::uint64_t before = frames[0].cull(*fresh, st).entries();
+        for (std::size_t k = 1; k < frames.size(); ++k) {
+            const std::string label = std::to_string(frames[k].lights.size()) + " lights, " + toString(a);
+            const CullResult outgrown = frames[k].cull(*fresh, st);
+            const CullResult sized = frames[k].cull(*fresh, st);
+            ASSERT_GT(outgrown.entries(), before + before / 16 + 256) << label << ": nothing outgrew";
+            EXPECT_EQ(outgrown.lightIndices, sized.lightIndices) << label;
+            EXPECT_EQ(outgrown.listCount, sized.listCount) << label;
+            EXPECT_EQ(outgrown.listOffset, sized.listOffset) << label;
+            checkCase(label, frames[k], st, *cpuBackend, *fresh);
+            before = sized.entries();
+        }
+    }
+}
+
 } // namespace
 
 namespace {

@@ -562,6 +562,10 @@ Context::StorageLayouts Context::createStorageLayouts(std::uint32_t bindings, co
     return out;
 }
 
+namespace {
+constexpr double kSpinMs = 2.0;
+} // namespace
+
 bool Context::submitAndWaitFor(const std::function<void(VkCommandBuffer)>& record, const std::string& n,
                                double timeoutMs, double& wallMs) {
     VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
@@ -598,7 +602,19 @@ bool Context::submitAndWaitFor(const std::function<void(VkCommandBuffer)>& recor
                                         : UINT64_MAX;
     const auto t0 = std::chrono::steady_clock::now();
     LC_VK(vkQueueSubmit(queue_, 1, &si, f));
-    const VkResult r = vkWaitForFences(device_, 1, &f, VK_TRUE, timeoutNs);
+    // On a GPU, poll the fence for up to kSpinMs before sleeping in the
+    // driver: the short submissions of a cull end within that, and a
+    // vkWaitForFences wake-up took about 85 us on the H100 (P1's wall clock
+    // 0.20 against 0.12 ms polled). Not on a CPU device, whose driver needs
+    // the cores the poll would take.
+    VkResult r = VK_NOT_READY;
+    if (!isCpuDevice()) {
+        const auto spinUntil = t0 + std::chrono::duration<double, std::milli>(std::min(kSpinMs, timeoutMs));
+        while ((r = vkGetFenceStatus(device_, f)) == VK_NOT_READY && std::chrono::steady_clock::now() < spinUntil) {
+        }
+        if (r != VK_SUCCESS && r != VK_NOT_READY) throwVkError("vkGetFenceStatus", r, __FILE__, __LINE__);
+    }
+    if (r == VK_NOT_READY) r = vkWaitForFences(device_, 1, &f, VK_TRUE, timeoutNs);
     wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (r == VK_TIMEOUT) {
         freeCmd.keep = true; // still pending: left to the context the caller abandons

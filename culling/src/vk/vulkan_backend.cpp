@@ -8,11 +8,18 @@
 //      the subgroup size, counted by ballot; each list's first entries (up to
 //      kMaxStashSlots, kMaxStashSlotsCpu on a CPU device) kept in the stash.
 //   3. prefix_sum: counts -> offsets, total in offsets[N].
-//   -- the host reads the total; when the stash holds every list whole it
-//      takes the entries from there and stops (no second submission) --
 //   4. cull_lists write pass: stashed lists copied, the longer ones tested
-//      again, indices written ascending into an index array sized exactly.
-//   fptl adds (always with the write pass, its lists being minmax's so far):
+//      again, indices written ascending into an index array sized from the
+//      previous cull (its entries and a margin; else the stash's size).
+//   -- one submission, no read-back between the passes; the host reads the
+//      total, and only when the lists outgrew the index array does a second
+//      submission run the write pass again into one sized exactly. On a CPU
+//      device, whose stash the host reads in place, the write pass waits
+//      for the total unless the previous cull's lists outgrew the stash --
+//   The depth buffer is the one the depth pre-pass left on the device when
+//   the cull is given that image (DepthImage::deviceCopy), else uploaded.
+//   fptl adds (in the second submission, always, sized exactly: its lists
+//   are minmax's so far):
 //   5. fine_prune, an invocation per entry: the light against its tile's
 //      geometry pixels, pruned entries marked;
 //   6. fine_prune pack, an invocation per list: kept entries to the front
@@ -271,6 +278,8 @@ private:
         zbinShader_, vertShader_;
     double lastCullWallMs_ = -1;
     std::uint32_t lastLongestList_ = 0; // of the previous cull: sizes a CPU device's stash
+    // Of the previous cull: its lists and entries size the next one's index array.
+    std::uint32_t lastListTotal_ = 0, lastEntries_ = 0;
     std::map<std::string, PipelineHandle> computePipelines_;
     PipelineLayoutHandle depthLayout_;
     RenderPassHandle renderPass_[2];
@@ -777,8 +786,28 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const auto* offs = static_cast<const std::uint32_t*>(staging.download(offsetBuf, (std::size_t(listTotal) + 1) * 4));
     const auto* tb = static_cast<const GpuTileBounds*>(staging.download(tileBuf, std::size_t(tiles) * sizeof(GpuTileBounds)));
     const auto* status = static_cast<const std::uint32_t*>(staging.download(statusBuf, 8));
-    const auto* stashed =
-        stashBytes ? static_cast<const std::uint32_t*>(staging.download(stashBuf, stashBytes)) : nullptr;
+    // The write pass runs in the same submission (no read-back between the
+    // passes) into an index array sized from the previous cull's entries with
+    // as many lists, with a margin (else the stash's size); only when the
+    // lists outgrow it does a second submission write them again, sized
+    // exactly. fptl prunes the written lists by entry: always a second
+    // submission, sized exactly.
+    const std::size_t firstCapacity =
+        lastListTotal_ == listTotal && lastEntries_ > 0
+            ? std::size_t(lastEntries_) + std::size_t(lastEntries_) / 16 + 256
+            : std::max<std::size_t>(std::size_t(listTotal) * stashSlots, 1);
+    // On a CPU device the stash is host memory: when the previous cull's
+    // lists fitted it, the host takes the lists from there (a write pass
+    // copying them cost lavapipe more, 4.2-4.3 against 3.8-4.5 ms at P1).
+    const auto* stashed = ctx_.isCpuDevice() && stashBytes
+                              ? static_cast<const std::uint32_t*>(staging.download(stashBuf, stashBytes))
+                              : nullptr;
+    const bool writeFirst = !fptl && !(stashed && lastLongestList_ <= stashSlots) &&
+                            firstCapacity * 4 <= lim.maxStorageBufferRange;
+    Buffer firstIndices =
+        writeFirst ? ctx_.createDeviceBuffer(firstCapacity * 4, ssbo, "cull.indices.first") : Buffer();
+    const auto* firstIdx =
+        writeFirst ? static_cast<const std::uint32_t*>(staging.download(firstIndices, firstCapacity * 4)) : nullptr;
     const auto* binWordsOut =
         zbin ? static_cast<const std::uint32_t*>(staging.download(binBuf, binTotal64 * 4)) : nullptr;
 
@@ -819,7 +848,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         vkUpdateDescriptorSets(dev, kBindings, writes.data(), 0, nullptr);
         return set;
     };
-    VkDescriptorSet set1 = makeSet(placeholder, "cull.set.count");
+    VkDescriptorSet set1 = makeSet(writeFirst ? firstIndices : placeholder, "cull.set.count");
 
     const std::uint32_t sg = ctx_.subgroupSize();
     const std::uint32_t algoId = std::uint32_t(algo), testId = std::uint32_t(settings.test),
@@ -932,6 +961,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
             dispatchAfter(cmd, countPipe, countGroups);
             // The scan reads the counts the count pass wrote.
             dispatchAfter(cmd, scanPipe, Grid{1, 1});
+            // The write pass reads the offsets the scan wrote.
+            if (writeFirst) dispatchAfter(cmd, writePipe, writeGroups);
             if (gpuClock) stamps.end(cmd, 0);
             staging.recordDownloads(cmd);
         },
@@ -944,6 +975,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const std::string loopLimitError = "Vulkan device '" + ctx_.deviceName() +
                                        "' ended a culling shader loop early (a driver loop cap); result discarded";
     if (*status & 8u) throw DeviceError(loopLimitError);
+    const std::string countMismatchError = "Vulkan write pass found a different entry count than the count pass";
+    if (*status & 2u) throw DeviceError(countMismatchError);
     res.volumeTests = (status[0] & 4u) ? 0 : status[1]; // wrapped: not counted
     std::uint64_t total64 = 0;
     std::uint32_t longest = 0;
@@ -963,11 +996,14 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                                                     : std::vector<std::uint32_t>();
     const std::vector<std::uint32_t> offs0 = fptl ? std::vector<std::uint32_t>(offs, offs + listTotal)
                                                   : std::vector<std::uint32_t>();
-    if (total > 0 && longest <= stashSlots && !fptl) {
+    if (total > 0 && stashed && !writeFirst && longest <= stashSlots && !fptl) {
         // The stash holds every list whole: the entries are in, no write pass.
         res.lightIndices.resize(total);
         for (std::uint32_t l = 0; l < listTotal; ++l)
             std::copy_n(stashed + std::size_t(l) * stashSlots, counts[l], res.lightIndices.begin() + offs[l]);
+    } else if (total > 0 && writeFirst && total <= firstCapacity) {
+        // The first submission wrote every list.
+        res.lightIndices.assign(firstIdx, firstIdx + total);
     } else if (total > 0) {
         Buffer indexBuf = ctx_.createDeviceBuffer(std::size_t(total) * 4, ssbo, "cull.indices");
         const std::uint32_t* idx = nullptr;
@@ -1001,8 +1037,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
             "cull.commands.write");
         if (gpuClock) gpuMs += stamps.milliseconds(1);
         if (*status2 & 8u) throw DeviceError(loopLimitError);
-        if (*status2 & 2u)
-            throw DeviceError("Vulkan write pass found a different entry count than the count pass");
+        if (*status2 & 2u) throw DeviceError(countMismatchError);
         if (fptl) {
             // Each list's kept entries lead its range: pack the ranges.
             std::uint32_t at = 0;
@@ -1060,6 +1095,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     res.timings.depthMs = lastDepthMs_;
     lastCullWallMs_ = wallMs;
     lastLongestList_ = longest;
+    lastListTotal_ = listTotal;
+    lastEntries_ = total;
     return res;
 }
 
