@@ -182,3 +182,32 @@ TEST_F(GpuTest, DepthImageIsTopRowFirst) {
 }
 
 } // namespace
+
+namespace {
+
+// The backend keeps its depth image and buffer while the resolution and the
+// depth direction stay. Renders that switch between them (a reversed-Z
+// camera, another size, back) give exactly what a fresh backend renders.
+TEST_F(GpuTest, DepthTargetsFollowTheResolutionAndDirection) {
+    std::unique_ptr<CullBackend> kept = makeVulkanBackend("");
+    Scene small = makeBuiltinScene("mountain");
+    small.camera.width = 320;
+    small.camera.height = 180;
+    Scene reversed = small;
+    reversed.camera.projection = ProjectionKind::ReversedZ;
+    Scene large = small;
+    large.camera.width = 400;
+    large.camera.height = 300;
+    for (const Scene* s : {&small, &reversed, &large, &small, &reversed}) {
+        const Projection proj(s->camera);
+        const DepthImage got = kept->renderDepth(*s, proj);
+        const DepthImage want = makeVulkanBackend("")->renderDepth(*s, proj);
+        ASSERT_EQ(got.width, want.width);
+        ASSERT_EQ(got.height, want.height);
+        EXPECT_EQ(got.clearDepth, want.clearDepth);
+        EXPECT_TRUE(got.depth == want.depth) << s->camera.width << "x" << s->camera.height;
+        EXPECT_GT(got.geometryPixelCount(), 0u);
+    }
+}
+
+} // namespace

@@ -289,6 +289,12 @@ private:
     // follows (DepthImage::deviceCopy): its id, buffer and a sample of its
     // pixels that a cull compares before trusting the id.
     std::uint64_t residentId_ = 0, nextDepthId_ = 0;
+    struct DepthTarget {
+        std::uint32_t width = 0, height = 0;
+        bool reversed = false;
+        Image image;
+        FramebufferHandle framebuffer;
+    } depthTarget_;
     Buffer residentDepth_;
     std::vector<float> residentSample_;
     static std::vector<float> depthSample(const DepthImage& d) {
@@ -536,31 +542,44 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
         staging.upload(vbuf, v.data(), v.size() * 4);
         staging.upload(ibuf, ix.data(), ix.size() * 4);
     }
-    Image img = ctx_.createDepthImage(W, H, VK_FORMAT_D32_SFLOAT, "depth.image");
-    // The depth goes into a storage buffer the cull reads in place (no
-    // readback and upload between the passes) and, from there, to the host.
-    // The previous one is released first: only one is kept.
-    residentDepth_ = Buffer();
-    residentId_ = 0;
-    Buffer resident = ctx_.createDeviceBuffer(VkDeviceSize(W) * H * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                                                          VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                              "depth.resident");
-    Staging back(ctx_);
-    const void* pixels = back.download(resident, std::size_t(W) * H * 4);
     VkRenderPass rp = depthRenderPass(reversed);
     VkPipeline pipe = depthPipeline(reversed);
-    VkFramebufferCreateInfo fci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
-    fci.renderPass = rp;
-    fci.attachmentCount = 1;
-    VkImageView view = img.view;
-    fci.pAttachments = &view;
-    fci.width = W;
-    fci.height = H;
-    fci.layers = 1;
-    VkFramebuffer fbRaw;
-    LC_VK(vkCreateFramebuffer(dev, &fci, nullptr, &fbRaw));
-    FramebufferHandle fb(dev, fbRaw);
-    ctx_.name(VK_OBJECT_TYPE_FRAMEBUFFER, fbRaw, "depth.framebuffer");
+    // The depth image, its framebuffer and the storage buffer the depth goes
+    // to (the cull reads it in place, no readback and upload between the
+    // passes; the host gets it from there) are kept while the resolution and
+    // the depth direction stay: fresh ones cost lavapipe a page fault per
+    // 4 KiB page touched, milliseconds at 1080p.
+    if (depthTarget_.width != W || depthTarget_.height != H || depthTarget_.reversed != reversed ||
+        !depthTarget_.framebuffer) {
+        depthTarget_ = DepthTarget{};
+        residentDepth_ = Buffer();
+        depthTarget_.image = ctx_.createDepthImage(W, H, VK_FORMAT_D32_SFLOAT, "depth.image");
+        VkFramebufferCreateInfo fci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+        fci.renderPass = rp;
+        fci.attachmentCount = 1;
+        VkImageView view = depthTarget_.image.view;
+        fci.pAttachments = &view;
+        fci.width = W;
+        fci.height = H;
+        fci.layers = 1;
+        VkFramebuffer fbRaw;
+        LC_VK(vkCreateFramebuffer(dev, &fci, nullptr, &fbRaw));
+        depthTarget_.framebuffer = FramebufferHandle(dev, fbRaw);
+        ctx_.name(VK_OBJECT_TYPE_FRAMEBUFFER, fbRaw, "depth.framebuffer");
+        depthTarget_.width = W;
+        depthTarget_.height = H;
+        depthTarget_.reversed = reversed;
+    }
+    if (!residentDepth_.buffer)
+        residentDepth_ = ctx_.createDeviceBuffer(VkDeviceSize(W) * H * 4,
+                                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                 "depth.resident");
+    residentId_ = 0; // rewritten below: no earlier image names it any more
+    const Buffer& resident = residentDepth_;
+    const Image& img = depthTarget_.image;
+    VkFramebuffer fb = depthTarget_.framebuffer;
+    Staging back(ctx_);
+    const void* pixels = back.download(resident, std::size_t(W) * H * 4);
 
     const bool gpuClock = useGpuTimestamps();
     TimestampPool stamps = gpuClock ? TimestampPool(ctx_, 1, "depth.timestamps") : TimestampPool();
@@ -622,7 +641,6 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
     out.clearDepth = clearDepth;
     out.depth.resize(std::size_t(W) * H);
     std::memcpy(out.depth.data(), pixels, out.depth.size() * 4);
-    residentDepth_ = std::move(resident);
     residentId_ = out.deviceCopy = ++nextDepthId_;
     residentSample_ = depthSample(out);
     return out;
