@@ -8,7 +8,7 @@
 // list is widened by eps = params.cluster.z (relative) + params.cluster.w
 // (absolute), so a light the double-precision CPU reference keeps is always
 // kept here too; the GPU lists may only hold MORE entries near a bound.
-#include "culling/gpu_shared.h"
+#include "culling/vk/gpu_shared.h"
 #include "spot_tests.glsl"
 
 // Local size is a specialisation constant. tile_bounds and prefix_sum run one

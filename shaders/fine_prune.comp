@@ -1,5 +1,5 @@
 #version 450
-// fptl's fine prune (culling/fine_prune.hpp), run after cull_lists wrote the
+// fptl's fine prune (culling/cpu/fine_prune.hpp), run after cull_lists wrote the
 // coarse (minmax) lists into the index array:
 //   WRITE_PASS 0: an invocation per entry of the index array. It finds its
 //     list (a binary search of the offsets), walks the geometry pixels of

@@ -2,12 +2,12 @@
 // The Lambert shading pass: one invocation per pixel (8x8 pixels per
 // workgroup), each looping over the lights of its pixel's list. The formula
 // and the order of float operations are those of the CPU reference
-// (culling/src/shade.cpp): `precise` keeps the compiler from contracting them
+// (culling/src/truth/shade.cpp): `precise` keeps the compiler from contracting them
 // into FMAs, so the two differ only by the device's sqrt/division rounding.
 //
 // Spaces: every position is VIEW space (right-handed, y up, camera looks down -z).
 #extension GL_GOOGLE_include_directive : require
-#include "culling/gpu_shade.h"
+#include "culling/vk/gpu_shade.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 // 1: every light in index order (no list arrays read); 0: the pixel's list.

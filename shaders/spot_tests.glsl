@@ -1,5 +1,5 @@
 // Spot-light cone tests for the culling compute shaders, the float twins of
-// culling/src/spot_tests.cpp (docs/SPOT_LIGHTS.md). View space. A spot
+// culling/src/math/spot_tests.cpp (docs/SPOT_LIGHTS.md). View space. A spot
 // light's volume is the spherical sector of points within `range` of the apex
 // whose angle to the unit `axis` is at most the outer angle (cos/sin given).
 //

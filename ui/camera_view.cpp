@@ -1,12 +1,12 @@
 #include "camera_view.hpp"
 
-#include "culling/custom_cull.hpp"
+#include "culling/custom/custom_cull.hpp"
 
 #include "document.hpp"
 #include "vtk_adapters.hpp"
 
-#include "culling/export.hpp"
-#include "culling/overlays.hpp"
+#include "culling/diagnostics/export.hpp"
+#include "culling/diagnostics/overlays.hpp"
 
 #include <QHelpEvent>
 #include <QTimer>

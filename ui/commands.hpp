@@ -3,7 +3,7 @@
 // to go both ways and applies itself through Document::apply*, which emits the
 // signals the panels observe.
 
-#include "culling/scene.hpp"
+#include "culling/scene/scene.hpp"
 
 #include <QUndoCommand>
 

@@ -1,7 +1,7 @@
 #include "cull_worker.hpp"
 
-#include "culling/errors.hpp"
-#include "culling/projection.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/math/projection.hpp"
 
 #include <chrono>
 #include <exception>

@@ -8,9 +8,9 @@
 // mode must not pile up runs); the run already in progress finishes, and the
 // document keeps the result with the highest generation number.
 
-#include "culling/backend.hpp"
-#include "culling/custom_cull.hpp"
-#include "culling/pipeline.hpp"
+#include "culling/core/backend.hpp"
+#include "culling/custom/custom_cull.hpp"
+#include "culling/core/pipeline.hpp"
 
 #include <QObject>
 #include <QString>

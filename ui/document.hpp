@@ -4,10 +4,10 @@
 // Panels and views observe it through signals; every edit of the scene goes
 // through its QUndoStack (the public edit functions below push commands).
 
-#include "culling/overlays.hpp"
-#include "culling/params.hpp"
-#include "culling/pipeline.hpp"
-#include "culling/scene.hpp"
+#include "culling/diagnostics/overlays.hpp"
+#include "culling/core/params.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/scene/scene.hpp"
 
 #include <QObject>
 #include <QString>

@@ -2,8 +2,8 @@
 
 #include "document.hpp"
 
-#include "culling/errors.hpp"
-#include "culling/projection.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/math/projection.hpp"
 
 #include <QFontDatabase>
 #include <QLabel>

@@ -4,7 +4,7 @@
 // algorithm's tests with their numbers, and the ground truth of the list's
 // pixels. Follows the document's selection and latest run.
 
-#include "culling/explain.hpp"
+#include "culling/diagnostics/explain.hpp"
 
 #include <QWidget>
 

@@ -4,7 +4,7 @@
 // scene's default placement volume, and the share of spot lights with their
 // outer-angle range.
 
-#include "culling/scene_io.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <QDialog>
 

@@ -7,11 +7,11 @@
 #include "spot_actor.hpp"
 #include "spot_handles.hpp"
 
-#include "culling/projection.hpp"
+#include "culling/math/projection.hpp"
 
 #include <QTimer>
 
-#include "culling/overlays.hpp"
+#include "culling/diagnostics/overlays.hpp"
 
 #include <optional>
 #include <vtkActor.h>

@@ -13,8 +13,8 @@
 #include "tile_inspector.hpp"
 #include "report_dock.hpp"
 
-#include "culling/errors.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <QAction>
 #include <QApplication>

@@ -6,11 +6,11 @@
 // Dialogs that ask the user something go through the replaceable functions in
 // `prompts`, so tests (and scripts) can answer them without a modal loop.
 
-#include "culling/params.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/params.hpp"
+#include "culling/scene/scene_io.hpp"
 
-#include "culling/custom_cull.hpp"
-#include "culling/gltf_io.hpp"
+#include "culling/custom/custom_cull.hpp"
+#include "culling/scene/gltf_io.hpp"
 
 #include <QMainWindow>
 #include <QMessageBox>

@@ -8,8 +8,8 @@
 #include "inspector_view.hpp"
 #include "overlay_actors.hpp"
 
-#include "culling/errors.hpp"
-#include "culling/export.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/diagnostics/export.hpp"
 
 #include <QAction>
 #include <QActionGroup>

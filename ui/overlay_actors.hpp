@@ -1,6 +1,6 @@
 #pragma once
 // The inspector view's inspection overlays, built from the document's latest
-// run with the culling library's overlay geometry (culling/overlays.hpp):
+// run with the culling library's overlay geometry (culling/diagnostics/overlays.hpp):
 // - the selected tile's frustum (translucent solid + outline);
 // - its depth cells: occupied cells filled, empty ones outlined, the selected
 //   cell highlighted; the halfz split as a filled quad; clustered froxels;
@@ -28,8 +28,8 @@
 // Each part follows its Document::OverlayOptions toggle. Translucent parts
 // rely on the renderer's depth peeling (set up by InspectorView).
 
-#include "culling/explain.hpp"
-#include "culling/overlays.hpp"
+#include "culling/diagnostics/explain.hpp"
+#include "culling/diagnostics/overlays.hpp"
 
 #include <vtkNew.h>
 #include <vtkSmartPointer.h>

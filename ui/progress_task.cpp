@@ -2,7 +2,7 @@
 
 #include "status_progress.hpp"
 
-#include "culling/errors.hpp"
+#include "culling/core/errors.hpp"
 
 #include <QEventLoop>
 #include <QThread>

@@ -4,8 +4,8 @@
 // (StatusProgress) shows how far they got and offers Cancel. The UI keeps
 // processing events (views repaint) but takes no input besides Cancel.
 
-#include "culling/depth.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/depth.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <QString>
 

@@ -2,8 +2,8 @@
 
 #include "document.hpp"
 
-#include "culling/backend.hpp"
-#include "culling/errors.hpp"
+#include "culling/core/backend.hpp"
+#include "culling/core/errors.hpp"
 
 #include <QComboBox>
 #include <QHBoxLayout>

@@ -1,5 +1,5 @@
 #pragma once
-// The Report dock: the speed-against-error sweep of culling/report.hpp on the
+// The Report dock: the speed-against-error sweep of culling/diagnostics/report.hpp on the
 // document's scene, run on its own thread (its own backends: a Vulkan sweep
 // opens its own device, so the culling worker is never blocked) with a
 // progress bar and cancel, plotted with VTK charts (total time against
@@ -7,8 +7,8 @@
 // line). Clicking a point loads that configuration into the document's
 // culling settings (and its tile size into the camera, one undo step).
 
-#include "culling/depth.hpp"
-#include "culling/report.hpp"
+#include "culling/core/depth.hpp"
+#include "culling/diagnostics/report.hpp"
 
 #include <QWidget>
 

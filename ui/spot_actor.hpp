@@ -4,7 +4,7 @@
 // spherical cap, world space, in each light's display colour). The inspector
 // view owns one and calls update() when lights change.
 
-#include "culling/scene.hpp"
+#include "culling/scene/scene.hpp"
 
 #include <vtkSmartPointer.h>
 

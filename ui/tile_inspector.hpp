@@ -4,7 +4,7 @@
 // need it, and the ground-truth verdict (needed / false positive / MISSING).
 // Rows come from lc::tileLightRows; a double click selects the light.
 
-#include "culling/overlays.hpp"
+#include "culling/diagnostics/overlays.hpp"
 
 #include <QAbstractTableModel>
 #include <QWidget>

@@ -2,7 +2,7 @@
 // Adapters from the culling library's plain structs to VTK data, at the edge
 // of the UI (the library itself never sees VTK).
 
-#include "culling/scene.hpp"
+#include "culling/scene/scene.hpp"
 
 #include <vtkSmartPointer.h>
 

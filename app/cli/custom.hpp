@@ -2,8 +2,8 @@
 // `lightcull run --shader FILE` and `lightcull check --lists FILE`: a
 // renderer's own culling judged like a built-in algorithm
 // (docs/CUSTOM_CULLING.md). The flags live here; main.cpp runs the commands.
-#include "culling/custom_cull.hpp"
-#include "culling/errors.hpp"
+#include "culling/custom/custom_cull.hpp"
+#include "culling/core/errors.hpp"
 
 #include <CLI/CLI.hpp>
 

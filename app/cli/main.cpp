@@ -13,13 +13,13 @@
 // table (see docs/CLI.md). Errors print one line on stderr and exit non-zero:
 // 2 for a bad command line, 1 for anything that failed while running.
 
-#include "culling/errors.hpp"
-#include "culling/explain.hpp"
-#include "culling/export.hpp"
-#include "culling/file_io.hpp"
-#include "culling/params.hpp"
-#include "culling/pipeline.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/diagnostics/explain.hpp"
+#include "culling/diagnostics/export.hpp"
+#include "culling/core/file_io.hpp"
+#include "culling/core/params.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/scene/scene_io.hpp"
 #include "custom.hpp"
 #include "report.hpp"
 #include "scene_source.hpp"

@@ -4,9 +4,9 @@
 
 #include "custom.hpp"
 
-#include "culling/errors.hpp"
-#include "culling/report.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/diagnostics/report.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <unistd.h>
 

@@ -1,5 +1,5 @@
 #pragma once
-// `lightcull report`: the speed-against-error sweep (culling/report.hpp) of
+// `lightcull report`: the speed-against-error sweep (culling/diagnostics/report.hpp) of
 // one scene, written as report.csv, report.md and pareto.png.
 #include "scene_source.hpp"
 

@@ -2,8 +2,8 @@
 // Where a CLI command's scene comes from: --scene FILE (scene JSON, .gltf or
 // .glb) or --builtin NAME, plus the glTF reading options. One definition
 // shared by run, bench, report and convert.
-#include "culling/gltf_io.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/scene/gltf_io.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <CLI/CLI.hpp>
 

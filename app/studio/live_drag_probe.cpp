@@ -6,7 +6,7 @@
 #include "inspector_view.hpp"
 #include "main_window.hpp"
 
-#include "culling/pipeline.hpp"
+#include "culling/core/pipeline.hpp"
 
 #include <vtkCommand.h>
 #include <vtkHandleWidget.h>

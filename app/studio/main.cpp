@@ -14,7 +14,7 @@
 #include "live_drag_probe.hpp"
 #include "main_window.hpp"
 
-#include "culling/scene_io.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <QApplication>
 #include <QCommandLineParser>

@@ -4,8 +4,8 @@
 // report, a hang, an allocation past the RSS limit or any other exception is
 // a bug. Loaded scenes are also written back as GLB (the writer must accept
 // whatever the reader produced).
-#include "culling/errors.hpp"
-#include "culling/gltf_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/scene/gltf_io.hpp"
 
 #include <unistd.h>
 

@@ -3,8 +3,8 @@
 // project's own readers; "stl" goes through OpenMesh's). Any input must
 // load into a mesh that validates or throw lc::InputError; a crash, a
 // sanitizer report or any other exception is a bug.
-#include "culling/errors.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <unistd.h>
 

@@ -4,8 +4,8 @@
 //
 // The scene "lives" in a folder that does not exist, so relative mesh paths in
 // the input fail to load (a clear InputError) instead of reading the disk.
-#include "culling/errors.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <cstddef>
 #include <cstdint>

@@ -5,8 +5,8 @@
 // LIGHTCULL_VALIDATION=1 is set before the first Vulkan instance is created;
 // one backend is shared per test executable (instance creation with the layer
 // costs a few hundred milliseconds on lavapipe).
-#include "culling/backend.hpp"
-#include "culling/depth.hpp"
+#include "culling/core/backend.hpp"
+#include "culling/core/depth.hpp"
 #include "vk/validation.hpp"
 #include "vk/vulkan_backend.hpp"
 

@@ -9,12 +9,12 @@
 
 #include "../unit/cli_support.hpp"
 
-#include "culling/custom_cull.hpp"
-#include "culling/errors.hpp"
-#include "culling/export.hpp"
-#include "culling/overlays.hpp"
-#include "culling/report.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/custom/custom_cull.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/diagnostics/export.hpp"
+#include "culling/diagnostics/overlays.hpp"
+#include "culling/diagnostics/report.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -3,7 +3,7 @@
 // and typed errors naming the failed call, its result and the source line.
 #include "gpu_test_env.hpp"
 
-#include "culling/errors.hpp"
+#include "culling/core/errors.hpp"
 #include "vk/vk_context.hpp"
 
 #include <algorithm>

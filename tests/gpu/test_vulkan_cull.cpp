@@ -7,10 +7,10 @@
 // invocations, and determinism. Validation is on; any message fails.
 #include "gpu_test_env.hpp"
 
-#include "culling/depth.hpp"
-#include "culling/ground_truth.hpp"
-#include "culling/pipeline.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/depth.hpp"
+#include "culling/truth/ground_truth.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <algorithm>
 #include <cmath>

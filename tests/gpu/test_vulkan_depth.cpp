@@ -4,8 +4,8 @@
 // coverage is identical except on triangle edges.
 #include "gpu_test_env.hpp"
 
-#include "culling/depth.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/depth.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -5,10 +5,10 @@
 // lists are typed errors before anything reaches the device. Validation is on.
 #include "gpu_test_env.hpp"
 
-#include "culling/errors.hpp"
-#include "culling/pipeline.hpp"
-#include "culling/scene_io.hpp"
-#include "culling/shade.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/scene/scene_io.hpp"
+#include "culling/truth/shade.hpp"
 
 #include <cmath>
 

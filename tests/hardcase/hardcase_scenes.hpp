@@ -8,12 +8,12 @@
 // Scenes are small on purpose (tens of pixels to a few hundred) so the whole
 // tier stays fast; the cases that need a size (1366x768) or a real asset
 // (maize, buildings) say so.
-#include "culling/backend.hpp"
-#include "culling/depth.hpp"
-#include "culling/errors.hpp"
-#include "culling/pipeline.hpp"
-#include "culling/projection.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/backend.hpp"
+#include "culling/core/depth.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/math/projection.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>
 

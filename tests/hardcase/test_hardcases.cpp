@@ -15,8 +15,8 @@
 #include "../gpu/gpu_test_env.hpp"
 #include "hardcase_scenes.hpp"
 
-#include "culling/depth.hpp"
-#include "culling/ground_truth.hpp"
+#include "culling/core/depth.hpp"
+#include "culling/truth/ground_truth.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -6,11 +6,11 @@
 // same on a builtin scene with many spots; Vulkan shading of a spot.
 #include "../gpu/gpu_test_env.hpp"
 
-#include "culling/errors.hpp"
-#include "culling/ground_truth.hpp"
-#include "culling/scene_io.hpp"
-#include "culling/shade.hpp"
-#include "culling/pipeline.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/truth/ground_truth.hpp"
+#include "culling/scene/scene_io.hpp"
+#include "culling/truth/shade.hpp"
+#include "culling/core/pipeline.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -21,9 +21,9 @@
 #include "inspector_view.hpp"
 #include "overlay_actors.hpp"
 
-#include "culling/backend.hpp"
-#include "culling/overlays.hpp"
-#include "culling/pipeline.hpp"
+#include "culling/core/backend.hpp"
+#include "culling/diagnostics/overlays.hpp"
+#include "culling/core/pipeline.hpp"
 
 #include <QDir>
 #include <QImage>

@@ -5,7 +5,7 @@
 // frames. (The picture's anti-aliased edges differ slightly from meshes drawn under the overlay; the render
 // baselines, within their tolerance, cover that.)
 #include "camera_view.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/scene/scene_io.hpp"
 #include "document.hpp"
 #include "studio_test_support.hpp"
 

@@ -11,8 +11,8 @@
 #include "main_window.hpp"
 #include "tile_inspector.hpp"
 
-#include "culling/custom_cull.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/custom/custom_cull.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <QAction>
 #include <QElapsedTimer>

@@ -14,9 +14,9 @@
 #include "tile_inspector.hpp"
 #include "scene_tree.hpp"
 
-#include "culling/explain.hpp"
-#include "culling/ground_truth.hpp"
-#include "culling/overlays.hpp"
+#include "culling/diagnostics/explain.hpp"
+#include "culling/truth/ground_truth.hpp"
+#include "culling/diagnostics/overlays.hpp"
 
 #include <vtkCamera.h>
 #include <vtkPolyData.h>

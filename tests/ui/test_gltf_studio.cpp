@@ -9,9 +9,9 @@
 #include "document.hpp"
 #include "main_window.hpp"
 
-#include "culling/gltf_io.hpp"
-#include "culling/pipeline.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/scene/gltf_io.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <QAction>
 #include <QElapsedTimer>

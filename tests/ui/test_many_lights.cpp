@@ -6,9 +6,9 @@
 // the document's geometry revision follows mesh edits only.
 
 #include "cull_worker.hpp"
-#include "culling/backend.hpp"
-#include "culling/pipeline.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/backend.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/scene/scene_io.hpp"
 #include "document.hpp"
 #include "inspector_view.hpp"
 #include "light_silhouettes.hpp"

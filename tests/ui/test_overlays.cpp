@@ -14,8 +14,8 @@
 #include "overlay_actors.hpp"
 #include "tile_inspector.hpp"
 
-#include "culling/overlays.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/diagnostics/overlays.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <QDir>
 #include <QAction>

@@ -15,9 +15,9 @@
 #include "document.hpp"
 #include "main_window.hpp"
 
-#include "culling/backend.hpp"
-#include "culling/export.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/backend.hpp"
+#include "culling/diagnostics/export.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <QAction>
 #include <QDir>

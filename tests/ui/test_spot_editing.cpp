@@ -12,8 +12,8 @@
 #include "property_panel.hpp"
 #include "spot_actor.hpp"
 
-#include "culling/pipeline.hpp"
-#include "culling/spot_tests.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/math/spot_tests.hpp"
 
 #include <QAction>
 #include <QComboBox>

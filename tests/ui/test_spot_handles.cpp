@@ -14,7 +14,7 @@
 #include "spot_actor.hpp"
 #include "spot_handles.hpp"
 
-#include "culling/overlays.hpp"
+#include "culling/diagnostics/overlays.hpp"
 
 #include <QAction>
 #include <QComboBox>

@@ -13,10 +13,10 @@
 #include "scene_tree.hpp"
 #include "tile_inspector.hpp"
 
-#include "culling/ground_truth.hpp"
-#include "culling/pipeline.hpp"
-#include "culling/projection.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/truth/ground_truth.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/math/projection.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <QAction>
 #include <QDoubleSpinBox>

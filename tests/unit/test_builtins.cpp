@@ -1,6 +1,6 @@
 // Built-in scenes and the light generator.
-#include "culling/errors.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,8 +3,8 @@
 // thing, a non-zero exit, and no output folder.
 #include "cli_support.hpp"
 
-#include "culling/params.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/params.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

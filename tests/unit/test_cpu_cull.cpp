@@ -5,9 +5,9 @@
 //  - a brute-force re-derivation of every list from the DESIGN rules over all
 //    tiles x all lights, which catches lists lost (or gained) by the backend's
 //    per-light tile rectangles.
-#include "culling/backend.hpp"
-#include "culling/errors.hpp"
-#include "culling/ground_truth.hpp"
+#include "culling/core/backend.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/truth/ground_truth.hpp"
 
 #include <gtest/gtest.h>
 

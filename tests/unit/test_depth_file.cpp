@@ -4,8 +4,8 @@
 // one-line errors naming the file.
 #include "cli_support.hpp"
 
-#include "culling/custom_cull.hpp"
-#include "culling/errors.hpp"
+#include "culling/custom/custom_cull.hpp"
+#include "culling/core/errors.hpp"
 
 #include <gtest/gtest.h>
 #include <png.h>

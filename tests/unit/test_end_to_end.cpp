@@ -4,8 +4,8 @@
 // to well under a minute.
 #include "cli_support.hpp"
 
-#include "culling/params.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/params.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -4,11 +4,11 @@
 // MISSING; `lightcull explain` prints the same explanation.
 #include "cli_support.hpp"
 
-#include "culling/explain.hpp"
-#include "culling/ground_truth.hpp"
-#include "culling/overlays.hpp"
-#include "culling/tile_math.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/diagnostics/explain.hpp"
+#include "culling/truth/ground_truth.hpp"
+#include "culling/diagnostics/overlays.hpp"
+#include "culling/math/tile_math.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
 // Exporters: summary.json, tiles.csv and heatmap.png from real pipeline runs,
 // read back and checked against the run; the atomic folder write on success
 // and on failure.
-#include "culling/errors.hpp"
-#include "culling/export.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/diagnostics/export.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -1,12 +1,12 @@
-// glTF 2.0 scenes (culling/gltf_io.hpp): round trips through .glb and .gltf,
+// glTF 2.0 scenes (culling/scene/gltf_io.hpp): round trips through .glb and .gltf,
 // every geometry feature the reader claims (docs/FORMATS.md), lights and
 // cameras with their conventions, and hostile files, each of which must be a
 // one-line InputError naming the file and the JSON path.
 #include "cli_support.hpp"
 
-#include "culling/errors.hpp"
-#include "culling/gltf_io.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/scene/gltf_io.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>

@@ -1,10 +1,10 @@
 // Ground truth and metrics on hand-built cases whose answers are known, the
 // spatial index against brute force, and the Lambert shading against
 // hand-computed values.
-#include "culling/errors.hpp"
-#include "culling/ground_truth.hpp"
-#include "culling/scene_io.hpp"
-#include "light_grid.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/truth/ground_truth.hpp"
+#include "culling/scene/scene_io.hpp"
+#include "truth/light_grid.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // The light generator reports progress and stops when cancelled, and neither
 // changes what it generates.
-#include "culling/errors.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <glm/glm.hpp>
 #include <gtest/gtest.h>

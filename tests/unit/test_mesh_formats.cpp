@@ -1,9 +1,9 @@
-// The project's own PLY and OFF readers (culling/src/mesh_ply.cpp,
+// The project's own PLY and OFF readers (culling/src/scene/mesh_ply.cpp,
 // mesh_off.cpp): every format variant against expectations derived by hand or
 // by an independent path (a tiny reference reader below, the OBJ parser), and
 // the exact error for truncated and garbage input.
-#include "culling/errors.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>

@@ -1,7 +1,7 @@
 // Regression tests for inputs the fuzzers (tests/fuzz/, scripts/fuzz.sh) found.
 // Each input file is kept verbatim in tests/data/fuzz_*.
-#include "culling/errors.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 

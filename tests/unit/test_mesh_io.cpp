@@ -1,8 +1,8 @@
 // Mesh loading: the shared real assets, small hand-made files whose expected
 // contents are derived by hand, and broken files that must give InputError
 // naming the file.
-#include "culling/errors.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 

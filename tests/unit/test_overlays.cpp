@@ -4,10 +4,10 @@
 // every list of a real run, the reverse look-up matches tiles.csv, and the
 // per-tile heat sums to the run's metrics. Plus the overlays.vtm files as
 // text (the VTK read-back is tests/ui/test_overlay_export.cpp).
-#include "culling/errors.hpp"
-#include "culling/export.hpp"
-#include "culling/overlays.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/diagnostics/export.hpp"
+#include "culling/diagnostics/overlays.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 

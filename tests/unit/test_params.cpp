@@ -1,6 +1,6 @@
 // The culling parameter table: order, defaults, parsing and its errors.
-#include "culling/errors.hpp"
-#include "culling/params.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/core/params.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
 // RunOptions::reuseDepth: a run that moved only lights may reuse the depth
 // image of an earlier run (the studio's Live drags do). The result must be the
 // one a fresh run gives, and a depth image of the wrong size is refused.
-#include "culling/errors.hpp"
-#include "culling/pipeline.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 

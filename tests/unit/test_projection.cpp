@@ -1,7 +1,7 @@
 // Projection math for every projection kind: closed forms against the matrix
 // and against GLM's own matrices, round trips, the y flip.
-#include "culling/errors.hpp"
-#include "culling/projection.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/math/projection.hpp"
 
 #include <glm/ext/matrix_clip_space.hpp>
 #include <gtest/gtest.h>

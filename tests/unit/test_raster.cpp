@@ -1,8 +1,8 @@
 // The CPU reference rasteriser: analytic depth of full-screen planes for every
 // projection kind, the top-left fill rule, the y orientation, clipping and the
 // depth test.
-#include "culling/depth.hpp"
-#include "culling/errors.hpp"
+#include "culling/core/depth.hpp"
+#include "culling/core/errors.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,10 +1,10 @@
-// The report's sweep (culling/report.hpp): which configurations it builds from
+// The report's sweep (culling/diagnostics/report.hpp): which configurations it builds from
 // the parameter table and which it skips, a real run on a tiny scene (rows,
 // timings, metrics, progress, cancel), the Pareto flags against their
 // definition, and the written folder (csv shape, atomic refusal).
-#include "culling/errors.hpp"
-#include "culling/report.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/diagnostics/report.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 

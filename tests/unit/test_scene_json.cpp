@@ -1,7 +1,7 @@
 // The scene JSON format: lossless round trip and every error path, each
 // checked for the file name, the field path and the line of the field.
-#include "culling/errors.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 

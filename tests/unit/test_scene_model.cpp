@@ -1,7 +1,7 @@
 // The scene model: light radius, every validation path, the view matrix.
-#include "culling/errors.hpp"
-#include "culling/scene.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/scene/scene.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 

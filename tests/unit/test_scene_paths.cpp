@@ -1,7 +1,7 @@
 // Mesh paths in saved scenes: written relative to the folder the scene is
 // saved in, whatever folder it was loaded from or imported out of.
-#include "culling/scene_io.hpp"
-#include "culling/scene.hpp"
+#include "culling/scene/scene_io.hpp"
+#include "culling/scene/scene.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

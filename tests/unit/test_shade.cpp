@@ -1,11 +1,11 @@
-// The shading pass's CPU reference (culling/shade.hpp) on real scenes: every
+// The shading pass's CPU reference (culling/truth/shade.hpp) on real scenes: every
 // pixel against a brute-force double-precision sum over the lights of the list
 // CullResult::listOfPixel names; the pipeline's image error against the
 // ground truth's own CPU path; zero error when every list holds every light.
-#include "culling/errors.hpp"
-#include "culling/pipeline.hpp"
-#include "culling/scene_io.hpp"
-#include "culling/shade.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/scene/scene_io.hpp"
+#include "culling/truth/shade.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // a chunk is decided here without the chunk's planes: a point is inside when
 // its view depth lies in [depthMin, depthMax] and it projects into the tile's
 // pixel rectangle.
-#include "culling/tile_math.hpp"
+#include "culling/math/tile_math.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,14 +2,14 @@
 // data, each cone test function on hand-built cases and against brute-force
 // sampling of the spherical sector, and the CPU backend's spot tests against
 // the exact-cone ground truth on a fixed scene with many spots.
-#include "culling/backend.hpp"
-#include "culling/errors.hpp"
-#include "culling/ground_truth.hpp"
-#include "culling/params.hpp"
-#include "culling/scene_io.hpp"
-#include "culling/shade.hpp"
-#include "culling/spot_tests.hpp"
-#include "light_grid.hpp"
+#include "culling/core/backend.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/truth/ground_truth.hpp"
+#include "culling/core/params.hpp"
+#include "culling/scene/scene_io.hpp"
+#include "culling/truth/shade.hpp"
+#include "culling/math/spot_tests.hpp"
+#include "truth/light_grid.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,8 +4,8 @@
 // lists exactly (a chunk the pass did not test, a wrong chunk, or a wrong
 // culling sphere would list or drop a light the run did not), and the
 // cone-sphere test's chunk sphere must be the chunk's bounding sphere.
-#include "culling/overlays.hpp"
-#include "culling/scene_io.hpp"
+#include "culling/diagnostics/overlays.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 

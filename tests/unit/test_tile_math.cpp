@@ -1,5 +1,5 @@
 // Tile grid, tile side planes, frustum chunks and depth slicing.
-#include "culling/tile_math.hpp"
+#include "culling/math/tile_math.hpp"
 
 #include <gtest/gtest.h>
 

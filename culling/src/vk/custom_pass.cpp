@@ -3,10 +3,10 @@
 // inputs docs/CUSTOM_CULLING.md fixes, dispatched one workgroup per tile with
 // robust buffer access and (by default) the validation layer on, waited for
 // with a time limit, read back and decoded into a CullResult.
-#include "culling/custom_cull.hpp"
+#include "culling/custom/custom_cull.hpp"
 
-#include "culling/errors.hpp"
-#include "custom_internal.hpp"
+#include "culling/core/errors.hpp"
+#include "custom/custom_internal.hpp"
 #include "vk/validation.hpp"
 #include "vk/vk_context.hpp"
 

@@ -3,8 +3,8 @@
 // docs/VULKAN.md).
 #include "vk/shade_pass.hpp"
 
-#include "culling/errors.hpp"
-#include "culling/gpu_shade.h"
+#include "culling/core/errors.hpp"
+#include "culling/vk/gpu_shade.h"
 #include "embedded_spirv.hpp"
 
 #include <cmath>

@@ -2,7 +2,7 @@
 // Internal: the Vulkan Lambert shading pass (shaders/shade.comp) on a backend's
 // context. Inputs are the CPU-built G-buffer (lc::ShadeInputs) so that both
 // backends shade the same positions, normals and per-pixel lists.
-#include "culling/shade.hpp"
+#include "culling/truth/shade.hpp"
 #include "vk/vk_context.hpp"
 
 #include <array>

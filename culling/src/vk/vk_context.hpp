@@ -2,7 +2,7 @@
 // Internal Vulkan plumbing of the backend: checked calls, move-only RAII owners
 // with debug names, and the headless context (instance, physical device, one
 // compute+graphics queue). Nothing here leaks into culling/include.
-#include "culling/errors.hpp"
+#include "culling/core/errors.hpp"
 
 #include <vulkan/vulkan.h>
 

@@ -31,8 +31,8 @@
 // tiles x lights x cells allocation.
 #include "vk/vulkan_backend.hpp"
 
-#include "culling/errors.hpp"
-#include "culling/gpu_shared.h"
+#include "culling/core/errors.hpp"
+#include "culling/vk/gpu_shared.h"
 #include "embedded_spirv.hpp"
 #include "vk/vk_context.hpp"
 #include "vk/shade_pass.hpp"

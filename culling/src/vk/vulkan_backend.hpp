@@ -1,6 +1,6 @@
 #pragma once
 // Internal: the Vulkan backend's factory. Vulkan headers stay behind culling/src.
-#include "culling/backend.hpp"
+#include "culling/core/backend.hpp"
 
 #include <memory>
 #include <string>

@@ -1,0 +1,90 @@
+#pragma once
+// A culling backend: the depth pre-pass and the culling pass on one device.
+// The CPU backend is the double-precision reference; the Vulkan backend (where
+// a device exists) runs the same passes as compute and raster work.
+
+#include "culling/core/cull_result.hpp"
+#include "culling/core/depth.hpp"
+#include "culling/math/spot_tests.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace lc {
+
+struct ShadeInputs; // culling/truth/shade.hpp
+
+// Lights transformed to view space with their radii, the input of every pass.
+// centers/radii are each light's range sphere (a spot light's apex sphere).
+struct ViewLights {
+    std::vector<glm::dvec3> centers; // view space
+    std::vector<double> radii;
+    std::vector<glm::dvec3> power;   // colour * intensity (linear RGB), for shading
+    // Spot lights (docs/SPOT_LIGHTS.md): both empty when no light is a spot
+    // (then every light is a point light); otherwise one entry per light, and
+    // spotAngles[i] == 0 marks light i as a point light.
+    std::vector<glm::dvec3> spotAxes; // view space, unit length
+    std::vector<double> spotAngles;   // outer half-angle in radians, (0, pi/2]
+    std::size_t size() const { return radii.size(); }
+    bool isSpot(std::size_t i) const { return i < spotAngles.size() && spotAngles[i] > 0.0; }
+    // Light i's cone. Precondition: isSpot(i).
+    SpotCone spotCone(std::size_t i) const {
+        return makeSpotCone(centers[i], spotAxes[i], radii[i], spotAngles[i]);
+    }
+    // The sphere a culling pass tests for light i under `test`: the range
+    // sphere for point lights, spotCullSphere for spot lights.
+    BoundingSphere cullSphere(std::size_t i, SpotTest test) const {
+        return isSpot(i) ? spotCullSphere(test, spotCone(i)) : BoundingSphere{centers[i], radii[i]};
+    }
+};
+// Validates every light (LightError naming it) and transforms it to view space.
+ViewLights makeViewLights(const Scene& scene);
+
+class CullBackend {
+public:
+    virtual ~CullBackend() = default;
+    virtual std::string name() const = 0;       // "cpu", "vulkan"
+    virtual std::string deviceName() const = 0;
+    // Depth pre-pass of the scene through the camera. Sets lastDepthMs().
+    virtual DepthImage renderDepth(const Scene& scene, const Projection& proj) = 0;
+    // Culling pass over a depth image (any backend's). Fills result timings.
+    virtual CullResult cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
+                            const ViewLights& lights, const CullSettings& settings) = 0;
+    double lastDepthMs() const { return lastDepthMs_; }
+    // CPU wall-clock milliseconds of the last renderDepth() around its
+    // submission (its readback included); where the depth time is a wall
+    // clock already, that.
+    double lastDepthWallMs() const { return lastDepthWallMs_ >= 0 ? lastDepthWallMs_ : lastDepthMs_; }
+    virtual std::string timingMethod() const = 0;
+    // CPU wall-clock milliseconds of the last cull() around its submissions
+    // (equal to its cullMs where that is the timing method; -1: not run).
+    virtual double lastCullWallMs() const { return -1; }
+    // Most device memory (buffers and images, as allocated) alive at once
+    // since the last resetPeakDeviceBytes(); 0 for backends without a device.
+    virtual std::size_t peakDeviceBytes() const { return 0; }
+    virtual void resetPeakDeviceBytes() {}
+    // Lambert shading pass (culling/truth/shade.hpp) over a G-buffer built by
+    // makeShadeInputs: each geometry pixel shaded from the lights of its list
+    // in `culled` (null: every light in index order). Returns RGB, 3 floats per
+    // pixel, background 0. Sets lastShadeMs(), timed like cull(). The default
+    // is the CPU reference (shadeCpu) timed by steady_clock.
+    virtual std::vector<float> shade(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled);
+    double lastShadeMs() const { return lastShadeMs_; }
+
+protected:
+    double lastDepthMs_ = -1;
+    double lastDepthWallMs_ = -1; // -1: the same as lastDepthMs_
+    double lastShadeMs_ = -1;
+};
+
+std::unique_ptr<CullBackend> makeCpuBackend();
+
+// Names of the backends this build can create ("cpu", and "vulkan" when built
+// with Vulkan). makeBackend throws Error with a clear message when the backend
+// is unknown or (Vulkan) no device matches `device` (index or name substring;
+// empty: LIGHTCULL_DEVICE, else the first discrete GPU, else the first device).
+std::vector<std::string> availableBackends();
+std::unique_ptr<CullBackend> makeBackend(const std::string& name, const std::string& device = {});
+
+} // namespace lc

@@ -1,0 +1,111 @@
+#pragma once
+// The output of a culling pass, from either backend.
+
+#include "culling/core/params.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace lc {
+
+struct DepthImage;
+class Projection;
+
+// Per-phase wall or device times in milliseconds; negative = not run.
+struct Timings {
+    double depthMs = -1, cullMs = -1, groundTruthMs = -1, shadeMs = -1;
+};
+
+// Lists stored compactly: list l covers lightIndices[listOffset[l] ..
+// listOffset[l] + listCount[l]), indices ascending. Memory grows with the
+// entries the scene produces: 4 bytes per entry + 8 per list + per-tile depth
+// bounds, never tiles x lights.
+//
+// List numbering: `all` has exactly one list. Every other algorithm has
+// listsPerTile lists per tile, list = tileIndex * listsPerTile + sub, where sub
+// is 0 (naive, minmax, 2.5d), 0 near / 1 far (halfz), or the depth slice
+// (clustered; 2.5d with cellLists: the cell of the tile's depth range).
+struct CullResult {
+    Algorithm algorithm = Algorithm::All;
+    CullSettings settings;
+    TileGrid grid;
+    std::uint32_t listsPerTile = 1;
+
+    // Per tile, view depth bounds of the pixels holding geometry. An empty tile
+    // has depthMin = +inf, depthMax = -inf (and, for all but `all`, an empty list).
+    // For `halfz`, halfzSplit[t] is the split: depth <= split -> near list.
+    std::vector<double> tileDepthMin, tileDepthMax, halfzSplit;
+    // Per tile: 2.5d occupancy mask of the cells over [depthMin, depthMax];
+    // clustered: occupied slices. Empty otherwise.
+    std::vector<std::uint32_t> cellMask;
+    // Clustered depth range: slices are `settings.slicing` over [clusterNear, clusterFar].
+    double clusterNear = 0, clusterFar = 0;
+    // zbin (docs/ALGORITHMS.md): the list of a tile is its screen-space light
+    // mask (the lights whose culling sphere passes the tile's side planes,
+    // with the camera's near and far: naive's test), stored as light indices.
+    // The lights sorted by the view depth of their culling sphere's centre
+    // (ties by index): zbinOrder[k] is the light at sorted position k,
+    // zbinRank[l] the position of light l. Bin b of settings.bins linear bins
+    // over [zbinNear, zbinFar] holds the lowest (zbinLo[b]) and highest
+    // (zbinHi[b]) sorted position of a light whose depth range reaches it;
+    // an empty bin has zbinLo > zbinHi. A pixel in bin b loops over the
+    // lights of its tile's mask whose rank lies in [zbinLo[b], zbinHi[b]].
+    std::vector<std::uint32_t> zbinOrder, zbinRank, zbinLo, zbinHi;
+    double zbinNear = 0, zbinFar = 0;
+    // A list per pixel chosen explicitly (row-major, kNoList where no
+    // geometry): set only on the per-pixel lists zbinPixelLists() builds.
+    std::vector<std::uint32_t> pixelList;
+
+    // 2.5d only (custom culling's `cells:N` rule, docs/CUSTOM_CULLING.md):
+    // one list per cell, settings.cells cells (settings.slicing) of the
+    // tile's [depthMin, depthMax], instead of one list per tile.
+    bool cellLists = false;
+
+    std::vector<std::uint32_t> listOffset, listCount, lightIndices;
+
+    // Light-versus-volume tests one pass over the lists performed (Vulkan: the
+    // candidates left by the light bins); 0 when the backend does not count.
+    std::uint64_t volumeTests = 0;
+
+    std::string backend;      // "cpu" or "vulkan"
+    std::string device;       // physical device name, or the CPU's
+    std::string timingMethod; // how cullMs/depthMs were taken
+    Timings timings;
+
+    std::uint32_t listCountTotal() const { return std::uint32_t(listCount.size()); }
+    std::uint64_t entries() const { return lightIndices.size(); }
+    // Bytes of the light lists in the form a renderer uploads and reads while
+    // shading: 4 per index and 8 per list (offset + count). halfz packs a
+    // tile's two adjacent lists as offset, near count, far count and split (16
+    // bytes per tile = 8 per list); clustered adds its depth range (8 bytes).
+    // So bytes() <= 4 * entries + 8 * lists + 8. The per-tile depth bounds and
+    // masks the culling computes on the way are in diagnosticBytes().
+    // zbin: the renderer's form instead, a 32-bit range per bin and a bit per
+    // light per tile: 4 x bins + 4 x tiles x ceil(lights / 32).
+    std::uint64_t bytes() const;
+    // Bytes of the per-tile intermediates kept for diagnostics and overlays,
+    // at the GPU's float precision: depth min/max (8 per tile) and cell/slice
+    // masks (4 per tile where the algorithm has them).
+    std::uint64_t diagnosticBytes() const;
+    // The list a shading pass loops over at pixel (px, py) whose geometry lies
+    // at view depth viewDepth. Follows exactly the rule the passes use.
+    std::uint32_t listOfPixel(std::uint32_t px, std::uint32_t py, double viewDepth) const;
+    // zbin: the bin of view depth d (clamped to the bins).
+    std::uint32_t zbinOf(double viewDepth) const;
+    // Empty when internally consistent (sizes, offsets in range, sorted, unique).
+    std::string validate(std::size_t lightCount) const;
+};
+
+// The per-pixel lists a zbin result stands for: one list per (tile, bin)
+// some geometry pixel falls in, holding the tile mask's lights whose rank is
+// in that bin's range (ascending index), with pixelList naming each pixel's.
+// The ground truth and the shading passes judge zbin through these. Any other
+// result is returned as is (a copy).
+CullResult zbinPixelLists(const CullResult& zbin, const DepthImage& depth, const Projection& proj);
+
+// Sorts lights for zbin: by view depth of the culling sphere's centre, ties by index.
+void zbinSortLights(const std::vector<double>& centreDepth, std::vector<std::uint32_t>& order,
+                    std::vector<std::uint32_t>& rank);
+
+} // namespace lc

@@ -1,0 +1,134 @@
+#pragma once
+// Bring your own culling (docs/CUSTOM_CULLING.md): run a renderer's own
+// culling compute shader (GLSL, HLSL or SPIR-V) on the Vulkan device with
+// the inputs the contract fixes, or read a dump of an engine's light lists,
+// and turn either into a CullResult that ground truth, the metrics, the
+// exports and the overlays judge exactly like a built-in algorithm's.
+
+#include "culling/core/backend.hpp"
+#include "culling/core/cull_result.hpp"
+#include "culling/core/depth.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/math/projection.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace lc {
+
+// How the lists come back (`--layout`).
+enum class ListLayout {
+    Fixed,   // fixed:N  per list: a count, then N indices (counts above N are overflow)
+    Compact, // compact[:N] one counter, per list offset+count, then an index array of N entries
+    Bitmask, // bitmask  per list ceil(lights / 32) words, bit i = light i
+};
+struct LayoutSpec {
+    ListLayout kind = ListLayout::Fixed;
+    std::uint32_t capacity = 64; // fixed: indices per list; compact: entries in all (0: 64 per list)
+};
+// "fixed:64", "compact", "compact:100000", "bitmask". Throws SettingsError("layout", ...).
+LayoutSpec parseLayout(const std::string& text);
+std::string toString(const LayoutSpec& l);
+
+// Which list a pixel loops over (`--lists`): tile = one list per tile (as
+// minmax), halfz = two per tile split at the middle of the tile's min/max
+// view depth (as halfz), froxel:N[:log|linear] = N slices of the froxel
+// range per tile (as clustered), cells:N[:log|linear] = N cells of the
+// tile's own min/max view depth per tile (2.5d's cells, each with a list).
+enum class ListKind { Tile, HalfZ, Froxel, Cells };
+struct ListSpec {
+    ListKind kind = ListKind::Tile;
+    std::uint32_t slices = 16;       // froxel, cells: 1..32
+    Slicing slicing = Slicing::Log;  // froxel, cells
+};
+ListSpec parseListSpec(const std::string& text); // throws SettingsError("lists", ...)
+std::string toString(const ListSpec& l);
+
+// The output buffer's size in 32-bit words for `lists` lists and `lights` lights.
+std::uint64_t layoutWords(const LayoutSpec& layout, std::uint64_t lists, std::uint64_t lights);
+
+struct CustomShaderOptions {
+    std::string path;              // .comp/.glsl (GLSL), .hlsl (HLSL), .spv (SPIR-V)
+    LayoutSpec layout;
+    ListSpec lists;
+    std::string entry = "main";
+    bool validation = true;        // the Khronos validation layer: user code, on by default
+    double timeoutMs = 10000;      // a dispatch still running then is a hang
+    std::string device;            // Vulkan device, as for the built-in backend
+};
+
+// The settings a shader states in its first line, `// lightcull: --layout
+// fixed:64 --lists tile` (`--entry NAME` too); flags given by the caller
+// override them. Throws SettingsError naming the file for a bad first line.
+void applyShaderHeader(const std::string& shaderText, const std::string& path, CustomShaderOptions& options,
+                       bool layoutGiven, bool listsGiven, bool entryGiven);
+
+// A shader file's options: its first-line settings (none for .spv), under
+// what the caller sets (a non-empty `layout`, `lists` or `entry` wins, as a
+// command-line flag does). Throws InputError naming the file when it cannot
+// be read or its first line is bad, SettingsError for a bad `layout`/`lists`.
+CustomShaderOptions shaderOptionsFromFile(const std::string& path, const std::string& layout = {},
+                                          const std::string& lists = {}, const std::string& entry = {});
+
+// What a custom culling (shader or dump) did beside its lists.
+struct CustomCullReport {
+    std::string source;                  // the shader or dump file
+    std::string layout, lists;           // as given
+    std::uint64_t overflowLists = 0;     // lists whose count exceeded the layout's capacity
+    std::uint64_t overflowEntries = 0;   // entries that did not fit (fixed: count - N summed; compact: past N)
+    std::uint64_t invalidIndices = 0;    // indices >= the light count (reported, never followed)
+    std::uint64_t duplicateIndices = 0;  // the same light twice in one list (kept once)
+    std::vector<std::string> validationMessages; // the validation layer's, during this shader's run
+    double passMs = -1;                  // CPU wall time around submit and wait of the dispatch
+    std::string device;
+    // The built-in algorithm with the same list rule on the CPU backend, for
+    // comparison: its entries, and lists where the two differ.
+    std::string builtinAlgorithm;
+    std::uint64_t builtinEntries = 0, listsDifferingFromBuiltin = 0;
+};
+
+// One false negative, located: in `tile`, `pixels` geometry pixels need
+// `light` but their list (`list`) does not hold it.
+struct MissedLight {
+    std::uint32_t tile = 0, list = 0, light = 0, pixels = 0;
+};
+// Every (list, light) pair behind run.truth's false negatives, most pixels first.
+std::vector<MissedLight> locateFalseNegatives(const RunOutput& run, const Projection& proj);
+
+// Decodes raw output words (as `layout` lays them out) into `result`'s lists
+// (ascending, unique), counting overflow, invalid and duplicate indices.
+// `result` must already hold the grid and list count (listOffset.size()).
+void decodeLists(const std::vector<std::uint32_t>& words, const LayoutSpec& layout, std::uint32_t lightCount,
+                 CullResult& result, CustomCullReport& report);
+
+// Runs the shader over `depth` on a Vulkan device of its own: compile, bind,
+// dispatch one workgroup per tile, read back, decode. The result has the list
+// rule of options.lists, tile bounds from the CPU reference, backend
+// "custom". Throws InputError (file:line) for compile errors, DeviceError for
+// a hang (after options.timeoutMs; the device is then abandoned and the next
+// call opens a fresh one) or any failed Vulkan call.
+CullResult runCustomShader(const CustomShaderOptions& options, const DepthImage& depth, const Projection& proj,
+                           const TileGrid& grid, const ViewLights& lights, CustomCullReport& report);
+
+// The depth pre-pass, the custom shader, ground truth and (unless off) the
+// image error, as runPipeline does for a built-in algorithm; `depthOverride`
+// (non-null) replaces the pre-pass with an engine's own depth buffer.
+RunOutput runCustomPipeline(const Scene& scene, const CustomShaderOptions& options, CullBackend& depthBackend,
+                            const RunOptions& runOptions, CustomCullReport& report,
+                            const DepthImage* depthOverride = nullptr);
+
+// An engine's own lists from a file: raw little-endian 32-bit words in
+// `layout` (as a GPU debugger's buffer export writes them), or CSV with one
+// line per list "list,light,light,..." (a header line is allowed). Judged on
+// `depth` like a shader's output.
+RunOutput checkListDump(const Scene& scene, const std::string& listsPath, const LayoutSpec& layout,
+                        const ListSpec& lists, const DepthImage& depth, const RunOptions& runOptions,
+                        CustomCullReport& report);
+
+// An engine's depth buffer: raw float32 window depth (width x height, row 0
+// at the top) or a 16-bit greyscale PNG (0..65535 -> 0..1), in the scene
+// camera's depth convention. Throws InputError naming the file.
+DepthImage loadDepthFile(const std::string& path, const Projection& proj);
+
+} // namespace lc

@@ -1,0 +1,59 @@
+#pragma once
+// Exact ground truth and the error metrics of docs/ARCHITECTURE.md:
+// per pixel with geometry, the lights whose sphere contains the pixel's
+// view-space position (double precision, from the depth at the pixel centre),
+// compared with the list the shading pass would loop over there.
+
+#include "culling/core/backend.hpp"
+#include "culling/truth/shade.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace lc {
+
+struct Metrics {
+    std::uint64_t falseNegatives = 0; // sum_p |needed(p) \ listed(p)|
+    std::uint64_t shadingWork = 0;    // W = sum_p |listed(p)|
+    std::uint64_t exactWork = 0;      // E = sum_p |needed(p)|
+    double efficiency = 1.0;          // E / W (1 when W == 0)
+    double meanList = 0;              // mean entries per list
+    std::uint32_t maxList = 0;
+    std::uint64_t resultBytes = 0;
+    std::uint64_t geometryPixels = 0;
+    // The best any culling of this result's granularity could do: with U(p)
+    // the union of needed(q) over the pixels q sharing p's list (its tile,
+    // cell or froxel), optimal_work = sum_p |U(p)| (DESIGN.md).
+    std::uint64_t optimalWork = 0;
+    double efficiencyVsOptimal = 1.0; // optimalWork / W (1 when W == 0)
+    double imageRmse = 0, imageMaxError = 0; // Lambert, culled vs all lights
+    bool imageErrorComputed = false;
+};
+
+struct GroundTruth {
+    Metrics metrics;
+    // Per list (CullResult numbering): sums over the pixels that use it.
+    std::vector<std::uint64_t> listShadingWork, listExactWork, listFalseNegatives;
+    // Per tile: pixels with geometry.
+    std::vector<std::uint32_t> tileGeometryPixels;
+};
+
+struct GroundTruthOptions {
+    // Lambert image error on the CPU (costs pixels x lights). runPipeline turns
+    // this off and takes the error from the backend's shading pass instead.
+    bool imageError = true;
+};
+
+GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
+                               const ViewLights& lights, const CullResult& result,
+                               const GroundTruthOptions& opt = {}, const CancelToken* cancel = nullptr);
+
+// For the tile inspector: in tile `tile`, how many geometry pixels need each
+// light (light index -> count, only lights needed by at least one pixel).
+std::vector<std::pair<std::uint32_t, std::uint32_t>>
+pixelsNeedingLights(const DepthImage& depth, const Projection& proj, const ViewLights& lights,
+                    const TileGrid& grid, std::uint32_t tile);
+
+// The Lambert shading and image error live in culling/truth/shade.hpp.
+
+} // namespace lc

@@ -1,0 +1,169 @@
+// CullResult helpers: size in bytes, the per-pixel list lookup, consistency check.
+#include "culling/core/cull_result.hpp"
+
+#include "culling/core/depth.hpp"
+#include "culling/core/errors.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace lc {
+
+// See cull_result.hpp: the lists as a renderer stores them. halfz's far list
+// starts where its near list ends (both backends lay lists out in list
+// order), so its offset is implied and the 4 bytes go to the split.
+std::uint64_t CullResult::bytes() const {
+    if (algorithm == Algorithm::ZBin)
+        return 4 * std::uint64_t(zbinLo.size()) +
+               4 * std::uint64_t(grid.tileCount()) * ((std::uint64_t(zbinRank.size()) + 31) / 32);
+    std::uint64_t b = 4 * entries() + 8 * std::uint64_t(listCount.size());
+    if (algorithm == Algorithm::Clustered) b += 8; // clusterNear, clusterFar as float
+    return b;
+}
+
+std::uint64_t CullResult::diagnosticBytes() const {
+    return 8 * std::uint64_t(tileDepthMin.size()) + 4 * std::uint64_t(cellMask.size());
+}
+
+// The lookup every shading pass (and the ground truth) uses: the pixel's tile,
+// then for halfz the side of the split, for clustered the depth slice over
+// [clusterNear, clusterFar].
+std::uint32_t CullResult::zbinOf(double viewDepth) const {
+    const std::size_t bins = zbinLo.size();
+    if (bins == 0 || !(zbinFar > zbinNear)) return 0;
+    const double t = (viewDepth - zbinNear) / (zbinFar - zbinNear) * double(bins);
+    if (!(t > 0)) return 0; // also NaN
+    return std::uint32_t(std::min(t, double(bins - 1)));
+}
+
+std::uint32_t CullResult::listOfPixel(std::uint32_t px, std::uint32_t py, double viewDepth) const {
+    if (!pixelList.empty()) return pixelList[std::size_t(py) * grid.width + px];
+    if (algorithm == Algorithm::All) return 0;
+    const std::uint32_t tile = grid.tileOfPixel(px, py);
+    switch (algorithm) {
+    case Algorithm::HalfZ: return tile * 2 + (viewDepth <= halfzSplit[tile] ? 0u : 1u);
+    case Algorithm::Clustered:
+        return tile * listsPerTile +
+               sliceOfDepth(settings.slicing, clusterNear, clusterFar, listsPerTile, viewDepth);
+    case Algorithm::TwoPointFiveD:
+        if (!cellLists) return tile;
+        return tile * listsPerTile +
+               sliceOfDepth(settings.slicing, tileDepthMin[tile], tileDepthMax[tile], listsPerTile, viewDepth);
+    default: return tile;
+    }
+}
+
+std::string CullResult::validate(std::size_t lightCount) const {
+    const std::uint64_t tiles = grid.tileCount();
+    std::uint32_t expectPerTile = 1;
+    if (algorithm == Algorithm::HalfZ) expectPerTile = 2;
+    if (algorithm == Algorithm::Clustered) expectPerTile = settings.cells;
+    if (algorithm == Algorithm::TwoPointFiveD && cellLists) expectPerTile = settings.cells;
+    if (algorithm != Algorithm::All && listsPerTile != expectPerTile)
+        return "listsPerTile is " + std::to_string(listsPerTile) + ", expected " +
+               std::to_string(expectPerTile);
+    const std::uint64_t lists = algorithm == Algorithm::All ? 1 : tiles * listsPerTile;
+    if (algorithm == Algorithm::ZBin && pixelList.empty()) {
+        const std::size_t n = lightCount;
+        if (zbinOrder.size() != n || zbinRank.size() != n) return "zbin order/rank hold the wrong number of lights";
+        for (std::size_t k = 0; k < n; ++k)
+            if (zbinOrder[k] >= n || zbinRank[zbinOrder[k]] != k) return "zbin order and rank are not inverse";
+        if (zbinLo.size() != settings.bins || zbinHi.size() != settings.bins) return "zbin bins size mismatch";
+        for (std::size_t b = 0; b < zbinLo.size(); ++b)
+            if (zbinLo[b] <= zbinHi[b] && zbinHi[b] >= n) return "zbin bin " + std::to_string(b) + " out of range";
+    }
+    if (!pixelList.empty()) {
+        // Per-pixel lists (zbinPixelLists): any number, each pixel names one.
+        if (pixelList.size() != std::size_t(grid.width) * grid.height) return "pixelList size mismatch";
+        for (std::uint32_t l : pixelList)
+            if (l != 0xffffffffu && l >= listCount.size()) return "pixelList names a list out of range";
+    } else if (listOffset.size() != lists || listCount.size() != lists)
+        return "list arrays hold " + std::to_string(listOffset.size()) + "/" +
+               std::to_string(listCount.size()) + " entries, expected " + std::to_string(lists);
+    if (tileDepthMin.size() != tiles || tileDepthMax.size() != tiles)
+        return "tile depth bounds hold " + std::to_string(tileDepthMin.size()) + " entries, expected " +
+               std::to_string(tiles);
+    if (algorithm == Algorithm::HalfZ && halfzSplit.size() != tiles) return "halfzSplit size mismatch";
+    if ((algorithm == Algorithm::TwoPointFiveD || algorithm == Algorithm::Clustered) &&
+        cellMask.size() != tiles)
+        return "cellMask size mismatch";
+    std::uint64_t total = 0;
+    for (std::size_t l = 0; l < listOffset.size(); ++l) {
+        const std::uint64_t o = listOffset[l], c = listCount[l];
+        if (o + c > lightIndices.size())
+            return "list " + std::to_string(l) + " runs past the index array";
+        total += c;
+        for (std::uint64_t i = o; i < o + c; ++i) {
+            if (lightIndices[i] >= lightCount)
+                return "list " + std::to_string(l) + " holds light " +
+                       std::to_string(lightIndices[i]) + " of " + std::to_string(lightCount);
+            if (i > o && lightIndices[i] <= lightIndices[i - 1])
+                return "list " + std::to_string(l) + " is not strictly ascending";
+        }
+    }
+    if (total != lightIndices.size()) return "index array is not compact";
+    return {};
+}
+
+void zbinSortLights(const std::vector<double>& centreDepth, std::vector<std::uint32_t>& order,
+                    std::vector<std::uint32_t>& rank) {
+    order.resize(centreDepth.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return centreDepth[a] < centreDepth[b]; });
+    rank.resize(order.size());
+    for (std::uint32_t k = 0; k < order.size(); ++k) rank[order[k]] = k;
+}
+
+CullResult zbinPixelLists(const CullResult& z, const DepthImage& depth, const Projection& proj) {
+    if (z.algorithm != Algorithm::ZBin || !z.pixelList.empty()) return z;
+    if (depth.width != z.grid.width || depth.height != z.grid.height)
+        throw Error("zbin: depth image does not match the cull result's grid");
+    CullResult m;
+    m.algorithm = Algorithm::ZBin;
+    m.settings = z.settings;
+    m.grid = z.grid;
+    m.listsPerTile = 1;
+    m.tileDepthMin = z.tileDepthMin;
+    m.tileDepthMax = z.tileDepthMax;
+    m.zbinOrder = z.zbinOrder;
+    m.zbinRank = z.zbinRank;
+    m.zbinLo = z.zbinLo;
+    m.zbinHi = z.zbinHi;
+    m.zbinNear = z.zbinNear;
+    m.zbinFar = z.zbinFar;
+    m.backend = z.backend;
+    m.device = z.device;
+    m.pixelList.assign(std::size_t(depth.width) * depth.height, 0xffffffffu);
+    // Per tile, the (bin, list) pairs made so far: a tile's pixels span few bins.
+    std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> made(z.grid.tileCount());
+    for (std::uint32_t y = 0; y < depth.height; ++y)
+        for (std::uint32_t x = 0; x < depth.width; ++x) {
+            if (!depth.hasGeometry(x, y)) continue;
+            const std::uint32_t t = z.grid.tileOfPixel(x, y), b = z.zbinOf(proj.viewDepthFromWindowDepth(depth.at(x, y)));
+            std::uint32_t list = 0xffffffffu;
+            for (const auto& [bin, l] : made[t])
+                if (bin == b) list = l;
+            if (list == 0xffffffffu) {
+                list = std::uint32_t(m.listCount.size());
+                made[t].emplace_back(b, list);
+                m.listOffset.push_back(std::uint32_t(m.lightIndices.size()));
+                const std::uint32_t lo = z.zbinLo[b], hi = z.zbinHi[b];
+                std::uint32_t count = 0;
+                for (std::uint32_t k = 0; k < z.listCount[t]; ++k) {
+                    const std::uint32_t light = z.lightIndices[z.listOffset[t] + k];
+                    if (lo <= z.zbinRank[light] && z.zbinRank[light] <= hi) {
+                        m.lightIndices.push_back(light);
+                        ++count;
+                    }
+                }
+                m.listCount.push_back(count);
+            }
+            m.pixelList[std::size_t(y) * depth.width + x] = list;
+        }
+    return m;
+}
+
+} // namespace lc

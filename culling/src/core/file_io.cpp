@@ -1,0 +1,130 @@
+#include "culling/core/file_io.hpp"
+
+#include "culling/core/errors.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+namespace lc {
+
+void writeFileSynced(const std::string& path, const std::string& text) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) throw Error("cannot create " + path + ": " + std::strerror(errno));
+    std::size_t done = 0;
+    while (done < text.size()) {
+        const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            const int err = errno;
+            ::close(fd);
+            throw Error("cannot write " + path + ": " + std::strerror(err));
+        }
+        done += std::size_t(n);
+    }
+    // fsync before any rename: otherwise a crash can leave the new name
+    // pointing at an empty file.
+    if (::fsync(fd) != 0) {
+        const int err = errno;
+        ::close(fd);
+        throw Error("cannot sync " + path + ": " + std::strerror(err));
+    }
+    if (::close(fd) != 0) throw Error("cannot write " + path + ": " + std::strerror(errno));
+}
+
+void writeFileAtomic(const std::string& path, const std::string& text) {
+    namespace fs = std::filesystem;
+    const fs::path target(path);
+    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    const std::string tmp = (dir / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()))).string();
+    try {
+        writeFileSynced(tmp, text);
+    } catch (const Error&) {
+        ::unlink(tmp.c_str());
+        throw;
+    }
+    if (::rename(tmp.c_str(), path.c_str()) != 0) {
+        const int err = errno;
+        ::unlink(tmp.c_str());
+        throw Error("cannot rename " + tmp + " to " + path + ": " + std::strerror(err));
+    }
+    if (const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dfd >= 0) {
+        ::fsync(dfd); // make the rename itself durable; best effort
+        ::close(dfd);
+    }
+}
+
+void syncFolder(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) throw Error("cannot open " + path + " to sync it: " + std::strerror(errno));
+    const int rc = ::fsync(fd);
+    const int err = errno;
+    ::close(fd);
+    if (rc != 0) throw Error("cannot sync " + path + ": " + std::strerror(err));
+}
+
+void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outputs, const std::string& action,
+                       const std::string& outputKind, const std::function<void(const std::string& tmp)>& fill) {
+    namespace fs = std::filesystem;
+    fs::path target = fs::path(dir).lexically_normal();
+    if (!target.has_filename()) target = target.parent_path();
+    const std::string name = target.filename().string();
+    if (dir.empty() || name.empty() || name == "." || name == "..")
+        throw Error("cannot " + action + " into '" + dir + "': give a folder name");
+    fs::path parent = target.parent_path();
+    if (parent.empty()) parent = ".";
+    std::error_code ec;
+    if (!fs::is_directory(parent, ec))
+        throw Error("cannot " + action + " into " + target.string() + ": parent folder " + parent.string() +
+                    " does not exist");
+    const bool exists = fs::exists(fs::symlink_status(target, ec));
+    if (exists) {
+        if (!fs::is_directory(fs::symlink_status(target, ec)))
+            throw Error("cannot " + action + " into " + target.string() + ": it exists and is not a folder");
+        for (const auto& e : fs::directory_iterator(target, ec))
+            if (!outputs.count(e.path().filename().string()))
+                throw Error("refusing to replace " + target.string() + ": it holds " + e.path().filename().string() +
+                            ", which is not a " + outputKind);
+        if (ec) throw Error("cannot read " + target.string() + ": " + ec.message());
+    }
+
+    std::string tmpl = (parent / ("." + name + ".tmp-XXXXXX")).string();
+    if (!::mkdtemp(tmpl.data()))
+        throw Error("cannot create a temporary folder beside " + target.string() + ": " + std::strerror(errno));
+    const fs::path tmp = tmpl;
+    fs::path aside;
+    try {
+        fill(tmp.string());
+        syncFolder(tmp.string());
+        if (exists) {
+            std::string asideTmpl = (parent / ("." + name + ".old-XXXXXX")).string();
+            if (!::mkdtemp(asideTmpl.data()))
+                throw Error("cannot create a temporary folder beside " + target.string() + ": " + std::strerror(errno));
+            aside = asideTmpl;
+            if (std::rename(target.c_str(), aside.c_str()) != 0) {
+                const int err = errno;
+                fs::remove(aside, ec);
+                aside.clear();
+                throw Error("cannot move " + target.string() + " aside: " + std::strerror(err));
+            }
+        }
+        if (std::rename(tmp.c_str(), target.c_str()) != 0) {
+            const int err = errno;
+            if (!aside.empty()) std::rename(aside.c_str(), target.c_str()); // restore
+            aside.clear();
+            throw Error("cannot rename " + tmp.string() + " to " + target.string() + ": " + std::strerror(err));
+        }
+    } catch (...) {
+        fs::remove_all(tmp, ec);
+        throw;
+    }
+    if (!aside.empty()) fs::remove_all(aside, ec);
+    syncFolder(parent.string());
+}
+
+} // namespace lc

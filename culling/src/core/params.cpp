@@ -1,0 +1,164 @@
+// The one table of culling parameters (params.hpp) and its string parser.
+#include "culling/core/params.hpp"
+
+#include "culling/core/errors.hpp"
+
+#include <charconv>
+
+namespace lc {
+
+namespace {
+
+constexpr std::pair<Algorithm, const char*> kAlgorithms[] = {
+    {Algorithm::All, "all"},          {Algorithm::Naive, "naive"},
+    {Algorithm::MinMax, "minmax"},    {Algorithm::HalfZ, "halfz"},
+    {Algorithm::TwoPointFiveD, "2.5d"}, {Algorithm::Clustered, "clustered"},
+    {Algorithm::Fptl, "fptl"},        {Algorithm::ZBin, "zbin"}};
+constexpr SphereTest kTests[] = {SphereTest::Planes, SphereTest::PlanesAabb, SphereTest::Exact};
+constexpr Slicing kSlicings[] = {Slicing::Log, Slicing::Linear};
+constexpr SpotTest kSpotTests[] = {SpotTest::ApexSphere, SpotTest::TightSphere, SpotTest::ConeSphere,
+                                   SpotTest::ConePlanes};
+
+std::string joined(const std::vector<std::string>& v) {
+    std::string s;
+    for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+    return s;
+}
+
+std::vector<ParamSpec> buildTable() {
+    std::vector<ParamSpec> t;
+    std::vector<std::string> algos;
+    for (const auto& a : kAlgorithms) algos.push_back(a.second);
+    std::vector<std::string> tests;
+    for (auto x : kTests) tests.push_back(toString(x));
+    std::vector<std::string> slicings;
+    for (auto x : kSlicings) slicings.push_back(toString(x));
+
+    t.push_back({"algorithm", ParamType::Choice, "2.5d", algos, 0, 0,
+                 "culling algorithm: all (no culling), naive (tile planes + camera near/far), "
+                 "minmax (tile min/max depth), halfz (two lists split at mid depth), 2.5d "
+                 "(depth-cell occupancy mask), clustered (3D froxel grid), fptl (fine-pruned tiles: "
+                 "minmax, then each light tested against the tile's pixels), zbin (Z-binning: a "
+                 "screen-space light mask per tile and linear view-depth bins of the depth-sorted lights)",
+                 "Algorithm"});
+    t.push_back({"test", ParamType::Choice, "planes", tests, 0, 0,
+                 "sphere-vs-volume test: planes (6 planes), planes+aabb (planes and the chunk's "
+                 "bounding box), exact (Euclidean distance to the frustum chunk)",
+                 "Sphere test"});
+    t.push_back({"cells", ParamType::Int, "32", {}, 1, 32,
+                 "2.5d occupancy cells per tile / clustered depth slices", "Cells"});
+    t.push_back({"slicing", ParamType::Choice, "log", slicings, 0, 0,
+                 "depth slicing of 2.5d cells and clustered slices: log or linear", "Slicing"});
+    t.push_back({"skip-empty", ParamType::Bool, "true", {}, 0, 1,
+                 "clustered: clusters holding no geometry get empty lists", "Skip empty"});
+    std::vector<std::string> spotTests;
+    for (auto x : kSpotTests) spotTests.push_back(toString(x));
+    t.push_back({"spot-test", ParamType::Choice, "apex-sphere", spotTests, 0, 0,
+                 "spot-light test: apex-sphere (range sphere at the apex), tight-sphere (smallest "
+                 "sphere around the cone), cone-sphere (tight sphere, then cone vs the cell's "
+                 "bounding sphere), cone-planes (tight sphere, then cone vs each cell plane)",
+                 "Spot test"});
+    t.push_back({"bins", ParamType::Int, "1024", {}, 1, 16384,
+                 "zbin: view-depth bins, linear from the near plane to the far plane (or the farthest "
+                 "light)", "Bins"});
+    t.push_back({"tile", ParamType::Int, "16", {}, 1, 256, "tile size in pixels", "Tile"});
+    t.push_back({"width", ParamType::Int, "1280", {}, 1, 16384, "render width in pixels", "Width"});
+    t.push_back({"height", ParamType::Int, "720", {}, 1, 16384, "render height in pixels", "Height"});
+    return t;
+}
+
+long long parseInt(const ParamSpec& p, const std::string& v) {
+    long long x = 0;
+    const char* b = v.data();
+    const char* e = v.data() + v.size();
+    auto [ptr, ec] = std::from_chars(b, e, x);
+    if (v.empty() || ec != std::errc() || ptr != e || x < p.minValue || x > p.maxValue)
+        throw SettingsError(p.name, "must be an integer in " + std::to_string(p.minValue) + ".." +
+                                        std::to_string(p.maxValue) + ", got '" + v + "'");
+    return x;
+}
+
+bool parseBool(const ParamSpec& p, const std::string& v) {
+    if (v == "true" || v == "1" || v == "yes" || v == "on") return true;
+    if (v == "false" || v == "0" || v == "no" || v == "off") return false;
+    throw SettingsError(p.name, "must be true or false, got '" + v + "'");
+}
+
+std::size_t parseChoice(const ParamSpec& p, const std::string& v) {
+    for (std::size_t i = 0; i < p.choices.size(); ++i)
+        if (p.choices[i] == v) return i;
+    throw SettingsError(p.name, "must be one of " + joined(p.choices) + ", got '" + v + "'");
+}
+
+} // namespace
+
+const char* toString(Algorithm a) {
+    for (const auto& x : kAlgorithms)
+        if (x.first == a) return x.second;
+    return "?";
+}
+
+Algorithm algorithmFromString(const std::string& s) {
+    for (const auto& x : kAlgorithms)
+        if (s == x.second) return x.first;
+    return kAlgorithms[parseChoice(cullParam("algorithm"), s)].first; // throws
+}
+
+std::string CullSettings::validate() const {
+    if (cells < 1 || cells > 32)
+        return "cells: must be an integer in 1..32, got " + std::to_string(cells);
+    if (bins < 1 || bins > 16384) return "bins: must be an integer in 1..16384, got " + std::to_string(bins);
+    bool knownAlgo = false;
+    for (const auto& x : kAlgorithms) knownAlgo |= x.first == algorithm;
+    if (!knownAlgo) return "algorithm: unknown value";
+    if (test != SphereTest::Planes && test != SphereTest::PlanesAabb && test != SphereTest::Exact)
+        return "test: unknown value";
+    if (slicing != Slicing::Log && slicing != Slicing::Linear) return "slicing: unknown value";
+    bool knownSpot = false;
+    for (auto x : kSpotTests) knownSpot |= x == spotTest;
+    if (!knownSpot) return "spot-test: unknown value";
+    return {};
+}
+
+const std::vector<ParamSpec>& cullParams() {
+    static const std::vector<ParamSpec> table = buildTable();
+    return table;
+}
+
+const ParamSpec& cullParam(const std::string& name) {
+    for (const auto& p : cullParams())
+        if (p.name == name) return p;
+    std::vector<std::string> names;
+    for (const auto& p : cullParams()) names.push_back(p.name);
+    throw SettingsError(name, "unknown parameter (known: " + joined(names) + ")");
+}
+
+void setParam(CullSettings& s, Camera& camera, const std::string& name, const std::string& value) {
+    const ParamSpec& p = cullParam(name);
+    if (name == "algorithm") s.algorithm = kAlgorithms[parseChoice(p, value)].first;
+    else if (name == "test") s.test = kTests[parseChoice(p, value)];
+    else if (name == "cells") s.cells = std::uint32_t(parseInt(p, value));
+    else if (name == "slicing") s.slicing = kSlicings[parseChoice(p, value)];
+    else if (name == "skip-empty") s.skipEmpty = parseBool(p, value);
+    else if (name == "spot-test") s.spotTest = kSpotTests[parseChoice(p, value)];
+    else if (name == "bins") s.bins = std::uint32_t(parseInt(p, value));
+    else if (name == "tile") camera.tileSize = std::uint32_t(parseInt(p, value));
+    else if (name == "width") camera.width = std::uint32_t(parseInt(p, value));
+    else if (name == "height") camera.height = std::uint32_t(parseInt(p, value));
+}
+
+std::string getParam(const CullSettings& s, const Camera& camera, const std::string& name) {
+    cullParam(name); // throws for unknown names
+    if (name == "algorithm") return toString(s.algorithm);
+    if (name == "test") return toString(s.test);
+    if (name == "cells") return std::to_string(s.cells);
+    if (name == "slicing") return toString(s.slicing);
+    if (name == "skip-empty") return s.skipEmpty ? "true" : "false";
+    if (name == "spot-test") return toString(s.spotTest);
+    if (name == "bins") return std::to_string(s.bins);
+    if (name == "tile") return std::to_string(camera.tileSize);
+    if (name == "width") return std::to_string(camera.width);
+    return std::to_string(camera.height);
+}
+
+} // namespace lc

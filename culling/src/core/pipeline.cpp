@@ -1,0 +1,197 @@
+// One run of the pipeline: validate, depth pre-pass, culling pass, ground truth.
+// Times are milliseconds: depth and cull as the backend measured them (its
+// timingMethod says how), ground truth as CPU wall time around the call.
+
+#include "culling/core/pipeline.hpp"
+
+#include "culling/core/errors.hpp"
+#include "culling/truth/shade.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <functional>
+#include <numeric>
+
+namespace lc {
+
+namespace {
+
+void throwIfCancelled(const CancelToken* cancel) {
+    if (cancel && cancel->cancelled.load()) throw Cancelled();
+}
+
+// CullSettings::validate names the field first ("cells: must be in 1..32");
+// the field becomes the SettingsError's field.
+[[noreturn]] void throwSettings(const std::string& message) {
+    const auto colon = message.find(": ");
+    if (colon != std::string::npos && colon > 0 && message.find(' ') > colon)
+        throw SettingsError(message.substr(0, colon), message.substr(colon + 2));
+    throw SettingsError("settings", message);
+}
+
+} // namespace
+
+namespace {
+
+// Rows [y0, y1) of a G-buffer.
+ShadeInputs rowsOf(const ShadeInputs& in, std::uint32_t y0, std::uint32_t y1) {
+    ShadeInputs s;
+    s.width = in.width;
+    s.height = y1 - y0;
+    s.perPixelLists = in.perPixelLists;
+    const std::size_t a = std::size_t(in.width) * y0, b = std::size_t(in.width) * y1;
+    s.position.assign(in.position.begin() + std::ptrdiff_t(3 * a),
+                      in.position.begin() + std::ptrdiff_t(3 * b));
+    s.normal.assign(in.normal.begin() + std::ptrdiff_t(3 * a), in.normal.begin() + std::ptrdiff_t(3 * b));
+    s.list.assign(in.list.begin() + std::ptrdiff_t(a), in.list.begin() + std::ptrdiff_t(b));
+    return s;
+}
+
+// One image of the shading pass: whole (sliceMs <= 0), or in row slices of
+// about sliceMs wall time, checking `cancel` between slices. Slices start on
+// multiples of `align` rows, where shadeCpu's own row bands start, so each
+// pixel gets the arithmetic of one whole-image call. Returns RGB and the
+// backend's shading time (the sum of the slices').
+std::vector<float> shadeImage(CullBackend& backend, const ShadeInputs& in, const ViewLights& lights,
+                              const CullResult* culled, std::uint32_t align, double sliceMs,
+                              const CancelToken* cancel, double& shadeMs,
+                              const std::function<void(double)>& rowsDone) {
+    if (sliceMs <= 0) {
+        std::vector<float> rgb = backend.shade(in, lights, culled);
+        shadeMs = backend.lastShadeMs();
+        return rgb;
+    }
+    std::vector<float> rgb(in.position.size(), 0.0f);
+    shadeMs = 0;
+    std::uint32_t rows = align;
+    for (std::uint32_t y0 = 0; y0 < in.height;) {
+        const std::uint32_t y1 = std::min(in.height, y0 + rows);
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::vector<float> part = backend.shade(rowsOf(in, y0, y1), lights, culled);
+        const double wallMs =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        shadeMs += backend.lastShadeMs() >= 0 ? backend.lastShadeMs() : wallMs;
+        std::copy(part.begin(), part.end(), rgb.begin() + std::ptrdiff_t(std::size_t(in.width) * y0 * 3));
+        throwIfCancelled(cancel);
+        if (rowsDone) rowsDone(double(y1) / double(in.height));
+        // The next slice: as many aligned rows as fit sliceMs at this rate.
+        const double perRowMs = std::max(wallMs, 1e-3) / double(y1 - y0);
+        rows = std::max(align, std::uint32_t(sliceMs / perRowMs) / align * align);
+        y0 = y1;
+    }
+    return rgb;
+}
+
+} // namespace
+
+void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
+                     const CancelToken* cancel, double sliceMs, const Progress& progress) {
+    // zbin: the lists its pixels loop over, a (tile, bin) each.
+    const ShadeInputs culledIn = makeShadeInputs(out.depth, proj, &out.result);
+    const CullResult& r = out.result;
+    // shadeCpu's row bands: a tile row (at least 4) for lists, 16 rows for all lights.
+    const std::uint32_t align = std::lcm(std::max(r.grid.tileSize, 4u), 16u);
+    double culledMs = 0, allMs = 0;
+    // The all-lights image costs more (every light at every pixel), but the
+    // split by images is what a user can follow: half each.
+    auto part = [&progress](double base) -> std::function<void(double)> {
+        if (!progress) return {};
+        return [&progress, base](double f) { progress(base + 0.5 * f); };
+    };
+    std::vector<float> culled =
+        shadeImage(backend, culledIn, out.lights, &r, align, sliceMs, cancel, culledMs, part(0.0));
+    out.result.timings.shadeMs = culledMs;
+    throwIfCancelled(cancel);
+    // `all` with one list of every light in order shades exactly the reference.
+    bool identity = r.listCount.size() == 1 && r.listCount[0] == out.lights.size();
+    for (std::size_t i = 0; identity && i < out.lights.size(); ++i)
+        identity = r.lightIndices[r.listOffset[0] + i] == i;
+    std::vector<float> all;
+    if (identity) {
+        all = culled;
+    } else {
+        ShadeInputs allIn = culledIn;
+        allIn.perPixelLists.reset();
+        for (std::uint32_t& l : allIn.list)
+            if (l != ShadeInputs::kNoList) l = 0;
+        all = shadeImage(backend, allIn, out.lights, nullptr, align, sliceMs, cancel, allMs, part(0.5));
+        throwIfCancelled(cancel);
+    }
+    const ImageError e = compareShadedImages(out.depth, culled, all);
+    Metrics& m = out.truth.metrics;
+    m.imageRmse = e.rmse;
+    m.imageMaxError = e.maxAbs;
+    m.imageErrorComputed = true;
+    if (keepImages) {
+        out.shadedCulled = std::move(culled);
+        out.shadedAll = std::move(all);
+    }
+}
+
+RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBackend& backend,
+                      const RunOptions& options, const CancelToken* cancel) {
+    using Clock = std::chrono::steady_clock;
+    scene.validate();
+    if (const std::string bad = settings.validate(); !bad.empty()) throwSettings(bad);
+
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
+
+    RunOutput out;
+    out.lights = makeViewLights(scene);
+    throwIfCancelled(cancel);
+
+    const auto t0 = Clock::now();
+    if (options.reuseDepth) {
+        out.depth = *options.reuseDepth;
+        out.depthReused = true;
+    } else {
+        out.depth = backend.renderDepth(scene, proj);
+    }
+    const double depthWallMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    if (out.depth.width != grid.width || out.depth.height != grid.height ||
+        out.depth.depth.size() != std::size_t(grid.width) * grid.height) {
+        const std::string size = std::to_string(out.depth.width) + "x" + std::to_string(out.depth.height);
+        const std::string cam = std::to_string(grid.width) + "x" + std::to_string(grid.height);
+        if (out.depthReused) throw Error("the reused depth image is " + size + " but the camera is " + cam);
+        throw Error("backend '" + backend.name() + "' returned a " + size + " depth image for a " + cam +
+                    " camera");
+    }
+    throwIfCancelled(cancel);
+
+    const auto t1 = Clock::now();
+    out.result = backend.cull(out.depth, proj, grid, out.lights, settings);
+    const double cullWallMs = std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
+    if (const std::string bad = out.result.validate(out.lights.size()); !bad.empty())
+        throw Error("backend '" + backend.name() + "' produced an inconsistent result: " + bad);
+    // A backend that did not time a phase gets the wall time around the call.
+    out.result.timings.depthMs = out.depthReused              ? 0.0
+                                 : backend.lastDepthMs() >= 0 ? backend.lastDepthMs()
+                                                              : depthWallMs;
+    if (out.result.timings.cullMs < 0) out.result.timings.cullMs = cullWallMs;
+    if (out.result.backend.empty()) out.result.backend = backend.name();
+    if (out.result.device.empty()) out.result.device = backend.deviceName();
+    if (out.result.timingMethod.empty()) out.result.timingMethod = backend.timingMethod();
+    throwIfCancelled(cancel);
+    judgeRun(out, proj, backend, options, cancel);
+    return out;
+}
+
+void judgeRun(RunOutput& out, const Projection& proj, CullBackend& shadeBackend, const RunOptions& options,
+              const CancelToken* cancel) {
+    using Clock = std::chrono::steady_clock;
+    if (options.groundTruth) {
+        GroundTruthOptions truthOptions = options.truthOptions;
+        truthOptions.imageError = false; // from the backend's shading pass below
+        const auto t0 = Clock::now();
+        out.truth = computeGroundTruth(out.depth, proj, out.lights, out.result, truthOptions, cancel);
+        out.truthComputed = true;
+        out.result.timings.groundTruthMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    }
+    if (options.truthOptions.imageError) {
+        throwIfCancelled(cancel);
+        shadeAndCompare(shadeBackend, out, proj, options.keepShadedImages, cancel);
+    }
+}
+
+} // namespace lc

@@ -1,0 +1,473 @@
+// Custom culling, the parts without Vulkan: the layout and list-rule specs, a
+// shader's first-line settings, decoding lists from raw words or CSV, locating
+// false negatives, reading an engine's depth buffer, and the pipelines that
+// judge a shader's or an engine's lists (docs/CUSTOM_CULLING.md).
+#include "culling/custom/custom_cull.hpp"
+
+#include "culling/core/errors.hpp"
+#include "culling/truth/ground_truth.hpp"
+#include "culling/core/pipeline.hpp"
+#include "custom/custom_internal.hpp"
+#include "truth/light_grid.hpp"
+
+#include <png.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace lc {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> splitOn(const std::string& s, char sep) {
+    std::vector<std::string> out;
+    std::string cur;
+    for (char c : s) {
+        if (c == sep) {
+            out.push_back(cur);
+            cur.clear();
+        } else {
+            cur += c;
+        }
+    }
+    out.push_back(cur);
+    return out;
+}
+
+bool parseUint(const std::string& s, std::uint64_t& v) {
+    if (s.empty() || s.size() > 12 || s.find_first_not_of("0123456789") != std::string::npos) return false;
+    v = std::stoull(s);
+    return true;
+}
+
+// The built-in algorithm whose list rule a ListSpec names.
+Algorithm ruleAlgorithm(const ListSpec& l) {
+    switch (l.kind) {
+    case ListKind::Tile: return Algorithm::MinMax;
+    case ListKind::HalfZ: return Algorithm::HalfZ;
+    case ListKind::Froxel: return Algorithm::Clustered;
+    case ListKind::Cells: return Algorithm::TwoPointFiveD;
+    }
+    return Algorithm::MinMax;
+}
+
+// Sorted, unique, valid lists into `result`.
+void assignLists(std::vector<std::vector<std::uint32_t>>& lists, std::uint32_t lightCount, CullResult& result,
+                 CustomCullReport& report) {
+    result.listOffset.assign(lists.size(), 0);
+    result.listCount.assign(lists.size(), 0);
+    result.lightIndices.clear();
+    for (std::size_t l = 0; l < lists.size(); ++l) {
+        auto& v = lists[l];
+        const auto bad = std::remove_if(v.begin(), v.end(), [&](std::uint32_t i) { return i >= lightCount; });
+        report.invalidIndices += std::uint64_t(v.end() - bad);
+        v.erase(bad, v.end());
+        std::sort(v.begin(), v.end());
+        const auto dup = std::unique(v.begin(), v.end());
+        report.duplicateIndices += std::uint64_t(v.end() - dup);
+        v.erase(dup, v.end());
+        result.listOffset[l] = std::uint32_t(result.lightIndices.size());
+        result.listCount[l] = std::uint32_t(v.size());
+        result.lightIndices.insert(result.lightIndices.end(), v.begin(), v.end());
+    }
+}
+
+} // namespace
+
+namespace detail {
+
+std::string readWholeFile(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, "", 0, "cannot open file for reading");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+CullResult ruleSkeleton(const DepthImage& depth, const Projection& proj, const TileGrid& grid, const ViewLights& lights,
+                        const ListSpec& lists) {
+    CullSettings s;
+    s.algorithm = ruleAlgorithm(lists);
+    s.cells = lists.kind == ListKind::Froxel || lists.kind == ListKind::Cells ? lists.slices : 1;
+    s.slicing = lists.slicing;
+    s.skipEmpty = false; // a custom froxel list may hold lights in empty froxels
+    if (const std::string bad = s.validate(); !bad.empty()) throw SettingsError("lists", bad);
+    CullResult r = makeCpuBackend()->cull(depth, proj, grid, lights, s);
+    if (lists.kind == ListKind::Cells) {
+        // 2.5d's tile bounds and cell masks, with a list per cell; no
+        // built-in algorithm makes such lists, so none to compare with.
+        r.cellLists = true;
+        r.listsPerTile = lists.slices;
+        r.listOffset.assign(std::size_t(grid.tileCount()) * lists.slices, 0);
+        r.listCount.assign(r.listOffset.size(), 0);
+        r.lightIndices.clear();
+    }
+    return r;
+}
+
+void compareWithBuiltin(const CullResult& custom, const CullResult& builtin, CustomCullReport& report) {
+    if (builtin.cellLists) {
+        report.builtinAlgorithm = "none (no built-in algorithm has a list per cell)";
+        return;
+    }
+    report.builtinAlgorithm = toString(builtin.algorithm);
+    report.builtinEntries = builtin.entries();
+    report.listsDifferingFromBuiltin = 0;
+    for (std::size_t l = 0; l < custom.listCount.size() && l < builtin.listCount.size(); ++l) {
+        const auto a = custom.lightIndices.begin() + custom.listOffset[l];
+        const auto b = builtin.lightIndices.begin() + builtin.listOffset[l];
+        if (custom.listCount[l] != builtin.listCount[l] || !std::equal(a, a + custom.listCount[l], b))
+            ++report.listsDifferingFromBuiltin;
+    }
+}
+
+} // namespace detail
+
+using detail::compareWithBuiltin;
+using detail::ruleSkeleton;
+
+LayoutSpec parseLayout(const std::string& text) {
+    const auto parts = splitOn(text, ':');
+    LayoutSpec l;
+    std::uint64_t n = 0;
+    if (parts[0] == "fixed" && parts.size() == 2 && parseUint(parts[1], n) && n >= 1 && n <= 65536) {
+        l.kind = ListLayout::Fixed;
+        l.capacity = std::uint32_t(n);
+    } else if (parts[0] == "compact" && parts.size() == 1) {
+        l.kind = ListLayout::Compact;
+        l.capacity = 0;
+    } else if (parts[0] == "compact" && parts.size() == 2 && parseUint(parts[1], n) && n >= 1 && n <= (1u << 28)) {
+        l.kind = ListLayout::Compact;
+        l.capacity = std::uint32_t(n);
+    } else if (parts[0] == "bitmask" && parts.size() == 1) {
+        l.kind = ListLayout::Bitmask;
+        l.capacity = 0;
+    } else {
+        throw SettingsError("layout", "'" + text + "' is not fixed:N (N in 1..65536), compact, compact:N or bitmask");
+    }
+    return l;
+}
+
+std::string toString(const LayoutSpec& l) {
+    switch (l.kind) {
+    case ListLayout::Fixed: return "fixed:" + std::to_string(l.capacity);
+    case ListLayout::Compact: return l.capacity ? "compact:" + std::to_string(l.capacity) : "compact";
+    case ListLayout::Bitmask: return "bitmask";
+    }
+    return "?";
+}
+
+ListSpec parseListSpec(const std::string& text) {
+    const auto parts = splitOn(text, ':');
+    ListSpec l;
+    std::uint64_t n = 0;
+    if (parts[0] == "tile" && parts.size() == 1) {
+        l.kind = ListKind::Tile;
+    } else if (parts[0] == "halfz" && parts.size() == 1) {
+        l.kind = ListKind::HalfZ;
+    } else if ((parts[0] == "froxel" || parts[0] == "cells") && (parts.size() == 2 || parts.size() == 3) &&
+               parseUint(parts[1], n) && n >= 1 && n <= 32 &&
+               (parts.size() == 2 || parts[2] == "log" || parts[2] == "linear")) {
+        l.kind = parts[0] == "froxel" ? ListKind::Froxel : ListKind::Cells;
+        l.slices = std::uint32_t(n);
+        l.slicing = parts.size() == 3 && parts[2] == "linear" ? Slicing::Linear : Slicing::Log;
+    } else {
+        throw SettingsError("lists", "'" + text + "' is not tile, halfz, froxel:N[:log|linear] or cells:N[:log|linear] (N in 1..32)");
+    }
+    return l;
+}
+
+std::string toString(const ListSpec& l) {
+    switch (l.kind) {
+    case ListKind::Tile: return "tile";
+    case ListKind::HalfZ: return "halfz";
+    case ListKind::Froxel: return "froxel:" + std::to_string(l.slices) + ":" + toString(l.slicing);
+    case ListKind::Cells: return "cells:" + std::to_string(l.slices) + ":" + toString(l.slicing);
+    }
+    return "?";
+}
+
+std::uint64_t layoutWords(const LayoutSpec& layout, std::uint64_t lists, std::uint64_t lights) {
+    switch (layout.kind) {
+    case ListLayout::Fixed: return lists * (std::uint64_t(layout.capacity) + 1);
+    case ListLayout::Bitmask: return lists * std::max<std::uint64_t>(1, (lights + 31) / 32);
+    case ListLayout::Compact: {
+        const std::uint64_t entries = layout.capacity ? layout.capacity : 64 * lists;
+        return 1 + 2 * lists + entries;
+    }
+    }
+    return 0;
+}
+
+void applyShaderHeader(const std::string& text, const std::string& path, CustomShaderOptions& o, bool layoutGiven,
+                       bool listsGiven, bool entryGiven) {
+    const std::string first = text.substr(0, text.find('\n'));
+    const std::string tag = "lightcull:";
+    const auto at = first.find(tag);
+    if (first.rfind("//", 0) != 0 || at == std::string::npos) return;
+    std::istringstream words(first.substr(at + tag.size()));
+    std::string flag, value;
+    while (words >> flag) {
+        if (!(words >> value)) throw InputError(path, "", 1, "lightcull settings: " + flag + " needs a value");
+        try {
+            if (flag == "--layout") {
+                if (!layoutGiven) o.layout = parseLayout(value);
+            } else if (flag == "--lists") {
+                if (!listsGiven) o.lists = parseListSpec(value);
+            } else if (flag == "--entry") {
+                if (!entryGiven) o.entry = value;
+            } else {
+                throw InputError(path, "", 1, "lightcull settings: unknown flag '" + flag + "' (--layout, --lists, --entry)");
+            }
+        } catch (const SettingsError& e) {
+            throw InputError(path, "", 1, std::string("lightcull settings: ") + e.what());
+        }
+    }
+}
+
+CustomShaderOptions shaderOptionsFromFile(const std::string& path, const std::string& layout, const std::string& lists,
+                                          const std::string& entry) {
+    CustomShaderOptions o;
+    o.path = path;
+    if (!layout.empty()) o.layout = parseLayout(layout);
+    if (!lists.empty()) o.lists = parseListSpec(lists);
+    if (!entry.empty()) o.entry = entry;
+    if (fs::path(path).extension() != ".spv") {
+        std::ifstream in(path, std::ios::binary);
+        if (!in) throw InputError(path, "", 0, "cannot open shader for reading");
+        std::string first;
+        std::getline(in, first);
+        applyShaderHeader(first, path, o, !layout.empty(), !lists.empty(), !entry.empty());
+    }
+    return o;
+}
+
+void decodeLists(const std::vector<std::uint32_t>& words, const LayoutSpec& layout, std::uint32_t lightCount,
+                 CullResult& result, CustomCullReport& report) {
+    const std::size_t lists = result.listOffset.size();
+    if (words.size() < layoutWords(layout, lists, lightCount))
+        throw Error("the list buffer holds " + std::to_string(words.size()) + " words; layout " + toString(layout) +
+                    " with " + std::to_string(lists) + " lists and " + std::to_string(lightCount) + " lights needs " +
+                    std::to_string(layoutWords(layout, lists, lightCount)));
+    std::vector<std::vector<std::uint32_t>> perList(lists);
+    if (layout.kind == ListLayout::Fixed) {
+        const std::uint64_t n = layout.capacity;
+        for (std::size_t l = 0; l < lists; ++l) {
+            const std::uint64_t base = l * (n + 1);
+            const std::uint64_t count = words[base];
+            if (count > n) {
+                ++report.overflowLists;
+                report.overflowEntries += count - n;
+            }
+            for (std::uint64_t i = 0; i < std::min(count, n); ++i) perList[l].push_back(words[base + 1 + i]);
+        }
+    } else if (layout.kind == ListLayout::Bitmask) {
+        const std::uint64_t w = std::max<std::uint64_t>(1, (std::uint64_t(lightCount) + 31) / 32);
+        for (std::size_t l = 0; l < lists; ++l)
+            for (std::uint64_t k = 0; k < w; ++k)
+                for (std::uint32_t bits = words[l * w + k]; bits; bits &= bits - 1)
+                    perList[l].push_back(std::uint32_t(k * 32 + std::uint32_t(__builtin_ctz(bits))));
+    } else {
+        const std::uint64_t cap = layout.capacity ? layout.capacity : 64 * std::uint64_t(lists);
+        const std::uint64_t start = 1 + 2 * std::uint64_t(lists);
+        for (std::size_t l = 0; l < lists; ++l) {
+            const std::uint64_t offset = words[1 + 2 * l], count = words[2 + 2 * l];
+            const std::uint64_t kept = offset >= cap ? 0 : std::min(count, cap - offset);
+            if (kept < count) {
+                ++report.overflowLists;
+                report.overflowEntries += count - kept;
+            }
+            for (std::uint64_t i = 0; i < kept; ++i) perList[l].push_back(words[start + offset + i]);
+        }
+    }
+    assignLists(perList, lightCount, result, report);
+}
+
+std::vector<MissedLight> locateFalseNegatives(const RunOutput& run, const Projection& proj) {
+    std::vector<MissedLight> out;
+    const CullResult& r = run.result;
+    if (!run.truthComputed || run.truth.metrics.falseNegatives == 0) return out;
+    const std::uint32_t per = r.algorithm == Algorithm::All ? 0 : std::max(r.listsPerTile, 1u);
+    for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t) {
+        bool any = false;
+        if (per == 0) any = true;
+        for (std::uint32_t k = 0; per && k < per && !any; ++k) any = run.truth.listFalseNegatives[t * per + k] > 0;
+        if (!any) continue;
+        std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> missed; // (list, light) -> pixels
+        const TileGrid::Rect rect = r.grid.tileRect(t % r.grid.tilesX, t / r.grid.tilesX);
+        for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
+            for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
+                if (!run.depth.hasGeometry(x, y)) continue;
+                const glm::dvec3 p = proj.viewPositionFromDepth(x, y, run.depth.at(x, y));
+                const std::uint32_t list = r.listOfPixel(x, y, -p.z);
+                const auto first = r.lightIndices.begin() + r.listOffset[list];
+                const auto last = first + r.listCount[list];
+                for (std::uint32_t i = 0; i < run.lights.size(); ++i)
+                    if (detail::lightNeeds(run.lights, i, p) && !std::binary_search(first, last, i)) ++missed[{list, i}];
+            }
+        for (const auto& [key, pixels] : missed) out.push_back({t, key.first, key.second, pixels});
+    }
+    std::stable_sort(out.begin(), out.end(), [](const MissedLight& a, const MissedLight& b) { return a.pixels > b.pixels; });
+    return out;
+}
+
+namespace {
+
+// Ground truth and the image error over decoded custom lists: runPipeline's
+// own last phases. Lists read from a dump are shaded on the CPU reference.
+void judge(RunOutput& out, const Projection& proj, CullBackend* shadeBackend, const RunOptions& runOptions) {
+    if (const std::string bad = out.result.validate(out.lights.size()); !bad.empty())
+        throw Error("custom lists are inconsistent after decoding: " + bad);
+    std::unique_ptr<CullBackend> cpu;
+    if (!shadeBackend) {
+        cpu = makeCpuBackend();
+        shadeBackend = cpu.get();
+    }
+    judgeRun(out, proj, *shadeBackend, runOptions);
+}
+
+} // namespace
+
+RunOutput runCustomPipeline(const Scene& scene, const CustomShaderOptions& options, CullBackend& depthBackend,
+                            const RunOptions& runOptions, CustomCullReport& report, const DepthImage* depthOverride) {
+    scene.validate();
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
+    RunOutput out;
+    out.lights = makeViewLights(scene);
+    if (depthOverride) {
+        out.depth = *depthOverride;
+        out.depthReused = true;
+    } else {
+        out.depth = depthBackend.renderDepth(scene, proj);
+    }
+    out.result = runCustomShader(options, out.depth, proj, grid, out.lights, report);
+    out.result.timings.depthMs = depthOverride ? 0.0 : depthBackend.lastDepthMs();
+    judge(out, proj, &depthBackend, runOptions);
+    out.custom = std::make_shared<CustomCullReport>(report);
+    return out;
+}
+
+RunOutput checkListDump(const Scene& scene, const std::string& listsPath, const LayoutSpec& layout,
+                        const ListSpec& lists, const DepthImage& depth, const RunOptions& runOptions,
+                        CustomCullReport& report) {
+    scene.validate();
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
+    RunOutput out;
+    out.lights = makeViewLights(scene);
+    out.depth = depth;
+    out.depthReused = true;
+    const CullResult skeleton = ruleSkeleton(depth, proj, grid, out.lights, lists);
+    CullResult r = skeleton;
+    report.source = listsPath;
+    report.layout = toString(layout);
+    report.lists = toString(lists);
+    const auto lightCount = std::uint32_t(out.lights.size());
+    const std::string ext = fs::path(listsPath).extension().string();
+    const std::string bytes = detail::readWholeFile(listsPath);
+    if (ext == ".csv") {
+        // One line per list: "list,light,light,...". Lists not named are empty.
+        std::vector<std::vector<std::uint32_t>> perList(r.listOffset.size());
+        std::istringstream in(bytes);
+        std::string line;
+        int lineNo = 0;
+        while (std::getline(in, line)) {
+            ++lineNo;
+            if (!line.empty() && line.back() == '\r') line.pop_back();
+            if (line.empty() || (lineNo == 1 && line.find_first_of("0123456789") != 0)) continue; // header
+            const auto fields = splitOn(line, ',');
+            std::uint64_t list = 0;
+            if (!parseUint(fields[0], list))
+                throw InputError(listsPath, "", lineNo, "'" + fields[0] + "' is not a list index");
+            if (list >= perList.size())
+                throw InputError(listsPath, "", lineNo, "list " + std::to_string(list) + " is outside 0.." +
+                                                            std::to_string(perList.size() - 1) + " (" + toString(lists) + ")");
+            for (std::size_t k = 1; k < fields.size(); ++k) {
+                std::uint64_t v = 0;
+                if (fields[k].empty()) continue;
+                if (!parseUint(fields[k], v) || v > 0xFFFFFFFFull)
+                    throw InputError(listsPath, "", lineNo, "'" + fields[k] + "' is not a light index");
+                perList[list].push_back(std::uint32_t(v));
+            }
+        }
+        assignLists(perList, lightCount, r, report);
+    } else {
+        if (bytes.size() % 4 != 0)
+            throw InputError(listsPath, "", 0, std::to_string(bytes.size()) + " bytes is not a whole number of 32-bit words");
+        const std::uint64_t need = layoutWords(layout, r.listOffset.size(), lightCount);
+        if (bytes.size() / 4 < need)
+            throw InputError(listsPath, "", 0, std::to_string(bytes.size() / 4) + " words, but " + toString(layout) +
+                                                   " with " + std::to_string(r.listOffset.size()) + " lists (" + toString(lists) +
+                                                   ") and " + std::to_string(lightCount) + " lights needs " + std::to_string(need));
+        std::vector<std::uint32_t> words(bytes.size() / 4);
+        for (std::size_t i = 0; i < words.size(); ++i) {
+            const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + 4 * i);
+            words[i] = std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 | std::uint32_t(b[3]) << 24;
+        }
+        decodeLists(words, layout, lightCount, r, report);
+    }
+    r.backend = "dump";
+    r.device = "engine lists from " + fs::path(listsPath).filename().string();
+    r.timingMethod = "not timed (lists read from a file)";
+    r.timings.cullMs = -1;
+    r.volumeTests = 0;
+    compareWithBuiltin(r, skeleton, report);
+    out.result = std::move(r);
+    judge(out, proj, nullptr, runOptions);
+    out.custom = std::make_shared<CustomCullReport>(report);
+    return out;
+}
+
+DepthImage loadDepthFile(const std::string& path, const Projection& proj) {
+    DepthImage d;
+    d.width = proj.width();
+    d.height = proj.height();
+    d.clearDepth = float(proj.clearDepth());
+    const std::size_t n = std::size_t(d.width) * d.height;
+    const std::string ext = fs::path(path).extension().string();
+    if (ext == ".png") {
+        png_image img;
+        std::memset(&img, 0, sizeof img);
+        img.version = PNG_IMAGE_VERSION;
+        if (!png_image_begin_read_from_file(&img, path.c_str()))
+            throw InputError(path, "", 0, std::string("not a readable PNG: ") + img.message);
+        if (img.width != d.width || img.height != d.height) {
+            png_image_free(&img);
+            throw InputError(path, "", 0, std::to_string(img.width) + "x" + std::to_string(img.height) +
+                                              " pixels, but the camera is " + std::to_string(d.width) + "x" +
+                                              std::to_string(d.height));
+        }
+        img.format = PNG_FORMAT_LINEAR_Y; // 16-bit grey, no gamma applied
+        std::vector<std::uint16_t> px(n);
+        if (!png_image_finish_read(&img, nullptr, px.data(), 0, nullptr))
+            throw InputError(path, "", 0, std::string("cannot decode: ") + img.message);
+        d.depth.resize(n);
+        for (std::size_t i = 0; i < n; ++i) d.depth[i] = float(px[i]) / 65535.0f;
+    } else {
+        std::error_code ec;
+        const auto size = fs::file_size(path, ec);
+        if (ec) throw InputError(path, "", 0, "cannot read: " + ec.message());
+        if (size != n * 4)
+            throw InputError(path, "", 0, std::to_string(size) + " bytes, but raw float32 depth of a " +
+                                              std::to_string(d.width) + "x" + std::to_string(d.height) + " camera is " +
+                                              std::to_string(n * 4));
+        std::ifstream in(path, std::ios::binary);
+        d.depth.resize(n);
+        in.read(reinterpret_cast<char*>(d.depth.data()), std::streamsize(n * 4));
+        if (!in) throw InputError(path, "", 0, "read error");
+    }
+    for (std::size_t i = 0; i < n; ++i)
+        if (!(d.depth[i] >= 0.0f && d.depth[i] <= 1.0f))
+            throw InputError(path, "", 0, "pixel " + std::to_string(i % d.width) + "," + std::to_string(i / d.width) +
+                                              " has window depth " + std::to_string(d.depth[i]) + ", outside [0, 1]");
+    return d;
+}
+
+} // namespace lc

@@ -1,0 +1,308 @@
+// One light in one list, explained: the CPU reference's tests (cpu_backend.cpp's
+// per-chunk test, step by step, with the same chunk, sphere and slack) and the
+// ground truth of the list's pixels.
+#include "culling/diagnostics/explain.hpp"
+
+#include "culling/core/errors.hpp"
+#include "culling/cpu/fine_prune.hpp"
+#include "culling/math/spot_tests.hpp"
+#include "culling/math/tile_math.hpp"
+#include "truth/light_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace lc {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string num(double v) {
+    char b[48];
+    std::snprintf(b, sizeof b, "%.4g", v);
+    return b;
+}
+
+bool tileEmpty(const CullResult& r, std::uint32_t t) { return !(r.tileDepthMin[t] <= r.tileDepthMax[t]); }
+
+} // namespace
+
+const char* chunkPlaneName(int plane) {
+    static const char* kPlane[6] = {"side plane left", "side plane right", "side plane top",
+                                    "side plane bottom", "depth min (chunk's near plane)",
+                                    "depth max (chunk's far plane)"};
+    return plane >= 0 && plane < 6 ? kPlane[plane] : "";
+}
+
+std::array<glm::dvec3, 4> chunkFace(const std::array<glm::dvec3, 8>& c, int plane) {
+    // Corners: near tl, tr, br, bl (0..3), far tl, tr, br, bl (4..7).
+    static const int kFace[6][4] = {{0, 3, 7, 4}, {1, 2, 6, 5}, {0, 1, 5, 4},
+                                    {3, 2, 6, 7}, {0, 1, 2, 3}, {4, 5, 6, 7}};
+    const int p = std::clamp(plane, 0, 5);
+    return {c[std::size_t(kFace[p][0])], c[std::size_t(kFace[p][1])], c[std::size_t(kFace[p][2])],
+            c[std::size_t(kFace[p][3])]};
+}
+
+std::uint32_t listOf(const CullResult& r, std::uint32_t tile, int sub) {
+    if (r.algorithm == Algorithm::All) return 0;
+    if (tile >= r.grid.tileCount())
+        throw SettingsError("tile", std::to_string(tile) + " is outside the " + std::to_string(r.grid.tilesX) + "x" +
+                                        std::to_string(r.grid.tilesY) + " tiles");
+    const std::uint32_t per = std::max(r.listsPerTile, 1u);
+    if (sub < 0) {
+        if (per > 1)
+            throw SettingsError("cell", std::string(toString(r.algorithm)) + " has " + std::to_string(per) +
+                                            " lists per tile: give the cell (0.." + std::to_string(per - 1) + ")");
+        return tile;
+    }
+    if (std::uint32_t(sub) >= per)
+        throw SettingsError("cell", std::to_string(sub) + " is outside 0.." + std::to_string(per - 1));
+    return tile * per + std::uint32_t(sub);
+}
+
+Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint32_t list, std::uint32_t light) {
+    const CullResult& r = run.result;
+    const ViewLights& lights = run.lights;
+    if (list >= r.listCount.size())
+        throw SettingsError("list", std::to_string(list) + " is outside 0.." + std::to_string(r.listCount.size() - 1));
+    if (light >= lights.size())
+        throw SettingsError("light", std::to_string(light) + " is outside 0.." + std::to_string(lights.size() - 1));
+    const CullSettings& s = r.settings;
+    Explanation e;
+    e.list = list;
+    e.light = light;
+    e.algorithm = run.custom ? "custom (" + std::string(toString(r.algorithm)) + " lists)" : toString(r.algorithm);
+    const std::uint32_t per = std::max(r.listsPerTile, 1u);
+    e.tile = r.algorithm == Algorithm::All ? 0 : list / per;
+    e.sub = per > 1 ? int(list % per) : -1;
+    const auto first = r.lightIndices.begin() + r.listOffset[list];
+    e.listed = std::binary_search(first, first + r.listCount[list], light);
+
+    const BoundingSphere sphere = lights.cullSphere(light, s.spotTest);
+    e.sphereCenter = sphere.center;
+    e.sphereRadius = sphere.radius;
+    const double rr = sphere.radius + sphereTestSlack(sphere.center, sphere.radius);
+    auto step = [&](std::string test, std::string numbers, bool passed) {
+        e.steps.push_back({std::move(test), std::move(numbers), passed});
+        return passed;
+    };
+
+    if (r.algorithm == Algorithm::All) {
+        step("all", "one list holds every light: nothing is tested", true);
+    } else {
+        const std::uint32_t t = e.tile;
+        const TileGrid::Rect rect = r.grid.tileRect(t % r.grid.tilesX, t / r.grid.tilesX);
+        const double tmin = r.tileDepthMin[t], tmax = r.tileDepthMax[t];
+        const double cd = -sphere.center.z;
+        const bool empty = tileEmpty(r, t);
+        bool ok = true;
+        double lo = 0, hi = 0;
+        const bool emptyListed = r.algorithm == Algorithm::Naive || r.algorithm == Algorithm::ZBin ||
+                                 (r.algorithm == Algorithm::Clustered && !s.skipEmpty);
+        if (empty && !emptyListed) {
+            ok = step("tile holds geometry", "no geometry pixel: the tile gets an empty list", false);
+        } else {
+            switch (r.algorithm) {
+            case Algorithm::ZBin: // the tile's mask: naive's screen-space volume
+            case Algorithm::Naive: {
+                // As the reference: the camera's near and far, an infinite far
+                // replaced by the farthest depth any light reaches.
+                double lightFar = 0;
+                for (std::size_t l = 0; l < lights.size(); ++l) {
+                    const BoundingSphere b = lights.cullSphere(l, s.spotTest);
+                    lightFar = std::max(lightFar, -b.center.z + b.radius);
+                }
+                lo = proj.nearPlane();
+                hi = std::isfinite(proj.farPlane()) ? proj.farPlane() : std::max(lightFar, lo);
+                break;
+            }
+            case Algorithm::Fptl:
+            case Algorithm::MinMax: lo = tmin, hi = tmax; break;
+            case Algorithm::TwoPointFiveD:
+                if (r.cellLists && e.sub >= 0) {
+                    lo = sliceBoundary(s.slicing, tmin, tmax, per, std::uint32_t(e.sub));
+                    hi = sliceBoundary(s.slicing, tmin, tmax, per, std::uint32_t(e.sub) + 1);
+                } else {
+                    lo = tmin, hi = tmax;
+                }
+                break;
+            case Algorithm::HalfZ:
+                lo = e.sub == 1 ? r.halfzSplit[t] : tmin;
+                hi = e.sub == 1 ? tmax : r.halfzSplit[t];
+                break;
+            case Algorithm::Clustered:
+                lo = sliceBoundary(s.slicing, r.clusterNear, r.clusterFar, per, std::uint32_t(e.sub));
+                hi = sliceBoundary(s.slicing, r.clusterNear, r.clusterFar, per, std::uint32_t(e.sub) + 1);
+                break;
+            default: break;
+            }
+            e.chunkDepthMin = lo;
+            e.chunkDepthMax = hi;
+            if (r.algorithm == Algorithm::TwoPointFiveD && !r.cellLists) {
+                const std::uint32_t m = sliceRangeMask(s.slicing, tmin, tmax, s.cells, cd - sphere.radius, cd + sphere.radius);
+                char bits[80];
+                std::snprintf(bits, sizeof bits, "light's cells 0x%08x & tile's occupied cells 0x%08x", m, r.cellMask[t]);
+                ok = step("cell mask (" + std::to_string(s.cells) + " " + toString(s.slicing) + " cells of " + num(tmin) +
+                              ".." + num(tmax) + ")",
+                          bits, (m & r.cellMask[t]) != 0) && ok;
+            }
+            if (r.algorithm == Algorithm::Clustered) {
+                const std::uint32_t m = sliceRangeMask(s.slicing, r.clusterNear, r.clusterFar, per, cd - sphere.radius,
+                                                       cd + sphere.radius);
+                const bool inRange = (m >> e.sub) & 1u;
+                ok = step("slice range", "the light's depth " + num(cd - sphere.radius) + ".." + num(cd + sphere.radius) +
+                                             (inRange ? " reaches" : " misses") + " slice " + std::to_string(e.sub),
+                          inRange) && ok;
+                if (s.skipEmpty) {
+                    const bool occ = (r.cellMask[t] >> e.sub) & 1u;
+                    ok = step("slice holds geometry (skip-empty)", occ ? "occupied" : "empty: skipped", occ) && ok;
+                }
+            }
+            const FrustumChunk chunk = makeFrustumChunk(proj, rect, lo, hi);
+            e.hasChunk = true;
+            e.chunkCorners = chunk.corners;
+            for (int k = 0; k < 6; ++k) {
+                const double d = signedDistance(chunk.planes[std::size_t(k)], sphere.center);
+                ok = step(chunkPlaneName(k), "signed distance " + num(d) + (d >= -rr ? " >= " : " < ") + "-r = " + num(-rr),
+                          d >= -rr) && ok;
+                if (e.decisivePlane < 0 || d + rr < e.decisiveMargin) e.decisivePlane = k, e.decisiveMargin = d + rr;
+            }
+            if (s.test != SphereTest::Planes) {
+                glm::dvec3 blo = chunk.corners[0], bhi = chunk.corners[0];
+                for (const auto& c : chunk.corners) blo = glm::min(blo, c), bhi = glm::max(bhi, c);
+                const double d = glm::length(sphere.center - glm::clamp(sphere.center, blo, bhi));
+                ok = step("box around the chunk (planes+aabb)", "distance " + num(d) + (d <= rr ? " <= " : " > ") + "r = " + num(rr),
+                          d <= rr) && ok;
+            }
+            if (s.test == SphereTest::Exact) {
+                const double d = distanceToChunk(chunk, sphere.center);
+                ok = step("exact distance to the chunk", "distance " + num(d) + (d <= rr ? " <= " : " > ") + "r = " + num(rr),
+                          d <= rr) && ok;
+            }
+            const bool coneRefines = s.spotTest == SpotTest::ConeSphere || s.spotTest == SpotTest::ConePlanes;
+            if (coneRefines && lights.isSpot(light)) {
+                const bool pass = spotIntersectsChunk(s.spotTest, s.test, lights.spotCone(light), chunk);
+                ok = step(std::string("spot cone (") + toString(s.spotTest) + ")",
+                          pass ? "the cone meets the chunk" : "the cone misses the chunk", pass) && ok;
+            }
+            if (r.algorithm == Algorithm::ZBin && light < r.zbinRank.size()) {
+                // After the mask, each pixel's bin: the light is looped over
+                // where its rank lies in the bin's range. Reported, not a test
+                // of the list (the mask is the list).
+                const std::uint32_t k = r.zbinRank[light];
+                std::uint32_t inRange = 0, pixels = 0;
+                for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
+                    for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
+                        if (!run.depth.hasGeometry(x, y)) continue;
+                        ++pixels;
+                        const std::uint32_t b = r.zbinOf(proj.viewDepthFromWindowDepth(run.depth.at(x, y)));
+                        inRange += r.zbinLo[b] <= k && k <= r.zbinHi[b];
+                    }
+                step("Z-bins (per pixel, after the mask)",
+                     "sorted position " + std::to_string(k) + " of " + std::to_string(lights.size()) + "; bins " +
+                         std::to_string(r.zbinOf(cd - sphere.radius)) + ".." + std::to_string(r.zbinOf(cd + sphere.radius)) +
+                         " of " + std::to_string(r.zbinLo.size()) + "; the pixels of " + std::to_string(inRange) + " of the tile's " +
+                         std::to_string(pixels) + " geometry pixels loop over it",
+                     inRange > 0);
+            }
+            if (r.algorithm == Algorithm::Fptl) {
+                // The fine prune, as the reference runs it (fine_prune.hpp):
+                // the tile's geometry pixels inside the light's volume.
+                std::uint32_t inside = 0, pixels = 0;
+                for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
+                    for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
+                        if (!run.depth.hasGeometry(x, y)) continue;
+                        ++pixels;
+                        inside += fptlPixelKeeps(lights, light, proj.viewPositionFromDepth(x, y, run.depth.at(x, y)));
+                    }
+                ok = step("fine prune (the tile's pixels)",
+                          std::to_string(inside) + " of the tile's " + std::to_string(pixels) +
+                              " geometry pixels lie inside the light's volume (+slack)",
+                          inside > 0) && ok;
+            }
+        }
+        e.testsPass = ok;
+    }
+    if (r.algorithm == Algorithm::All) e.testsPass = true;
+
+    // Ground truth over the list's pixels.
+    e.nearestDistance = kInf;
+    double neededToCentre = kInf;
+    std::uint32_t x0 = 0, y0 = 0, x1 = r.grid.width, y1 = r.grid.height;
+    if (r.algorithm != Algorithm::All) {
+        const TileGrid::Rect rect = r.grid.tileRect(e.tile % r.grid.tilesX, e.tile / r.grid.tilesX);
+        x0 = rect.x0, y0 = rect.y0, x1 = rect.x1, y1 = rect.y1;
+    }
+    for (std::uint32_t y = y0; y < y1; ++y)
+        for (std::uint32_t x = x0; x < x1; ++x) {
+            if (!run.depth.hasGeometry(x, y)) continue;
+            const glm::dvec3 p = proj.viewPositionFromDepth(x, y, run.depth.at(x, y));
+            if (r.listOfPixel(x, y, -p.z) != list) continue;
+            ++e.listPixels;
+            if (detail::lightNeeds(lights, light, p)) {
+                ++e.pixelsNeeding;
+                const double toCentre = glm::length(p - lights.centers[light]);
+                if (!e.hasNeededPixel || toCentre < neededToCentre) {
+                    e.hasNeededPixel = true;
+                    e.neededPosition = p;
+                    neededToCentre = toCentre;
+                }
+                continue;
+            }
+            const double d = std::max(0.0, glm::length(p - lights.centers[light]) - lights.radii[light]);
+            if (d < e.nearestDistance) {
+                e.nearestDistance = d;
+                e.nearestPosition = p;
+                e.nearestX = x, e.nearestY = y;
+            }
+        }
+    if (e.pixelsNeeding > 0 || e.listPixels == 0) e.nearestDistance = -1;
+
+    std::string failed;
+    for (const ExplainStep& st : e.steps)
+        if (!st.passed && failed.empty()) failed = st.test;
+    if (e.listed && e.pixelsNeeding > 0) {
+        e.verdict = "needed: listed, and " + std::to_string(e.pixelsNeeding) + " of the list's " +
+                    std::to_string(e.listPixels) + " pixels need it";
+    } else if (e.listed) {
+        e.verdict = e.listPixels == 0 ? "listed, but no pixel uses this list"
+                                      : "false positive: listed, but none of the list's " + std::to_string(e.listPixels) +
+                                            " pixels is inside its volume; the nearest is " + num(e.nearestDistance) +
+                                            " beyond its range (pixel " + std::to_string(e.nearestX) + "," +
+                                            std::to_string(e.nearestY) + ")" +
+                                            (e.testsPass ? ": the tests are conservative here (the sphere meets the "
+                                                           "chunk, not the pixels' surfaces)"
+                                                         : "");
+    } else if (e.pixelsNeeding > 0) {
+        e.verdict = "MISSING: not listed, but " + std::to_string(e.pixelsNeeding) + " of the list's pixels need it" +
+                    (failed.empty() ? std::string(" (the reference's tests keep it: this pass dropped it)")
+                                    : " (rejected by '" + failed + "')");
+    } else {
+        e.verdict = "not listed, rightly: no pixel of the list needs it" +
+                    (failed.empty() ? std::string() : " (rejected by '" + failed + "')");
+    }
+    return e;
+}
+
+std::string Explanation::text(const std::string& lightName) const {
+    std::string out = "light " + std::to_string(light) + (lightName.empty() ? "" : " '" + lightName + "'") + " in list " +
+                      std::to_string(list) + " (tile " + std::to_string(tile) + (sub >= 0 ? ", sub-list " + std::to_string(sub) : "") +
+                      "), " + algorithm + "\n";
+    out += "  culling sphere: centre (" + num(sphereCenter.x) + ", " + num(sphereCenter.y) + ", " + num(sphereCenter.z) +
+           ") view space, radius " + num(sphereRadius) + "; its view depth " + num(-sphereCenter.z - sphereRadius) +
+           ".." + num(-sphereCenter.z + sphereRadius) + "\n";
+    if (chunkDepthMax > 0) out += "  tested chunk: view depth " + num(chunkDepthMin) + ".." + num(chunkDepthMax) + "\n";
+    for (const ExplainStep& s : steps) out += std::string("  ") + (s.passed ? "pass  " : "FAIL  ") + s.test + ": " + s.numbers + "\n";
+    if (decisivePlane >= 0)
+        out += std::string("  ") + (decisiveMargin < 0 ? "rejected by the " : "closest to rejecting it: the ") +
+               chunkPlaneName(decisivePlane) + " (signed distance + r = " + num(decisiveMargin) + ")\n";
+    out += "  tests: " + std::string(testsPass ? "keep it" : "reject it") + "; the list " +
+           (listed ? "holds it" : "does not hold it") + "\n";
+    out += "  verdict: " + verdict + "\n";
+    return out;
+}
+
+} // namespace lc

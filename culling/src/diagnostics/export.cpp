@@ -1,0 +1,430 @@
+// Diagnostics exporters: summary.json, tiles.csv, heatmap.png, and the atomic
+// folder write that the CLI's `run --out` and the studio share. The formats are
+// documented in docs/CLI.md.
+
+#include "culling/diagnostics/export.hpp"
+
+#include "culling/custom/custom_cull.hpp"
+#include "culling/core/file_io.hpp"
+#include "culling/diagnostics/overlays.hpp"
+
+#include "culling/core/errors.hpp"
+#include "culling/truth/shade.hpp"
+#include "diagnostics/font5x7.hpp"
+
+#include <nlohmann/json.hpp>
+#include <png.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <csetjmp>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <set>
+
+#include <fcntl.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+namespace lc {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Shortest text that reads back as the same double.
+std::string roundTrip(double v) {
+    std::array<char, 64> buf{};
+    const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+    return std::string(buf.data(), r.ptr);
+}
+
+nlohmann::ordered_json msOrNull(double ms) {
+    return ms >= 0 ? nlohmann::ordered_json(ms) : nlohmann::ordered_json(nullptr);
+}
+
+bool tileHasDepth(const CullResult& r, std::size_t t) {
+    return t < r.tileDepthMin.size() && t < r.tileDepthMax.size() &&
+           std::isfinite(r.tileDepthMin[t]) && std::isfinite(r.tileDepthMax[t]) &&
+           r.tileDepthMin[t] <= r.tileDepthMax[t];
+}
+
+// ---- colour -----------------------------------------------------------------
+
+// Viridis (matplotlib), sampled at 9 evenly spaced points, interpolated
+// linearly in sRGB. Perceptually ordered: light = more lights per list.
+glm::dvec3 viridis(double t) {
+    static constexpr double k[9][3] = {{68, 1, 84},    {71, 44, 122},  {59, 81, 139},
+                                       {44, 113, 142}, {33, 144, 141}, {39, 173, 129},
+                                       {92, 200, 99},  {170, 220, 50}, {253, 231, 37}};
+    t = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0) * 8.0;
+    const int i = std::min(int(t), 7);
+    const double f = t - i;
+    return glm::dvec3(k[i][0] + f * (k[i + 1][0] - k[i][0]), k[i][1] + f * (k[i + 1][1] - k[i][1]),
+                      k[i][2] + f * (k[i + 1][2] - k[i][2])) / 255.0;
+}
+
+struct Canvas {
+    RgbImage& img;
+    void set(int x, int y, glm::dvec3 c) {
+        if (x < 0 || y < 0 || x >= int(img.width) || y >= int(img.height)) return;
+        std::uint8_t* p = &img.rgb[(std::size_t(y) * img.width + x) * 3];
+        for (int i = 0; i < 3; ++i) p[i] = std::uint8_t(std::lround(std::clamp(c[i], 0.0, 1.0) * 255.0));
+    }
+    void fill(int x0, int y0, int x1, int y1, glm::dvec3 c) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) set(x, y, c);
+    }
+    int textWidth(const std::string& s, int scale) const {
+        return s.empty() ? 0 : int(s.size()) * detail::kGlyphAdvance * scale - scale;
+    }
+    void text(int x, int y, const std::string& s, int scale, glm::dvec3 c) {
+        for (char ch : s) {
+            const auto& g = detail::glyph5x7(ch);
+            for (int r = 0; r < detail::kGlyphHeight; ++r)
+                for (int b = 0; b < 5; ++b)
+                    if (g.rows[r] & (0x10 >> b)) fill(x + b * scale, y + r * scale, x + (b + 1) * scale, y + (r + 1) * scale, c);
+            x += detail::kGlyphAdvance * scale;
+        }
+    }
+};
+
+std::string fixed2(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.2f", v);
+    return buf;
+}
+
+// ---- files ------------------------------------------------------------------
+
+
+// libpng reports errors by longjmp; this function holds no C++ object with a
+// destructor between setjmp and the libpng calls, so the jump is safe. Returns
+// an empty string on success, else libpng's message.
+const char* writePngRaw(FILE* f, const RgbImage& img, png_bytep* rows, char* errBuf) {
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, errBuf, [](png_structp p, png_const_charp msg) {
+        char* buf = static_cast<char*>(png_get_error_ptr(p));
+        std::snprintf(buf, 256, "%s", msg);
+        png_longjmp(p, 1);
+    }, nullptr);
+    if (!png) return "png_create_write_struct failed";
+    png_infop info = png_create_info_struct(png);
+    if (!info) {
+        png_destroy_write_struct(&png, nullptr);
+        return "png_create_info_struct failed";
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        return errBuf[0] ? errBuf : "libpng error";
+    }
+    png_init_io(png, f);
+    png_set_IHDR(png, info, img.width, img.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+    png_write_image(png, rows);
+    png_write_end(png, nullptr);
+    png_destroy_write_struct(&png, &info);
+    return nullptr;
+}
+
+} // namespace
+
+std::string summaryJson(const Scene& scene, const CullSettings& settings, const RunOutput& run) {
+    const CullResult& r = run.result;
+    const Metrics& m = run.truth.metrics;
+    nlohmann::ordered_json j;
+    j["scene"] = scene.name;
+    j["algorithm"] = run.custom ? std::string("custom") : std::string(toString(settings.algorithm));
+    j["test"] = toString(settings.test);
+    j["backend"] = r.backend;
+    j["device"] = r.device;
+    j["timing_method"] = r.timingMethod;
+    j["width"] = r.grid.width;
+    j["height"] = r.grid.height;
+    j["tile_size"] = r.grid.tileSize;
+    j["tiles_x"] = r.grid.tilesX;
+    j["tiles_y"] = r.grid.tilesY;
+    j["cells"] = settings.cells;
+    j["slicing"] = toString(settings.slicing);
+    j["skip_empty"] = settings.skipEmpty;
+    j["spot_test"] = toString(settings.spotTest);
+    j["bins"] = settings.bins;
+    j["lights"] = run.lights.size();
+    std::size_t spots = 0;
+    for (std::size_t i = 0; i < run.lights.size(); ++i) spots += run.lights.isSpot(i);
+    j["spot_lights"] = spots;
+    j["timings_ms"] = {{"depth", msOrNull(r.timings.depthMs)},
+                       {"cull", msOrNull(r.timings.cullMs)},
+                       {"ground_truth", msOrNull(r.timings.groundTruthMs)},
+                       {"shade", msOrNull(r.timings.shadeMs)}};
+    nlohmann::ordered_json mj;
+    mj["false_negatives"] = m.falseNegatives;
+    mj["shading_work"] = m.shadingWork;
+    mj["exact_work"] = m.exactWork;
+    mj["efficiency"] = m.efficiency;
+    mj["optimal_work"] = m.optimalWork;
+    mj["efficiency_vs_optimal"] = m.efficiencyVsOptimal;
+    mj["mean_list"] = m.meanList;
+    mj["max_list"] = m.maxList;
+    mj["result_bytes"] = m.resultBytes;
+    mj["list_entries"] = r.entries();
+    mj["lists"] = r.listCountTotal();
+    mj["geometry_pixels"] = m.geometryPixels;
+    mj["image_rmse"] = m.imageErrorComputed ? nlohmann::ordered_json(m.imageRmse) : nlohmann::ordered_json(nullptr);
+    mj["image_max_error"] =
+        m.imageErrorComputed ? nlohmann::ordered_json(m.imageMaxError) : nlohmann::ordered_json(nullptr);
+    j["metrics"] = mj;
+    if (run.custom) {
+        // docs/CUSTOM_CULLING.md: what the user's culling did beside its lists.
+        const CustomCullReport& c = *run.custom;
+        nlohmann::ordered_json cj;
+        cj["source"] = c.source;
+        cj["layout"] = c.layout;
+        cj["lists"] = c.lists;
+        cj["pass_ms"] = c.passMs >= 0 ? nlohmann::ordered_json(c.passMs) : nlohmann::ordered_json(nullptr);
+        cj["overflow_lists"] = c.overflowLists;
+        cj["overflow_entries"] = c.overflowEntries;
+        cj["invalid_indices"] = c.invalidIndices;
+        cj["duplicate_indices"] = c.duplicateIndices;
+        cj["validation_messages"] = c.validationMessages;
+        cj["builtin_algorithm"] = c.builtinAlgorithm;
+        cj["builtin_entries"] = c.builtinEntries;
+        cj["lists_differing_from_builtin"] = c.listsDifferingFromBuiltin;
+        // Every false negative located: tile, list, light and the pixels that
+        // needed it (the 1,000 with most pixels; the total is in metrics).
+        const Projection proj(scene.camera);
+        nlohmann::ordered_json missed = nlohmann::ordered_json::array();
+        const std::vector<MissedLight> located = locateFalseNegatives(run, proj);
+        for (std::size_t i = 0; i < located.size() && i < 1000; ++i) {
+            const MissedLight& ml = located[i];
+            nlohmann::ordered_json e;
+            e["tile"] = {ml.tile % r.grid.tilesX, ml.tile / r.grid.tilesX};
+            e["list"] = ml.list;
+            e["light"] = ml.light;
+            e["light_name"] = ml.light < scene.lights.size() ? scene.lights[ml.light].name : std::string();
+            e["pixels"] = ml.pixels;
+            missed.push_back(std::move(e));
+        }
+        cj["missed"] = std::move(missed);
+        cj["missed_pairs"] = located.size();
+        j["custom"] = std::move(cj);
+    }
+    return j.dump(2) + "\n";
+}
+
+std::string tilesCsv(const RunOutput& run) {
+    const CullResult& r = run.result;
+    std::string out = "tile_x,tile_y,cell,view_depth_min,view_depth_max,cell_mask,count,lights\n";
+    const std::size_t lists = r.listCount.size();
+    const std::uint32_t per = std::max(r.listsPerTile, 1u);
+    for (std::size_t l = 0; l < lists; ++l) {
+        std::string row;
+        if (r.algorithm == Algorithm::All) {
+            // The one list of `all` belongs to no tile: tile -1,-1, no depth range.
+            row = "-1,-1,0,,,0,";
+        } else {
+            const std::size_t t = l / per;
+            const std::uint32_t sub = std::uint32_t(l % per);
+            const std::uint32_t tx = r.grid.tilesX ? std::uint32_t(t % r.grid.tilesX) : 0;
+            const std::uint32_t ty = r.grid.tilesX ? std::uint32_t(t / r.grid.tilesX) : 0;
+            row = std::to_string(tx) + "," + std::to_string(ty) + "," + std::to_string(sub) + ",";
+            if (tileHasDepth(r, t)) {
+                // The view-depth interval the list serves: the tile's geometry
+                // bounds; halfz halves at the split; clustered: its slice.
+                double lo = r.tileDepthMin[t], hi = r.tileDepthMax[t];
+                if (r.algorithm == Algorithm::HalfZ && t < r.halfzSplit.size())
+                    (sub == 0 ? hi : lo) = r.halfzSplit[t];
+                else if (r.algorithm == Algorithm::Clustered) {
+                    lo = sliceBoundary(r.settings.slicing, r.clusterNear, r.clusterFar, per, sub);
+                    hi = sliceBoundary(r.settings.slicing, r.clusterNear, r.clusterFar, per, sub + 1);
+                }
+                row += roundTrip(lo) + "," + roundTrip(hi) + ",";
+            } else {
+                row += ",,";
+            }
+            row += std::to_string(t < r.cellMask.size() ? r.cellMask[t] : 0u) + ",";
+        }
+        const std::uint32_t off = r.listOffset[l], cnt = r.listCount[l];
+        row += std::to_string(cnt) + ",";
+        for (std::uint32_t k = 0; k < cnt; ++k) {
+            if (k) row += ' ';
+            row += std::to_string(r.lightIndices[off + k]);
+        }
+        out += row;
+        out += '\n';
+    }
+    return out;
+}
+
+RgbImage heatmapImage(const RunOutput& run) {
+    const DepthImage& depth = run.depth;
+    const CullResult& r = run.result;
+    const std::uint32_t W = depth.width, H = depth.height;
+    const int scale = std::max(1, int(W) / 480);
+    const int legendH = scale * 29;
+    RgbImage img;
+    img.width = W;
+    img.height = H + std::uint32_t(legendH);
+    img.rgb.assign(std::size_t(img.width) * img.height * 3, 0);
+    Canvas cv{img};
+
+    // List-length range over all lists, for the colour scale.
+    std::uint32_t minList = std::numeric_limits<std::uint32_t>::max(), maxList = 0;
+    for (std::uint32_t c : r.listCount) minList = std::min(minList, c), maxList = std::max(maxList, c);
+    if (r.listCount.empty()) minList = 0;
+    const double mean = r.listCount.empty() ? 0.0 : double(r.entries()) / double(r.listCount.size());
+    auto colourOf = [&](double count) {
+        return viridis(maxList > minList ? (count - minList) / double(maxList - minList) : 0.0);
+    };
+
+    // Per tile, the list length its pixels loop over: for one list per tile
+    // the list's count; with several (halfz, clustered) the mean over the
+    // tile's geometry pixels, from the ground truth's per-list shading work
+    // (sum of |listed| over the pixels using the list). Tiles without geometry
+    // (or without ground truth) show their longest list.
+    const std::uint32_t per = std::max(r.listsPerTile, 1u);
+    const std::size_t tiles = r.grid.tileCount();
+    std::vector<double> tileValue(std::max<std::size_t>(tiles, 1), 0.0);
+    const GroundTruth& gt = run.truth;
+    for (std::size_t t = 0; t < tileValue.size(); ++t) {
+        if (r.algorithm == Algorithm::All) {
+            tileValue[t] = r.listCount.empty() ? 0 : r.listCount[0];
+            continue;
+        }
+        std::uint32_t longest = 0;
+        std::uint64_t work = 0;
+        for (std::uint32_t s = 0; s < per && t * per + s < r.listCount.size(); ++s) {
+            longest = std::max(longest, r.listCount[t * per + s]);
+            if (t * per + s < gt.listShadingWork.size()) work += gt.listShadingWork[t * per + s];
+        }
+        const std::uint32_t px = t < gt.tileGeometryPixels.size() ? gt.tileGeometryPixels[t] : 0;
+        tileValue[t] = px ? double(work) / px : longest;
+    }
+
+    // Grey from depth, near bright, histogram-equalised: a pixel's grey is
+    // 1 - (fraction of geometry pixels nearer than it). Window depth is
+    // monotonic in view depth for every projection kind, so this needs no
+    // linearisation, and perspective depth (bunched near 1) still shows detail.
+    const bool reversed = depth.clearDepth == 0.0f; // reversed-Z: larger is nearer
+    std::vector<float> sorted;
+    sorted.reserve(depth.depth.size());
+    for (float d : depth.depth)
+        if (d != depth.clearDepth) sorted.push_back(reversed ? -d : d);
+    std::sort(sorted.begin(), sorted.end());
+    const std::uint32_t ts = std::max(r.grid.tileSize, 1u);
+    for (std::uint32_t y = 0; y < H; ++y)
+        for (std::uint32_t x = 0; x < W; ++x) {
+            const std::size_t t = tiles ? r.grid.tileOfPixel(x, y) : 0;
+            double shade = 0.12; // background: dim
+            if (depth.hasGeometry(x, y)) {
+                const float key = reversed ? -depth.at(x, y) : depth.at(x, y);
+                const double rank =
+                    double(std::lower_bound(sorted.begin(), sorted.end(), key) - sorted.begin());
+                const double farness = sorted.size() > 1 ? rank / double(sorted.size() - 1) : 0.0;
+                shade = 0.3 + 0.7 * (1.0 - farness);
+            }
+            glm::dvec3 c = colourOf(t < tileValue.size() ? tileValue[t] : 0.0) * shade;
+            if (x % ts == 0 || y % ts == 0) c = c * 0.8 + glm::dvec3(0.2); // faint tile grid
+            cv.set(int(x), int(y), c);
+        }
+
+    // Legend band: colour bar from the shortest to the longest list, a white
+    // tick above it at the mean, and the three numbers.
+    const int y0 = int(H), m = 4 * scale;
+    cv.fill(0, y0, int(W), y0 + legendH, glm::dvec3(0.1));
+    const int bx0 = int(W) > 2 * m + 1 ? m : 0, bx1 = int(W) > 2 * m + 1 ? int(W) - m : int(W);
+    for (int x = bx0; x < bx1; ++x) {
+        const double t = bx1 - bx0 > 1 ? double(x - bx0) / double(bx1 - bx0 - 1) : 0.0;
+        cv.fill(x, y0 + m, x + 1, y0 + m + 10 * scale, viridis(t));
+    }
+    if (maxList > minList) {
+        const int mx = bx0 + int(std::lround((mean - minList) / double(maxList - minList) * (bx1 - bx0 - 1)));
+        // Above the bar only, so that the bar itself stays a clean scale.
+        cv.fill(mx - scale, y0 + scale, mx + scale, y0 + m, glm::dvec3(1.0));
+    }
+    const int ty = y0 + m + 10 * scale + 3 * scale;
+    const std::string left = "MIN " + std::to_string(minList);
+    const std::string right = "MAX " + std::to_string(maxList);
+    const std::string centre = "MEAN " + fixed2(mean) + " LIGHTS/LIST";
+    cv.text(bx0, ty, left, scale, glm::dvec3(1.0));
+    cv.text(bx1 - cv.textWidth(right, scale), ty, right, scale, glm::dvec3(1.0));
+    const int cw = cv.textWidth(centre, scale);
+    const int cx = (int(W) - cw) / 2;
+    // Only when it fits between the other two labels.
+    if (cx > bx0 + cv.textWidth(left, scale) + 2 * scale &&
+        cx + cw < bx1 - cv.textWidth(right, scale) - 2 * scale)
+        cv.text(cx, ty, centre, scale, glm::dvec3(1.0));
+    return img;
+}
+
+void writePng(const RgbImage& img, const std::string& path) {
+    if (img.width == 0 || img.height == 0 || img.rgb.size() != std::size_t(img.width) * img.height * 3)
+        throw Error("cannot write " + path + ": image is empty or its size is inconsistent");
+    std::vector<png_bytep> rows(img.height);
+    for (std::uint32_t y = 0; y < img.height; ++y)
+        rows[y] = const_cast<png_bytep>(&img.rgb[std::size_t(y) * img.width * 3]);
+    FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) throw Error("cannot create " + path + ": " + std::strerror(errno));
+    char errBuf[256] = {0};
+    const char* err = writePngRaw(f, img, rows.data(), errBuf);
+    const std::string message = err ? err : "";
+    const bool flushed = std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
+    const int closeErr = std::fclose(f);
+    if (err || !flushed || closeErr != 0) {
+        std::remove(path.c_str());
+        throw Error("cannot write " + path + ": " + (err ? message : std::string(std::strerror(errno))));
+    }
+}
+
+ShadedPictures shadedPictures(const RunOutput& run) {
+    const DepthImage& d = run.depth;
+    const std::size_t n = std::size_t(d.width) * d.height * 3;
+    if (run.shadedCulled.size() != n || run.shadedAll.size() != n)
+        throw Error("cannot write the shaded images: they do not match the " + std::to_string(d.width) + "x" +
+                    std::to_string(d.height) + " depth image");
+    // One exposure for both shaded images so they compare by eye; the
+    // difference is scaled so that the largest error is white.
+    ShadedPictures p;
+    p.exposure = exposureFor(d, run.shadedAll);
+    p.error = compareShadedImages(d, run.shadedCulled, run.shadedAll);
+    p.culled = {d.width, d.height, shadedPicture(run.shadedCulled, p.exposure)};
+    p.all = {d.width, d.height, shadedPicture(run.shadedAll, p.exposure)};
+    p.difference = {d.width, d.height, differencePicture(run.shadedCulled, run.shadedAll, p.error.maxAbs)};
+    return p;
+}
+
+void writeShadedImages(const RunOutput& run, const std::string& dir) {
+    const ShadedPictures p = shadedPictures(run);
+    const fs::path base(dir);
+    writePng(p.culled, (base / "shaded_culled.png").string());
+    writePng(p.all, (base / "shaded_all.png").string());
+    writePng(p.difference, (base / "shaded_diff.png").string());
+}
+
+void exportDiagnostics(const Scene& scene, const CullSettings& settings, const RunOutput& run,
+                       const std::string& dir, const std::vector<NamedImage>& viewImages) {
+    for (const NamedImage& v : viewImages)
+        if (std::find(std::begin(kExportViewImages), std::end(kExportViewImages), v.fileName) ==
+            std::end(kExportViewImages))
+            throw Error("cannot export diagnostics image '" + v.fileName + "': not a view image name");
+    static const std::set<std::string> kOutputs = {"summary.json", "tiles.csv", "heatmap.png",
+                                                   "overlays.vtm", "overlays", kExportViewImages[0],
+                                                   kExportViewImages[1],
+                                                   // writeShadedImages
+                                                   "shaded_culled.png", "shaded_all.png", "shaded_diff.png"};
+    writeFolderAtomic(dir, kOutputs, "export diagnostics", "diagnostics output", [&](const std::string& out) {
+        const fs::path tmp = out;
+        writeFileSynced((tmp / "summary.json").string(), summaryJson(scene, settings, run));
+        writeFileSynced((tmp / "tiles.csv").string(), tilesCsv(run));
+        writePng(heatmapImage(run), (tmp / "heatmap.png").string());
+        if (!run.shadedAll.empty()) writeShadedImages(run, tmp.string());
+        writeOverlaysVtm(scene, run, tmp.string());
+        for (const NamedImage& v : viewImages) writePng(v.image, (tmp / v.fileName).string());
+    });
+}
+
+} // namespace lc

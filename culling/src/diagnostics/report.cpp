@@ -1,0 +1,659 @@
+// The speed-against-error report (report.hpp): the sweep, the Pareto fronts,
+// report.csv / report.md / pareto.png and their atomic folder write.
+
+#include "culling/diagnostics/report.hpp"
+
+#include "culling/core/backend.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/core/file_io.hpp"
+#include "culling/truth/ground_truth.hpp"
+#include "culling/truth/shade.hpp"
+#include "diagnostics/font5x7.hpp"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <set>
+
+#include <fcntl.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+namespace lc {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool cancelled(const CancelToken* c) { return c && c->cancelled.load(); }
+
+double median(std::vector<double> v) {
+    if (v.empty()) return -1;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string fmt(const char* f, double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, f, v);
+    return buf;
+}
+
+// Shortest text that reads back as the same double.
+std::string roundTrip(double v) {
+    std::array<char, 64> buf{};
+    const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+    return std::string(buf.data(), r.ptr);
+}
+
+bool sweptByTable(const ParamSpec& p) { return p.name != "width" && p.name != "height"; }
+
+// Values of one parameter in the sweep.
+std::vector<std::string> sweepValues(const ParamSpec& p, const ReportOptions& o) {
+    if (auto it = o.fixed.find(p.name); it != o.fixed.end()) return {it->second};
+    auto asText = [](const std::vector<std::uint32_t>& v) {
+        std::vector<std::string> s;
+        for (auto x : v) s.push_back(std::to_string(x));
+        return s;
+    };
+    if (p.name == "tile") return asText(o.tileSizes);
+    if (p.name == "cells") return asText(o.cellCounts);
+    switch (p.type) {
+    case ParamType::Choice: return p.choices;
+    case ParamType::Bool: return {"false", "true"};
+    default: return {p.defaultValue};
+    }
+}
+
+} // namespace
+
+bool paramAppliesTo(const std::string& name, Algorithm a, std::uint32_t cells, bool sceneHasSpotLights) {
+    if (name == "algorithm") return true;
+    if (name == "width" || name == "height") return false;
+    if (a == Algorithm::All) return false;
+    if (name.rfind("spot-", 0) == 0) return sceneHasSpotLights;
+    if (name == "cells") return a == Algorithm::TwoPointFiveD || a == Algorithm::Clustered;
+    if (name == "slicing") return (a == Algorithm::TwoPointFiveD || a == Algorithm::Clustered) && cells > 1;
+    if (name == "skip-empty") return a == Algorithm::Clustered;
+    if (name == "bins") return a == Algorithm::ZBin;
+    return true; // tile, test, and parameters added later
+}
+
+std::string ReportConfig::label() const {
+    if (!customLabel.empty()) return customLabel;
+    std::string s = toString(settings.algorithm);
+    for (const ParamSpec& p : cullParams()) {
+        if (p.name == "algorithm") continue;
+        auto it = params.find(p.name);
+        if (it != params.end() && !it->second.empty()) s += " " + p.name + "=" + it->second;
+    }
+    return s;
+}
+
+std::vector<ReportConfig> reportConfigs(const ReportOptions& options, const std::string& backend,
+                                        bool sceneHasSpotLights) {
+    for (const auto& [name, value] : options.fixed) {
+        const ParamSpec& p = cullParam(name); // throws for unknown names
+        if (!sweptByTable(p)) throw SettingsError(name, "is part of the camera, not swept by the report");
+        CullSettings s;
+        Camera c;
+        setParam(s, c, name, value); // throws for bad values
+    }
+    std::vector<const ParamSpec*> specs;
+    for (const ParamSpec& p : cullParams())
+        if (sweptByTable(p)) specs.push_back(&p);
+
+    std::vector<ReportConfig> out;
+    const ParamSpec& algoSpec = cullParam("algorithm");
+    for (const std::string& algoName : sweepValues(algoSpec, options)) {
+        const Algorithm algo = algorithmFromString(algoName);
+        // Odometer over the other parameters; a parameter that does not apply
+        // keeps one (its default) value and an empty column.
+        std::vector<std::vector<std::string>> values;
+        for (const ParamSpec* p : specs) values.push_back(p->name == "algorithm" ? std::vector<std::string>{algoName}
+                                                                                 : sweepValues(*p, options));
+        std::vector<std::size_t> idx(specs.size(), 0);
+        std::set<std::string> seen;
+        for (;;) {
+            ReportConfig cfg;
+            cfg.backend = backend;
+            Camera cam;
+            std::uint32_t cells = 0;
+            for (std::size_t k = 0; k < specs.size(); ++k)
+                if (specs[k]->name == "cells") cells = std::uint32_t(std::stoul(values[k][idx[k]]));
+            if (cells == 0) cells = cfg.settings.cells;
+            for (std::size_t k = 0; k < specs.size(); ++k) {
+                const ParamSpec& p = *specs[k];
+                const bool applies = paramAppliesTo(p.name, algo, cells, sceneHasSpotLights);
+                const std::string v = applies ? values[k][idx[k]] : std::string();
+                if (applies) setParam(cfg.settings, cam, p.name, v);
+                cfg.params[p.name] = v;
+            }
+            cfg.tileSize = cam.tileSize;
+            // Non-applying parameters repeat a configuration: keep it once.
+            if (seen.insert(cfg.label()).second) out.push_back(std::move(cfg));
+            std::size_t k = 0;
+            while (k < specs.size() && ++idx[k] == values[k].size()) idx[k++] = 0;
+            if (k == specs.size()) break;
+        }
+    }
+    return out;
+}
+
+void markPareto(std::vector<ReportRow>& rows) {
+    for (ReportRow& a : rows) {
+        a.paretoEfficiency = a.paretoError = a.falseNegatives == 0;
+        if (a.falseNegatives) continue;
+        for (const ReportRow& b : rows) {
+            if (&a == &b || b.falseNegatives || b.config.backend != a.config.backend) continue;
+            if (b.totalMs <= a.totalMs && b.efficiency >= a.efficiency &&
+                (b.totalMs < a.totalMs || b.efficiency > a.efficiency))
+                a.paretoEfficiency = false;
+            if (b.totalMs <= a.totalMs && b.imageRmse <= a.imageRmse &&
+                (b.totalMs < a.totalMs || b.imageRmse < a.imageRmse))
+                a.paretoError = false;
+        }
+    }
+}
+
+namespace {
+
+// A row after its timed culls: ground truth, `repeat` timed shades of the
+// culled lists on `shader`, and the image error against `allImage`.
+void judgeRow(ReportRow& row, const std::vector<double>& cullMs, const CullResult& result, const DepthImage& depth,
+              const Projection& proj, const ViewLights& lights, CullBackend& shader, const std::vector<float>& allImage,
+              const ReportOptions& options, const CancelToken* cancel) {
+    GroundTruthOptions gto;
+    gto.imageError = false;
+    const GroundTruth truth = computeGroundTruth(depth, proj, lights, result, gto, cancel);
+    const ShadeInputs in = makeShadeInputs(depth, proj, &result);
+    std::vector<float> image;
+    std::vector<double> shadeMs;
+    for (int r = 0; r < options.warmup + options.repeat; ++r) {
+        image = shader.shade(in, lights, &result);
+        if (r >= options.warmup) shadeMs.push_back(shader.lastShadeMs());
+    }
+    const ImageError err = compareShadedImages(depth, image, allImage);
+    row.cullMs = median(cullMs);
+    row.shadeMs = median(shadeMs);
+    row.totalMs = row.cullMs + row.shadeMs;
+    const Metrics& m = truth.metrics;
+    row.efficiency = m.efficiency;
+    row.optimalWork = m.optimalWork;
+    row.efficiencyVsOptimal = m.efficiencyVsOptimal;
+    row.falseNegatives = m.falseNegatives;
+    row.meanList = m.meanList;
+    row.maxList = m.maxList;
+    row.resultBytes = m.resultBytes;
+    row.imageRmse = err.rmse;
+    row.imageMaxError = err.maxAbs;
+}
+
+} // namespace
+
+Report runReport(const Scene& sceneIn, const ReportOptions& options, const ReportProgress& progress,
+                 const CancelToken* cancel) {
+    sceneIn.validate();
+    if (options.repeat < 1 || options.repeat > 1000) throw SettingsError("repeat", "must be in 1..1000");
+    if (options.warmup < 0 || options.warmup > 1000) throw SettingsError("warmup", "must be in 0..1000");
+    std::vector<std::string> backends = options.backends.empty() ? availableBackends() : options.backends;
+
+    Report rep;
+    rep.sceneName = sceneIn.name;
+    rep.width = sceneIn.camera.width;
+    rep.height = sceneIn.camera.height;
+    rep.lights = sceneIn.lights.size();
+    rep.repeat = options.repeat;
+    rep.warmup = options.warmup;
+    for (const ParamSpec& p : cullParams())
+        if (sweptByTable(p)) rep.paramNames.push_back(p.name);
+
+    const bool hasSpots = std::any_of(sceneIn.lights.begin(), sceneIn.lights.end(),
+                                      [](const PointLight& l) { return l.isSpot(); });
+    // Open every backend first: the total is known before the first run.
+    std::vector<std::pair<std::unique_ptr<CullBackend>, std::vector<ReportConfig>>> work;
+    std::size_t total = 0;
+    for (const std::string& name : backends) {
+        std::unique_ptr<CullBackend> b;
+        try {
+            b = makeBackend(name, options.device);
+        } catch (const Error& e) {
+            if (backends.size() == 1) throw;
+            rep.notes.push_back(name + ": not run (" + e.what() + ")");
+            continue;
+        }
+        std::vector<ReportConfig> cfgs = reportConfigs(options, b->name(), hasSpots);
+        total += cfgs.size();
+        work.emplace_back(std::move(b), std::move(cfgs));
+    }
+
+    total += options.shaders.size();
+    const ViewLights lights = makeViewLights(sceneIn);
+    const Projection proj(sceneIn.camera);
+    std::size_t done = 0;
+    // For the custom shaders: the depth, shading backend and all-lights image
+    // of the vulkan backend (else the first that ran).
+    std::shared_ptr<const DepthImage> shaderDepth;
+    std::shared_ptr<const std::vector<float>> shaderAll;
+    CullBackend* shaderShade = nullptr;
+    for (auto& [backend, cfgs] : work) {
+        if (cancelled(cancel)) throw Cancelled();
+        rep.backendDevices.emplace_back(backend->name(), backend->deviceName());
+        rep.backendTiming.emplace_back(backend->name(), backend->timingMethod());
+        // Depth does not depend on any swept parameter: one pre-pass and one
+        // all-lights image per backend.
+        const DepthImage depth = backend->renderDepth(sceneIn, proj);
+        const ShadeInputs allIn = makeShadeInputs(depth, proj, nullptr);
+        const std::vector<float> allImage = backend->shade(allIn, lights, nullptr);
+        if (!shaderDepth || backend->name() == "vulkan") {
+            shaderDepth = std::make_shared<const DepthImage>(depth);
+            shaderAll = std::make_shared<const std::vector<float>>(allImage);
+            shaderShade = backend.get();
+        }
+        for (const ReportConfig& cfg : cfgs) {
+            if (cancelled(cancel)) throw Cancelled();
+            const TileGrid grid = TileGrid::make(sceneIn.camera.width, sceneIn.camera.height, cfg.tileSize);
+            ReportRow row;
+            row.config = cfg;
+            row.device = backend->deviceName();
+            std::vector<double> cullMs;
+            CullResult result;
+            for (int r = 0; r < options.warmup + options.repeat; ++r) {
+                result = backend->cull(depth, proj, grid, lights, cfg.settings);
+                if (r >= options.warmup) cullMs.push_back(result.timings.cullMs);
+            }
+            if (const std::string bad = result.validate(lights.size()); !bad.empty())
+                throw Error("backend '" + backend->name() + "' produced an inconsistent result for " + cfg.label() +
+                            ": " + bad);
+            judgeRow(row, cullMs, result, depth, proj, lights, *backend, allImage, options, cancel);
+            rep.rows.push_back(std::move(row));
+            ++done;
+            if (progress) progress(done, total, cfg.backend + " " + cfg.label());
+        }
+    }
+    for (const CustomShaderOptions& so : options.shaders) {
+        if (cancelled(cancel)) throw Cancelled();
+        if (!shaderDepth) throw Error("custom shaders need a backend for the depth pre-pass");
+        const TileGrid grid = TileGrid::make(sceneIn.camera.width, sceneIn.camera.height, sceneIn.camera.tileSize);
+        ReportRow row;
+        row.config.backend = "vulkan"; // it runs on a Vulkan device: judged beside the vulkan rows
+        row.config.tileSize = grid.tileSize;
+        const std::string file = std::filesystem::path(so.path).filename().string();
+        row.config.params["algorithm"] = "custom:" + file;
+        row.config.params["tile"] = std::to_string(grid.tileSize);
+        row.config.customLabel = "custom:" + file + " " + toString(so.layout) + " " + toString(so.lists);
+        std::vector<double> cullMs;
+        CullResult result;
+        CustomCullReport crep;
+        for (int r = 0; r < options.warmup + options.repeat; ++r) {
+            crep = CustomCullReport{};
+            result = runCustomShader(so, *shaderDepth, proj, grid, lights, crep);
+            if (r >= options.warmup) cullMs.push_back(crep.passMs);
+        }
+        row.device = crep.device;
+        judgeRow(row, cullMs, result, *shaderDepth, proj, lights, *shaderShade, *shaderAll, options, cancel);
+        if (crep.overflowLists || crep.invalidIndices || !crep.validationMessages.empty())
+            rep.notes.push_back(row.config.customLabel + ": " + std::to_string(crep.overflowLists) + " overflowed lists, " +
+                                std::to_string(crep.invalidIndices) + " invalid indices, " +
+                                std::to_string(crep.validationMessages.size()) + " validation messages");
+        rep.rows.push_back(std::move(row));
+        ++done;
+        if (progress) progress(done, total, "custom " + file);
+    }
+    markPareto(rep.rows);
+    return rep;
+}
+
+// ---- report.csv ----------------------------------------------------------------
+
+std::string reportCsv(const Report& rep) {
+    std::string out = "backend,device";
+    for (const std::string& p : rep.paramNames) {
+        std::string col = p;
+        std::replace(col.begin(), col.end(), '-', '_');
+        out += "," + col;
+    }
+    out += ",cull_ms,shade_ms,total_ms,efficiency,false_negatives,mean_list,max_list,result_bytes,"
+           "image_rmse,image_max_error,pareto_efficiency,pareto_error,optimal_work,efficiency_vs_optimal\n";
+    auto quoted = [](const std::string& s) {
+        if (s.find_first_of(",\"\n") == std::string::npos) return s;
+        std::string q = "\"";
+        for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+        return q + "\"";
+    };
+    for (const ReportRow& r : rep.rows) {
+        out += r.config.backend + "," + quoted(r.device);
+        for (const std::string& p : rep.paramNames) {
+            auto it = r.config.params.find(p);
+            out += "," + (it == r.config.params.end() ? std::string() : it->second);
+        }
+        out += "," + roundTrip(r.cullMs) + "," + roundTrip(r.shadeMs) + "," + roundTrip(r.totalMs) + "," +
+               roundTrip(r.efficiency) + "," + std::to_string(r.falseNegatives) + "," + roundTrip(r.meanList) + "," +
+               std::to_string(r.maxList) + "," + std::to_string(r.resultBytes) + "," + roundTrip(r.imageRmse) + "," +
+               roundTrip(r.imageMaxError) + "," + (r.paretoEfficiency ? "1" : "0") + "," +
+               (r.paretoError ? "1" : "0") + "," + std::to_string(r.optimalWork) + "," +
+               roundTrip(r.efficiencyVsOptimal) + "\n";
+    }
+    return out;
+}
+
+// ---- report.md -----------------------------------------------------------------
+
+namespace {
+
+std::string describe(const ReportRow& r) {
+    return "`" + r.config.label() + "` (" + r.config.backend + ": cull " + fmt("%.3f", r.cullMs) + " ms + shade " +
+           fmt("%.3f", r.shadeMs) + " ms = " + fmt("%.3f", r.totalMs) + " ms, efficiency " +
+           fmt("%.3f", r.efficiency) + ", image RMSE " + fmt("%.3g", r.imageRmse) + ")";
+}
+
+} // namespace
+
+std::string reportMarkdown(const Report& rep) {
+    std::string md = "# Culling report: " + rep.sceneName + "\n\n";
+    md += std::to_string(rep.width) + "x" + std::to_string(rep.height) + ", " + std::to_string(rep.lights) +
+          " lights, " + std::to_string(rep.rows.size()) + " configurations; times are medians of " +
+          std::to_string(rep.repeat) + " runs after " + std::to_string(rep.warmup) + " untimed. Total = culling pass + shading pass (the depth pre-pass, the "
+          "same for every configuration, is not included).\n\n";
+    for (std::size_t i = 0; i < rep.backendDevices.size(); ++i)
+        md += "- backend `" + rep.backendDevices[i].first + "`: " + rep.backendDevices[i].second + "; timing: " +
+              rep.backendTiming[i].second + "\n";
+    for (const std::string& n : rep.notes) md += "- " + n + "\n";
+    md += "\n## Reading\n\n";
+    if (rep.rows.empty()) {
+        md += "No configuration ran.\n";
+    } else {
+        std::uint64_t fnRows = 0;
+        for (const ReportRow& r : rep.rows) fnRows += r.falseNegatives > 0;
+        md += fnRows == 0 ? "- Every configuration has zero false negatives.\n"
+                          : "- **" + std::to_string(fnRows) +
+                                " configurations have false negatives** (lights missing where they matter); they "
+                                "are left off the Pareto fronts.\n";
+        for (const auto& [backend, device] : rep.backendDevices) {
+            std::vector<const ReportRow*> rows;
+            for (const ReportRow& r : rep.rows)
+                if (r.config.backend == backend) rows.push_back(&r);
+            if (rows.empty()) continue;
+            const ReportRow* fastest = *std::min_element(rows.begin(), rows.end(), [](auto* a, auto* b) {
+                return a->totalMs < b->totalMs;
+            });
+            const ReportRow* tightest = *std::max_element(rows.begin(), rows.end(), [](auto* a, auto* b) {
+                return a->efficiency < b->efficiency || (a->efficiency == b->efficiency && a->totalMs > b->totalMs);
+            });
+            const ReportRow* slowest = *std::max_element(rows.begin(), rows.end(), [](auto* a, auto* b) {
+                return a->totalMs < b->totalMs;
+            });
+            md += "- On " + backend + ", the fastest configuration is " + describe(*fastest) + "; the slowest takes " +
+                  fmt("%.1f", fastest->totalMs > 0 ? slowest->totalMs / fastest->totalMs : 0.0) +
+                  "x as long. The most efficient is " + describe(*tightest) + ", at " +
+                  fmt("%.1f", 100.0 * tightest->efficiencyVsOptimal) +
+                  "% of the best lists its own tiles, cells or froxels allow (efficiency_vs_optimal).\n";
+            std::vector<const ReportRow*> front;
+            for (const ReportRow* r : rows)
+                if (r->paretoEfficiency) front.push_back(r);
+            std::sort(front.begin(), front.end(), [](auto* a, auto* b) { return a->totalMs < b->totalMs; });
+            md += "- " + backend + " Pareto front, time against efficiency (" + std::to_string(front.size()) +
+                  " configurations, fastest first):";
+            for (std::size_t i = 0; i < front.size(); ++i) {
+                md += (i ? "; " : " ") + std::string("`") + front[i]->config.label() + "` " +
+                      fmt("%.3f", front[i]->totalMs) + " ms / " + fmt("%.3f", front[i]->efficiency);
+                if (i)
+                    md += " (+" + fmt("%.3f", front[i]->totalMs - front[i - 1]->totalMs) + " ms buys +" +
+                          fmt("%.3f", front[i]->efficiency - front[i - 1]->efficiency) + " efficiency)";
+            }
+            md += ".\n";
+            std::size_t errFront = 0;
+            for (const ReportRow* r : rows) errFront += r->paretoError;
+            md += "- " + backend + " Pareto front, time against image error: " + std::to_string(errFront) +
+                  " configurations.";
+            // Shading against culling: where the time goes at the two ends.
+            md += " At the fastest configuration culling is " +
+                  fmt("%.0f", fastest->totalMs > 0 ? 100.0 * fastest->cullMs / fastest->totalMs : 0.0) +
+                  "% of the total; at the most efficient " +
+                  fmt("%.0f", tightest->totalMs > 0 ? 100.0 * tightest->cullMs / tightest->totalMs : 0.0) + "%.\n";
+            // Best per algorithm.
+            md += "- Best total per algorithm on " + backend + ":";
+            bool first = true;
+            for (const std::string& a : cullParam("algorithm").choices) {
+                const ReportRow* best = nullptr;
+                for (const ReportRow* r : rows)
+                    if (toString(r->config.settings.algorithm) == a && (!best || r->totalMs < best->totalMs)) best = r;
+                if (!best) continue;
+                md += (first ? " " : "; ") + a + " " + fmt("%.3f", best->totalMs) + " ms (efficiency " +
+                      fmt("%.3f", best->efficiency) + ")";
+                first = false;
+            }
+            md += ".\n";
+        }
+    }
+    md += "\n## Table\n\n| backend | configuration | cull ms | shade ms | total ms | efficiency | of optimum | FN | "
+          "mean list | max list | bytes | image RMSE | image max | Pareto |\n|---|---|---:|---:|---:|---:|---:|---:|---:|"
+          "---:|---:|---:|---:|---|\n";
+    for (const ReportRow& r : rep.rows) {
+        std::string pareto = r.paretoEfficiency ? "E" : "";
+        if (r.paretoError) pareto += pareto.empty() ? "I" : " I";
+        md += "| " + r.config.backend + " | " + r.config.label() + " | " + fmt("%.3f", r.cullMs) + " | " +
+              fmt("%.3f", r.shadeMs) + " | " + fmt("%.3f", r.totalMs) + " | " + fmt("%.4f", r.efficiency) + " | " +
+              fmt("%.3f", r.efficiencyVsOptimal) + " | " + std::to_string(r.falseNegatives) + " | " + fmt("%.2f", r.meanList) + " | " + std::to_string(r.maxList) +
+              " | " + std::to_string(r.resultBytes) + " | " + fmt("%.4g", r.imageRmse) + " | " +
+              fmt("%.4g", r.imageMaxError) + " | " + pareto + " |\n";
+    }
+    md += "\nPareto: E = on the time/efficiency front, I = on the time/image-error front (per backend).\n";
+    return md;
+}
+
+// ---- pareto.png ------------------------------------------------------------------
+
+namespace {
+
+struct Plot {
+    RgbImage& img;
+    void set(int x, int y, glm::dvec3 c) {
+        if (x < 0 || y < 0 || x >= int(img.width) || y >= int(img.height)) return;
+        std::uint8_t* p = &img.rgb[(std::size_t(y) * img.width + x) * 3];
+        for (int i = 0; i < 3; ++i) p[i] = std::uint8_t(std::lround(std::clamp(c[i], 0.0, 1.0) * 255.0));
+    }
+    void fill(int x0, int y0, int x1, int y1, glm::dvec3 c) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) set(x, y, c);
+    }
+    void line(int x0, int y0, int x1, int y1, glm::dvec3 c, int w = 1) {
+        const int n = std::max(std::abs(x1 - x0), std::abs(y1 - y0));
+        for (int i = 0; i <= n; ++i) {
+            const double t = n ? double(i) / n : 0.0;
+            const int x = int(std::lround(x0 + t * (x1 - x0))), y = int(std::lround(y0 + t * (y1 - y0)));
+            fill(x - w / 2, y - w / 2, x - w / 2 + w, y - w / 2 + w, c);
+        }
+    }
+    static int textWidth(const std::string& s, int scale) {
+        return s.empty() ? 0 : int(s.size()) * detail::kGlyphAdvance * scale - scale;
+    }
+    void text(int x, int y, const std::string& s, int scale, glm::dvec3 c) {
+        for (char ch : s) {
+            const auto& g = detail::glyph5x7(ch);
+            for (int r = 0; r < detail::kGlyphHeight; ++r)
+                for (int b = 0; b < 5; ++b)
+                    if (g.rows[r] & (0x10 >> b))
+                        fill(x + b * scale, y + r * scale, x + (b + 1) * scale, y + (r + 1) * scale, c);
+            x += detail::kGlyphAdvance * scale;
+        }
+    }
+};
+
+// Okabe-Ito colours, one per algorithm in table order.
+glm::dvec3 algorithmColour(Algorithm a) {
+    static const glm::dvec3 k[] = {{0.0, 0.0, 0.0},   {0.90, 0.62, 0.0}, {0.34, 0.71, 0.91},
+                                   {0.0, 0.62, 0.45}, {0.80, 0.47, 0.65}, {0.0, 0.45, 0.70}};
+    return k[std::min<std::size_t>(std::size_t(a), 5)];
+}
+
+std::string tickText(double v) {
+    if (v == 0) return "0";
+    const double a = std::abs(v);
+    if (a >= 1000 || a < 0.001) return fmt("%.0e", v);
+    if (a >= 10) return fmt("%.0f", v);
+    if (a >= 1) return fmt("%.1f", v);
+    return fmt("%.3g", v);
+}
+
+// One scatter panel: x = total ms (log scale when it spans more than 10x),
+// y = `yOf`; the Pareto front of each backend joined by a line.
+void drawPanel(Plot& p, int x0, int y0, int w, int h, const Report& rep, const std::string& title,
+               const std::string& yLabel, double (*yOf)(const ReportRow&), bool (*onFront)(const ReportRow&)) {
+    const glm::dvec3 ink(0.1), grid(0.88);
+    const int left = x0 + 70, right = x0 + w - 15, top = y0 + 30, bottom = y0 + h - 45;
+    p.text(x0 + (w - Plot::textWidth(title, 2)) / 2, y0 + 6, title, 2, ink);
+    double xmin = 1e300, xmax = -1e300, ymin = 0, ymax = -1e300;
+    for (const ReportRow& r : rep.rows) {
+        if (!(r.totalMs > 0) || !std::isfinite(yOf(r))) continue;
+        xmin = std::min(xmin, r.totalMs), xmax = std::max(xmax, r.totalMs);
+        ymin = std::min(ymin, yOf(r)), ymax = std::max(ymax, yOf(r));
+    }
+    if (!(xmin <= xmax)) xmin = 0.1, xmax = 1;
+    if (!(ymax > ymin)) ymax = ymin + 1;
+    const bool logX = xmax > 10 * xmin;
+    double lx0 = logX ? std::log10(xmin) : 0.0, lx1 = logX ? std::log10(xmax) : xmax * 1.05;
+    if (logX) {
+        lx0 = std::floor(lx0 * 2) / 2, lx1 = std::ceil(lx1 * 2) / 2;
+    } else if (lx1 <= lx0) {
+        lx1 = lx0 + 1;
+    }
+    ymax *= 1.05;
+    auto px = [&](double ms) {
+        const double t = logX ? (std::log10(ms) - lx0) / (lx1 - lx0) : (ms - lx0) / (lx1 - lx0);
+        return left + int(std::lround(t * (right - left)));
+    };
+    auto py = [&](double v) { return bottom - int(std::lround((v - ymin) / (ymax - ymin) * (bottom - top))); };
+    // Grid and ticks.
+    for (int i = 0; i <= 4; ++i) {
+        const double v = ymin + (ymax - ymin) * i / 4.0;
+        const int y = py(v);
+        p.line(left, y, right, y, grid);
+        const std::string t = tickText(v);
+        p.text(left - 6 - Plot::textWidth(t, 1), y - 3, t, 1, ink);
+    }
+    if (logX) {
+        for (double e = lx0; e <= lx1 + 1e-9; e += 0.5) {
+            const int x = px(std::pow(10.0, e));
+            p.line(x, top, x, bottom, grid);
+            const std::string t = tickText(std::pow(10.0, e));
+            p.text(x - Plot::textWidth(t, 1) / 2, bottom + 6, t, 1, ink);
+        }
+    } else {
+        for (int i = 0; i <= 4; ++i) {
+            const double v = lx0 + (lx1 - lx0) * i / 4.0;
+            const int x = px(v);
+            p.line(x, top, x, bottom, grid);
+            const std::string t = tickText(v);
+            p.text(x - Plot::textWidth(t, 1) / 2, bottom + 6, t, 1, ink);
+        }
+    }
+    p.line(left, top, left, bottom, ink);
+    p.line(left, bottom, right, bottom, ink);
+    const std::string xl = std::string("TOTAL MS = CULL + SHADE") + (logX ? " (LOG SCALE)" : "");
+    p.text(left + (right - left - Plot::textWidth(xl, 1)) / 2, bottom + 20, xl, 1, ink);
+    p.text(x0 + 4, top - 14, yLabel, 1, ink);
+    // Fronts first (under the points), per backend.
+    for (const auto& [backend, device] : rep.backendDevices) {
+        std::vector<const ReportRow*> front;
+        for (const ReportRow& r : rep.rows)
+            if (r.config.backend == backend && onFront(r) && r.totalMs > 0) front.push_back(&r);
+        std::sort(front.begin(), front.end(), [](auto* a, auto* b) { return a->totalMs < b->totalMs; });
+        for (std::size_t i = 1; i < front.size(); ++i)
+            p.line(px(front[i - 1]->totalMs), py(yOf(*front[i - 1])), px(front[i]->totalMs), py(yOf(*front[i])),
+                   glm::dvec3(0.85, 0.1, 0.1), 2);
+    }
+    std::size_t customDrawn = 0;
+    for (const ReportRow& r : rep.rows) {
+        if (!(r.totalMs > 0) || !std::isfinite(yOf(r))) continue;
+        const int x = px(r.totalMs), y = py(yOf(r));
+        if (!r.config.customLabel.empty()) {
+            // A custom shader: a cross in its own colour, named beside it
+            // (and its false negatives, which keep it off the front).
+            const glm::dvec3 c(0.55, 0.0, 0.6);
+            if (onFront(r)) p.fill(x - 6, y - 6, x + 7, y + 7, glm::dvec3(0.85, 0.1, 0.1));
+            p.line(x - 5, y - 5, x + 5, y + 5, c, 2);
+            p.line(x - 5, y + 5, x + 5, y - 5, c, 2);
+            std::string name = r.config.params.count("algorithm") ? r.config.params.at("algorithm").substr(7) : "custom";
+            if (r.falseNegatives) name += " FN " + std::to_string(r.falseNegatives);
+            // Labels of nearby shaders would overlap: each one its own line.
+            const int line = int(customDrawn++ % 3) - 1;
+            p.line(x + 5, y, x + 8, y - 3 + 11 * line + 3, c, 1);
+            p.text(x + 9, y - 3 + 11 * line, name, 1, c);
+            continue;
+        }
+        const glm::dvec3 c = algorithmColour(r.config.settings.algorithm);
+        const bool second = !rep.backendDevices.empty() && r.config.backend != rep.backendDevices.front().first;
+        if (onFront(r)) p.fill(x - 5, y - 5, x + 6, y + 6, glm::dvec3(0.85, 0.1, 0.1));
+        if (second) { // hollow square: the second backend
+            p.fill(x - 3, y - 3, x + 4, y + 4, c);
+            p.fill(x - 1, y - 1, x + 2, y + 2, glm::dvec3(1.0));
+        } else {
+            p.fill(x - 3, y - 3, x + 4, y + 4, c);
+        }
+    }
+}
+
+} // namespace
+
+RgbImage paretoImage(const Report& rep) {
+    const int panelW = 560, panelH = 420, legendH = 60;
+    RgbImage img;
+    img.width = 2 * panelW;
+    img.height = panelH + legendH;
+    img.rgb.assign(std::size_t(img.width) * img.height * 3, 255);
+    Plot p{img};
+    drawPanel(p, 0, 0, panelW, panelH, rep, "TIME VS EFFICIENCY", "EFFICIENCY E/W",
+              [](const ReportRow& r) { return r.efficiency; }, [](const ReportRow& r) { return r.paretoEfficiency; });
+    drawPanel(p, panelW, 0, panelW, panelH, rep, "TIME VS IMAGE ERROR", "IMAGE RMSE",
+              [](const ReportRow& r) { return r.imageRmse; }, [](const ReportRow& r) { return r.paretoError; });
+    // Legend: algorithms, backends, the front.
+    const glm::dvec3 ink(0.1);
+    int x = 20, y = panelH + 10;
+    for (const std::string& a : cullParam("algorithm").choices) {
+        p.fill(x, y, x + 9, y + 9, algorithmColour(algorithmFromString(a)));
+        p.text(x + 14, y + 1, a, 1, ink);
+        x += 14 + Plot::textWidth(a, 1) + 24;
+    }
+    if (std::any_of(rep.rows.begin(), rep.rows.end(), [](const ReportRow& r) { return !r.config.customLabel.empty(); })) {
+        p.line(x, y, x + 9, y + 9, glm::dvec3(0.55, 0.0, 0.6), 2);
+        p.line(x, y + 9, x + 9, y, glm::dvec3(0.55, 0.0, 0.6), 2);
+        p.text(x + 14, y + 1, "CUSTOM SHADER", 1, ink);
+        x += 14 + Plot::textWidth("CUSTOM SHADER", 1) + 24;
+    }
+    p.fill(x, y - 1, x + 11, y + 10, glm::dvec3(0.85, 0.1, 0.1));
+    p.fill(x + 2, y + 1, x + 9, y + 8, glm::dvec3(0.3));
+    p.text(x + 16, y + 1, "PARETO FRONT (LINE JOINS IT)", 1, ink);
+    x = 20, y += 22;
+    for (std::size_t i = 0; i < rep.backendDevices.size(); ++i) {
+        p.fill(x, y, x + 9, y + 9, glm::dvec3(0.3));
+        if (i > 0) p.fill(x + 2, y + 2, x + 7, y + 7, glm::dvec3(1.0));
+        const std::string t = rep.backendDevices[i].first + (i ? " (HOLLOW)" : " (FILLED)");
+        p.text(x + 14, y + 1, t, 1, ink);
+        x += 14 + Plot::textWidth(t, 1) + 24;
+    }
+    const std::string info = rep.sceneName + " " + std::to_string(rep.width) + "X" + std::to_string(rep.height) +
+                             " " + std::to_string(rep.lights) + " LIGHTS";
+    p.text(int(img.width) - 20 - Plot::textWidth(info, 1), y + 1, info, 1, ink);
+    return img;
+}
+
+// ---- the folder ------------------------------------------------------------------
+
+
+void writeReport(const Report& rep, const std::string& dir) {
+    writeFolderAtomic(dir, {"report.csv", "report.md", "pareto.png"}, "write the report", "report output",
+                      [&](const std::string& out) {
+                          const fs::path tmp = out;
+                          writeFileSynced((tmp / "report.csv").string(), reportCsv(rep));
+                          writeFileSynced((tmp / "report.md").string(), reportMarkdown(rep));
+                          writePng(paretoImage(rep), (tmp / "pareto.png").string());
+                      });
+}
+
+} // namespace lc
