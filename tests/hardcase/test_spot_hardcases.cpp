@@ -5,6 +5,7 @@
 // superset of the CPU lists (validation layer on, any message fails); the
 // same on a builtin scene with many spots; Vulkan shading of a spot.
 #include "../gpu/gpu_test_env.hpp"
+#include "hardcase_scenes.hpp"
 
 #include "culling/core/errors.hpp"
 #include "culling/truth/ground_truth.hpp"
@@ -25,23 +26,13 @@ const Algorithm kAlgorithms[] = {Algorithm::All,    Algorithm::Naive,         Al
 const SpotTest kSpotTests[] = {SpotTest::ApexSphere, SpotTest::TightSphere, SpotTest::ConeSphere,
                                SpotTest::ConePlanes};
 
-void addQuad(Mesh& m, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) {
-    const auto base = std::uint32_t(m.vertexCount());
-    for (const glm::dvec3& p : {a, b, c, d})
-        for (int i = 0; i < 3; ++i) m.positions.push_back(float(p[i]));
-    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-}
-
 // Camera at the origin looking down -Z at a wall at depth 10 and a floor
 // reaching back to it, 160x96 pixels in 16-pixel tiles.
 Scene room() {
+    using hardcase::addQuad;
     Scene s;
     s.name = "spot-room";
-    s.camera.position = {0, 0, 0};
-    s.camera.target = {0, 0, -1};
-    s.camera.width = 160;
-    s.camera.height = 96;
-    s.camera.tileSize = 16;
+    s.camera = hardcase::camera({0, 0, 0}, {0, 0, -1}, 160, 96);
     s.camera.nearPlane = 0.1;
     s.camera.farPlane = 100;
     Mesh m;

@@ -1,17 +1,19 @@
 #pragma once
 // Shared by the ui and render tests: their own main (the GL surface format
 // must be set before QApplication, so QTEST_MAIN cannot be used), isolated
-// QSettings, the test window every ui test starts from, and small waiting
-// helpers.
+// QSettings, the test window every ui test starts from, opening a built-in
+// scene with parameters set through the UI, and waiting for a run.
 
 #include <QApplication>
 #include <QDir>
+#include <QElapsedTimer>
 #include <QSignalSpy>
 #include <QSurfaceFormat>
 #include <QTemporaryDir>
 #include <QTest>
 #include <QVTKOpenGLNativeWidget.h>
 
+#include "document.hpp"
 #include "main_window.hpp"
 
 #include <cstdio>
@@ -59,6 +61,41 @@ inline std::unique_ptr<lcui::MainWindow> makeTestWindow(QSize size = QSize(1400,
     w->resize(size);
     w->show();
     return w;
+}
+
+// How long a test waits for one run: generous, 2 shared cores and lavapipe.
+constexpr int kRunTimeoutMs = 120000;
+
+// Waits until the window shows run `generation` or a newer one, with its
+// ground truth when `truth`. False on a timeout or when that run failed.
+inline bool waitRun(lcui::MainWindow& w, quint64 generation, bool truth = false) {
+    QSignalSpy done(&w, &lcui::MainWindow::runFinished);
+    QSignalSpy failed(&w, &lcui::MainWindow::runFailed);
+    const lcui::Document* doc = w.document();
+    auto shown = [&] {
+        return doc->runGeneration() >= generation && doc->runOutput() && (!truth || doc->runOutput()->truthComputed);
+    };
+    QElapsedTimer t;
+    t.start();
+    while (!shown() && t.elapsed() < kRunTimeoutMs) {
+        for (const auto& f : failed)
+            if (f.at(0).toULongLong() >= generation) return false;
+        done.wait(100);
+    }
+    return shown();
+}
+
+// Opens a built-in scene and sets culling parameters through the UI as a user
+// would (name, value: "width", "320"; the toolbar's parameter names), then
+// clears the undo stack: the set-up is not an edit under test. No run: the
+// caller runs (waitRun(w, w.runCulling())) after any further set-up.
+inline bool openBuiltinWith(lcui::MainWindow& w, const QString& builtin,
+                            std::initializer_list<std::pair<const char*, QString>> params) {
+    if (!w.openBuiltin(builtin)) return false;
+    for (const auto& [name, value] : params)
+        if (!w.setParamFromUi(name, value)) return false;
+    w.document()->undoStack()->clear();
+    return true;
 }
 
 } // namespace lctest

@@ -40,17 +40,7 @@ class ExplainPanelTest : public QObject {
     std::unique_ptr<MainWindow> w_;
     Document* doc() const { return w_->document(); }
 
-    bool waitTruth(quint64 generation) {
-        QSignalSpy done(w_.get(), &MainWindow::runFinished);
-        QElapsedTimer t;
-        t.start();
-        while (t.elapsed() < 120000) {
-            if (doc()->runGeneration() >= generation && doc()->runOutput() && doc()->runOutput()->truthComputed)
-                return true;
-            done.wait(100);
-        }
-        return false;
-    }
+    bool waitTruth(quint64 generation) { return lctest::waitRun(*w_, generation, true); }
 
 private slots:
     void init() {

@@ -42,7 +42,6 @@ using namespace lcui;
 
 namespace {
 
-constexpr int kRunTimeoutMs = 120000;
 
 // The atrium with 48 lights (a third of them spots) at 320x180, as a glTF.
 lc::Scene smallAtrium() {
@@ -68,7 +67,7 @@ class GltfStudioTest : public QObject {
         QSignalSpy failed(w_.get(), &MainWindow::runFailed);
         QElapsedTimer t;
         t.start();
-        while (!doc()->runOutput() && failed.isEmpty() && t.elapsed() < kRunTimeoutMs) done.wait(200);
+        while (!doc()->runOutput() && failed.isEmpty() && t.elapsed() < lctest::kRunTimeoutMs) done.wait(200);
         return doc()->runOutput() != nullptr;
     }
     QString writeAtrium(const QString& name) {

@@ -38,7 +38,6 @@ using namespace lcui;
 
 namespace {
 
-constexpr int kRunTimeoutMs = 120000;
 
 // The selection outline's colour (InspectorView: opaque, unlit 1, 0.85, 0.1),
 // with room for blending under the translucent rings.
@@ -56,16 +55,7 @@ class ManyLightsTest : public QObject {
     Document* doc() { return w_->document(); }
     InspectorView* view() { return w_->inspectorView(); }
 
-    bool waitRun(quint64 generation, bool truth = false) {
-        QElapsedTimer t;
-        t.start();
-        auto done = [&] {
-            return doc()->runGeneration() >= generation && (!truth || doc()->runOutput()->truthComputed);
-        };
-        while (!done() && t.elapsed() < kRunTimeoutMs)
-            QTest::qWait(20);
-        return done();
-    }
+    bool waitRun(quint64 generation, bool truth = false) { return lctest::waitRun(*w_, generation, truth); }
 
     // atrium at 320x180 on the CPU backend, with `count` generated lights.
     void openWithLights(std::uint32_t count) {

@@ -52,7 +52,6 @@ using namespace lcui;
 
 namespace {
 
-constexpr int kRunTimeoutMs = 120000;
 
 // Lists of tile t, straight from the CullResult arrays.
 std::vector<std::uint32_t> listsOfTile(const lc::CullResult& r, std::uint32_t t) {
@@ -186,24 +185,13 @@ class OverlaysTest : public QObject {
 
     Document* doc() { return w_->document(); }
 
-    bool waitRun(quint64 generation) {
-        QSignalSpy done(w_.get(), &MainWindow::runFinished);
-        QElapsedTimer t;
-        t.start();
-        while (doc()->runGeneration() < generation && t.elapsed() < kRunTimeoutMs) done.wait(200);
-        return doc()->runGeneration() >= generation;
-    }
+    bool waitRun(quint64 generation) { return lctest::waitRun(*w_, generation); }
 
     void openSmall(const QString& algorithm = "2.5d", const QString& size = "320x180", const QString& tile = "16") {
-        QVERIFY(w_->openBuiltin("atrium"));
         const QStringList wh = size.split('x');
-        QVERIFY(w_->setParamFromUi("width", wh[0]));
-        QVERIFY(w_->setParamFromUi("height", wh[1]));
-        QVERIFY(w_->setParamFromUi("tile", tile));
-        QVERIFY(w_->setParamFromUi("algorithm", algorithm));
-        doc()->undoStack()->clear();
+        QVERIFY(lctest::openBuiltinWith(
+            *w_, "atrium", {{"width", wh[0]}, {"height", wh[1]}, {"tile", tile}, {"algorithm", algorithm}}));
         QVERIFY(waitRun(w_->runCulling()));
-        QVERIFY(doc()->runOutput());
     }
 
     // The tile with the most listed lights.
@@ -523,7 +511,7 @@ private slots:
         cli.start(LC_CLI_PATH, {"run", "--builtin", "atrium", "--width", "320", "--height", "180", "--tile", "16",
                                 "--algorithm", "clustered", "--cells", "16", "--backend", "cpu",
                                 "--no-image-error", "--out", out});
-        QVERIFY(cli.waitForFinished(kRunTimeoutMs));
+        QVERIFY(cli.waitForFinished(lctest::kRunTimeoutMs));
         QVERIFY2(cli.exitCode() == 0, cli.readAllStandardError().constData());
         // The same run in-process, to check the file against.
         lc::Scene scene = lc::makeBuiltinScene("atrium");

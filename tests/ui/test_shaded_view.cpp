@@ -46,7 +46,6 @@ using Mode = CameraView::ImageMode;
 
 namespace {
 
-constexpr int kRunTimeoutMs = 120000;
 const char* const kModes[] = {"shaded-culled", "shaded-all", "difference"};
 const char* const kPngOfMode[] = {"shaded_culled.png", "shaded_all.png", "shaded_diff.png"};
 
@@ -104,7 +103,7 @@ class ShadedViewTest : public QObject {
         QProcess cli;
         cli.start(LC_CLI_PATH, {"run", "--builtin", "atrium", "--width", "320", "--height", "180", "--tile", "16",
                                 "--algorithm", "2.5d", "--backend", backend, "--shaded-images", "--out", out});
-        if (!cli.waitForFinished(kRunTimeoutMs) || cli.exitCode() != 0) {
+        if (!cli.waitForFinished(lctest::kRunTimeoutMs) || cli.exitCode() != 0) {
             qWarning("lightcull failed: %s", cli.readAllStandardError().constData());
             return {};
         }
@@ -115,7 +114,7 @@ class ShadedViewTest : public QObject {
     bool waitShaded(quint64 generation) {
         QElapsedTimer t;
         t.start();
-        while (t.elapsed() < kRunTimeoutMs) {
+        while (t.elapsed() < lctest::kRunTimeoutMs) {
             const auto run = doc()->runOutput();
             if (doc()->runGeneration() == generation && run && !run->shadedAll.empty()) return true;
             if (doc()->runGeneration() > generation) return false;
@@ -123,21 +122,12 @@ class ShadedViewTest : public QObject {
         }
         return false;
     }
-    bool waitRun(quint64 generation) {
-        QElapsedTimer t;
-        t.start();
-        while (doc()->runGeneration() < generation && t.elapsed() < kRunTimeoutMs) QTest::qWait(20);
-        return doc()->runGeneration() >= generation && doc()->runOutput()->truthComputed;
-    }
+    bool waitRun(quint64 generation) { return lctest::waitRun(*w_, generation, true); }
 
     void openSmall(const QString& backend = "cpu") {
-        QVERIFY(w_->openBuiltin("atrium"));
-        QVERIFY(w_->setParamFromUi("width", "320"));
-        QVERIFY(w_->setParamFromUi("height", "180"));
-        QVERIFY(w_->setParamFromUi("tile", "16"));
-        QVERIFY(w_->setParamFromUi("algorithm", "2.5d"));
+        QVERIFY(lctest::openBuiltinWith(*w_, "atrium",
+                                        {{"width", "320"}, {"height", "180"}, {"tile", "16"}, {"algorithm", "2.5d"}}));
         w_->setBackend(backend);
-        doc()->undoStack()->clear();
     }
 
     void pickMode(const char* name) {
@@ -270,13 +260,13 @@ private slots:
         pickMode("difference");
         QProgressBar* bar = nullptr;
         QTRY_VERIFY_WITH_TIMEOUT((bar = w_->findChild<QProgressBar*>("statusProgress_shading")) && bar->value() > 0,
-                                 kRunTimeoutMs);
+                                 lctest::kRunTimeoutMs);
         QVERIFY(bar->isVisible());
         QVERIFY(bar->value() < bar->maximum());
         auto* cancel = w_->findChild<QToolButton*>("statusCancel_shading");
         QVERIFY(cancel && cancel->isVisible());
         QTest::mouseClick(cancel, Qt::LeftButton);
-        QTRY_COMPARE_WITH_TIMEOUT(ended.count(), 1, kRunTimeoutMs);
+        QTRY_COMPARE_WITH_TIMEOUT(ended.count(), 1, lctest::kRunTimeoutMs);
         QCOMPARE(ended.at(0).at(0).value<quint64>(), gen);
         QCOMPARE(ended.at(0).at(1).toBool(), false);
         QTRY_VERIFY(!w_->findChild<QProgressBar*>("statusProgress_shading"));
@@ -341,7 +331,7 @@ private slots:
             service.worker()->post(std::move(r));
         }, Qt::DirectConnection);
         QCOMPARE(service.request(scene, {}, "cpu", "", false, /*shade=*/true), quint64(1));
-        QTRY_VERIFY_WITH_TIMEOUT(ended.count() == 2, kRunTimeoutMs);
+        QTRY_VERIFY_WITH_TIMEOUT(ended.count() == 2, lctest::kRunTimeoutMs);
         QVERIFY(posted);
         QCOMPARE(ended.at(0).at(0).value<quint64>(), quint64(1));
         QCOMPARE(ended.at(0).at(1).toBool(), false); // cancelled

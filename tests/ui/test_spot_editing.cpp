@@ -34,7 +34,6 @@
 using namespace lcui;
 
 namespace {
-constexpr int kRunTimeoutMs = 120000;
 }
 
 class SpotEditingTest : public QObject {
@@ -214,7 +213,7 @@ private slots:
         const quint64 gen = w_->runCulling();
         QElapsedTimer t;
         t.start();
-        while (doc()->runGeneration() < gen && t.elapsed() < kRunTimeoutMs) QTest::qWait(50);
+        while (doc()->runGeneration() < gen && t.elapsed() < lctest::kRunTimeoutMs) QTest::qWait(50);
         QVERIFY(doc()->runGeneration() >= gen);
         auto run = doc()->runOutput();
         QVERIFY(run);

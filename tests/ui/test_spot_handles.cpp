@@ -42,7 +42,6 @@ using namespace lcui;
 
 namespace {
 
-constexpr int kRunTimeoutMs = 120000;
 
 glm::dvec3 worldPosition(vtkPointHandleRepresentation3D* rep) {
     double p[3];
@@ -84,13 +83,7 @@ class SpotHandlesTest : public QObject {
         return int(doc()->scene().lights.size()) == before + 1 ? before : -1;
     }
     const lc::PointLight& light(int i) { return doc()->scene().lights[std::size_t(i)]; }
-    bool runAndWait() {
-        const quint64 gen = w_->runCulling();
-        QElapsedTimer t;
-        t.start();
-        while (doc()->runGeneration() < gen && t.elapsed() < kRunTimeoutMs) QTest::qWait(20);
-        return doc()->runGeneration() >= gen && doc()->runOutput();
-    }
+    bool runAndWait() { return lctest::waitRun(*w_, w_->runCulling()); }
 
 private slots:
     void init() {
@@ -262,7 +255,7 @@ private slots:
             return run && run->lights.isSpot(std::size_t(i)) &&
                    glm::length(run->lights.spotAxes[std::size_t(i)] - targetView) < 1e-9;
         };
-        while (!turned() && t.elapsed() < kRunTimeoutMs) QTest::qWait(20);
+        while (!turned() && t.elapsed() < lctest::kRunTimeoutMs) QTest::qWait(20);
         QVERIFY(turned());
         w->InvokeEvent(vtkCommand::EndInteractionEvent);
         QCOMPARE(doc()->undoStack()->count(), steps + 1);

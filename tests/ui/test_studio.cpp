@@ -65,7 +65,6 @@ using namespace lcui;
 
 namespace {
 
-constexpr int kRunTimeoutMs = 120000; // generous: 2 shared cores, CPU backend
 
 std::string sceneText(const Document* d) { return lc::serializeScene(d->scene()); }
 
@@ -92,24 +91,11 @@ class StudioTest : public QObject {
     Document* doc() { return w_->document(); }
 
     // Waits for the run with `generation` (or a newer one) to be shown.
-    bool waitRun(quint64 generation) {
-        QSignalSpy done(w_.get(), &MainWindow::runFinished);
-        QSignalSpy failed(w_.get(), &MainWindow::runFailed);
-        QElapsedTimer t;
-        t.start();
-        while (doc()->runGeneration() < generation && t.elapsed() < kRunTimeoutMs) {
-            if (!failed.isEmpty() && failed.last().at(0).toULongLong() >= generation) return false;
-            done.wait(200);
-        }
-        return doc()->runGeneration() >= generation;
-    }
+    bool waitRun(quint64 generation) { return lctest::waitRun(*w_, generation); }
 
     // Opens the built-in scene at 320x180 on the CPU backend and waits for its run.
     void openSmall(const QString& builtin = "atrium") {
-        QVERIFY(w_->openBuiltin(builtin));
-        QVERIFY(w_->setParamFromUi("width", "320"));
-        QVERIFY(w_->setParamFromUi("height", "180"));
-        doc()->undoStack()->clear(); // the resolution change is set-up, not an edit under test
+        QVERIFY(lctest::openBuiltinWith(*w_, builtin, {{"width", "320"}, {"height", "180"}}));
         QVERIFY(waitRun(w_->runCulling()));
     }
 
@@ -227,7 +213,7 @@ private slots:
         cli.start(LC_CLI_PATH, {"run", "--builtin", "atrium", "--width", "320", "--height", "180", "--tile",
                                 "16", "--algorithm", "2.5d", "--cells", "32", "--slicing", "log", "--test",
                                 "planes", "--backend", "cpu", "--no-image-error", "--out", out});
-        QVERIFY(cli.waitForFinished(kRunTimeoutMs));
+        QVERIFY(cli.waitForFinished(lctest::kRunTimeoutMs));
         QVERIFY2(cli.exitCode() == 0, cli.readAllStandardError().constData());
         std::ifstream sf((out + "/summary.json").toStdString());
         const auto summary = nlohmann::json::parse(sf);
@@ -334,7 +320,7 @@ private slots:
         QSignalSpy failed(w_.get(), &MainWindow::runFailed);
         const quint64 shown = doc()->runGeneration();
         w_->cullService()->request(doc()->scene(), doc()->settings(), "no-such-backend", "");
-        QVERIFY(failed.wait(kRunTimeoutMs));
+        QVERIFY(failed.wait(lctest::kRunTimeoutMs));
         QCOMPARE(doc()->runGeneration(), shown);
         QVERIFY(w_->messageLog()->toPlainText().contains("no-such-backend"));
         QVERIFY(waitRun(w_->runCulling())); // and cpu works again
@@ -483,7 +469,7 @@ private slots:
         const std::string before = sceneText(doc());
         QSignalSpy failed(w_.get(), &MainWindow::runFailed);
         w_->runCulling();
-        QVERIFY(failed.wait(kRunTimeoutMs));
+        QVERIFY(failed.wait(lctest::kRunTimeoutMs));
         const QString msg = failed.last().at(1).toString();
         QVERIFY2(msg.contains(QString::fromStdString(bad.name)), qPrintable(msg));
         QVERIFY(w_->messageLog()->toPlainText().contains("failed"));
@@ -669,7 +655,7 @@ private slots:
         const QString shot = tmp_.path() + "/wall.png";
         QProcess studio;
         studio.start(LC_STUDIO_PATH, {"--builtin", "wall", "--run", "--screenshot", shot, "--quit"});
-        QVERIFY(studio.waitForFinished(kRunTimeoutMs));
+        QVERIFY(studio.waitForFinished(lctest::kRunTimeoutMs));
         QVERIFY2(studio.exitCode() == 0, studio.readAllStandardError().constData());
         QImage img(shot);
         QVERIFY(!img.isNull());
