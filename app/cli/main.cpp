@@ -302,11 +302,14 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
         for (int i = 0; i < opt.warmup + opt.repeat; ++i) {
             const lc::DepthImage depth = backend->renderDepth(scene, proj);
             const double d = backend->lastDepthMs(), dw = backend->lastDepthWallMs();
-            // Peak device memory of the culling pass alone (its buffers, the
-            // staging copies included; the depth image is the input).
+            // Peak device memory of the culling pass alone: what it allocates
+            // beyond what is alive before it (its buffers, the staging copies
+            // included; the depth image is the input, on the device already
+            // when the backend rendered it).
             backend->resetPeakDeviceBytes();
+            const std::size_t alive = backend->peakDeviceBytes();
             last = backend->cull(depth, proj, grid, lights, settings);
-            peakDeviceBytes = std::max(peakDeviceBytes, backend->peakDeviceBytes());
+            peakDeviceBytes = std::max(peakDeviceBytes, backend->peakDeviceBytes() - alive);
             if (i >= opt.warmup) {
                 depthMs.push_back(d);
                 depthWallMs.push_back(dw);
