@@ -106,6 +106,9 @@ Grid groupsFor(std::uint64_t invocations, const VkPhysicalDeviceLimits& lim) {
 }
 
 void computeBarrier(VkCommandBuffer cmd, VkAccessFlags dstAccess, VkPipelineStageFlags dstStage);
+// One global memory barrier: `dstAccess` at `dstStage` waits for `srcAccess` at `srcStage`.
+void memoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags srcStage, VkAccessFlags srcAccess,
+                   VkPipelineStageFlags dstStage, VkAccessFlags dstAccess);
 
 // Host <-> device data of one submission. Buffers the host can map are
 // written and read in place (lavapipe: no copies at all); others go through
@@ -150,31 +153,22 @@ public:
             }
         if (!any) return;
         // The passes read (status: also OR into) what the copies wrote.
-        VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-        mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        mb.dstAccessMask = dstAccess;
-        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, dstStage, 0, 1, &mb, 0, nullptr, 0, nullptr);
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, dstStage, dstAccess);
     }
     void recordDownloads(VkCommandBuffer cmd) const {
         bool anyCopy = false;
         for (const Copy& c : copies_) anyCopy = anyCopy || !c.up;
         if (anyCopy) {
             // The copies read what the compute passes wrote.
-            VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-            mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-            mb.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1,
-                                 &mb, 0, nullptr, 0, nullptr);
+            computeBarrier(cmd, VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
             for (const Copy& c : copies_)
                 if (!c.up) {
                     VkBufferCopy region{0, 0, c.bytes};
                     vkCmdCopyBuffer(cmd, c.device, c.staging, 1, &region);
                 }
             // The host reads the staging buffers the copies wrote.
-            mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-            mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0,
-                                 nullptr, 0, nullptr);
+            memoryBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                          VK_ACCESS_HOST_READ_BIT);
         }
         // The host reads the mapped buffers the compute passes wrote.
         if (mappedReads_) computeBarrier(cmd, VK_ACCESS_HOST_READ_BIT, VK_PIPELINE_STAGE_HOST_BIT);
@@ -193,12 +187,16 @@ private:
 };
 
 // Memory barrier between two compute dispatches of one command buffer.
-void computeBarrier(VkCommandBuffer cmd, VkAccessFlags dstAccess, VkPipelineStageFlags dstStage) {
+void memoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags srcStage, VkAccessFlags srcAccess,
+                   VkPipelineStageFlags dstStage, VkAccessFlags dstAccess) {
     VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    mb.srcAccessMask = srcAccess;
     mb.dstAccessMask = dstAccess;
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, dstStage, 0, 1, &mb, 0, nullptr, 0,
-                         nullptr);
+    vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &mb, 0, nullptr, 0, nullptr);
+}
+
+void computeBarrier(VkCommandBuffer cmd, VkAccessFlags dstAccess, VkPipelineStageFlags dstStage) {
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, dstStage, dstAccess);
 }
 
 // GpuCullParams.depthBins: LC_DEPTH_BINS slices of the lights' depth extent
@@ -621,12 +619,9 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
             region.imageExtent = {W, H, 1};
             vkCmdCopyImageToBuffer(cmd, img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, resident.buffer, 1, &region);
             // The readback copy (or, mapped, the host) reads what the image copy wrote.
-            VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-            mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-            mb.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_HOST_READ_BIT;
-            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                 VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0, nullptr, 0,
-                                 nullptr);
+            memoryBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
+                          VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_HOST_READ_BIT);
             back.recordDownloads(cmd);
         },
         "depth.commands");
@@ -950,14 +945,10 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         [&](VkCommandBuffer cmd) {
             if (gpuClock) stamps.reset(cmd);
             staging.recordUploads(cmd);
-            if (residentDepth) {
-                // The passes read the depth the depth submission's copy wrote.
-                VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-                mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-                mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-                vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
-                                     &mb, 0, nullptr, 0, nullptr);
-            }
+            // The passes read the depth the depth submission's copy wrote.
+            if (residentDepth)
+                memoryBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
             if (gpuClock) stamps.begin(cmd, 0);
             vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, computeLayout_, 0, 1, &set1, 0, nullptr);
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, boundsPipe);
