@@ -438,8 +438,9 @@ TEST_F(GpuTest, ResultBytesFollowTheEntries) {
 // back afterwards (live memory before == after). Nothing per tile x light:
 // at 65,536 lights the peak stays far below tiles x lights x 4 bytes.
 // A rendered depth image whose pixels changed after the render, its id kept
-// (a caller that forgot to reset deviceCopy), and an older render's image:
-// the cull reads the pixels it is given, not the device's copy.
+// (a caller that forgot to reset deviceCopy), an older render's image, and
+// another backend's: the cull reads the pixels it is given, not the device's
+// copy.
 TEST_F(GpuTest, TheCullReadsTheDepthItIsGiven) {
     CullBackend& vk = gputest::vulkan();
     Scene scene = sized("atrium", 320, 180);
@@ -460,6 +461,16 @@ TEST_F(GpuTest, TheCullReadsTheDepthItIsGiven) {
     const CullResult after = f.cull(vk, st);
     EXPECT_EQ(after.lightIndices, before.lightIndices);
     EXPECT_EQ(after.tileDepthMax, before.tileDepthMax);
+    // Two fresh backends' first renders: their ids differ, so an image one
+    // rendered never names the other's copy; each culls the other's pixels.
+    std::unique_ptr<CullBackend> a = makeVulkanBackend(""), b = makeVulkanBackend("");
+    const DepthImage fromA = a->renderDepth(scene, f.proj);
+    const DepthImage fromB = b->renderDepth(other, Projection(other.camera));
+    EXPECT_NE(fromA.deviceCopy, fromB.deviceCopy);
+    const CullResult bOnA = a->cull(fromB, f.proj, f.grid, f.lights, st);
+    const CullResult bOnB = b->cull(fromB, f.proj, f.grid, f.lights, st);
+    EXPECT_EQ(bOnA.lightIndices, bOnB.lightIndices);
+    EXPECT_EQ(bOnA.tileDepthMax, bOnB.tileDepthMax);
 }
 
 TEST_F(GpuTest, DeviceMemoryPeakAndNoLeak) {

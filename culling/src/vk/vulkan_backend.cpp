@@ -42,6 +42,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -286,7 +287,13 @@ private:
     // The last rendered depth image, kept on the device for the cull that
     // follows (DepthImage::deviceCopy): its id, buffer and a sample of its
     // pixels that a cull compares before trusting the id.
-    std::uint64_t residentId_ = 0, nextDepthId_ = 0;
+    // Ids are unique across backends (one counter for the process), so an
+    // image another backend rendered never names this one's copy.
+    std::uint64_t residentId_ = 0;
+    static std::uint64_t nextDepthId() {
+        static std::atomic<std::uint64_t> next{0};
+        return ++next;
+    }
     struct DepthTarget {
         std::uint32_t width = 0, height = 0;
         bool reversed = false;
@@ -636,7 +643,7 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
     out.clearDepth = clearDepth;
     out.depth.resize(std::size_t(W) * H);
     std::memcpy(out.depth.data(), pixels, out.depth.size() * 4);
-    residentId_ = out.deviceCopy = ++nextDepthId_;
+    residentId_ = out.deviceCopy = nextDepthId();
     residentSample_ = depthSample(out);
     return out;
 }
