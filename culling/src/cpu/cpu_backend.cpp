@@ -385,11 +385,8 @@ public:
         return r;
     }
 
-    double lastCullWallMs() const override { return lastCullWallMs_; }
-
 private:
     std::string device_;
-    double lastCullWallMs_ = -1;
 };
 
 } // namespace

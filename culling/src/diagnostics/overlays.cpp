@@ -1,9 +1,9 @@
 // Overlay geometry (tile frustums, depth cells, light cell ranges, reverse
 // look-up, per-tile heat) and the overlays.vtm writer. See overlays.hpp.
 //
-// The VTK XML is written by hand (culling/ must not link VTK): ASCII
-// DataArrays, Float64 points written as the shortest text that reads back as
-// the same double, so a reader gets exactly the corners the culling used.
+// The VTK XML is written by hand (culling/ must not link VTK): binary
+// appended DataArrays, zlib-compressed (AppendedData below), Float64 points,
+// so a reader gets exactly the corners the culling used.
 #include "culling/diagnostics/overlays.hpp"
 
 #include "culling/core/errors.hpp"
@@ -12,7 +12,6 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <charconv>
 #include <cstring>
 #include <deque>
 #include <filesystem>

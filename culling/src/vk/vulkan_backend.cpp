@@ -249,7 +249,6 @@ public:
     }
     std::size_t peakDeviceBytes() const override { return std::size_t(ctx_.memoryStats().peak); }
     void resetPeakDeviceBytes() override { ctx_.resetPeakMemory(); }
-    double lastCullWallMs() const override { return lastCullWallMs_; }
 
     DepthImage renderDepth(const Scene& scene, const Projection& proj) override;
     CullResult cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
@@ -275,7 +274,6 @@ private:
     PipelineLayoutHandle computeLayout_;
     ShaderModuleHandle boundsShader_, boundsWideShader_, binsShader_, cullShader_, scanShader_, pruneShader_,
         zbinShader_, vertShader_;
-    double lastCullWallMs_ = -1;
     std::uint32_t lastLongestList_ = 0; // of the previous cull: sizes a CPU device's stash
     // Of the previous cull: its lists and entries size the next one's index array.
     std::uint32_t lastListTotal_ = 0, lastEntries_ = 0;
@@ -299,8 +297,8 @@ private:
         bool reversed = false;
         Image image;
         FramebufferHandle framebuffer;
+        Buffer depth; // the storage buffer the image is copied to
     } depthTarget_;
-    Buffer residentDepth_;
     std::vector<float> residentSample_;
     static std::vector<float> depthSample(const DepthImage& d) {
         std::vector<float> s;
@@ -310,7 +308,7 @@ private:
         return s;
     }
     bool isResident(const DepthImage& d) const {
-        return d.deviceCopy != 0 && d.deviceCopy == residentId_ && residentDepth_.buffer &&
+        return d.deviceCopy != 0 && d.deviceCopy == residentId_ && depthTarget_.depth.buffer &&
                residentSample_ == depthSample(d);
     }
 };
@@ -557,7 +555,6 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
     if (depthTarget_.width != W || depthTarget_.height != H || depthTarget_.reversed != reversed ||
         !depthTarget_.framebuffer) {
         depthTarget_ = DepthTarget{};
-        residentDepth_ = Buffer();
         depthTarget_.image = ctx_.createDepthImage(W, H, VK_FORMAT_D32_SFLOAT, "depth.image");
         VkFramebufferCreateInfo fci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
         fci.renderPass = rp;
@@ -571,16 +568,15 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
         LC_VK(vkCreateFramebuffer(dev, &fci, nullptr, &fbRaw));
         depthTarget_.framebuffer = FramebufferHandle(dev, fbRaw);
         ctx_.name(VK_OBJECT_TYPE_FRAMEBUFFER, fbRaw, "depth.framebuffer");
+        depthTarget_.depth = ctx_.createDeviceBuffer(
+            VkDeviceSize(W) * H * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+            "depth.resident");
         depthTarget_.width = W;
         depthTarget_.height = H;
         depthTarget_.reversed = reversed;
     }
-    if (!residentDepth_.buffer)
-        residentDepth_ = ctx_.createDeviceBuffer(VkDeviceSize(W) * H * 4,
-                                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                                 "depth.resident");
     residentId_ = 0; // rewritten below: no earlier image names it any more
-    const Buffer& resident = residentDepth_;
+    const Buffer& resident = depthTarget_.depth;
     const Image& img = depthTarget_.image;
     VkFramebuffer fb = depthTarget_.framebuffer;
     Staging back(ctx_);
@@ -784,7 +780,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const bool residentDepth = isResident(depth);
     Buffer uploadedDepth =
         residentDepth ? Buffer() : ctx_.createDeviceBuffer(depth.depth.size() * 4, ssbo, "cull.depth");
-    const Buffer& depthBuf = residentDepth ? residentDepth_ : uploadedDepth;
+    const Buffer& depthBuf = residentDepth ? depthTarget_.depth : uploadedDepth;
     Buffer tileBuf = ctx_.createDeviceBuffer(std::size_t(tiles) * sizeof(GpuTileBounds), ssbo, "cull.tiles");
     Buffer lightBuf = ctx_.createDeviceBuffer(std::size_t(n) * sizeof(GpuLight), ssbo, "cull.lights");
     Buffer binBuf = ctx_.createDeviceBuffer(binTotal64 * 4, ssbo, "cull.bins");

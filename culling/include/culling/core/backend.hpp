@@ -59,7 +59,7 @@ public:
     virtual std::string timingMethod() const = 0;
     // CPU wall-clock milliseconds of the last cull() around its submissions
     // (equal to its cullMs where that is the timing method; -1: not run).
-    virtual double lastCullWallMs() const { return -1; }
+    double lastCullWallMs() const { return lastCullWallMs_; }
     // Most device memory (buffers and images, as allocated) alive at once
     // since the last resetPeakDeviceBytes(); 0 for backends without a device.
     virtual std::size_t peakDeviceBytes() const { return 0; }
@@ -75,6 +75,7 @@ public:
 protected:
     double lastDepthMs_ = -1;
     double lastDepthWallMs_ = -1; // -1: the same as lastDepthMs_
+    double lastCullWallMs_ = -1;
     double lastShadeMs_ = -1;
 };
 
