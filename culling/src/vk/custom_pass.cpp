@@ -391,21 +391,16 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
     const bool finished = st->ctx->submitAndWaitFor(
         [&](VkCommandBuffer cmd) {
             vkCmdFillBuffer(cmd, st->out.buffer, 0, VK_WHOLE_SIZE, 0);
-            VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
             // Hazard: the shader's list writes and atomics must follow the zero fill.
-            mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-            mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb,
-                                 0, nullptr, 0, nullptr);
+            vk::memoryBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                              VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, st->pipeline);
             vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pl, 0, 1, &set, 0, nullptr);
             vkCmdDispatch(cmd, grid.tilesX, grid.tilesY, 1);
             // Hazard: the host reads the lists only after the shader's writes.
-            VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-            toHost.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-            toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost,
-                                 0, nullptr, 0, nullptr);
+            vk::memoryBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                              VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
         },
         "custom.cull", o.timeoutMs, wallMs);
     if (!finished) {

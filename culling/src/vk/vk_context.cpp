@@ -34,6 +34,14 @@ const char* resultName(VkResult r) {
     }
 }
 
+void memoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags srcStage, VkAccessFlags srcAccess,
+                   VkPipelineStageFlags dstStage, VkAccessFlags dstAccess) {
+    VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    mb.srcAccessMask = srcAccess;
+    mb.dstAccessMask = dstAccess;
+    vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &mb, 0, nullptr, 0, nullptr);
+}
+
 void throwVkError(const char* call, VkResult r, const char* file, int line) {
     throw DeviceError(std::string("Vulkan call failed: ") + call + " returned " + resultName(r) + " (" +
                       resultName(r) + " = " + std::to_string(int(r)) + ") at " + file + ":" +

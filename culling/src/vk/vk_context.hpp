@@ -18,6 +18,11 @@ namespace lc::vk {
 const char* resultName(VkResult r);
 [[noreturn]] void throwVkError(const char* call, VkResult r, const char* file, int line);
 
+// One global memory barrier: `dstAccess` at `dstStage` waits for `srcAccess`
+// at `srcStage` (this submission's commands and those submitted before).
+void memoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags srcStage, VkAccessFlags srcAccess,
+                   VkPipelineStageFlags dstStage, VkAccessFlags dstAccess);
+
 // Every Vulkan call that returns a VkResult goes through this: failure throws
 // lc::DeviceError naming the call, the result and the source position.
 #define LC_VK(call)                                                       \

@@ -107,9 +107,6 @@ Grid groupsFor(std::uint64_t invocations, const VkPhysicalDeviceLimits& lim) {
 }
 
 void computeBarrier(VkCommandBuffer cmd, VkAccessFlags dstAccess, VkPipelineStageFlags dstStage);
-// One global memory barrier: `dstAccess` at `dstStage` waits for `srcAccess` at `srcStage`.
-void memoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags srcStage, VkAccessFlags srcAccess,
-                   VkPipelineStageFlags dstStage, VkAccessFlags dstAccess);
 
 // Host <-> device data of one submission. Buffers the host can map are
 // written and read in place (lavapipe: no copies at all); others go through
@@ -188,14 +185,6 @@ private:
 };
 
 // Memory barrier between two compute dispatches of one command buffer.
-void memoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags srcStage, VkAccessFlags srcAccess,
-                   VkPipelineStageFlags dstStage, VkAccessFlags dstAccess) {
-    VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    mb.srcAccessMask = srcAccess;
-    mb.dstAccessMask = dstAccess;
-    vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &mb, 0, nullptr, 0, nullptr);
-}
-
 void computeBarrier(VkCommandBuffer cmd, VkAccessFlags dstAccess, VkPipelineStageFlags dstStage) {
     memoryBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, dstStage, dstAccess);
 }
