@@ -12,6 +12,13 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 // 1: every light in index order (no list arrays read); 0: the pixel's list.
 layout(constant_id = 0) const uint ALL_LIGHTS = 0u;
+// 1: the lights come from the uniform block (binding 8), which holds lights
+// C.x .. C.x + BLOCK_LIGHTS - 1; 0: from the storage buffer (binding 3).
+// lavapipe loads a storage buffer lane by lane in a loop with a bounds check,
+// a uniform block with one branch-free gather: the all-lights image, every
+// light at every pixel, is mostly these loads.
+layout(constant_id = 1) const uint LIGHTS_IN_BLOCK = 0u;
+layout(constant_id = 2) const uint BLOCK_LIGHTS = 1u;
 
 layout(std430, binding = 0) readonly buffer Params { GpuShadeParams P; };
 layout(std430, binding = 1) readonly buffer PixelBuf { GpuShadePixel pixels[]; };
@@ -20,7 +27,15 @@ layout(std430, binding = 3) readonly buffer LightBuf { GpuShadeLight lights[]; }
 layout(std430, binding = 4) readonly buffer OffsetBuf { uint listOffset[]; };
 layout(std430, binding = 5) readonly buffer CountBuf { uint listCount[]; };
 layout(std430, binding = 6) readonly buffer IndexBuf { uint lightIndices[]; };
-layout(std430, binding = 7) writeonly buffer OutBuf { float rgb[]; };
+layout(std430, binding = 7) buffer OutBuf { float rgb[]; };
+layout(std140, binding = 8) uniform LightBlock { GpuShadeLight blockLights[BLOCK_LIGHTS]; };
+// x: the first light of this dispatch, y: how many (all lights: the image is
+// shaded in chunks of at most BLOCK_LIGHTS lights, in index order), z: 1 when
+// an earlier chunk's sums are in rgb to add to (the same float additions in
+// the same order as one loop).
+layout(push_constant) uniform Chunk { uvec4 C; };
+
+#define LIGHT(li, field) (LIGHTS_IN_BLOCK != 0u ? blockLights[(li) - C.x].field : lights[li].field)
 
 void main() {
     uint x = gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
@@ -28,23 +43,24 @@ void main() {
     uint i = y * P.size.x + x;
     uint l = pixelList[i];
     precise vec3 acc = vec3(0.0);
+    if (ALL_LIGHTS != 0u && C.z != 0u) acc = vec3(rgb[3u * i + 0u], rgb[3u * i + 1u], rgb[3u * i + 2u]);
     if (l != LC_SHADE_NO_LIST) {
         vec3 p = pixels[i].position.xyz, n = pixels[i].normal.xyz;
-        uint first = (ALL_LIGHTS != 0u) ? 0u : listOffset[l];
-        uint count = (ALL_LIGHTS != 0u) ? P.size.z : listCount[l];
+        uint first = (ALL_LIGHTS != 0u) ? C.x : listOffset[l];
+        uint count = (ALL_LIGHTS != 0u) ? C.y : listCount[l];
         for (uint k = 0u; k < count; ++k) {
-            uint li = (ALL_LIGHTS != 0u) ? k : lightIndices[first + k];
-            precise vec3 d = lights[li].position.xyz - p;
+            uint li = (ALL_LIGHTS != 0u) ? first + k : lightIndices[first + k];
+            precise vec3 d = LIGHT(li, position.xyz) - p;
             precise float d2 = (d.x * d.x + d.y * d.y) + d.z * d.z;
             // A light exactly at the pixel has no direction: clamp the length.
             precise float len = sqrt(max(d2, 1e-30));
             precise float ndl = ((n.x * d.x + n.y * d.y) + n.z * d.z) / len;
             precise float f = max(ndl, 0.0) / max(d2, 1e-4);
             // Spot cone (shade.cpp): inside when -(axis.d) >= len cos a.
-            vec4 s = lights[li].spot;
+            vec4 s = LIGHT(li, spot);
             precise float axial = 0.0 - ((s.x * d.x + s.y * d.y) + s.z * d.z);
             if (!(axial >= len * s.w)) f = 0.0;
-            acc += lights[li].power.xyz * f;
+            acc += LIGHT(li, power.xyz) * f;
         }
     }
     rgb[3u * i + 0u] = acc.x;

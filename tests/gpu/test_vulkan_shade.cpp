@@ -83,6 +83,28 @@ TEST_F(VulkanShade, MatchesTheCpuReferenceForEveryAlgorithmAndAllLights) {
     }
 }
 
+TEST_F(VulkanShade, LightsBeyondOneUniformBlockShadeInChunksAsOneLoop) {
+    // A uniform block holds at most 65,536 / 48 = 1,365 lights, so 3,000
+    // lights take at least three chunks of the all-lights image, each adding
+    // to the sums the last one left; a list image with as many lights reads
+    // them from the storage buffer. Both must equal the CPU reference's
+    // single loop over the same lights in the same order.
+    CullBackend& gpu = gputest::vulkan();
+    const Scene scene = smallScene("atrium", 64, 36, 3000);
+    const Projection proj(scene.camera);
+    const ViewLights lights = makeViewLights(scene);
+    ASSERT_EQ(lights.size(), 3000u);
+    const DepthImage depth = makeCpuBackend()->renderDepth(scene, proj);
+    const ShadeInputs allIn = makeShadeInputs(depth, proj, nullptr);
+    expectSameImage(gpu.shade(allIn, lights, nullptr), shadeCpu(allIn, lights, nullptr), allIn, "all lights");
+    CullSettings settings;
+    settings.algorithm = Algorithm::Naive;
+    const CullResult result = gpu.cull(depth, proj, TileGrid::make(64, 36, 16), lights, settings);
+    ASSERT_GT(result.lightIndices.size(), 2000u);
+    const ShadeInputs in = makeShadeInputs(depth, proj, &result);
+    expectSameImage(gpu.shade(in, lights, &result), shadeCpu(in, lights, &result), in, "naive lists");
+}
+
 TEST_F(VulkanShade, PipelineImageErrorAgreesWithTheCpuBackendOnTheSameDepth) {
     CullBackend& gpu = gputest::vulkan();
     const Scene scene = smallScene("forest", 96, 54, 48);

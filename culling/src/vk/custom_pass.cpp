@@ -315,35 +315,20 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
         "custom.uploadDepth");
 
     // Layouts, pipeline, descriptors.
-    VkDescriptorSetLayoutBinding b[5]{};
-    const VkDescriptorType types[5] = {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
-    for (std::uint32_t i = 0; i < 5; ++i) {
-        b[i].binding = i;
-        b[i].descriptorType = types[i];
-        b[i].descriptorCount = 1;
-        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-    }
-    VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    lci.bindingCount = 5;
-    lci.pBindings = b;
-    VkDescriptorSetLayout sl;
-    LC_VK(vkCreateDescriptorSetLayout(dev, &lci, nullptr, &sl));
-    st->setLayout = vk::DescriptorSetLayoutHandle(dev, sl);
-    VkPipelineLayoutCreateInfo plci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    plci.setLayoutCount = 1;
-    plci.pSetLayouts = &sl;
-    VkPipelineLayout pl;
-    LC_VK(vkCreatePipelineLayout(dev, &plci, nullptr, &pl));
-    st->pipelineLayout = vk::PipelineLayoutHandle(dev, pl);
+    const std::vector<VkDescriptorType> types = {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+                                                 VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                                                 VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                 VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+    auto layouts = ctx.createPassLayouts(types, "custom");
+    st->setLayout = std::move(layouts.set);
+    st->pipelineLayout = std::move(layouts.pipeline);
     st->module = ctx.createShader(spirv.data(), spirv.size(), "custom.shader");
     VkComputePipelineCreateInfo cpi{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     cpi.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
     cpi.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     cpi.stage.module = st->module;
     cpi.stage.pName = entry.c_str();
-    cpi.layout = pl;
+    cpi.layout = st->pipelineLayout;
     VkPipeline pipe;
     const VkResult pr = vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &cpi, nullptr, &pipe);
     if (pr != VK_SUCCESS)
@@ -364,6 +349,7 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
     VkDescriptorSetAllocateInfo dsai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     dsai.descriptorPool = pool;
     dsai.descriptorSetCount = 1;
+    VkDescriptorSetLayout sl = st->setLayout;
     dsai.pSetLayouts = &sl;
     VkDescriptorSet set;
     LC_VK(vkAllocateDescriptorSets(dev, &dsai, &set));
@@ -396,7 +382,7 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
                               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                               VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, st->pipeline);
-            vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pl, 0, 1, &set, 0, nullptr);
+            vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, st->pipelineLayout, 0, 1, &set, 0, nullptr);
             vkCmdDispatch(cmd, grid.tilesX, grid.tilesY, 1);
             // Hazard: the host reads the lists only after the shader's writes.
             vk::memoryBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,

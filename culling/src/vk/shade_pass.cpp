@@ -17,28 +17,36 @@
 namespace lc::vk {
 
 namespace {
-constexpr std::uint32_t kBindings = 8; // shade.comp bindings 0..7
+constexpr std::uint32_t kBindings = 9; // shade.comp bindings 0..8: storage buffers, then the light block
 constexpr std::uint32_t kGroup = 8;    // shade.comp local size, x and y
+constexpr std::uint32_t kPushBytes = 16; // shade.comp's Chunk
 } // namespace
 
 ShadePass::ShadePass(Context& ctx) : ctx_(ctx) {
-    auto layouts = ctx_.createStorageLayouts(kBindings, "shade");
+    std::vector<VkDescriptorType> types(kBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    types[8] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; // one chunk of lights per dispatch
+    auto layouts = ctx_.createPassLayouts(types, "shade", kPushBytes);
     setLayout_ = std::move(layouts.set);
     layout_ = std::move(layouts.pipeline);
     const spirv::Code code = spirv::shade();
     shader_ = ctx_.createShader(code.words, code.wordCount, "shader.shade");
+    // The lights a uniform block holds: as many as the device's range
+    // allows, a multiple of 16 so that every chunk's offset (48 bytes a
+    // light) is a multiple of 256, the largest offset alignment Vulkan allows.
+    const std::uint32_t range = std::min<std::uint32_t>(ctx_.properties().limits.maxUniformBufferRange, 1u << 16);
+    blockLights_ = std::max<std::uint32_t>(range / sizeof(GpuShadeLight) / 16 * 16, 16);
 }
 
-VkPipeline ShadePass::pipeline(bool allLights) {
-    PipelineHandle& pipe = pipelines_[allLights ? 1 : 0];
+VkPipeline ShadePass::pipeline(bool allLights, bool lightsInBlock) {
+    PipelineHandle& pipe = pipelines_[(allLights ? 2 : 0) + (lightsInBlock ? 1 : 0)];
     if (pipe) return pipe;
-    const std::uint32_t all = allLights ? 1u : 0u;
-    VkSpecializationMapEntry entry{0, 0, 4};
+    const std::uint32_t spec[3] = {allLights ? 1u : 0u, lightsInBlock ? 1u : 0u, blockLights_};
+    const VkSpecializationMapEntry entries[3] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}};
     VkSpecializationInfo si{};
-    si.mapEntryCount = 1;
-    si.pMapEntries = &entry;
-    si.dataSize = 4;
-    si.pData = &all;
+    si.mapEntryCount = 3;
+    si.pMapEntries = entries;
+    si.dataSize = sizeof spec;
+    si.pData = spec;
     VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
     ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -48,7 +56,8 @@ VkPipeline ShadePass::pipeline(bool allLights) {
     ci.layout = layout_;
     VkPipeline p;
     LC_VK(vkCreateComputePipelines(ctx_.device(), VK_NULL_HANDLE, 1, &ci, nullptr, &p));
-    ctx_.name(VK_OBJECT_TYPE_PIPELINE, p, allLights ? "pipeline.shade.all" : "pipeline.shade.lists");
+    ctx_.name(VK_OBJECT_TYPE_PIPELINE, p,
+              std::string(allLights ? "pipeline.shade.all" : "pipeline.shade.lists") + (lightsInBlock ? ".block" : ""));
     pipe = PipelineHandle(ctx_.device(), p);
     return pipe;
 }
@@ -93,6 +102,15 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     Buffer countBuf = ctx_.createBuffer(culled ? listTotal * 4 : 4, usage, "shade.listCounts");
     Buffer indexBuf = ctx_.createBuffer(culled ? culled->lightIndices.size() * 4 : 4, usage, "shade.lightIndices");
     Buffer outBuf = ctx_.createBuffer(pixels * 3 * 4, usage, "shade.rgb");
+    // The lights again as uniform blocks of blockLights_ each (the last one
+    // padded): every chunk of the all-lights image, and a list image's lights
+    // when one block holds them all.
+    const bool allLights = culled == nullptr;
+    const bool inBlock = allLights || lightCount <= blockLights_;
+    const std::size_t chunks = allLights ? std::max<std::size_t>((lightCount + blockLights_ - 1) / blockLights_, 1) : 1;
+    const std::size_t blockBytes = std::size_t(blockLights_) * sizeof(GpuShadeLight);
+    Buffer blockBuf = ctx_.createBuffer(inBlock ? chunks * blockBytes : 4, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                                        "shade.lightBlocks");
 
     params.as<GpuShadeParams>()->size =
         glm::uvec4(in.width, in.height, std::uint32_t(lightCount), std::uint32_t(listTotal));
@@ -109,6 +127,7 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
         L[i].spot = lights.isSpot(i) ? glm::vec4(glm::vec3(lights.spotAxes[i]), float(std::cos(lights.spotAngles[i])))
                                      : glm::vec4(0.0f, 0.0f, 0.0f, -2.0f);
     }
+    if (inBlock && lightCount) std::memcpy(blockBuf.mapped, L, lightCount * sizeof(GpuShadeLight));
     if (culled) {
         std::memcpy(offsetBuf.mapped, culled->listOffset.data(), listTotal * 4);
         std::memcpy(countBuf.mapped, culled->listCount.data(), listTotal * 4);
@@ -117,11 +136,12 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     }
 
     VkDevice dev = ctx_.device();
-    VkDescriptorPoolSize ps{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings};
+    const VkDescriptorPoolSize ps[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings - 1},
+                                        {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, 1}};
     VkDescriptorPoolCreateInfo dpci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     dpci.maxSets = 1;
-    dpci.poolSizeCount = 1;
-    dpci.pPoolSizes = &ps;
+    dpci.poolSizeCount = 2;
+    dpci.pPoolSizes = ps;
     VkDescriptorPool poolRaw;
     LC_VK(vkCreateDescriptorPool(dev, &dpci, nullptr, &poolRaw));
     DescriptorPoolHandle pool(dev, poolRaw);
@@ -134,27 +154,40 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     VkDescriptorSet set;
     LC_VK(vkAllocateDescriptorSets(dev, &ai, &set));
     ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_SET, set, "shade.set");
-    const Buffer* bufs[kBindings] = {&params, &pixelBuf, &listBuf, &lightBuf, &offsetBuf, &countBuf, &indexBuf, &outBuf};
+    const Buffer* bufs[kBindings] = {&params,   &pixelBuf, &listBuf, &lightBuf, &offsetBuf,
+                                     &countBuf, &indexBuf, &outBuf,  &blockBuf};
     std::array<VkDescriptorBufferInfo, kBindings> infos{};
     std::array<VkWriteDescriptorSet, kBindings> writes{};
     for (std::uint32_t i = 0; i < kBindings; ++i) {
-        infos[i] = {bufs[i]->buffer, 0, VK_WHOLE_SIZE};
+        infos[i] = {bufs[i]->buffer, 0, i == 8 ? (inBlock ? blockBytes : 4) : VK_WHOLE_SIZE};
         writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
         writes[i].dstSet = set;
         writes[i].dstBinding = i;
         writes[i].descriptorCount = 1;
-        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        writes[i].descriptorType = i == 8 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         writes[i].pBufferInfo = &infos[i];
     }
     vkUpdateDescriptorSets(dev, kBindings, writes.data(), 0, nullptr);
 
-    VkPipeline pipe = pipeline(culled == nullptr);
+    VkPipeline pipe = pipeline(allLights, inBlock);
     ms = ctx_.submitAndWait(
         [&](VkCommandBuffer cmd) {
-            vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set, 0, nullptr);
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
-            vkCmdDispatch(cmd, gx, gy, 1);
-            // The host reads the shaded image the dispatch wrote.
+            for (std::size_t c = 0; c < chunks; ++c) {
+                const std::uint32_t first = std::uint32_t(c * blockLights_);
+                const std::uint32_t chunk[4] = {
+                    inBlock ? first : 0u, std::uint32_t(std::min<std::size_t>(blockLights_, lightCount - first)),
+                    c > 0 ? 1u : 0u, 0u};
+                const std::uint32_t offset = std::uint32_t(c * blockBytes);
+                if (c > 0) // Hazard: this chunk adds to the sums the previous one wrote.
+                    memoryBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                                  VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                                  VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+                vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set, 1, &offset);
+                vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, kPushBytes, chunk);
+                vkCmdDispatch(cmd, gx, gy, 1);
+            }
+            // The host reads the shaded image the dispatches wrote.
             memoryBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
                           VK_ACCESS_HOST_READ_BIT);
         },

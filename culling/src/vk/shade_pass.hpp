@@ -18,13 +18,14 @@ public:
     std::vector<float> run(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled, double& ms);
 
 private:
-    VkPipeline pipeline(bool allLights);
+    VkPipeline pipeline(bool allLights, bool lightsInBlock);
 
     Context& ctx_;
     DescriptorSetLayoutHandle setLayout_;
     PipelineLayoutHandle layout_;
     ShaderModuleHandle shader_;
-    std::array<PipelineHandle, 2> pipelines_;
+    std::array<PipelineHandle, 4> pipelines_; // [2 x all lights + lights in the block]
+    std::uint32_t blockLights_ = 0;           // lights per uniform block (shade.comp BLOCK_LIGHTS)
 };
 
 } // namespace lc::vk

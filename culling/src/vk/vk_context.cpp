@@ -544,25 +544,29 @@ ShaderModuleHandle Context::createShader(const std::uint32_t* words, std::size_t
     return ShaderModuleHandle(device_, m);
 }
 
-Context::StorageLayouts Context::createStorageLayouts(std::uint32_t bindings, const std::string& n) const {
-    std::vector<VkDescriptorSetLayoutBinding> b(bindings);
-    for (std::uint32_t i = 0; i < bindings; ++i) {
+Context::PassLayouts Context::createPassLayouts(const std::vector<VkDescriptorType>& types, const std::string& n,
+                                                std::uint32_t pushConstantBytes) const {
+    std::vector<VkDescriptorSetLayoutBinding> b(types.size());
+    for (std::uint32_t i = 0; i < types.size(); ++i) {
         b[i].binding = i;
-        b[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        b[i].descriptorType = types[i];
         b[i].descriptorCount = 1;
         b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
     }
     VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    lci.bindingCount = bindings;
+    lci.bindingCount = std::uint32_t(b.size());
     lci.pBindings = b.data();
     VkDescriptorSetLayout sl;
     LC_VK(vkCreateDescriptorSetLayout(device_, &lci, nullptr, &sl));
-    StorageLayouts out;
+    PassLayouts out;
     out.set = DescriptorSetLayoutHandle(device_, sl);
     name(VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, sl, n + ".setLayout");
+    const VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantBytes};
     VkPipelineLayoutCreateInfo pci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
     pci.setLayoutCount = 1;
     pci.pSetLayouts = &sl;
+    pci.pushConstantRangeCount = pushConstantBytes ? 1 : 0;
+    pci.pPushConstantRanges = &push;
     VkPipelineLayout pl;
     LC_VK(vkCreatePipelineLayout(device_, &pci, nullptr, &pl));
     out.pipeline = PipelineLayoutHandle(device_, pl);

@@ -209,14 +209,16 @@ public:
     Image createDepthImage(std::uint32_t w, std::uint32_t h, VkFormat format, const std::string& name) const;
     ShaderModuleHandle createShader(const std::uint32_t* words, std::size_t wordCount,
                                     const std::string& name) const;
-    // The layouts of a compute pass whose bindings 0..bindings-1 are all
-    // storage buffers: one descriptor set layout and a pipeline layout over it,
-    // named "<name>.setLayout" and "<name>.pipelineLayout".
-    struct StorageLayouts {
+    // The layouts of a compute pass whose binding i has descriptor type
+    // types[i]: one descriptor set layout and a pipeline layout over it (with
+    // `pushConstantBytes` of compute push constants when not 0), named
+    // "<name>.setLayout" and "<name>.pipelineLayout".
+    struct PassLayouts {
         DescriptorSetLayoutHandle set;
         PipelineLayoutHandle pipeline;
     };
-    StorageLayouts createStorageLayouts(std::uint32_t bindings, const std::string& name) const;
+    PassLayouts createPassLayouts(const std::vector<VkDescriptorType>& types, const std::string& name,
+                                  std::uint32_t pushConstantBytes = 0) const;
 
     // Records a one-time command buffer, submits it, waits. Returns the CPU
     // wall-clock milliseconds from submit to the fence signalling.

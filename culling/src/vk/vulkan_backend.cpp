@@ -303,7 +303,7 @@ private:
 };
 
 void VulkanBackend::createComputeObjects() {
-    auto layouts = ctx_.createStorageLayouts(kBindings, "cull");
+    auto layouts = ctx_.createPassLayouts(std::vector<VkDescriptorType>(kBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER), "cull");
     setLayout_ = std::move(layouts.set);
     computeLayout_ = std::move(layouts.pipeline);
 
