@@ -33,6 +33,10 @@ layout(constant_id = 8) const uint DEPTH_LOAD = 2u;
 // light_bins and cull_lists: 1 when the lists filter their candidates through
 // the depth bins (binding 8, after the row masks).
 layout(constant_id = 9) const uint DEPTH_BINS = 0u;
+// cull_lists, clustered on a CPU device: 0, or the slices (at most 32) one
+// invocation takes: an invocation per tile and TILE_WALK slices instead of
+// one per list.
+layout(constant_id = 10) const uint TILE_WALK = 0u;
 
 layout(std430, binding = 0) readonly buffer Params { GpuCullParams params; };
 // A private copy of the parameters, filled by loadParams() at the top of every

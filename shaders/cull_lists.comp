@@ -31,6 +31,20 @@ bool spotConeOutsideChunkPlane(GpuSpotCone s, vec4 plane, float eps) {
     return spotConeOutsidePlane(s.apexRange.xyz, s.axisCos.xyz, s.apexRange.w, s.axisCos.w, s.sinAngle.x, plane, eps);
 }
 
+// The chunk's bounding sphere for the spot cone-sphere test: centroid of the
+// corners, farthest corner, widened. Unrolled: lavapipe caps the loop
+// iterations of an invocation (vulkan_backend.cpp, kLoopLimit), so no loops
+// per list or light.
+void chunkSphere(Chunk ch, out vec3 cellCentre, out float cellRadius) {
+    cellCentre = 0.125 * (((ch.corners[0] + ch.corners[1]) + (ch.corners[2] + ch.corners[3])) +
+                          ((ch.corners[4] + ch.corners[5]) + (ch.corners[6] + ch.corners[7])));
+    cellRadius = max(max(max(distance(ch.corners[0], cellCentre), distance(ch.corners[1], cellCentre)),
+                         max(distance(ch.corners[2], cellCentre), distance(ch.corners[3], cellCentre))),
+                     max(max(distance(ch.corners[4], cellCentre), distance(ch.corners[5], cellCentre)),
+                         max(distance(ch.corners[6], cellCentre), distance(ch.corners[7], cellCentre))));
+    cellRadius += (length(cellCentre) + cellRadius) * P.cluster.z + P.cluster.w;
+}
+
 // Whether light l (a candidate of the list's bins) goes into the list: the
 // sphere against the list's chunk, then the spot cone refinements and the
 // 2.5d cell test, as the CPU reference.
@@ -75,6 +89,122 @@ bool lightKept(uint l, Chunk ch, uint spotMode, vec3 cellCentre, float cellRadiu
     return pass;
 }
 
+// Clustered on a CPU device (TILE_WALK slices an invocation): the lists of
+// slices q * TILE_WALK .. of one tile in one walk over the tile's candidates,
+// each candidate tested only against the slices its depth range reaches. An
+// invocation per list cost lavapipe one SIMD pass per 8 of the tile's 32
+// lists, most of them empty, and the same candidate words read by every
+// list. The lists are the per-list walk's: the same chunks (same
+// expressions) and the same test; a light goes into its slices' lists in
+// ascending order. The slice range of a light is found from the chunks'
+// own widened bounds (the chunk test's near and far planes can keep no
+// slice outside it), so it is exact whatever the slicing.
+float walkChunkLo(uint c) { return max(widenDown(sliceBoundary(P.cluster.x, P.cluster.y, c)), isOrtho() ? -3.4e38 : 0.0); }
+float walkChunkHi(uint c) { return widenUp(sliceBoundary(P.cluster.x, P.cluster.y, c + 1u)); }
+
+void clusteredTileWalk(uint id) {
+    uint groups = (CELLS + TILE_WALK - 1u) / TILE_WALK;
+    uint tile = id / groups, q = id % groups;
+    if (tile >= P.size.z * P.size.w) return;
+    uint firstCell = q * TILE_WALK, endCell = min(firstCell + TILE_WALK, CELLS);
+    uint firstList = tile * P.counts.y;
+    uint stashSlots = P.bins.z;
+    GpuTileBounds tb = tiles[tile];
+    uint mine = ((endCell - firstCell >= 32u) ? 0xffffffffu : ((1u << (endCell - firstCell)) - 1u)) << firstCell;
+    uint walk = mine;
+    if ((P.counts.w & LC_FLAG_SKIP_EMPTY) != 0u) walk = tb.depthMin <= tb.depthMax ? walk & tb.cellMask : 0u;
+    uint n[32]; // the counts of slices firstCell .. endCell - 1
+    for (uint k = 0u; k < TILE_WALK; ++k) n[k] = 0u;
+    if (WRITE_PASS != 0u) {
+        // Lists that do not fit the index array are left to the host (as the
+        // per-list walk); lists the stash holds whole are copied.
+        uint lists = walk;
+        while (lists != 0u) {
+            uint c = uint(findLSB(lists));
+            lists &= lists - 1u;
+            uint list = firstList + c, count = listCount[list], base = listOffset[list];
+            if (base + count > uint(lightIndices.length())) {
+                walk &= ~(1u << c);
+            } else if (count <= stashSlots) {
+                for (uint i = 0u; i < count; ++i) lightIndices[base + i] = stash[list * stashSlots + i];
+                walk &= ~(1u << c);
+            }
+        }
+    }
+    uint tested = 0u;
+    bool cut = false;
+    if (walk != 0u) {
+        uint cLo = uint(findLSB(walk)), cHi = uint(findMSB(walk));
+        float rangeLo = walkChunkLo(cLo), rangeHi = walkChunkHi(cHi);
+        uint tilesX = P.size.z, words = P.bins.x;
+        uint columnBase = (tile % tilesX) * words, rowBase = P.bins.y + (tile / tilesX) * words;
+        bool depthBins = DEPTH_BINS != 0u;
+        uint nearBase = P.bins.w + depthBinOf(rangeHi) * words;
+        uint farBase = P.bins.w + (LC_DEPTH_BINS + depthBinOf(rangeLo)) * words;
+        uint spotMode = P.counts.w & (LC_FLAG_SPOT_CONE_SPHERE | LC_FLAG_SPOT_CONE_PLANES);
+        bool logSlices = SLICING == LC_SLICING_LOG && P.cluster.x > 0.0 && P.cluster.y > P.cluster.x;
+        float sliceScale = logSlices ? float(CELLS) / log2(P.cluster.y / P.cluster.x)
+                                     : float(CELLS) / max(P.cluster.y - P.cluster.x, 1e-30);
+        uint w = 0u, m = 0u;
+        uvec4 quad = uvec4(0u);
+        while (true) { // as the per-list walk (LANES == 1 in main)
+            while (m == 0u && w < words) {
+                if ((w & 3u) == 0u) {
+                    quad = binQuads[(columnBase + w) >> 2u] & binQuads[(rowBase + w) >> 2u];
+                    if (depthBins) quad &= binQuads[(nearBase + w) >> 2u] & binQuads[(farBase + w) >> 2u];
+                }
+                m = quad[w & 3u];
+                ++w;
+            }
+            if (m == 0u) break;
+            uint l = (w - 1u) * 32u + uint(findLSB(m));
+            m &= m - 1u;
+            vec4 L = lights[l].centerRadius;
+            float r = widenedRadius(L);
+            float a = widenDown(-L.z - r), b = widenUp(-L.z + r);
+            // A first guess of the slices from the slicing's inverse, then
+            // moved out while a neighbour's chunk still reaches [a, b].
+            float ta = logSlices ? (a > P.cluster.x ? (log2(a) - log2(P.cluster.x)) * sliceScale : 0.0)
+                                 : (a - P.cluster.x) * sliceScale;
+            float tb2 = logSlices ? (b > P.cluster.x ? (log2(b) - log2(P.cluster.x)) * sliceScale : 0.0)
+                                  : (b - P.cluster.x) * sliceScale;
+            uint c0 = uint(clamp(ta, float(cLo), float(cHi))), c1 = uint(clamp(tb2, float(cLo), float(cHi)));
+            c1 = max(c1, c0);
+            while (c0 > cLo && walkChunkHi(c0 - 1u) >= a) --c0;
+            while (c1 < cHi && walkChunkLo(c1 + 1u) <= b) ++c1;
+            uint cand = walk & ((((c1 - c0 + 1u) >= 32u) ? 0xffffffffu : ((1u << (c1 - c0 + 1u)) - 1u)) << c0);
+            while (cand != 0u) {
+                uint c = uint(findLSB(cand));
+                cand &= cand - 1u;
+                ++tested;
+                Chunk ch = makeChunk(tile, walkChunkLo(c), walkChunkHi(c));
+                vec3 cellCentre = vec3(0.0);
+                float cellRadius = 0.0;
+                if (spotMode == LC_FLAG_SPOT_CONE_SPHERE) chunkSphere(ch, cellCentre, cellRadius);
+                if (lightKept(l, ch, spotMode, cellCentre, cellRadius, false, 0.0, 0.0, 0.0, 0.0, 0u)) {
+                    uint list = firstList + c, k = n[c - firstCell];
+                    if (WRITE_PASS != 0u) lightIndices[listOffset[list] + k] = l;
+                    else if (k < stashSlots) stash[list * stashSlots + k] = l;
+                    n[c - firstCell] = k + 1u;
+                }
+            }
+        }
+        cut = w < words || m != 0u; // a loop ended by the driver's cap, not by the candidates
+    }
+    if (cut) atomicOr(status, STATUS_LOOP_LIMIT);
+    if (WRITE_PASS == 0u) {
+        for (uint c = firstCell; c < endCell; ++c) listCount[firstList + c] = n[c - firstCell];
+        if (tested != 0u && atomicAdd(candidateTests, tested) + tested < tested) atomicOr(status, STATUS_TESTS_OVERFLOW);
+    } else {
+        uint lists = walk;
+        while (lists != 0u) {
+            uint c = uint(findLSB(lists));
+            lists &= lists - 1u;
+            if (n[c - firstCell] != listCount[firstList + c]) atomicOr(status, STATUS_COUNT_MISMATCH);
+        }
+    }
+}
+
 void main() {
     loadParams();
     uint id = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
@@ -86,6 +216,10 @@ void main() {
         } else if (id < lightCount && id < uint(lightIndices.length())) {
             lightIndices[id] = id;
         }
+        return;
+    }
+    if (TILE_WALK != 0u) {
+        clusteredTileWalk(id);
         return;
     }
     uint stashSlots = P.bins.z;
@@ -149,15 +283,7 @@ void main() {
         vec3 cellCentre = vec3(0.0);
         float cellRadius = 0.0;
         if (spotMode == LC_FLAG_SPOT_CONE_SPHERE) {
-            // Unrolled: lavapipe caps the loop iterations of an invocation
-            // (vulkan_backend.cpp, kLoopLimit), so no loops per list or light.
-            cellCentre = 0.125 * (((ch.corners[0] + ch.corners[1]) + (ch.corners[2] + ch.corners[3])) +
-                                  ((ch.corners[4] + ch.corners[5]) + (ch.corners[6] + ch.corners[7])));
-            cellRadius = max(max(max(distance(ch.corners[0], cellCentre), distance(ch.corners[1], cellCentre)),
-                                 max(distance(ch.corners[2], cellCentre), distance(ch.corners[3], cellCentre))),
-                             max(max(distance(ch.corners[4], cellCentre), distance(ch.corners[5], cellCentre)),
-                                 max(distance(ch.corners[6], cellCentre), distance(ch.corners[7], cellCentre))));
-            cellRadius += (length(cellCentre) + cellRadius) * P.cluster.z + P.cluster.w;
+            chunkSphere(ch, cellCentre, cellRadius);
         }
         // 2.5d: the cell of view depth d is (log2(d) - cellLog0) * cellScale
         // (log slicing; sliceOf's log(d / lo) / log(hi / lo) x CELLS with the
@@ -210,7 +336,7 @@ void main() {
                     ++n;
                 }
             }
-            cut = w < words; // a loop ended by the driver's cap, not by the list
+            cut = w < words || m != 0u; // a loop ended by the driver's cap, not by the list
         } else {
             // A subgroup per list (GPUs): lane i takes words i, i + LANES, ...
             uint w0 = 0u;

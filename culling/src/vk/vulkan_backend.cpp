@@ -67,7 +67,7 @@ constexpr float kRelEps = 2e-5f;
 constexpr float kAbsEps = 1e-6f;
 
 constexpr std::uint32_t kBindings = 11; // cull_common.glsl bindings 0..10
-constexpr std::uint32_t kSpecConstants = 10; // cull_common.glsl constant_id 0..9
+constexpr std::uint32_t kSpecConstants = 11; // cull_common.glsl constant_id 0..10
 using SpecConstants = std::array<std::uint32_t, kSpecConstants>;
 enum Binding : std::uint32_t { bParams, bDepth, bTiles, bLights, bCounts, bOffsets, bIndices, bStatus, bBins };
 // Stash slots per list at most (cull_common.glsl binding 10): the count pass
@@ -859,9 +859,9 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const std::uint32_t algoId = std::uint32_t(algo), testId = std::uint32_t(settings.test),
                         slicingId = std::uint32_t(settings.slicing);
     auto spec = [&](std::uint32_t local, std::uint32_t write, std::uint32_t lanesPerTile = 1,
-                    std::uint32_t depthLoad = 2) {
-        return SpecConstants{local, grid.tileSize, cells,        slicingId, algoId, testId,
-                             write, lanesPerTile,  depthLoad, depthBins ? 1u : 0u};
+                    std::uint32_t depthLoad = 2, std::uint32_t tileWalk = 0) {
+        return SpecConstants{local, grid.tileSize, cells,     slicingId,          algoId,  testId,
+                             write, lanesPerTile,  depthLoad, depthBins ? 1u : 0u, tileWalk};
     };
     // Work layout per device kind (the LANES constant): on a CPU device
     // (lavapipe) an invocation per tile and per list, so SIMD lanes are tiles /
@@ -894,6 +894,22 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                                           ": the driver caps a shader invocation at 65,535 loop iterations)");
     const bool subgroupLanes = lanes > 1;
     const std::uint32_t itemsPerGroup = kLocal / lanes;
+    // clustered on a CPU device: an invocation per tile and `walk` slices
+    // (cull_lists.comp, clusteredTileWalk), as many as its loops fit the cap:
+    // the words, per candidate at most 2 x walk + 3 iterations (its slice
+    // range found and walked), the slices' counts and checks, and the
+    // stashed lists copied. Fewer invocations walk the words fewer times.
+    std::uint32_t walk = 0;
+    if (algo == Algorithm::Clustered && ctx_.isCpuDevice() && lanes == 1)
+        for (std::uint32_t s : {32u, 16u, 8u, 4u}) {
+            const std::uint64_t iters = std::uint64_t(binWords) + (2ull * s + 3) * n + 4ull * s + std::uint64_t(s) * stashCap;
+            if (iters <= kLoopLimit) {
+                walk = std::min(s, cells);
+                break;
+            }
+        }
+    const std::uint64_t listItems =
+        walk ? std::uint64_t(tiles) * ((cells + walk - 1) / walk) : std::uint64_t(listTotal) * lanes;
     // Wide depth loads (tile_bounds.comp, LC_WIDE_DEPTH_LOADS): an invocation
     // per tile, 8 or 2 pixels a load where the width and the tile size are
     // multiples of it, so every tile row starts on a whole load.
@@ -905,8 +921,10 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                       : computePipeline("tile_bounds", boundsShader_, spec(kLocal, 0, lanes), subgroupLanes);
     const Grid boundsGroups = Grid{(grid.tilesX + itemsPerGroup - 1) / itemsPerGroup, grid.tilesY};
     VkPipeline binsPipe = computePipeline("light_bins", binsShader_, spec(kLocal, 0), false);
-    VkPipeline countPipe = computePipeline("cull_lists.count", cullShader_, spec(kLocal, 0, lanes), subgroupLanes);
-    VkPipeline writePipe = computePipeline("cull_lists.write", cullShader_, spec(kLocal, 1, lanes), subgroupLanes);
+    VkPipeline countPipe =
+        computePipeline("cull_lists.count", cullShader_, spec(kLocal, 0, lanes, 2, walk), subgroupLanes);
+    VkPipeline writePipe =
+        computePipeline("cull_lists.write", cullShader_, spec(kLocal, 1, lanes, 2, walk), subgroupLanes);
     VkPipeline prunePipe = fptl ? computePipeline("fine_prune", pruneShader_, spec(kLocal, 0), false) : VK_NULL_HANDLE;
     VkPipeline packPipe = fptl ? computePipeline("fine_prune.pack", pruneShader_, spec(kLocal, 1), false) : VK_NULL_HANDLE;
     VkPipeline zbinInitPipe = zbin ? computePipeline("zbin.init", zbinShader_, spec(kLocal, 0), false) : VK_NULL_HANDLE;
@@ -921,8 +939,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const bool all = algo == Algorithm::All;
     // One bins invocation per plane word and per pair of depth-bin words.
     const Grid binGroups = groupsFor(planeBinWords + depthBinWords, lim);
-    const Grid countGroups = groupsFor(all ? 1 : std::uint64_t(listTotal) * lanes, lim);
-    const Grid writeGroups = groupsFor(all ? n : std::uint64_t(listTotal) * lanes, lim);
+    const Grid countGroups = groupsFor(all ? 1 : listItems, lim);
+    const Grid writeGroups = groupsFor(all ? n : listItems, lim);
     const Grid packGroups = groupsFor(listTotal, lim);
 
     // A dispatch that reads (or ORs into) what the dispatches before it wrote.
