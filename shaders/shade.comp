@@ -29,41 +29,79 @@ layout(std430, binding = 5) readonly buffer CountBuf { uint listCount[]; };
 layout(std430, binding = 6) readonly buffer IndexBuf { uint lightIndices[]; };
 layout(std430, binding = 7) buffer OutBuf { float rgb[]; };
 layout(std140, binding = 8) uniform LightBlock { GpuShadeLight blockLights[BLOCK_LIGHTS]; };
-// x: the first light of this dispatch, y: how many (all lights: the image is
+// All lights: x: the first light of this dispatch, y: how many (the image is
 // shaded in chunks of at most BLOCK_LIGHTS lights, in index order), z: 1 when
 // an earlier chunk's sums are in rgb to add to (the same float additions in
-// the same order as one loop).
+// the same order as one loop). Lists: x: the first light of the block.
 layout(push_constant) uniform Chunk { uvec4 C; };
 
 #define LIGHT(li, field) (LIGHTS_IN_BLOCK != 0u ? blockLights[(li) - C.x].field : lights[li].field)
 
+// One light's term at one pixel, the CPU reference's float operations in its
+// order (shade.cpp).
+vec3 lightTerm(vec3 p, vec3 n, vec3 lightPos, vec3 power, vec4 s) {
+    precise vec3 d = lightPos - p;
+    precise float d2 = (d.x * d.x + d.y * d.y) + d.z * d.z;
+    // A light exactly at the pixel has no direction: clamp the length.
+    precise float len = sqrt(max(d2, 1e-30));
+    precise float ndl = ((n.x * d.x + n.y * d.y) + n.z * d.z) / len;
+    precise float f = max(ndl, 0.0) / max(d2, 1e-4);
+    // Spot cone (shade.cpp): inside when -(axis.d) >= len cos a.
+    precise float axial = 0.0 - ((s.x * d.x + s.y * d.y) + s.z * d.z);
+    if (!(axial >= len * s.w)) f = 0.0;
+    precise vec3 term = power * f;
+    return term;
+}
+
+vec3 storedSum(uint i) { return vec3(rgb[3u * i + 0u], rgb[3u * i + 1u], rgb[3u * i + 2u]); }
+void store(uint i, vec3 v) {
+    rgb[3u * i + 0u] = v.x;
+    rgb[3u * i + 1u] = v.y;
+    rgb[3u * i + 2u] = v.z;
+}
+
+// All lights: two horizontally adjacent pixels an invocation, so that each
+// light loaded serves both (the loads are most of this loop on lavapipe).
+void shadeAllLights() {
+    uint x = 2u * gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
+    if (x >= P.size.x || y >= P.size.y) return;
+    bool second = x + 1u < P.size.x;
+    uint i0 = y * P.size.x + x, i1 = second ? i0 + 1u : i0;
+    bool lit0 = pixelList[i0] != LC_SHADE_NO_LIST, lit1 = pixelList[i1] != LC_SHADE_NO_LIST;
+    vec3 p0 = pixels[i0].position.xyz, n0 = pixels[i0].normal.xyz;
+    vec3 p1 = pixels[i1].position.xyz, n1 = pixels[i1].normal.xyz;
+    precise vec3 acc0 = C.z != 0u ? storedSum(i0) : vec3(0.0);
+    precise vec3 acc1 = C.z != 0u ? storedSum(i1) : vec3(0.0);
+    if (lit0 || lit1) {
+        for (uint k = 0u; k < C.y; ++k) {
+            uint li = C.x + k;
+            vec3 lp = LIGHT(li, position.xyz), pw = LIGHT(li, power.xyz);
+            vec4 s = LIGHT(li, spot);
+            acc0 += lightTerm(p0, n0, lp, pw, s);
+            acc1 += lightTerm(p1, n1, lp, pw, s);
+        }
+    }
+    store(i0, lit0 ? acc0 : vec3(0.0));
+    if (second) store(i1, lit1 ? acc1 : vec3(0.0));
+}
+
 void main() {
+    if (ALL_LIGHTS != 0u) {
+        shadeAllLights();
+        return;
+    }
     uint x = gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
     if (x >= P.size.x || y >= P.size.y) return;
     uint i = y * P.size.x + x;
     uint l = pixelList[i];
     precise vec3 acc = vec3(0.0);
-    if (ALL_LIGHTS != 0u && C.z != 0u) acc = vec3(rgb[3u * i + 0u], rgb[3u * i + 1u], rgb[3u * i + 2u]);
     if (l != LC_SHADE_NO_LIST) {
         vec3 p = pixels[i].position.xyz, n = pixels[i].normal.xyz;
-        uint first = (ALL_LIGHTS != 0u) ? C.x : listOffset[l];
-        uint count = (ALL_LIGHTS != 0u) ? C.y : listCount[l];
+        uint first = listOffset[l], count = listCount[l];
         for (uint k = 0u; k < count; ++k) {
-            uint li = (ALL_LIGHTS != 0u) ? first + k : lightIndices[first + k];
-            precise vec3 d = LIGHT(li, position.xyz) - p;
-            precise float d2 = (d.x * d.x + d.y * d.y) + d.z * d.z;
-            // A light exactly at the pixel has no direction: clamp the length.
-            precise float len = sqrt(max(d2, 1e-30));
-            precise float ndl = ((n.x * d.x + n.y * d.y) + n.z * d.z) / len;
-            precise float f = max(ndl, 0.0) / max(d2, 1e-4);
-            // Spot cone (shade.cpp): inside when -(axis.d) >= len cos a.
-            vec4 s = LIGHT(li, spot);
-            precise float axial = 0.0 - ((s.x * d.x + s.y * d.y) + s.z * d.z);
-            if (!(axial >= len * s.w)) f = 0.0;
-            acc += LIGHT(li, power.xyz) * f;
+            uint li = lightIndices[first + k];
+            acc += lightTerm(p, n, LIGHT(li, position.xyz), LIGHT(li, power.xyz), LIGHT(li, spot));
         }
     }
-    rgb[3u * i + 0u] = acc.x;
-    rgb[3u * i + 1u] = acc.y;
-    rgb[3u * i + 2u] = acc.z;
+    store(i, acc);
 }

@@ -88,9 +88,11 @@ TEST_F(VulkanShade, LightsBeyondOneUniformBlockShadeInChunksAsOneLoop) {
     // lights take at least three chunks of the all-lights image, each adding
     // to the sums the last one left; a list image with as many lights reads
     // them from the storage buffer. Both must equal the CPU reference's
-    // single loop over the same lights in the same order.
+    // single loop over the same lights in the same order. An odd width: the
+    // all-lights image shades two pixels of a row an invocation, and the
+    // last invocation of each row has one.
     CullBackend& gpu = gputest::vulkan();
-    const Scene scene = smallScene("atrium", 64, 36, 3000);
+    const Scene scene = smallScene("atrium", 65, 37, 3000);
     const Projection proj(scene.camera);
     const ViewLights lights = makeViewLights(scene);
     ASSERT_EQ(lights.size(), 3000u);
@@ -99,7 +101,7 @@ TEST_F(VulkanShade, LightsBeyondOneUniformBlockShadeInChunksAsOneLoop) {
     expectSameImage(gpu.shade(allIn, lights, nullptr), shadeCpu(allIn, lights, nullptr), allIn, "all lights");
     CullSettings settings;
     settings.algorithm = Algorithm::Naive;
-    const CullResult result = gpu.cull(depth, proj, TileGrid::make(64, 36, 16), lights, settings);
+    const CullResult result = gpu.cull(depth, proj, TileGrid::make(65, 37, 16), lights, settings);
     ASSERT_GT(result.lightIndices.size(), 2000u);
     const ShadeInputs in = makeShadeInputs(depth, proj, &result);
     expectSameImage(gpu.shade(in, lights, &result), shadeCpu(in, lights, &result), in, "naive lists");
