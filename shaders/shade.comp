@@ -1,6 +1,7 @@
 #version 450
 // The Lambert shading pass: one invocation per pixel (8x8 pixels per
-// workgroup), each looping over the lights of its pixel's list. The formula
+// workgroup), each looping over the lights of its pixel's list, or per two
+// pixels of a row for the all-lights image. The formula
 // and the order of float operations are those of the CPU reference
 // (culling/src/truth/shade.cpp): `precise` keeps the compiler from contracting them
 // into FMAs, so the two differ only by the device's sqrt/division rounding.
