@@ -33,7 +33,7 @@ layout(std140, binding = 8) uniform LightBlock { GpuShadeLight blockLights[BLOCK
 // All lights: x: the first light of this dispatch, y: how many (the image is
 // shaded in chunks of at most BLOCK_LIGHTS lights, in index order), z: 1 when
 // an earlier chunk's sums are in rgb to add to (the same float additions in
-// the same order as one loop). Lists: x: the first light of the block.
+// the same order as one loop). Lists from the block go in the same chunks.
 layout(push_constant) uniform Chunk { uvec4 C; };
 
 #define LIGHT(li, field) (LIGHTS_IN_BLOCK != 0u ? blockLights[(li) - C.x].field : lights[li].field)
@@ -95,13 +95,16 @@ void main() {
     if (x >= P.size.x || y >= P.size.y) return;
     uint i = y * P.size.x + x;
     uint l = pixelList[i];
-    precise vec3 acc = vec3(0.0);
+    precise vec3 acc = C.z != 0u ? storedSum(i) : vec3(0.0);
     if (l != LC_SHADE_NO_LIST) {
         vec3 p = pixels[i].position.xyz, n = pixels[i].normal.xyz;
         uint first = listOffset[l], count = listCount[l];
         for (uint k = 0u; k < count; ++k) {
             uint li = lightIndices[first + k];
-            acc += lightTerm(p, n, LIGHT(li, position.xyz), LIGHT(li, power.xyz), LIGHT(li, spot));
+            // From the block: only the lights of this chunk (ascending lists,
+            // so the chunks add them in the list's order).
+            if (LIGHTS_IN_BLOCK == 0u || li - C.x < C.y)
+                acc += lightTerm(p, n, LIGHT(li, position.xyz), LIGHT(li, power.xyz), LIGHT(li, spot));
         }
     }
     store(i, acc);

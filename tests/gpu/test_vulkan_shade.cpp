@@ -10,6 +10,7 @@
 #include "culling/scene/scene_io.hpp"
 #include "culling/truth/shade.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 using namespace lc;
@@ -86,9 +87,10 @@ TEST_F(VulkanShade, MatchesTheCpuReferenceForEveryAlgorithmAndAllLights) {
 TEST_F(VulkanShade, LightsBeyondOneUniformBlockShadeInChunksAsOneLoop) {
     // A uniform block holds at most 65,536 / 48 = 1,365 lights, so 3,000
     // lights take at least three chunks of the all-lights image, each adding
-    // to the sums the last one left; a list image with as many lights reads
-    // them from the storage buffer. Both must equal the CPU reference's
-    // single loop over the same lights in the same order. An odd width: the
+    // to the sums the last one left; a list image with as many lights goes
+    // in the same chunks when its lists ascend, else reads the storage
+    // buffer. All must equal the CPU reference's single loop over the same
+    // lights in the same order. An odd width: the
     // all-lights image shades two pixels of a row an invocation, and the
     // last invocation of each row has one.
     CullBackend& gpu = gputest::vulkan();
@@ -105,6 +107,15 @@ TEST_F(VulkanShade, LightsBeyondOneUniformBlockShadeInChunksAsOneLoop) {
     ASSERT_GT(result.lightIndices.size(), 2000u);
     const ShadeInputs in = makeShadeInputs(depth, proj, &result);
     expectSameImage(gpu.shade(in, lights, &result), shadeCpu(in, lights, &result), in, "naive lists");
+    // Lists not in ascending order (a custom shader's may be any): one pass
+    // over the storage buffer, in the lists' own order.
+    CullResult reversed = result;
+    for (std::size_t l = 0; l < reversed.listCount.size(); ++l) {
+        const auto b = reversed.lightIndices.begin() + reversed.listOffset[l];
+        std::reverse(b, b + reversed.listCount[l]);
+    }
+    const ShadeInputs rin = makeShadeInputs(depth, proj, &reversed);
+    expectSameImage(gpu.shade(rin, lights, &reversed), shadeCpu(rin, lights, &reversed), rin, "descending lists");
 }
 
 TEST_F(VulkanShade, PipelineImageErrorAgreesWithTheCpuBackendOnTheSameDepth) {

@@ -107,9 +107,16 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     // The lights again as uniform blocks of blockLights_ each (the last one
     // padded): every chunk of the all-lights image, and a list image's lights
     // when one block holds them all.
+    // A list image goes in chunks too when every list is in ascending light
+    // order: each chunk then adds its lights in the list's own order. Other
+    // lists (a custom shader's, say) read the storage buffer in one pass.
     const bool allLights = culled == nullptr;
-    const bool inBlock = allLights || lightCount <= blockLights_;
-    const std::size_t chunks = allLights ? std::max<std::size_t>((lightCount + blockLights_ - 1) / blockLights_, 1) : 1;
+    bool ascending = culled != nullptr;
+    for (std::size_t l = 0; ascending && l < listTotal; ++l)
+        for (std::uint32_t k = 1; ascending && k < culled->listCount[l]; ++k)
+            ascending = culled->lightIndices[culled->listOffset[l] + k - 1] < culled->lightIndices[culled->listOffset[l] + k];
+    const bool inBlock = allLights || lightCount <= blockLights_ || ascending;
+    const std::size_t chunks = inBlock ? std::max<std::size_t>((lightCount + blockLights_ - 1) / blockLights_, 1) : 1;
     const std::size_t blockBytes = std::size_t(blockLights_) * sizeof(GpuShadeLight);
     Buffer blockBuf = ctx_.createBuffer(inBlock ? chunks * blockBytes : 4, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                                         "shade.lightBlocks");
