@@ -31,6 +31,23 @@ bool spotConeOutsideChunkPlane(GpuSpotCone s, vec4 plane, float eps) {
     return spotConeOutsidePlane(s.apexRange.xyz, s.axisCos.xyz, s.apexRange.w, s.axisCos.w, s.sinAngle.x, plane, eps);
 }
 
+// An invocation's walk over its bins' candidates (CPU devices): while the
+// current word m has no candidate left, the next word of the column, row and
+// depth bins ANDed (fetched four words a load into quad; w counts the words
+// taken). Returns the word to take candidates from, 0 when none is left.
+uint nextCandidateWord(inout uint w, uint m, inout uvec4 quad, uint words, uint columnBase, uint rowBase,
+                       bool depthBins, uint nearBase, uint farBase) {
+    while (m == 0u && w < words) {
+        if ((w & 3u) == 0u) {
+            quad = binQuads[(columnBase + w) >> 2u] & binQuads[(rowBase + w) >> 2u];
+            if (depthBins) quad &= binQuads[(nearBase + w) >> 2u] & binQuads[(farBase + w) >> 2u];
+        }
+        m = quad[w & 3u];
+        ++w;
+    }
+    return m;
+}
+
 // The chunk's bounding sphere for the spot cone-sphere test: centroid of the
 // corners, farthest corner, widened. Unrolled: lavapipe caps the loop
 // iterations of an invocation (vulkan_backend.cpp, kLoopLimit), so no loops
@@ -110,8 +127,7 @@ void clusteredTileWalk(uint id) {
     uint firstList = tile * P.counts.y;
     uint stashSlots = P.bins.z;
     GpuTileBounds tb = tiles[tile];
-    uint mine = ((endCell - firstCell >= 32u) ? 0xffffffffu : ((1u << (endCell - firstCell)) - 1u)) << firstCell;
-    uint walk = mine;
+    uint walk = ((endCell - firstCell >= 32u) ? 0xffffffffu : ((1u << (endCell - firstCell)) - 1u)) << firstCell;
     if ((P.counts.w & LC_FLAG_SKIP_EMPTY) != 0u) walk = tb.depthMin <= tb.depthMax ? walk & tb.cellMask : 0u;
     uint n[32]; // the counts of slices firstCell .. endCell - 1
     for (uint k = 0u; k < TILE_WALK; ++k) n[k] = 0u;
@@ -148,14 +164,7 @@ void clusteredTileWalk(uint id) {
         uint w = 0u, m = 0u;
         uvec4 quad = uvec4(0u);
         while (true) { // as the per-list walk (LANES == 1 in main)
-            while (m == 0u && w < words) {
-                if ((w & 3u) == 0u) {
-                    quad = binQuads[(columnBase + w) >> 2u] & binQuads[(rowBase + w) >> 2u];
-                    if (depthBins) quad &= binQuads[(nearBase + w) >> 2u] & binQuads[(farBase + w) >> 2u];
-                }
-                m = quad[w & 3u];
-                ++w;
-            }
+            m = nextCandidateWord(w, m, quad, words, columnBase, rowBase, depthBins, nearBase, farBase);
             if (m == 0u) break;
             uint l = (w - 1u) * 32u + uint(findLSB(m));
             m &= m - 1u;
@@ -317,14 +326,7 @@ void main() {
             uint w = 0u, m = 0u;
             uvec4 quad = uvec4(0u);
             while (true) {
-                while (m == 0u && w < words) {
-                    if ((w & 3u) == 0u) {
-                        quad = binQuads[(columnBase + w) >> 2u] & binQuads[(rowBase + w) >> 2u];
-                        if (depthBins) quad &= binQuads[(nearBase + w) >> 2u] & binQuads[(farBase + w) >> 2u];
-                    }
-                    m = quad[w & 3u];
-                    ++w;
-                }
+                m = nextCandidateWord(w, m, quad, words, columnBase, rowBase, depthBins, nearBase, farBase);
                 if (m == 0u) break;
                 uint l = (w - 1u) * 32u + uint(findLSB(m));
                 m &= m - 1u;
