@@ -1,7 +1,7 @@
 #version 450
-// The Lambert shading pass: one invocation per pixel (8x8 pixels per
-// workgroup), each looping over the lights of its pixel's list, or per two
-// pixels of a row for the all-lights image. The formula
+// The Lambert shading pass: one invocation per four pixels of a row (8x8
+// invocations per workgroup), each pixel looping over the lights of its
+// list, or over every light for the all-lights image. The formula
 // and the order of float operations are those of the CPU reference
 // (culling/src/truth/shade.cpp): `precise` keeps the compiler from contracting them
 // into FMAs, so the two differ only by the device's sqrt/division rounding.
@@ -61,51 +61,57 @@ void store(uint i, vec3 v) {
     rgb[3u * i + 2u] = v.z;
 }
 
-// All lights: two horizontally adjacent pixels an invocation, so that each
-// light loaded serves both (the loads are most of this loop on lavapipe).
-void shadeAllLights() {
-    uint x = 2u * gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
-    if (x >= P.size.x || y >= P.size.y) return;
-    bool second = x + 1u < P.size.x;
-    uint i0 = y * P.size.x + x, i1 = second ? i0 + 1u : i0;
-    bool lit0 = pixelList[i0] != LC_SHADE_NO_LIST, lit1 = pixelList[i1] != LC_SHADE_NO_LIST;
-    vec3 p0 = pixels[i0].position.xyz, n0 = pixels[i0].normal.xyz;
-    vec3 p1 = pixels[i1].position.xyz, n1 = pixels[i1].normal.xyz;
-    precise vec3 acc0 = C.z != 0u ? storedSum(i0) : vec3(0.0);
-    precise vec3 acc1 = C.z != 0u ? storedSum(i1) : vec3(0.0);
-    if (lit0 || lit1) {
-        for (uint k = 0u; k < C.y; ++k) {
-            uint li = C.x + k;
-            vec3 lp = LIGHT(li, position.xyz), pw = LIGHT(li, power.xyz);
-            vec4 s = LIGHT(li, spot);
-            acc0 += lightTerm(p0, n0, lp, pw, s);
-            acc1 += lightTerm(p1, n1, lp, pw, s);
-        }
+// One pixel's list, in the list's order (the chunk's lights only when they
+// come from the block).
+vec3 shadeList(uint l, vec3 p, vec3 n, vec3 sum) {
+    precise vec3 acc = sum;
+    uint first = listOffset[l], count = listCount[l];
+    for (uint k = 0u; k < count; ++k) {
+        uint li = lightIndices[first + k];
+        if (LIGHTS_IN_BLOCK == 0u || li - C.x < C.y)
+            acc += lightTerm(p, n, LIGHT(li, position.xyz), LIGHT(li, power.xyz), LIGHT(li, spot));
     }
-    store(i0, lit0 ? acc0 : vec3(0.0));
-    if (second) store(i1, lit1 ? acc1 : vec3(0.0));
+    return acc;
 }
 
+// Four pixels of a row an invocation, so that each light loaded (and each
+// index, where the four share a list: a tile's) serves all four; on lavapipe
+// these loads are most of the loop. The last group of a row may be short:
+// its missing pixels repeat the row's last one and are not stored.
+const uint PX = 4u;
+
 void main() {
-    if (ALL_LIGHTS != 0u) {
-        shadeAllLights();
-        return;
-    }
-    uint x = gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
+    uint x = PX * gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
     if (x >= P.size.x || y >= P.size.y) return;
-    uint i = y * P.size.x + x;
-    uint l = pixelList[i];
-    precise vec3 acc = C.z != 0u ? storedSum(i) : vec3(0.0);
-    if (l != LC_SHADE_NO_LIST) {
-        vec3 p = pixels[i].position.xyz, n = pixels[i].normal.xyz;
-        uint first = listOffset[l], count = listCount[l];
-        for (uint k = 0u; k < count; ++k) {
-            uint li = lightIndices[first + k];
-            // From the block: only the lights of this chunk (ascending lists,
-            // so the chunks add them in the list's order).
-            if (LIGHTS_IN_BLOCK == 0u || li - C.x < C.y)
-                acc += lightTerm(p, n, LIGHT(li, position.xyz), LIGHT(li, power.xyz), LIGHT(li, spot));
-        }
+    uint i[PX], l[PX];
+    vec3 p[PX], n[PX];
+    precise vec3 acc[PX];
+    bool same = true, lit = false;
+    for (uint j = 0u; j < PX; ++j) {
+        i[j] = y * P.size.x + min(x + j, P.size.x - 1u);
+        l[j] = pixelList[i[j]];
+        same = same && l[j] == l[0];
+        lit = lit || l[j] != LC_SHADE_NO_LIST;
+        p[j] = pixels[i[j]].position.xyz;
+        n[j] = pixels[i[j]].normal.xyz;
+        acc[j] = C.z != 0u ? storedSum(i[j]) : vec3(0.0);
     }
-    store(i, acc);
+    if ((ALL_LIGHTS != 0u || same) && lit) {
+        // One loop for the group: this chunk's lights, or the shared list.
+        uint first = ALL_LIGHTS != 0u ? 0u : listOffset[l[0]];
+        uint count = ALL_LIGHTS != 0u ? C.y : listCount[l[0]];
+        for (uint k = 0u; k < count; ++k) {
+            uint li = ALL_LIGHTS != 0u ? C.x + k : lightIndices[first + k];
+            if (ALL_LIGHTS != 0u || LIGHTS_IN_BLOCK == 0u || li - C.x < C.y) {
+                vec3 lp = LIGHT(li, position.xyz), pw = LIGHT(li, power.xyz);
+                vec4 s = LIGHT(li, spot);
+                for (uint j = 0u; j < PX; ++j) acc[j] += lightTerm(p[j], n[j], lp, pw, s);
+            }
+        }
+    } else if (ALL_LIGHTS == 0u && !same) {
+        for (uint j = 0u; j < PX; ++j)
+            if (l[j] != LC_SHADE_NO_LIST) acc[j] = shadeList(l[j], p[j], n[j], acc[j]);
+    }
+    for (uint j = 0u; j < PX; ++j)
+        if (x + j < P.size.x) store(i[j], l[j] != LC_SHADE_NO_LIST ? acc[j] : vec3(0.0));
 }

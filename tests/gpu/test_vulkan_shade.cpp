@@ -91,8 +91,7 @@ TEST_F(VulkanShade, LightsBeyondOneUniformBlockShadeInChunksAsOneLoop) {
     // in the same chunks when its lists ascend, else reads the storage
     // buffer. All must equal the CPU reference's single loop over the same
     // lights in the same order. An odd width: the
-    // all-lights image shades two pixels of a row an invocation, and the
-    // last invocation of each row has one.
+    // last pixel group of each row is short.
     CullBackend& gpu = gputest::vulkan();
     const Scene scene = smallScene("atrium", 65, 37, 3000);
     const Projection proj(scene.camera);
@@ -116,6 +115,35 @@ TEST_F(VulkanShade, LightsBeyondOneUniformBlockShadeInChunksAsOneLoop) {
     }
     const ShadeInputs rin = makeShadeInputs(depth, proj, &reversed);
     expectSameImage(gpu.shade(rin, lights, &reversed), shadeCpu(rin, lights, &reversed), rin, "descending lists");
+}
+
+TEST_F(VulkanShade, FourPixelGroupsShadeEachPixelWithItsOwnListAtEveryWidth) {
+    // shade.comp shades four pixels of a row an invocation: one loop for the
+    // four where they share a list, a loop each where they do not. Widths of
+    // every remainder mod 4 (the last group of a row is short) and 6-pixel
+    // tiles, so that groups straddle two tiles' lists; the all-lights image
+    // too. Each pixel must get its own list's lights, in its order.
+    CullBackend& gpu = gputest::vulkan();
+    for (std::uint32_t w : {60u, 61u, 62u, 63u}) {
+        Scene scene = smallScene("atrium", w, 30, 40);
+        scene.camera.tileSize = 6;
+        const Projection proj(scene.camera);
+        const ViewLights lights = makeViewLights(scene);
+        const DepthImage depth = makeCpuBackend()->renderDepth(scene, proj);
+        const std::string at = "width " + std::to_string(w);
+        const ShadeInputs allIn = makeShadeInputs(depth, proj, nullptr);
+        expectSameImage(gpu.shade(allIn, lights, nullptr), shadeCpu(allIn, lights, nullptr), allIn,
+                        at + ", all lights");
+        for (Algorithm algo : {Algorithm::Naive, Algorithm::TwoPointFiveD, Algorithm::Clustered}) {
+            CullSettings settings;
+            settings.algorithm = algo;
+            settings.cells = 8;
+            const CullResult result = gpu.cull(depth, proj, TileGrid::make(w, 30, 6), lights, settings);
+            const ShadeInputs in = makeShadeInputs(depth, proj, &result);
+            expectSameImage(gpu.shade(in, lights, &result), shadeCpu(in, lights, &result), in,
+                            at + ", " + toString(algo));
+        }
+    }
 }
 
 TEST_F(VulkanShade, PipelineImageErrorAgreesWithTheCpuBackendOnTheSameDepth) {

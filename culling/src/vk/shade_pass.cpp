@@ -89,8 +89,8 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     if (pixels * sizeof(GpuShadePixel) > lim.maxStorageBufferRange)
         throw DeviceError("shading: a " + std::to_string(in.width) + "x" + std::to_string(in.height) +
                           " G-buffer exceeds this device's storage buffer range");
-    // The all-lights image takes two pixels of a row an invocation (shade.comp).
-    const std::uint32_t columns = culled ? in.width : (in.width + 1) / 2;
+    // Two pixels of a row an invocation (shade.comp).
+    const std::uint32_t columns = (in.width + 3) / 4;
     const std::uint32_t gx = (columns + kGroup - 1) / kGroup, gy = (in.height + kGroup - 1) / kGroup;
     if (gx > lim.maxComputeWorkGroupCount[0] || gy > lim.maxComputeWorkGroupCount[1])
         throw DeviceError("shading: too many workgroups for one dispatch on this device");
