@@ -168,10 +168,13 @@ bool CullWorker::shadeLast() {
     try {
         if (cancel->cancelled) throw lc::Cancelled();
         auto full = std::make_shared<lc::RunOutput>(*last_);
+        const bool same = shaded_ && lc::sameAllLightsImage(*shaded_, shadedScene_->camera, *full, lastScene_->camera);
         lc::shadeAndCompare(*backend_, *full, lc::Projection(lastScene_->camera), true, cancel.get(),
-                            kShadeSliceMs,
-                            [this, generation](double f) { emit shadingProgress(generation, f); });
+                            kShadeSliceMs, [this, generation](double f) { emit shadingProgress(generation, f); },
+                            same ? shaded_.get() : nullptr);
         last_ = full;
+        shaded_ = full;
+        shadedScene_ = lastScene_;
         shaded = true;
         emit finished(generation, last_);
     } catch (const lc::Cancelled&) {
@@ -238,6 +241,7 @@ void CullWorker::drain() {
         try {
             if (!backend_ || req.backend != backendName_ || req.device != deviceSelector_) {
                 backend_.reset(); // release the old device before opening a new one
+                shaded_.reset();  // its images are the old backend's
                 backendName_.clear();
                 depthCamera_.reset();
                 depthMeshes_.reset();

@@ -119,6 +119,11 @@ private:
     quint64 lastGeneration_ = 0;
     std::shared_ptr<const lc::Scene> lastScene_;
     std::shared_ptr<const lc::RunOutput> last_;
+    // The last run shaded on backend_, with its scene: its all-lights image
+    // serves a later run with the same (lc::sameAllLightsImage), as when the
+    // user compares algorithms in a shaded mode.
+    std::shared_ptr<const lc::RunOutput> shaded_;
+    std::shared_ptr<const lc::Scene> shadedScene_;
 };
 
 // The UI-side handle: starts the thread, numbers the requests.

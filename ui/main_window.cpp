@@ -551,11 +551,12 @@ void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::Run
     // A Live edit's lists arrive before its ground truth: log once, with it;
     // the shaded images come last, with the image error.
     if (!out->shadedAll.empty()) {
-        log(tr("run %1: image RMSE %2, max error %3, shading %4 ms")
+        log(tr("run %1: image RMSE %2, max error %3, shading %4 ms%5")
                 .arg(generation)
                 .arg(m.imageRmse, 0, 'g', 6)
                 .arg(m.imageMaxError, 0, 'g', 6)
-                .arg(out->result.timings.shadeMs, 0, 'f', 2));
+                .arg(out->result.timings.shadeMs, 0, 'f', 2)
+                .arg(out->allLightsReused ? tr(" (the all-lights image kept: same pixels and lights)") : QString()));
         emit runFinished(generation);
         return;
     }

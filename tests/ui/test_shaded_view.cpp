@@ -90,24 +90,25 @@ class ShadedViewTest : public QObject {
 
     std::unique_ptr<MainWindow> w_;
     QTemporaryDir tmp_;
-    std::map<QString, QString> cliDirs_; // backend -> the CLI's --out folder
+    std::map<QString, QString> cliDirs_; // backend-algorithm -> the CLI's --out folder
 
     Document* doc() { return w_->document(); }
     CameraView* cv() { return w_->cameraView(); }
 
     // Runs `lightcull run --shaded-images` once per backend on the scene the
     // studio tests open.
-    QString cliOut(const QString& backend) {
-        if (cliDirs_.count(backend)) return cliDirs_[backend];
-        const QString out = tmp_.path() + "/cli-" + backend;
+    QString cliOut(const QString& backend, const QString& algorithm = "2.5d") {
+        const QString key = backend + "-" + algorithm;
+        if (cliDirs_.count(key)) return cliDirs_[key];
+        const QString out = tmp_.path() + "/cli-" + key;
         QProcess cli;
         cli.start(LC_CLI_PATH, {"run", "--builtin", "atrium", "--width", "320", "--height", "180", "--tile", "16",
-                                "--algorithm", "2.5d", "--backend", backend, "--shaded-images", "--out", out});
+                                "--algorithm", algorithm, "--backend", backend, "--shaded-images", "--out", out});
         if (!cli.waitForFinished(lctest::kRunTimeoutMs) || cli.exitCode() != 0) {
             qWarning("lightcull failed: %s", cli.readAllStandardError().constData());
             return {};
         }
-        return cliDirs_[backend] = out;
+        return cliDirs_[key] = out;
     }
 
     // Waits until the shown run is `generation` with its shaded images.
@@ -210,6 +211,40 @@ private slots:
                            int((1.0 - (vp[3] - v * (vp[3] - vp[1]))) * cv()->height()));
         QTest::mouseClick(cv(), Qt::LeftButton, {}, click);
         QTRY_COMPARE(doc()->selectedTile(), ty * 20 + tx);
+    }
+
+    // Comparing algorithms in Difference mode: the next run keeps the
+    // all-lights image (it depends on the pixels and lights, not the lists)
+    // and shades only its culled one, and its three pictures and error are
+    // still exactly the CLI's for that algorithm; a moved light brings a new
+    // all-lights image.
+    void algorithmChangeKeepsTheAllLightsImage() {
+        QVERIFY2(vulkanAvailable(), "no Vulkan backend: the studio would fall back to the CPU");
+        const QString cli = cliOut("vulkan", "clustered");
+        QVERIFY(!cli.isEmpty());
+        openSmall("vulkan");
+        pickMode("difference");
+        QVERIFY(waitShaded(w_->runCulling()));
+        QVERIFY(!doc()->runOutput()->allLightsReused);
+        const std::vector<float> all = doc()->runOutput()->shadedAll;
+
+        QVERIFY(w_->setParamFromUi("algorithm", "clustered"));
+        QVERIFY(waitShaded(w_->runCulling()));
+        QVERIFY(doc()->runOutput()->allLightsReused);
+        QVERIFY(doc()->runOutput()->shadedAll == all);
+        for (int i = 0; i < 3; ++i) {
+            pickMode(kModes[i]);
+            cv()->renderNow();
+            QCOMPARE(differingPixels(cv()->shownImage(), cli + "/" + kPngOfMode[i]), 0L);
+        }
+        const nlohmann::json summary = readJson(cli + "/summary.json");
+        QCOMPARE(cv()->shownImageRmse(), summary["metrics"]["image_rmse"].get<double>());
+
+        const glm::dvec3 p = doc()->scene().lights[0].position;
+        doc()->moveLight(0, p + glm::dvec3(0.3, 0, 0), doc()->newDragId());
+        QVERIFY(waitShaded(w_->runCulling()));
+        QVERIFY(!doc()->runOutput()->allLightsReused);
+        QVERIFY(doc()->runOutput()->shadedAll != all);
     }
 
     // In the heat-map mode nothing is shaded; picking a shaded mode shades

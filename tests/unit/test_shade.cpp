@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 
 using namespace lc;
 
@@ -197,4 +198,52 @@ TEST(Shade, ZBinPixelsShadeTheirBinsLightsOnly) {
     EXPECT_EQ(viaResult, shadeCpu(makeShadeInputs(zbin.depth, proj, &perPixel), zbin.lights, &perPixel));
     EXPECT_EQ(viaResult, shadeLambertCpu(zbin.depth, proj, zbin.lights, &zbin.result));
     EXPECT_NE(viaResult, shadeLambertCpu(naive.depth, proj, naive.lights, &naive.result));
+}
+
+// The all-lights image of an earlier run serves a later one only where the
+// pixels and the lights' shading values are the same: a change of algorithm,
+// tile size or light range keeps it (and the images and error then equal a
+// run shaded from scratch); a moved or recoloured light, a turned spot, an
+// edited depth pixel or another camera does not.
+TEST(Shade, AllLightsImageIsKeptOnlyForTheSamePixelsAndLights) {
+    Scene scene = smallScene("atrium", 96, 54, 16, 24);
+    scene.lights[3].kind = LightKind::Spot; // a cone among the inputs
+    scene.lights[3].outerAngleDeg = 40.0;
+    auto cpu = makeCpuBackend();
+    const Projection proj(scene.camera);
+    RunOutput first = cpuRun(scene, Algorithm::TwoPointFiveD);
+    shadeAndCompare(*cpu, first, proj, true);
+    ASSERT_FALSE(first.allLightsReused);
+
+    // Another algorithm, tile size and light range: the same all-lights image.
+    Scene tiles = scene;
+    tiles.camera.tileSize = 8;
+    tiles.lights[5].explicitRadius = 0.5 * scene.lights[5].radius();
+    RunOutput second = cpuRun(tiles, Algorithm::Clustered);
+    ASSERT_TRUE(sameAllLightsImage(first, scene.camera, second, tiles.camera));
+    RunOutput fresh = second;
+    shadeAndCompare(*cpu, fresh, proj, true);
+    shadeAndCompare(*cpu, second, proj, true, nullptr, 0, {}, &first);
+    EXPECT_TRUE(second.allLightsReused);
+    EXPECT_EQ(second.shadedAll, fresh.shadedAll);
+    EXPECT_EQ(second.shadedCulled, fresh.shadedCulled);
+    EXPECT_NE(second.shadedCulled, first.shadedCulled) << "the lists changed: the culled image must follow";
+    EXPECT_EQ(second.truth.metrics.imageRmse, fresh.truth.metrics.imageRmse);
+    EXPECT_EQ(second.truth.metrics.imageMaxError, fresh.truth.metrics.imageMaxError);
+
+    // What the all-lights image depends on.
+    auto differs = [&](const char* what, const std::function<void(Scene&)>& edit) {
+        Scene s = scene;
+        edit(s);
+        const RunOutput run = cpuRun(s, Algorithm::TwoPointFiveD);
+        EXPECT_FALSE(sameAllLightsImage(first, scene.camera, run, s.camera)) << what;
+    };
+    differs("a moved light", [](Scene& s) { s.lights[2].position.x += 0.01; });
+    differs("a recoloured light", [](Scene& s) { s.lights[2].color.g *= 0.5; });
+    differs("a turned spot", [](Scene& s) { s.lights[3].direction = glm::dvec3(0.1, -1, 0); });
+    differs("a wider spot", [](Scene& s) { s.lights[3].outerAngleDeg = 45.0; });
+    differs("another camera", [](Scene& s) { s.camera.fovYDeg += 1; });
+    RunOutput edited = first;
+    edited.depth.depth[edited.depth.depth.size() / 2] *= 0.999f;
+    EXPECT_FALSE(sameAllLightsImage(first, scene.camera, edited, scene.camera)) << "a depth pixel";
 }

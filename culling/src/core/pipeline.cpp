@@ -85,30 +85,36 @@ std::vector<float> shadeImage(CullBackend& backend, const ShadeInputs& in, const
 } // namespace
 
 void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
-                     const CancelToken* cancel, double sliceMs, const Progress& progress) {
+                     const CancelToken* cancel, double sliceMs, const Progress& progress, const RunOutput* earlier) {
     // zbin: the lists its pixels loop over, a (tile, bin) each.
     const ShadeInputs culledIn = makeShadeInputs(out.depth, proj, &out.result);
     const CullResult& r = out.result;
     // shadeCpu's row bands: a tile row (at least 4) for lists, 16 rows for all lights.
     const std::uint32_t align = std::lcm(std::max(r.grid.tileSize, 4u), 16u);
     double culledMs = 0, allMs = 0;
+    // `all` with one list of every light in order shades exactly the reference.
+    bool identity = r.listCount.size() == 1 && r.listCount[0] == out.lights.size();
+    for (std::size_t i = 0; identity && i < out.lights.size(); ++i)
+        identity = r.lightIndices[r.listOffset[0] + i] == i;
+    const bool reuse = !identity && earlier && earlier->shadedAll.size() == culledIn.position.size();
     // The all-lights image costs more (every light at every pixel), but the
-    // split by images is what a user can follow: half each.
-    auto part = [&progress](double base) -> std::function<void(double)> {
+    // split by images is what a user can follow: half each, unless one is
+    // all there is to shade.
+    const double culledShare = identity || reuse ? 1.0 : 0.5;
+    auto part = [&progress, culledShare](double base) -> std::function<void(double)> {
         if (!progress) return {};
-        return [&progress, base](double f) { progress(base + 0.5 * f); };
+        return [&progress, base, culledShare](double f) { progress(base + culledShare * f); };
     };
     std::vector<float> culled =
         shadeImage(backend, culledIn, out.lights, &r, align, sliceMs, cancel, culledMs, part(0.0));
     out.result.timings.shadeMs = culledMs;
     throwIfCancelled(cancel);
-    // `all` with one list of every light in order shades exactly the reference.
-    bool identity = r.listCount.size() == 1 && r.listCount[0] == out.lights.size();
-    for (std::size_t i = 0; identity && i < out.lights.size(); ++i)
-        identity = r.lightIndices[r.listOffset[0] + i] == i;
     std::vector<float> all;
+    out.allLightsReused = reuse;
     if (identity) {
         all = culled;
+    } else if (reuse) {
+        all = earlier->shadedAll;
     } else {
         ShadeInputs allIn = culledIn;
         allIn.perPixelLists.reset();
@@ -126,6 +132,16 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
         out.shadedCulled = std::move(culled);
         out.shadedAll = std::move(all);
     }
+}
+
+bool sameAllLightsImage(const RunOutput& a, const Camera& ca, const RunOutput& b, const Camera& cb) {
+    Camera c = cb;
+    c.tileSize = ca.tileSize; // tiles shape the lists only
+    const DepthImage &da = a.depth, &db = b.depth;
+    const ViewLights &la = a.lights, &lb = b.lights;
+    return ca == c && da.width == db.width && da.height == db.height && da.clearDepth == db.clearDepth &&
+           da.depth == db.depth && la.centers == lb.centers && la.power == lb.power && la.spotAxes == lb.spotAxes &&
+           la.spotAngles == lb.spotAngles;
 }
 
 RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBackend& backend,

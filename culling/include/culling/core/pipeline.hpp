@@ -23,6 +23,9 @@ struct RunOutput {
     // True when the depth pre-pass was skipped for RunOptions::reuseDepth
     // (timings.depthMs is then 0).
     bool depthReused = false;
+    // True when shadeAndCompare took an earlier run's all-lights image
+    // instead of shading it again.
+    bool allLightsReused = false;
     // False when RunOptions::groundTruth was off: `truth` is then empty.
     bool truthComputed = false;
     // Set when the lists came from a custom shader or an engine's dump
@@ -63,9 +66,19 @@ void judgeRun(RunOutput& out, const Projection& proj, CullBackend& shadeBackend,
 // time and checks `cancel` between them (the studio: a newer edit waits one
 // slice, not a whole image), with the same pixels as whole images; shadeMs is
 // then the sum of the slices'. `progress` gets the fraction of rows shaded
-// over both images after each slice.
+// over both images after each slice. `earlier`: a run shaded before on the
+// same backend whose all-lights image this run's equals
+// (sameAllLightsImage); its image is taken instead of shading every light
+// again, and out.allLightsReused set.
 void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
                      const CancelToken* cancel = nullptr, double sliceMs = 0,
-                     const Progress& progress = {});
+                     const Progress& progress = {}, const RunOutput* earlier = nullptr);
+
+// True when run `b` (camera cb) shades the same all-lights image as run `a`
+// (camera ca) has: the same camera (its tile size aside), depth pixels and
+// lights' positions, power and cones. Lists, settings, tiles and light radii
+// do not enter that image, so a change of algorithm, tile size or a light's
+// range keeps it.
+bool sameAllLightsImage(const RunOutput& a, const Camera& ca, const RunOutput& b, const Camera& cb);
 
 } // namespace lc
