@@ -2,6 +2,7 @@
 //
 //   lightcull-studio [--scene FILE | --builtin NAME] [--lights N [--seed S]] [--run]
 //                    [--screenshot FILE.png] [--quit] [--measure-live-drag SECONDS]
+//                    [--measure-shading ROUNDS]
 //
 // With no arguments it opens the built-in default scene and runs culling once.
 // --screenshot grabs the whole main window once the run's result has arrived
@@ -12,6 +13,7 @@
 #include "cull_worker.hpp"
 #include "document.hpp"
 #include "live_drag_probe.hpp"
+#include "shading_probe.hpp"
 #include "main_window.hpp"
 
 #include "culling/scene/scene_io.hpp"
@@ -74,11 +76,17 @@ int main(int argc, char** argv) {
                                "Benchmark: drag one light with Live on for SECONDS, print the rate of results "
                                "shown and their latency, then quit.",
                                "SECONDS");
+    QCommandLineOption shadingOpt("measure-shading",
+                                  "Benchmark: in Difference mode, ROUNDS runs alternating a moved light and a "
+                                  "switch between 2.5d and clustered; print how long the shaded pictures take "
+                                  "after the lists, then quit.",
+                                  "ROUNDS");
     QCommandLineOption shaderOpt("shader",
                                  "Cull with this custom culling shader (as Culling > Custom shader...; "
                                  "docs/CUSTOM_CULLING.md).",
                                  "FILE");
-    parser.addOptions({sceneOpt, builtinOpt, lightsOpt, seedOpt, shaderOpt, runOpt, shotOpt, quitOpt, dragOpt});
+    parser.addOptions(
+        {sceneOpt, builtinOpt, lightsOpt, seedOpt, shaderOpt, runOpt, shotOpt, quitOpt, dragOpt, shadingOpt});
     parser.process(app);
     if (parser.isSet(sceneOpt) && parser.isSet(builtinOpt)) {
         std::fprintf(stderr, "lightcull-studio: --scene and --builtin are exclusive\n");
@@ -88,11 +96,13 @@ int main(int argc, char** argv) {
     long long lightCount = -1;
     unsigned long long seed = 1;
     double dragSeconds = 0;
+    int shadingRounds = 0;
     {
-        bool ok1 = true, ok2 = true, ok3 = true;
+        bool ok1 = true, ok2 = true, ok3 = true, ok4 = true;
         if (parser.isSet(lightsOpt)) lightCount = parser.value(lightsOpt).toLongLong(&ok1);
         seed = parser.value(seedOpt).toULongLong(&ok2);
         if (parser.isSet(dragOpt)) dragSeconds = parser.value(dragOpt).toDouble(&ok3);
+        if (parser.isSet(shadingOpt)) shadingRounds = parser.value(shadingOpt).toInt(&ok4);
         if (!ok1 || lightCount == 0 || lightCount > 1000000 || lightCount < -1) {
             std::fprintf(stderr, "lightcull-studio: --lights: expected a count in [1, 1000000], got '%s'\n",
                          qPrintable(parser.value(lightsOpt)));
@@ -108,11 +118,20 @@ int main(int argc, char** argv) {
                          qPrintable(parser.value(dragOpt)));
             return 2;
         }
+        if (!ok4 || (parser.isSet(shadingOpt) && !(shadingRounds >= 2 && shadingRounds <= 1000))) {
+            std::fprintf(stderr, "lightcull-studio: --measure-shading: expected rounds in [2, 1000], got '%s'\n",
+                         qPrintable(parser.value(shadingOpt)));
+            return 2;
+        }
+        if (dragSeconds > 0 && shadingRounds > 0) {
+            std::fprintf(stderr, "lightcull-studio: --measure-live-drag and --measure-shading are exclusive\n");
+            return 2;
+        }
     }
 
     lcui::MainWindow window;
     // A script has nobody to answer dialogs: errors go to stderr instead.
-    const bool scripted = parser.isSet(quitOpt) || dragSeconds > 0;
+    const bool scripted = parser.isSet(quitOpt) || dragSeconds > 0 || shadingRounds > 0;
     if (scripted)
         window.prompts.showError = [](QWidget*, const QString& title, const QString& text) {
             std::fprintf(stderr, "lightcull-studio: %s: %s\n", qPrintable(title), qPrintable(text));
@@ -169,6 +188,31 @@ int main(int argc, char** argv) {
             if (g >= target && !started) {
                 started = true;
                 QTimer::singleShot(500, probe, &LiveDragProbe::start); // let both views settle
+            }
+        });
+        return app.exec();
+    }
+
+    if (shadingRounds > 0) {
+        auto* probe = new ShadingProbe(&window, shadingRounds);
+        QObject::connect(probe, &ShadingProbe::done, &app, [&window, &app](const ShadingReport& r) {
+            std::fprintf(stdout,
+                         "shading: pictures after the lists, Difference mode: moved light median %.1f ms "
+                         "(max %.1f, %d rounds, all-lights image shaded each: %s); algorithm switch median "
+                         "%.1f ms (max %.1f, %d rounds, all-lights image kept each: %s); culled image "
+                         "shading median %.1f ms\n",
+                         r.lightMedianMs, r.lightMaxMs, r.lightRounds, r.allLightsShadedOnEveryLightRound ? "yes" : "no",
+                         r.algorithmMedianMs, r.algorithmMaxMs, r.algorithmRounds,
+                         r.allLightsKeptOnEveryAlgorithmRound ? "yes" : "no", r.medianCulledShadeMs);
+            window.document()->undoStack()->setClean();
+            app.exit(r.lightRounds > 0 && r.algorithmRounds > 0 ? 0 : 1);
+        });
+        const quint64 target = window.cullService()->lastGeneration();
+        QObject::connect(&window, &lcui::MainWindow::runFinished, probe, [probe, target](quint64 g) {
+            static bool started = false;
+            if (g >= target && !started) {
+                started = true;
+                QTimer::singleShot(500, probe, &ShadingProbe::start); // let both views settle
             }
         });
         return app.exec();
