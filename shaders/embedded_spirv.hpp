@@ -20,6 +20,6 @@ Code cullLists();   // per-list light tests: count pass and write pass
 Code prefixSum();   // exclusive scan of the list counts into offsets
 Code zbin();        // zbin: the depth bins of the depth-sorted lights
 Code finePrune();   // fptl: prune the coarse lists against the tile's pixels, then pack them
-Code shade();       // Lambert shading pass, one invocation per pixel
+Code shade();       // Lambert shading pass, one invocation per four pixels of a row
 
 } // namespace lc::spirv

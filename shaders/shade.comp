@@ -61,15 +61,35 @@ void store(uint i, vec3 v) {
     rgb[3u * i + 2u] = v.z;
 }
 
-// One pixel's list, in the list's order (the chunk's lights only when they
-// come from the block).
+// The first position in lightIndices[b, e) (ascending) holding a light of
+// at least v.
+uint lowerBound(uint b, uint e, uint v) {
+    while (b < e) {
+        uint m = b + (e - b) / 2u;
+        if (lightIndices[m] < v) b = m + 1u;
+        else e = m;
+    }
+    return b;
+}
+
+// Where list l's lights of this dispatch lie in lightIndices: the whole list
+// from the storage buffer; from the block, the part within this chunk's
+// lights, one run of an ascending list (found by bisection rather than
+// walking the list once per chunk).
+uvec2 listRange(uint l) {
+    uint first = listOffset[l], end = first + listCount[l];
+    if (LIGHTS_IN_BLOCK == 0u || (C.x == 0u && C.y >= P.size.z)) return uvec2(first, end);
+    uint b = lowerBound(first, end, C.x);
+    return uvec2(b, lowerBound(b, end, C.x + C.y));
+}
+
+// One pixel's list, in the list's order.
 vec3 shadeList(uint l, vec3 p, vec3 n, vec3 sum) {
     precise vec3 acc = sum;
-    uint first = listOffset[l], count = listCount[l];
-    for (uint k = 0u; k < count; ++k) {
-        uint li = lightIndices[first + k];
-        if (LIGHTS_IN_BLOCK == 0u || li - C.x < C.y)
-            acc += lightTerm(p, n, LIGHT(li, position.xyz), LIGHT(li, power.xyz), LIGHT(li, spot));
+    uvec2 r = listRange(l);
+    for (uint k = r.x; k < r.y; ++k) {
+        uint li = lightIndices[k];
+        acc += lightTerm(p, n, LIGHT(li, position.xyz), LIGHT(li, power.xyz), LIGHT(li, spot));
     }
     return acc;
 }
@@ -98,15 +118,12 @@ void main() {
     }
     if ((ALL_LIGHTS != 0u || same) && lit) {
         // One loop for the group: this chunk's lights, or the shared list.
-        uint first = ALL_LIGHTS != 0u ? 0u : listOffset[l[0]];
-        uint count = ALL_LIGHTS != 0u ? C.y : listCount[l[0]];
-        for (uint k = 0u; k < count; ++k) {
-            uint li = ALL_LIGHTS != 0u ? C.x + k : lightIndices[first + k];
-            if (ALL_LIGHTS != 0u || LIGHTS_IN_BLOCK == 0u || li - C.x < C.y) {
-                vec3 lp = LIGHT(li, position.xyz), pw = LIGHT(li, power.xyz);
-                vec4 s = LIGHT(li, spot);
-                for (uint j = 0u; j < PX; ++j) acc[j] += lightTerm(p[j], n[j], lp, pw, s);
-            }
+        uvec2 r = ALL_LIGHTS != 0u ? uvec2(0u, C.y) : listRange(l[0]);
+        for (uint k = r.x; k < r.y; ++k) {
+            uint li = ALL_LIGHTS != 0u ? C.x + k : lightIndices[k];
+            vec3 lp = LIGHT(li, position.xyz), pw = LIGHT(li, power.xyz);
+            vec4 s = LIGHT(li, spot);
+            for (uint j = 0u; j < PX; ++j) acc[j] += lightTerm(p[j], n[j], lp, pw, s);
         }
     } else if (ALL_LIGHTS == 0u && !same) {
         for (uint j = 0u; j < PX; ++j)

@@ -88,7 +88,8 @@ TEST_F(VulkanShade, LightsBeyondOneUniformBlockShadeInChunksAsOneLoop) {
     // A uniform block holds at most 65,536 / 48 = 1,365 lights, so 3,000
     // lights take at least three chunks of the all-lights image, each adding
     // to the sums the last one left; a list image with as many lights goes
-    // in the same chunks when its lists ascend, else reads the storage
+    // in the same chunks when its lists ascend (each chunk's lights one run
+    // of the list, found by bisection), else reads the storage
     // buffer. All must equal the CPU reference's single loop over the same
     // lights in the same order. An odd width: the
     // last pixel group of each row is short.
@@ -106,6 +107,11 @@ TEST_F(VulkanShade, LightsBeyondOneUniformBlockShadeInChunksAsOneLoop) {
     ASSERT_GT(result.lightIndices.size(), 2000u);
     const ShadeInputs in = makeShadeInputs(depth, proj, &result);
     expectSameImage(gpu.shade(in, lights, &result), shadeCpu(in, lights, &result), in, "naive lists");
+    // 6-pixel tiles: groups of four pixels across two tiles walk each
+    // pixel's list on its own, chunk by chunk too.
+    const CullResult small = gpu.cull(depth, proj, TileGrid::make(65, 37, 6), lights, settings);
+    const ShadeInputs sin = makeShadeInputs(depth, proj, &small);
+    expectSameImage(gpu.shade(sin, lights, &small), shadeCpu(sin, lights, &small), sin, "naive lists, 6 px tiles");
     // Lists not in ascending order (a custom shader's may be any): one pass
     // over the storage buffer, in the lists' own order.
     CullResult reversed = result;

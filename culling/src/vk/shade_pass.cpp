@@ -1,5 +1,5 @@
 // The Vulkan shading pass: one dispatch of shaders/shade.comp over the image,
-// 8x8 pixels per workgroup, every buffer host-visible (as the culling passes;
+// 8x8 invocations of four pixels each per workgroup, every buffer host-visible (as the culling passes;
 // docs/VULKAN.md).
 #include "vk/shade_pass.hpp"
 
@@ -89,7 +89,7 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     if (pixels * sizeof(GpuShadePixel) > lim.maxStorageBufferRange)
         throw DeviceError("shading: a " + std::to_string(in.width) + "x" + std::to_string(in.height) +
                           " G-buffer exceeds this device's storage buffer range");
-    // Two pixels of a row an invocation (shade.comp).
+    // Four pixels of a row an invocation (shade.comp).
     const std::uint32_t columns = (in.width + 3) / 4;
     const std::uint32_t gx = (columns + kGroup - 1) / kGroup, gy = (in.height + kGroup - 1) / kGroup;
     if (gx > lim.maxComputeWorkGroupCount[0] || gy > lim.maxComputeWorkGroupCount[1])
