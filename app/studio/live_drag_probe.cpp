@@ -5,6 +5,7 @@
 #include "document.hpp"
 #include "inspector_view.hpp"
 #include "main_window.hpp"
+#include "probe_stats.hpp"
 
 #include "culling/core/pipeline.hpp"
 
@@ -16,14 +17,6 @@
 #include <algorithm>
 #include <cmath>
 
-namespace {
-double median(std::vector<double> v) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-} // namespace
 
 LiveDragProbe::LiveDragProbe(lcui::MainWindow* window, double seconds, double motionHz)
     : QObject(window), window_(window), seconds_(seconds) {

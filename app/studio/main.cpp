@@ -26,6 +26,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <memory>
 
 namespace {
@@ -46,6 +47,19 @@ bool haveDisplay(int argc, char** argv) {
     for (int i = 1; i < argc; ++i) std::fprintf(stderr, " %s", argv[i]);
     std::fprintf(stderr, "\n");
     return false;
+}
+
+// A benchmark starts once the opening run's result is in and both views
+// have settled.
+void startAfterOpeningRun(lcui::MainWindow& window, QObject* probe, std::function<void()> start) {
+    const quint64 target = window.cullService()->lastGeneration();
+    auto started = std::make_shared<bool>(false);
+    QObject::connect(&window, &lcui::MainWindow::runFinished, probe, [probe, target, started, start](quint64 g) {
+        if (g >= target && !*started) {
+            *started = true;
+            QTimer::singleShot(500, probe, start);
+        }
+    });
 }
 
 } // namespace
@@ -182,14 +196,7 @@ int main(int argc, char** argv) {
             window.document()->undoStack()->setClean();
             app.exit(r.shown > 0 ? 0 : 1);
         });
-        const quint64 target = window.cullService()->lastGeneration();
-        QObject::connect(&window, &lcui::MainWindow::runFinished, probe, [probe, target](quint64 g) {
-            static bool started = false;
-            if (g >= target && !started) {
-                started = true;
-                QTimer::singleShot(500, probe, &LiveDragProbe::start); // let both views settle
-            }
-        });
+        startAfterOpeningRun(window, probe, [probe] { probe->start(); });
         return app.exec();
     }
 
@@ -207,14 +214,7 @@ int main(int argc, char** argv) {
             window.document()->undoStack()->setClean();
             app.exit(r.lightRounds > 0 && r.algorithmRounds > 0 ? 0 : 1);
         });
-        const quint64 target = window.cullService()->lastGeneration();
-        QObject::connect(&window, &lcui::MainWindow::runFinished, probe, [probe, target](quint64 g) {
-            static bool started = false;
-            if (g >= target && !started) {
-                started = true;
-                QTimer::singleShot(500, probe, &ShadingProbe::start); // let both views settle
-            }
-        });
+        startAfterOpeningRun(window, probe, [probe] { probe->start(); });
         return app.exec();
     }
 

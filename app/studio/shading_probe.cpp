@@ -4,6 +4,7 @@
 #include "cull_worker.hpp"
 #include "document.hpp"
 #include "main_window.hpp"
+#include "probe_stats.hpp"
 
 #include "culling/core/pipeline.hpp"
 
@@ -13,12 +14,6 @@
 #include <algorithm>
 
 namespace {
-double median(std::vector<double> v) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 double maxOf(const std::vector<double>& v) { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
 } // namespace
 

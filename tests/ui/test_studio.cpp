@@ -679,6 +679,25 @@ private slots:
         QVERIFY(QString::fromUtf8(headless.readAllStandardError()).contains("xvfb-run"));
     }
 
+    // The shading benchmark as a user starts it: it measures both kinds of
+    // rounds, the algorithm switch keeping the all-lights image and the moved
+    // light shading a new one, and says so; bad rounds are a clear error.
+    void scriptedShadingBenchmark() {
+        QProcess studio;
+        studio.start(LC_STUDIO_PATH, {"--builtin", "wall", "--measure-shading", "2"});
+        QVERIFY(studio.waitForFinished(lctest::kRunTimeoutMs));
+        const QString out = QString::fromUtf8(studio.readAllStandardOutput());
+        QVERIFY2(studio.exitCode() == 0, studio.readAllStandardError().constData());
+        QVERIFY2(out.contains("1 rounds, all-lights image shaded each: yes"), qPrintable(out));
+        QVERIFY2(out.contains("1 rounds, all-lights image kept each: yes"), qPrintable(out));
+
+        QProcess bad;
+        bad.start(LC_STUDIO_PATH, {"--builtin", "wall", "--measure-shading", "1"});
+        QVERIFY(bad.waitForFinished(30000));
+        QCOMPARE(bad.exitCode(), 2);
+        QVERIFY(QString::fromUtf8(bad.readAllStandardError()).contains("--measure-shading: expected rounds in [2, 1000]"));
+    }
+
     void tenThousandLightsStayOneActor() {
         openSmall();
         // Radii up to sqrt(10 / 1) = 3.2: a dense but readable cloud.
