@@ -2,22 +2,24 @@
 //
 //   lightcull-studio [--scene FILE | --builtin NAME] [--lights N [--seed S]] [--run]
 //                    [--screenshot FILE.png] [--quit] [--measure-live-drag SECONDS]
-//                    [--measure-shading ROUNDS]
+//                    [--measure-shading ROUNDS] [--image-mode MODE]
 //
 // With no arguments it opens the built-in default scene and runs culling once.
-// --screenshot grabs the whole main window once the run's result has arrived
-// and both views have rendered; --quit exits afterwards (exit code 0 only when
+// --screenshot grabs the whole main window once the run's result (with its
+// shaded pictures, in a shaded --image-mode) has arrived and both views have
+// rendered; --quit exits afterwards (exit code 0 only when
 // every requested step worked).
 
 #include "camera_view.hpp"
 #include "cull_worker.hpp"
 #include "document.hpp"
 #include "live_drag_probe.hpp"
-#include "shading_probe.hpp"
 #include "main_window.hpp"
+#include "shading_probe.hpp"
 
 #include "culling/scene/scene_io.hpp"
 
+#include <QAction>
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QSurfaceFormat>
@@ -28,6 +30,7 @@
 #include <cstdlib>
 #include <functional>
 #include <memory>
+#include <utility>
 
 namespace {
 
@@ -95,12 +98,16 @@ int main(int argc, char** argv) {
                                   "switch between 2.5d and clustered; print how long the shaded pictures take "
                                   "after the lists, then quit.",
                                   "ROUNDS");
+    QCommandLineOption imageModeOpt("image-mode",
+                                    "The camera view's image (as View > Camera image, and remembered like it): "
+                                    "heat, shaded-culled, shaded-all or difference.",
+                                    "MODE");
     QCommandLineOption shaderOpt("shader",
                                  "Cull with this custom culling shader (as Culling > Custom shader...; "
                                  "docs/CUSTOM_CULLING.md).",
                                  "FILE");
     parser.addOptions(
-        {sceneOpt, builtinOpt, lightsOpt, seedOpt, shaderOpt, runOpt, shotOpt, quitOpt, dragOpt, shadingOpt});
+        {sceneOpt, builtinOpt, lightsOpt, seedOpt, shaderOpt, runOpt, shotOpt, quitOpt, dragOpt, shadingOpt, imageModeOpt});
     parser.process(app);
     if (parser.isSet(sceneOpt) && parser.isSet(builtinOpt)) {
         std::fprintf(stderr, "lightcull-studio: --scene and --builtin are exclusive\n");
@@ -111,6 +118,7 @@ int main(int argc, char** argv) {
     unsigned long long seed = 1;
     double dragSeconds = 0;
     int shadingRounds = 0;
+    auto imageMode = lcui::CameraView::ImageMode::Heat;
     {
         bool ok1 = true, ok2 = true, ok3 = true, ok4 = true;
         if (parser.isSet(lightsOpt)) lightCount = parser.value(lightsOpt).toLongLong(&ok1);
@@ -137,6 +145,13 @@ int main(int argc, char** argv) {
                          qPrintable(parser.value(shadingOpt)));
             return 2;
         }
+        if (parser.isSet(imageModeOpt) && !lcui::CameraView::fromString(parser.value(imageModeOpt), &imageMode)) {
+            std::fprintf(stderr,
+                         "lightcull-studio: --image-mode: expected heat, shaded-culled, shaded-all or difference, "
+                         "got '%s'\n",
+                         qPrintable(parser.value(imageModeOpt)));
+            return 2;
+        }
         if (dragSeconds > 0 && shadingRounds > 0) {
             std::fprintf(stderr, "lightcull-studio: --measure-live-drag and --measure-shading are exclusive\n");
             return 2;
@@ -151,6 +166,9 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "lightcull-studio: %s: %s\n", qPrintable(title), qPrintable(text));
         };
     window.show();
+    // Before the scene opens, so that its first run brings the pictures.
+    if (parser.isSet(imageModeOpt))
+        window.action(QString("actionImage_%1").arg(lcui::CameraView::toString(imageMode)))->trigger();
 
     // Opening a scene runs culling once (so does the default start).
     bool ok = true;
@@ -229,7 +247,9 @@ int main(int argc, char** argv) {
                     std::fprintf(stderr, "lightcull-studio: cannot write screenshot %s\n", qPrintable(shot));
                     code = 1;
                 } else {
-                    std::fprintf(stdout, "screenshot written to %s\n", qPrintable(shot));
+                    const auto run = window.document()->runOutput();
+                    std::fprintf(stdout, "screenshot written to %s%s\n", qPrintable(shot),
+                                 run && !run->shadedAll.empty() ? " (with the shaded pictures)" : "");
                 }
             }
             if (scripted) {
@@ -241,11 +261,19 @@ int main(int argc, char** argv) {
     if (!shot.isEmpty() || scripted) {
         if (wantRun) {
             const quint64 target = window.cullService()->lastGeneration();
-            QObject::connect(&window, &lcui::MainWindow::runFinished, &window,
-                             [finish, target](quint64 g) { if (g >= target) finish(true); });
-            QObject::connect(&window, &lcui::MainWindow::runFailed, &window, [finish, target](quint64 g, const QString& m) {
+            // Once: in a shaded image mode, when the pictures have come too.
+            auto once = [finish, done = std::make_shared<bool>(false)](bool runOk) {
+                if (!std::exchange(*done, true)) finish(runOk);
+            };
+            QObject::connect(&window, &lcui::MainWindow::runFinished, &window, [&window, once, target](quint64 g) {
+                const auto run = window.document()->runOutput();
+                const bool pictures = !lcui::CameraView::needsShading(window.cameraView()->imageMode()) ||
+                                      (run && !run->shadedAll.empty());
+                if (g >= target && pictures) once(true);
+            });
+            QObject::connect(&window, &lcui::MainWindow::runFailed, &window, [once, target](quint64 g, const QString& m) {
                 std::fprintf(stderr, "lightcull-studio: culling failed: %s\n", qPrintable(m));
-                if (g >= target) finish(false);
+                if (g >= target) once(false);
             });
         } else {
             finish(true);

@@ -27,6 +27,7 @@
 #include <QMessageBox>
 #include <QPlainTextEdit>
 #include <QProcess>
+#include <QSettings>
 #include <QProcessEnvironment>
 #include <QSet>
 #include <QStatusBar>
@@ -665,6 +666,31 @@ private slots:
         for (int y = 0; y < img.height(); y += 7)
             for (int x = 0; x < img.width(); x += 7) colours.insert(img.pixel(x, y));
         QVERIFY(colours.size() > 50);
+
+        QVERIFY(!QString::fromUtf8(studio.readAllStandardOutput()).contains("shaded pictures"));
+
+        // In a shaded image mode the screenshot waits for the pictures; the
+        // mode is remembered as a pick in View > Camera image is; a mode
+        // that does not exist is a clear error.
+        const QString shaded = tmp_.path() + "/wall-difference.png";
+        QProcess pictures;
+        pictures.start(LC_STUDIO_PATH,
+                       {"--builtin", "wall", "--image-mode", "difference", "--screenshot", shaded, "--quit"});
+        QVERIFY(pictures.waitForFinished(lctest::kRunTimeoutMs));
+        QVERIFY2(pictures.exitCode() == 0, pictures.readAllStandardError().constData());
+        const QString said = QString::fromUtf8(pictures.readAllStandardOutput());
+        QVERIFY2(said.contains("screenshot written to " + shaded + " (with the shaded pictures)"), qPrintable(said));
+        QVERIFY(!QImage(shaded).isNull());
+        QSettings studioSettings("LightCull", "LightCull Studio"); // the studio's own, in this run's folder
+        studioSettings.sync();
+        QCOMPARE(studioSettings.value("cameraView/imageMode").toString(), QString("difference"));
+        QProcess badMode;
+        badMode.start(LC_STUDIO_PATH, {"--image-mode", "shaded", "--quit"});
+        QVERIFY(badMode.waitForFinished(30000));
+        QCOMPARE(badMode.exitCode(), 2);
+        QVERIFY(QString::fromUtf8(badMode.readAllStandardError()).contains("--image-mode: expected heat"));
+        studioSettings.setValue("cameraView/imageMode", "heat"); // the next start is the default one
+        studioSettings.sync();
 
         // Without a display: a clear message, a non-zero exit, no crash.
         QProcess headless;
