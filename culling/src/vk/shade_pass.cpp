@@ -1,6 +1,6 @@
-// The Vulkan shading pass: one dispatch of shaders/shade.comp over the image,
-// 8x8 invocations of four pixels each per workgroup, every buffer host-visible (as the culling passes;
-// docs/VULKAN.md).
+// The Vulkan shading pass: one dispatch of shaders/shade.comp over the image
+// per chunk of lights, 8x8 invocations of four pixels each per workgroup,
+// every buffer host-visible (as the culling passes; docs/VULKAN.md).
 #include "vk/shade_pass.hpp"
 
 #include "culling/core/errors.hpp"
@@ -71,12 +71,17 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     const std::size_t lightCount = lights.size();
     const std::size_t listTotal = culled ? culled->listCount.size() : 1;
     // The shader trusts its indices: check every one here (typed errors, never
-    // an out-of-bounds read on the device).
+    // an out-of-bounds read on the device). On the way, whether every list is
+    // in ascending light order: such lists go in the chunks of lights below.
+    bool ascending = culled != nullptr;
     if (culled) {
         if (culled->listOffset.size() != listTotal) throw Error("shading: cull result offsets and counts differ");
-        for (std::size_t l = 0; l < listTotal; ++l)
+        for (std::size_t l = 0; l < listTotal; ++l) {
             if (std::size_t(culled->listOffset[l]) + culled->listCount[l] > culled->lightIndices.size())
                 throw Error("shading: list " + std::to_string(l) + " overruns the index array");
+            const std::uint32_t* list = culled->lightIndices.data() + culled->listOffset[l];
+            for (std::uint32_t k = 1; ascending && k < culled->listCount[l]; ++k) ascending = list[k - 1] < list[k];
+        }
         for (std::uint32_t i : culled->lightIndices)
             if (i >= lightCount)
                 throw Error("shading: a list names light " + std::to_string(i) + " of " + std::to_string(lightCount));
@@ -111,10 +116,6 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     // order: each chunk then adds its lights in the list's own order. Other
     // lists (a custom shader's, say) read the storage buffer in one pass.
     const bool allLights = culled == nullptr;
-    bool ascending = culled != nullptr;
-    for (std::size_t l = 0; ascending && l < listTotal; ++l)
-        for (std::uint32_t k = 1; ascending && k < culled->listCount[l]; ++k)
-            ascending = culled->lightIndices[culled->listOffset[l] + k - 1] < culled->lightIndices[culled->listOffset[l] + k];
     const bool inBlock = allLights || lightCount <= blockLights_ || ascending;
     const std::size_t chunks = inBlock ? std::max<std::size_t>((lightCount + blockLights_ - 1) / blockLights_, 1) : 1;
     const std::size_t blockBytes = std::size_t(blockLights_) * sizeof(GpuShadeLight);
