@@ -168,7 +168,7 @@ bool CullWorker::shadeLast() {
     try {
         if (cancel->cancelled) throw lc::Cancelled();
         auto full = std::make_shared<lc::RunOutput>(*last_);
-        const bool same = shaded_ && lc::sameAllLightsImage(*shaded_, shadedScene_->camera, *full, lastScene_->camera);
+        const bool same = shaded_ && lc::samePixels(*shaded_, shadedScene_->camera, *full, lastScene_->camera);
         lc::shadeAndCompare(*backend_, *full, lc::Projection(lastScene_->camera), true, cancel.get(),
                             kShadeSliceMs, [this, generation](double f) { emit shadingProgress(generation, f); },
                             same ? shaded_.get() : nullptr);

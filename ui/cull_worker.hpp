@@ -120,8 +120,9 @@ private:
     std::shared_ptr<const lc::Scene> lastScene_;
     std::shared_ptr<const lc::RunOutput> last_;
     // The last run shaded on backend_, with its scene: its all-lights image
-    // serves a later run with the same (lc::sameAllLightsImage), as when the
-    // user compares algorithms in a shaded mode.
+    // serves a later run with the same pixels (lc::samePixels), kept as it is
+    // when the lights are the same too (the user compares algorithms in a
+    // shaded mode) or updated for the few that changed (a dragged light).
     std::shared_ptr<const lc::RunOutput> shaded_;
     std::shared_ptr<const lc::Scene> shadedScene_;
 };

@@ -545,6 +545,20 @@ quint64 MainWindow::runCulling(bool liveEdit) {
 void MainWindow::setLive(bool live) { action("actionLive")->setChecked(live); }
 bool MainWindow::isLive() const { return action("actionLive")->isChecked(); }
 
+namespace {
+// How a run's all-lights image was made, when not shaded from every light.
+QString allLightsNote(const lc::RunOutput& out) {
+    if (out.allLightsReused) return MainWindow::tr(" (the all-lights image kept: same pixels and lights)");
+    if (!out.allLightsUpdate) return {};
+    const auto& u = *out.allLightsUpdate;
+    return MainWindow::tr(" (the all-lights image updated for the lights that changed: terms out %1, in %2; "
+                          "pixels shaded again from every light %3)")
+        .arg(qulonglong(u.removed))
+        .arg(qulonglong(u.added))
+        .arg(qulonglong(u.pixelsShadedAgain));
+}
+} // namespace
+
 void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::RunOutput> out) {
     if (!doc_->setRunOutput(out, generation)) return; // an older run finished late
     const auto& m = out->truth.metrics;
@@ -556,7 +570,7 @@ void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::Run
                 .arg(m.imageRmse, 0, 'g', 6)
                 .arg(m.imageMaxError, 0, 'g', 6)
                 .arg(out->result.timings.shadeMs, 0, 'f', 2)
-                .arg(out->allLightsReused ? tr(" (the all-lights image kept: same pixels and lights)") : QString()));
+                .arg(allLightsNote(*out)));
         emit runFinished(generation);
         return;
     }

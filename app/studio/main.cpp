@@ -223,10 +223,10 @@ int main(int argc, char** argv) {
         QObject::connect(probe, &ShadingProbe::done, &app, [&window, &app](const ShadingReport& r) {
             std::fprintf(stdout,
                          "shading: pictures after the lists, Difference mode: moved light median %.1f ms "
-                         "(max %.1f, %d rounds, all-lights image shaded each: %s); algorithm switch median "
+                         "(max %.1f, %d rounds, all-lights image updated each: %s); algorithm switch median "
                          "%.1f ms (max %.1f, %d rounds, all-lights image kept each: %s); culled image "
                          "shading median %.1f ms\n",
-                         r.lightMedianMs, r.lightMaxMs, r.lightRounds, r.allLightsShadedOnEveryLightRound ? "yes" : "no",
+                         r.lightMedianMs, r.lightMaxMs, r.lightRounds, r.allLightsUpdatedOnEveryLightRound ? "yes" : "no",
                          r.algorithmMedianMs, r.algorithmMaxMs, r.algorithmRounds,
                          r.allLightsKeptOnEveryAlgorithmRound ? "yes" : "no", r.medianCulledShadeMs);
             window.document()->undoStack()->setClean();

@@ -75,7 +75,7 @@ void ShadingProbe::onFinished(quint64 generation) {
             culledShade_.push_back(run->result.timings.shadeMs);
             if (round_ % 2 == 0) {
                 light_.push_back(ms);
-                report_.allLightsShadedOnEveryLightRound &= !run->allLightsReused;
+                report_.allLightsUpdatedOnEveryLightRound &= run->allLightsUpdate.has_value();
             } else {
                 algorithm_.push_back(ms);
                 report_.allLightsKeptOnEveryAlgorithmRound &= run->allLightsReused;

@@ -24,7 +24,7 @@ struct ShadingReport {
     // The culled image's shading time (the slices' sum), median over all rounds.
     double medianCulledShadeMs = 0;
     bool allLightsKeptOnEveryAlgorithmRound = true;
-    bool allLightsShadedOnEveryLightRound = true;
+    bool allLightsUpdatedOnEveryLightRound = true; // for the moved light, not shaded from every light
 };
 
 class ShadingProbe : public QObject {

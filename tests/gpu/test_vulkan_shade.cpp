@@ -9,6 +9,7 @@
 #include "culling/core/pipeline.hpp"
 #include "culling/scene/scene_io.hpp"
 #include "culling/truth/shade.hpp"
+#include "updated_image.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -170,6 +171,40 @@ TEST_F(VulkanShade, PipelineImageErrorAgreesWithTheCpuBackendOnTheSameDepth) {
     EXPECT_GT(ref.rmse, 0.0);
     EXPECT_NEAR(run.truth.metrics.imageRmse, ref.rmse, 1e-3 * ref.rmse);
     EXPECT_NEAR(run.truth.metrics.imageMaxError, ref.maxAbs, 1e-3 * ref.maxAbs);
+}
+
+// The studio's update of the all-lights image on the device: a dragged
+// light's old and new terms shaded alone by the Vulkan pass, and the pixels
+// where dimming a light that outshone the rest cancelled too much shaded
+// again by the same pass, each image within 2^-14 of the device's fresh one
+// (bitwise where nothing was carried).
+TEST_F(VulkanShade, EditedLightsUpdateTheAllLightsImageCloseToAFreshOne) {
+    CullBackend& gpu = gputest::vulkan();
+    Scene scene = smallScene("atrium", 96, 54, 24);
+    scene.lights[4].intensity *= 1e6;
+    const Projection proj(scene.camera);
+    CullSettings settings;
+    settings.algorithm = Algorithm::TwoPointFiveD;
+    RunOptions opt;
+    opt.truthOptions.imageError = false;
+    RunOutput prev = runPipeline(scene, settings, gpu, opt);
+    shadeAndCompare(gpu, prev, proj, true);
+    auto step = [&](const char* what) {
+        opt.reuseDepth = &prev.depth; // the lights moved, not the meshes
+        RunOutput run = runPipeline(scene, settings, gpu, opt);
+        RunOutput fresh = run;
+        shadeAndCompare(gpu, fresh, proj, true);
+        shadeAndCompare(gpu, run, proj, true, nullptr, 0, {}, &prev);
+        EXPECT_TRUE(run.allLightsUpdate) << what;
+        lc::testutil::expectCloseToFresh(run, fresh, what);
+        prev = std::move(run);
+    };
+    scene.lights[6].position.x += 0.2;
+    step("a moved light");
+    EXPECT_EQ(prev.allLightsUpdate->pixelsShadedAgain, 0u);
+    scene.lights[4].intensity *= 1e-6;
+    step("a dimmed light that outshone the rest");
+    EXPECT_GT(prev.allLightsUpdate->pixelsShadedAgain, 100u);
 }
 
 TEST_F(VulkanShade, BadListsAreTypedErrorsAndZeroLightsShadeBlack) {

@@ -714,7 +714,7 @@ private slots:
         QVERIFY(studio.waitForFinished(lctest::kRunTimeoutMs));
         const QString out = QString::fromUtf8(studio.readAllStandardOutput());
         QVERIFY2(studio.exitCode() == 0, studio.readAllStandardError().constData());
-        QVERIFY2(out.contains("1 rounds, all-lights image shaded each: yes"), qPrintable(out));
+        QVERIFY2(out.contains("1 rounds, all-lights image updated each: yes"), qPrintable(out));
         QVERIFY2(out.contains("1 rounds, all-lights image kept each: yes"), qPrintable(out));
 
         QProcess bad;

@@ -6,6 +6,7 @@
 #include "culling/core/pipeline.hpp"
 #include "culling/scene/scene_io.hpp"
 #include "culling/truth/shade.hpp"
+#include "updated_image.hpp"
 
 #include <gtest/gtest.h>
 
@@ -13,6 +14,7 @@
 #include <functional>
 
 using namespace lc;
+using lc::testutil::expectCloseToFresh;
 
 namespace {
 
@@ -246,4 +248,99 @@ TEST(Shade, AllLightsImageIsKeptOnlyForTheSamePixelsAndLights) {
     RunOutput edited = first;
     edited.depth.depth[edited.depth.depth.size() / 2] *= 0.999f;
     EXPECT_FALSE(sameAllLightsImage(first, scene.camera, edited, scene.camera)) << "a depth pixel";
+}
+
+
+// A chain of light edits, each run's all-lights image updated from the one
+// before (the changed lights' old terms out, new terms in) rather than shaded
+// from every light: moves, a recolour, a turned spot, a light added and one
+// removed (the list shifts: matched by value, only the removed light's term
+// goes). Each image stays within 2^-14 of a freshly shaded one, untouched
+// pixels bitwise, and the counts of terms say what changed.
+TEST(Shade, EditedLightsUpdateTheAllLightsImageCloseToAFreshOne) {
+    Scene scene = smallScene("atrium", 96, 54, 16, 24);
+    scene.lights[3].kind = LightKind::Spot;
+    scene.lights[3].outerAngleDeg = 40.0;
+    auto cpu = makeCpuBackend();
+    const Projection proj(scene.camera);
+    RunOutput prev = cpuRun(scene, Algorithm::TwoPointFiveD);
+    shadeAndCompare(*cpu, prev, proj, true);
+    ASSERT_FALSE(prev.allLightsUpdate);
+    EXPECT_TRUE(prev.shadedAllCarried.empty()) << "shaded from every light: nothing carried";
+
+    struct Edit {
+        const char* what;
+        std::function<void(Scene&)> apply;
+        std::size_t removed, added;
+    };
+    std::vector<Edit> edits;
+    for (int step = 0; step < 24; ++step)
+        edits.push_back({"a drag step", [step](Scene& s) { s.lights[5].position.x += step % 2 ? 0.07 : -0.05; }, 1,
+                         1});
+    edits.push_back({"a recoloured light", [](Scene& s) { s.lights[2].color.g *= 0.5; }, 1, 1});
+    edits.push_back({"a turned spot", [](Scene& s) { s.lights[3].direction = glm::dvec3(0.1, -1, 0); }, 1, 1});
+    edits.push_back({"an added light", [](Scene& s) {
+                         s.lights.push_back(s.lights[7]);
+                         s.lights.back().position.y += 0.3;
+                     },
+                     0, 1});
+    edits.push_back({"a removed light", [](Scene& s) { s.lights.erase(s.lights.begin() + 1); }, 1, 0});
+    edits.push_back({"two lights moved at once", [](Scene& s) {
+                         s.lights[0].position.z += 0.2;
+                         s.lights[9].position.x -= 0.2;
+                     },
+                     2, 2});
+    double worst = 0;
+    for (const Edit& e : edits) {
+        e.apply(scene);
+        RunOutput run = cpuRun(scene, Algorithm::TwoPointFiveD);
+        RunOutput fresh = run;
+        shadeAndCompare(*cpu, fresh, proj, true);
+        shadeAndCompare(*cpu, run, proj, true, nullptr, 0, {}, &prev);
+        ASSERT_TRUE(run.allLightsUpdate) << e.what;
+        EXPECT_FALSE(run.allLightsReused) << e.what;
+        EXPECT_EQ(run.allLightsUpdate->removed, e.removed) << e.what;
+        EXPECT_EQ(run.allLightsUpdate->added, e.added) << e.what;
+        worst = std::max(worst, expectCloseToFresh(run, fresh, e.what));
+        prev = std::move(run);
+    }
+    EXPECT_GT(worst, 0.0) << "some pixel carried rounding: the updates did run";
+
+    // More lights changed than half the terms: shaded from every light.
+    for (Light& l : scene.lights) l.position.y += 0.01;
+    RunOutput moved = cpuRun(scene, Algorithm::TwoPointFiveD);
+    shadeAndCompare(*cpu, moved, proj, true, nullptr, 0, {}, &prev);
+    EXPECT_FALSE(moved.allLightsUpdate);
+    EXPECT_TRUE(moved.shadedAllCarried.empty());
+}
+
+// A light that outshines the rest, dimmed: subtracting its term leaves the
+// other lights' small sum beside the rounding of a large one. Those pixels
+// carry far more than kCarryLimit times their value and are shaded again
+// from every light, so they equal a fresh image bitwise; without that they
+// would be off by about the bright term's rounding, far beyond 2^-14.
+TEST(Shade, PixelsWhereAnUpdateCancelsTooMuchAreShadedAgain) {
+    Scene scene = smallScene("atrium", 96, 54, 16, 24);
+    scene.lights[4].intensity *= 1e6;
+    auto cpu = makeCpuBackend();
+    const Projection proj(scene.camera);
+    RunOutput bright = cpuRun(scene, Algorithm::TwoPointFiveD);
+    shadeAndCompare(*cpu, bright, proj, true);
+
+    scene.lights[4].intensity *= 1e-6;
+    RunOutput dimmed = cpuRun(scene, Algorithm::TwoPointFiveD);
+    RunOutput fresh = dimmed;
+    shadeAndCompare(*cpu, fresh, proj, true);
+    shadeAndCompare(*cpu, dimmed, proj, true, nullptr, 0, {}, &bright);
+    ASSERT_TRUE(dimmed.allLightsUpdate);
+    EXPECT_GT(dimmed.allLightsUpdate->pixelsShadedAgain, 100u);
+    std::size_t lit = 0;
+    for (std::uint32_t l : makeShadeInputs(dimmed.depth, proj, nullptr).list) lit += l != ShadeInputs::kNoList;
+    EXPECT_LT(dimmed.allLightsUpdate->pixelsShadedAgain, lit) << "only where the dimmed light reached";
+    expectCloseToFresh(dimmed, fresh, "the dimmed light");
+    std::size_t again = 0;
+    for (std::size_t i = 0; i < dimmed.shadedAll.size() / 3; ++i)
+        again += dimmed.shadedAllCarried[3 * i] == 0 && dimmed.shadedAllCarried[3 * i + 1] == 0 &&
+                 dimmed.shadedAllCarried[3 * i + 2] == 0 && dimmed.shadedAll[3 * i] != bright.shadedAll[3 * i];
+    EXPECT_EQ(again, dimmed.allLightsUpdate->pixelsShadedAgain) << "shaded again: nothing carried";
 }

@@ -8,7 +8,9 @@
 #include "culling/truth/shade.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <numeric>
 
@@ -84,6 +86,67 @@ std::vector<float> shadeImage(CullBackend& backend, const ShadeInputs& in, const
 
 } // namespace
 
+namespace {
+
+// What shades a light: its position, power and cone (not its range).
+using ShadingKey = std::array<double, 10>;
+ShadingKey shadingKey(const ViewLights& l, std::size_t i) {
+    const glm::dvec3 c = l.centers[i], p = l.power[i];
+    const glm::dvec3 a = l.isSpot(i) ? l.spotAxes[i] : glm::dvec3(0.0);
+    return {c.x, c.y, c.z, p.x, p.y, p.z, a.x, a.y, a.z, l.isSpot(i) ? l.spotAngles[i] : 0.0};
+}
+
+// The lights of `before` no light of `after` shades as (gone) and those of
+// `after` no light of `before` does (come), matched one to one by value, so
+// that a light moved in the list or another with its values is no change.
+struct LightsDiff {
+    std::vector<std::size_t> gone, come;
+};
+LightsDiff diffShadingLights(const ViewLights& before, const ViewLights& after) {
+    auto sorted = [](const ViewLights& l) {
+        std::vector<std::pair<ShadingKey, std::size_t>> keys(l.size());
+        for (std::size_t i = 0; i < l.size(); ++i) keys[i] = {shadingKey(l, i), i};
+        std::sort(keys.begin(), keys.end());
+        return keys;
+    };
+    const auto b = sorted(before), a = sorted(after);
+    LightsDiff d;
+    std::size_t i = 0, j = 0;
+    while (i < b.size() || j < a.size()) {
+        if (j == a.size() || (i < b.size() && b[i].first < a[j].first)) {
+            d.gone.push_back(b[i++].second);
+        } else if (i == b.size() || a[j].first < b[i].first) {
+            d.come.push_back(a[j++].second);
+        } else {
+            ++i, ++j;
+        }
+    }
+    std::sort(d.gone.begin(), d.gone.end());
+    std::sort(d.come.begin(), d.come.end());
+    return d;
+}
+
+ViewLights lightsOf(const ViewLights& l, const std::vector<std::size_t>& which) {
+    ViewLights s;
+    const bool spots = !l.spotAngles.empty();
+    for (std::size_t i : which) {
+        s.centers.push_back(l.centers[i]);
+        s.radii.push_back(l.radii[i]);
+        s.power.push_back(l.power[i]);
+        if (spots) {
+            s.spotAxes.push_back(l.spotAxes[i]);
+            s.spotAngles.push_back(l.spotAngles[i]);
+        }
+    }
+    return s;
+}
+
+bool sameLights(const ViewLights& a, const ViewLights& b) {
+    return a.centers == b.centers && a.power == b.power && a.spotAxes == b.spotAxes && a.spotAngles == b.spotAngles;
+}
+
+} // namespace
+
 void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
                      const CancelToken* cancel, double sliceMs, const Progress& progress, const RunOutput* earlier) {
     // zbin: the lists its pixels loop over, a (tile, bin) each.
@@ -96,31 +159,90 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
     bool identity = r.listCount.size() == 1 && r.listCount[0] == out.lights.size();
     for (std::size_t i = 0; identity && i < out.lights.size(); ++i)
         identity = r.lightIndices[r.listOffset[0] + i] == i;
-    const bool reuse = !identity && earlier && earlier->shadedAll.size() == culledIn.position.size();
+    const bool usable = !identity && earlier && earlier->shadedAll.size() == culledIn.position.size();
+    const bool reuse = usable && sameLights(earlier->lights, out.lights);
+    LightsDiff diff;
+    if (usable && !reuse) diff = diffShadingLights(earlier->lights, out.lights);
+    const std::size_t changed = diff.gone.size() + diff.come.size();
+    const bool update =
+        usable && !reuse && changed > 0 && 2 * changed <= std::max(earlier->lights.size(), out.lights.size());
     // The all-lights image costs more (every light at every pixel), but the
     // split by images is what a user can follow: half each, unless one is
-    // all there is to shade.
-    const double culledShare = identity || reuse ? 1.0 : 0.5;
-    auto part = [&progress, culledShare](double base) -> std::function<void(double)> {
+    // all there is to shade (an update's few lights: a tenth).
+    const double culledShare = identity || reuse ? 1.0 : update ? 0.9 : 0.5;
+    auto part = [&progress](double base, double share) -> std::function<void(double)> {
         if (!progress) return {};
-        return [&progress, base, culledShare](double f) { progress(base + culledShare * f); };
+        return [&progress, base, share](double f) { progress(base + share * f); };
     };
     std::vector<float> culled =
-        shadeImage(backend, culledIn, out.lights, &r, align, sliceMs, cancel, culledMs, part(0.0));
+        shadeImage(backend, culledIn, out.lights, &r, align, sliceMs, cancel, culledMs, part(0.0, culledShare));
     out.result.timings.shadeMs = culledMs;
     throwIfCancelled(cancel);
-    std::vector<float> all;
+    std::vector<float> all, carried;
     out.allLightsReused = reuse;
+    out.allLightsUpdate.reset();
+    ShadeInputs allIn;
+    if (!identity && !reuse) {
+        allIn = culledIn;
+        allIn.perPixelLists.reset();
+        for (std::uint32_t& l : allIn.list)
+            if (l != ShadeInputs::kNoList) l = 0;
+    }
     if (identity) {
         all = culled;
     } else if (reuse) {
         all = earlier->shadedAll;
+        carried = earlier->shadedAllCarried;
+    } else if (update) {
+        // The changed lights' terms, each set shaded alone over every pixel.
+        auto termsOf = [&](const std::vector<std::size_t>& which, const ViewLights& from, double base) {
+            if (which.empty()) return std::vector<float>(culledIn.position.size(), 0.0f);
+            std::vector<float> t = shadeImage(backend, allIn, lightsOf(from, which), nullptr, align, sliceMs,
+                                              cancel, allMs, part(base, 0.02));
+            throwIfCancelled(cancel);
+            return t;
+        };
+        const std::vector<float> gone = termsOf(diff.gone, earlier->lights, 0.9);
+        const std::vector<float> come = termsOf(diff.come, out.lights, 0.92);
+        all = earlier->shadedAll;
+        carried = earlier->shadedAllCarried;
+        carried.resize(all.size(), 0.0f);
+        // Each subtraction and addition rounds by at most half an ulp of its
+        // result, and the terms by a few ulps of themselves: `carried` sums
+        // the magnitudes those roundings scale with. Where it outgrows the
+        // value (a light that outshone the rest moved away), the pixel is
+        // shaded again from every light.
+        ShadeInputs again = allIn;
+        std::uint64_t pixelsAgain = 0;
+        for (std::size_t i = 0; i < again.list.size(); ++i) {
+            if (again.list[i] == ShadeInputs::kNoList) continue;
+            bool redo = false;
+            for (std::size_t k = 3 * i; k < 3 * i + 3; ++k) {
+                if (gone[k] == 0.0f && come[k] == 0.0f) continue;
+                const float v = (all[k] - gone[k]) + come[k];
+                all[k] = v;
+                carried[k] += std::fabs(gone[k]) + std::fabs(come[k]) + std::fabs(v);
+                redo = redo || !(carried[k] <= kCarryLimit * std::fabs(v));
+            }
+            if (redo) ++pixelsAgain;
+            else again.list[i] = ShadeInputs::kNoList;
+        }
+        if (pixelsAgain > 0) {
+            double againMs = 0;
+            const std::vector<float> fresh = shadeImage(backend, again, out.lights, nullptr, align, sliceMs, cancel,
+                                                        againMs, part(0.94, 0.06));
+            throwIfCancelled(cancel);
+            for (std::size_t i = 0; i < again.list.size(); ++i) {
+                if (again.list[i] == ShadeInputs::kNoList) continue;
+                for (std::size_t k = 3 * i; k < 3 * i + 3; ++k) {
+                    all[k] = fresh[k];
+                    carried[k] = 0.0f;
+                }
+            }
+        }
+        out.allLightsUpdate = RunOutput::AllLightsUpdate{diff.gone.size(), diff.come.size(), pixelsAgain};
     } else {
-        ShadeInputs allIn = culledIn;
-        allIn.perPixelLists.reset();
-        for (std::uint32_t& l : allIn.list)
-            if (l != ShadeInputs::kNoList) l = 0;
-        all = shadeImage(backend, allIn, out.lights, nullptr, align, sliceMs, cancel, allMs, part(0.5));
+        all = shadeImage(backend, allIn, out.lights, nullptr, align, sliceMs, cancel, allMs, part(0.5, 0.5));
         throwIfCancelled(cancel);
     }
     const ImageError e = compareShadedImages(out.depth, culled, all);
@@ -131,17 +253,20 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
     if (keepImages) {
         out.shadedCulled = std::move(culled);
         out.shadedAll = std::move(all);
+        out.shadedAllCarried = std::move(carried);
     }
 }
 
-bool sameAllLightsImage(const RunOutput& a, const Camera& ca, const RunOutput& b, const Camera& cb) {
+bool samePixels(const RunOutput& a, const Camera& ca, const RunOutput& b, const Camera& cb) {
     Camera c = cb;
     c.tileSize = ca.tileSize; // tiles shape the lists only
     const DepthImage &da = a.depth, &db = b.depth;
-    const ViewLights &la = a.lights, &lb = b.lights;
     return ca == c && da.width == db.width && da.height == db.height && da.clearDepth == db.clearDepth &&
-           da.depth == db.depth && la.centers == lb.centers && la.power == lb.power && la.spotAxes == lb.spotAxes &&
-           la.spotAngles == lb.spotAngles;
+           da.depth == db.depth;
+}
+
+bool sameAllLightsImage(const RunOutput& a, const Camera& ca, const RunOutput& b, const Camera& cb) {
+    return samePixels(a, ca, b, cb) && sameLights(a.lights, b.lights);
 }
 
 RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBackend& backend,

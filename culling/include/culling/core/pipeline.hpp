@@ -7,7 +7,9 @@
 #include "culling/scene/scene.hpp"
 #include "culling/scene/scene_io.hpp"
 
+#include <cstdint>
 #include <memory>
+#include <optional>
 
 namespace lc {
 
@@ -23,9 +25,24 @@ struct RunOutput {
     // True when the depth pre-pass was skipped for RunOptions::reuseDepth
     // (timings.depthMs is then 0).
     bool depthReused = false;
+    // Per channel of shadedAll, after shadeAndCompare updated an earlier
+    // run's image: the magnitudes the value has carried through updates since
+    // its pixel was last shaded from every light, which bound how far it may
+    // stand from a freshly shaded value. Empty when every pixel was shaded
+    // from every light (or the image is not kept).
+    std::vector<float> shadedAllCarried;
     // True when shadeAndCompare took an earlier run's all-lights image
     // instead of shading it again.
     bool allLightsReused = false;
+    // Set when shadeAndCompare made the all-lights image from an earlier
+    // run's by the lights that changed: their old terms taken out, their new
+    // ones added, and the pixels where that cancelled too much shaded again
+    // from every light.
+    struct AllLightsUpdate {
+        std::size_t removed = 0, added = 0; // light terms taken out, put in
+        std::uint64_t pixelsShadedAgain = 0;
+    };
+    std::optional<AllLightsUpdate> allLightsUpdate;
     // False when RunOptions::groundTruth was off: `truth` is then empty.
     bool truthComputed = false;
     // Set when the lists came from a custom shader or an engine's dump
@@ -67,9 +84,15 @@ void judgeRun(RunOutput& out, const Projection& proj, CullBackend& shadeBackend,
 // slice, not a whole image), with the same pixels as whole images; shadeMs is
 // then the sum of the slices'. `progress` gets the fraction of rows shaded
 // over both images after each slice. `earlier`: a run shaded before on the
-// same backend whose all-lights image this run's equals
-// (sameAllLightsImage); its image is taken instead of shading every light
-// again, and out.allLightsReused set.
+// same backend with the same pixels (samePixels) and its images kept. Where
+// its lights equal this run's in order (sameAllLightsImage), its all-lights
+// image is taken as it is (out.allLightsReused). Where the lights that
+// changed (moved, recoloured, added or removed: their old and new terms) are
+// at most half as many as the lights, its image is updated: the old terms
+// shaded alone and subtracted, the new ones added, and every pixel whose
+// carried magnitudes exceed kCarryLimit times its value shaded again from
+// every light (out.allLightsUpdate, out.shadedAllCarried). Otherwise the
+// image is shaded from every light.
 void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
                      const CancelToken* cancel = nullptr, double sliceMs = 0,
                      const Progress& progress = {}, const RunOutput* earlier = nullptr);
@@ -80,5 +103,13 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
 // do not enter that image, so a change of algorithm, tile size or a light's
 // range keeps it.
 bool sameAllLightsImage(const RunOutput& a, const Camera& ca, const RunOutput& b, const Camera& cb);
+
+// True when runs `a` and `b` shade the same pixels: the same camera (its tile
+// size aside) and depth pixels. Their lights may differ.
+bool samePixels(const RunOutput& a, const Camera& ca, const RunOutput& b, const Camera& cb);
+
+// An updated all-lights value is shaded again from every light once the
+// magnitudes it carried exceed this many times its own (shadeAndCompare).
+inline constexpr float kCarryLimit = 256.0f;
 
 } // namespace lc
