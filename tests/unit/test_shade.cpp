@@ -28,6 +28,14 @@ Scene smallScene(const std::string& builtin, std::uint32_t w, std::uint32_t h, s
     return s;
 }
 
+// A small atrium with 24 lights, light 3 a spot: a cone among the inputs.
+Scene atriumWithSpot() {
+    Scene s = smallScene("atrium", 96, 54, 16, 24);
+    s.lights[3].kind = LightKind::Spot;
+    s.lights[3].outerAngleDeg = 40.0;
+    return s;
+}
+
 RunOutput cpuRun(const Scene& scene, Algorithm algo, std::uint32_t cells = 8) {
     CullSettings settings;
     settings.algorithm = algo;
@@ -208,9 +216,7 @@ TEST(Shade, ZBinPixelsShadeTheirBinsLightsOnly) {
 // run shaded from scratch); a moved or recoloured light, a turned spot, an
 // edited depth pixel or another camera does not.
 TEST(Shade, AllLightsImageIsKeptOnlyForTheSamePixelsAndLights) {
-    Scene scene = smallScene("atrium", 96, 54, 16, 24);
-    scene.lights[3].kind = LightKind::Spot; // a cone among the inputs
-    scene.lights[3].outerAngleDeg = 40.0;
+    const Scene scene = atriumWithSpot();
     auto cpu = makeCpuBackend();
     const Projection proj(scene.camera);
     RunOutput first = cpuRun(scene, Algorithm::TwoPointFiveD);
@@ -258,9 +264,7 @@ TEST(Shade, AllLightsImageIsKeptOnlyForTheSamePixelsAndLights) {
 // goes). Each image stays within 2^-14 of a freshly shaded one, untouched
 // pixels bitwise, and the counts of terms say what changed.
 TEST(Shade, EditedLightsUpdateTheAllLightsImageCloseToAFreshOne) {
-    Scene scene = smallScene("atrium", 96, 54, 16, 24);
-    scene.lights[3].kind = LightKind::Spot;
-    scene.lights[3].outerAngleDeg = 40.0;
+    Scene scene = atriumWithSpot();
     auto cpu = makeCpuBackend();
     const Projection proj(scene.camera);
     RunOutput prev = cpuRun(scene, Algorithm::TwoPointFiveD);
