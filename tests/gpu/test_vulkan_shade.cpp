@@ -174,14 +174,21 @@ TEST_F(VulkanShade, PipelineImageErrorAgreesWithTheCpuBackendOnTheSameDepth) {
 }
 
 // The studio's update of the all-lights image on the device: a dragged
-// light's old and new terms shaded alone by the Vulkan pass, and the pixels
-// where dimming a light that outshone the rest cancelled too much shaded
-// again by the same pass, each image within 2^-14 of the device's fresh one
+// light's and a turned spot's old and new terms shaded alone by the Vulkan
+// pass, and the pixels where dimming a spot that outshone the rest
+// cancelled too much shaded again by the same pass, each image within 2^-14 of the device's fresh one
 // (bitwise where nothing was carried).
 TEST_F(VulkanShade, EditedLightsUpdateTheAllLightsImageCloseToAFreshOne) {
     CullBackend& gpu = gputest::vulkan();
     Scene scene = smallScene("atrium", 96, 54, 24);
-    scene.lights[4].intensity *= 1e6;
+    Light& spot = scene.lights[4]; // at the camera, outshining the rest in the middle of the view
+    spot.kind = LightKind::Spot;
+    spot.position = scene.camera.position;
+    spot.direction = scene.camera.target - scene.camera.position;
+    spot.outerAngleDeg = 12.0;
+    spot.intensity *= 1e6;
+    scene.lights[9].kind = LightKind::Spot; // a cone among the moved lights
+    scene.lights[9].outerAngleDeg = 50.0;
     const Projection proj(scene.camera);
     CullSettings settings;
     settings.algorithm = Algorithm::TwoPointFiveD;
@@ -201,6 +208,10 @@ TEST_F(VulkanShade, EditedLightsUpdateTheAllLightsImageCloseToAFreshOne) {
     };
     scene.lights[6].position.x += 0.2;
     step("a moved light");
+    EXPECT_EQ(prev.allLightsUpdate->pixelsShadedAgain, 0u);
+    scene.lights[9].position.z -= 0.2;
+    scene.lights[9].direction = glm::dvec3(0.2, -1, 0.1);
+    step("a moved and turned spot");
     EXPECT_EQ(prev.allLightsUpdate->pixelsShadedAgain, 0u);
     scene.lights[4].intensity *= 1e-6;
     step("a dimmed light that outshone the rest");

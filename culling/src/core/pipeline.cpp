@@ -98,9 +98,12 @@ ShadingKey shadingKey(const ViewLights& l, std::size_t i) {
 
 // The lights of `before` no light of `after` shades as (gone) and those of
 // `after` no light of `before` does (come), matched one to one by value, so
-// that a light moved in the list or another with its values is no change.
+// that a light removed or inserted before others does not change them.
+// `reordered`: the matched lights are not in the same order in both (a sum
+// in another order rounds differently).
 struct LightsDiff {
     std::vector<std::size_t> gone, come;
+    bool reordered = false;
 };
 LightsDiff diffShadingLights(const ViewLights& before, const ViewLights& after) {
     auto sorted = [](const ViewLights& l) {
@@ -111,6 +114,7 @@ LightsDiff diffShadingLights(const ViewLights& before, const ViewLights& after) 
     };
     const auto b = sorted(before), a = sorted(after);
     LightsDiff d;
+    std::vector<std::pair<std::size_t, std::size_t>> matched; // (before, after)
     std::size_t i = 0, j = 0;
     while (i < b.size() || j < a.size()) {
         if (j == a.size() || (i < b.size() && b[i].first < a[j].first)) {
@@ -118,9 +122,12 @@ LightsDiff diffShadingLights(const ViewLights& before, const ViewLights& after) 
         } else if (i == b.size() || a[j].first < b[i].first) {
             d.come.push_back(a[j++].second);
         } else {
-            ++i, ++j;
+            matched.emplace_back(b[i++].second, a[j++].second);
         }
     }
+    std::sort(matched.begin(), matched.end());
+    for (std::size_t k = 1; k < matched.size() && !d.reordered; ++k)
+        d.reordered = matched[k].second < matched[k - 1].second;
     std::sort(d.gone.begin(), d.gone.end());
     std::sort(d.come.begin(), d.come.end());
     return d;
@@ -159,26 +166,18 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
     bool identity = r.listCount.size() == 1 && r.listCount[0] == out.lights.size();
     for (std::size_t i = 0; identity && i < out.lights.size(); ++i)
         identity = r.lightIndices[r.listOffset[0] + i] == i;
-    const bool usable = !identity && earlier && earlier->shadedAll.size() == culledIn.position.size();
+    const bool usable = !identity && earlier && earlier->shadedAll.size() == culledIn.position.size() &&
+                        earlier->depth.width == out.depth.width && earlier->depth.depth == out.depth.depth;
     const bool reuse = usable && sameLights(earlier->lights, out.lights);
     LightsDiff diff;
     if (usable && !reuse) diff = diffShadingLights(earlier->lights, out.lights);
     const std::size_t changed = diff.gone.size() + diff.come.size();
-    const bool update =
-        usable && !reuse && changed > 0 && 2 * changed <= std::max(earlier->lights.size(), out.lights.size());
-    // The all-lights image costs more (every light at every pixel), but the
-    // split by images is what a user can follow: half each, unless one is
-    // all there is to shade (an update's few lights: a tenth).
-    const double culledShare = identity || reuse ? 1.0 : update ? 0.9 : 0.5;
+    bool update = usable && !reuse && !diff.reordered && changed > 0 &&
+                  2 * changed <= std::max(earlier->lights.size(), out.lights.size());
     auto part = [&progress](double base, double share) -> std::function<void(double)> {
         if (!progress) return {};
         return [&progress, base, share](double f) { progress(base + share * f); };
     };
-    std::vector<float> culled =
-        shadeImage(backend, culledIn, out.lights, &r, align, sliceMs, cancel, culledMs, part(0.0, culledShare));
-    out.result.timings.shadeMs = culledMs;
-    throwIfCancelled(cancel);
-    std::vector<float> all, carried;
     out.allLightsReused = reuse;
     out.allLightsUpdate.reset();
     ShadeInputs allIn;
@@ -188,37 +187,44 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
         for (std::uint32_t& l : allIn.list)
             if (l != ShadeInputs::kNoList) l = 0;
     }
-    if (identity) {
-        all = culled;
-    } else if (reuse) {
-        all = earlier->shadedAll;
-        carried = earlier->shadedAllCarried;
-    } else if (update) {
-        // The changed lights' terms, each set shaded alone over every pixel.
-        auto termsOf = [&](const std::vector<std::size_t>& which, const ViewLights& from, double base) {
+    std::vector<float> all, carried;
+    // An update: the pixels to shade again from every light, kNoList elsewhere.
+    ShadeInputs again;
+    std::uint64_t pixelsAgain = 0, lit = 0;
+    double base = 0; // progress so far
+    if (update) {
+        // The changed lights' terms first, each set shaded alone over every
+        // pixel: they decide how much is left to shade.
+        auto termsOf = [&](const std::vector<std::size_t>& which, const ViewLights& from, double at) {
             if (which.empty()) return std::vector<float>(culledIn.position.size(), 0.0f);
+            double ms = 0;
             std::vector<float> t = shadeImage(backend, allIn, lightsOf(from, which), nullptr, align, sliceMs,
-                                              cancel, allMs, part(base, 0.02));
+                                              cancel, ms, part(at, 0.05));
             throwIfCancelled(cancel);
             return t;
         };
-        const std::vector<float> gone = termsOf(diff.gone, earlier->lights, 0.9);
-        const std::vector<float> come = termsOf(diff.come, out.lights, 0.92);
+        const std::vector<float> gone = termsOf(diff.gone, earlier->lights, 0.0);
+        const std::vector<float> come = termsOf(diff.come, out.lights, 0.05);
+        base = 0.1;
         all = earlier->shadedAll;
         carried = earlier->shadedAllCarried;
         carried.resize(all.size(), 0.0f);
         // Each subtraction and addition rounds by at most half an ulp of its
-        // result, and the terms by a few ulps of themselves: `carried` sums
-        // the magnitudes those roundings scale with. Where it outgrows the
-        // value (a light that outshone the rest moved away), the pixel is
-        // shaded again from every light.
-        ShadeInputs again = allIn;
-        std::uint64_t pixelsAgain = 0;
+        // result; `carried` sums the magnitudes those roundings scale with,
+        // starting, where a value was shaded from every light (nothing
+        // carried yet), from that sum's own rounding: about sqrt(n) ulps of
+        // it over n lights. Where it outgrows the value (a light that
+        // outshone the rest moved away), the pixel is shaded again from
+        // every light.
+        const float freshUlps = float(std::sqrt(double(earlier->lights.size())));
+        again = allIn;
         for (std::size_t i = 0; i < again.list.size(); ++i) {
             if (again.list[i] == ShadeInputs::kNoList) continue;
+            ++lit;
             bool redo = false;
             for (std::size_t k = 3 * i; k < 3 * i + 3; ++k) {
                 if (gone[k] == 0.0f && come[k] == 0.0f) continue;
+                if (carried[k] == 0.0f) carried[k] = freshUlps * std::fabs(all[k]);
                 const float v = (all[k] - gone[k]) + come[k];
                 all[k] = v;
                 carried[k] += std::fabs(gone[k]) + std::fabs(come[k]) + std::fabs(v);
@@ -227,10 +233,34 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
             if (redo) ++pixelsAgain;
             else again.list[i] = ShadeInputs::kNoList;
         }
+        // Most pixels to shade again costs about what shading every light does.
+        if (2 * pixelsAgain > lit) {
+            update = false;
+            all.clear();
+            carried.clear();
+        }
+    }
+    // The all-lights image costs more (every light at every pixel), but the
+    // split by images is what a user can follow: half each, unless one is
+    // all there is to shade; an update's pixels shaded again by their share.
+    const double culledShare = (1.0 - base) * (identity || reuse ? 1.0
+                                                : update     ? 1.0 / (1.0 + double(pixelsAgain) / double(std::max<std::uint64_t>(lit, 1)))
+                                                             : 0.5);
+    std::vector<float> culled =
+        shadeImage(backend, culledIn, out.lights, &r, align, sliceMs, cancel, culledMs, part(base, culledShare));
+    out.result.timings.shadeMs = culledMs;
+    throwIfCancelled(cancel);
+    const double rest = base + culledShare, restShare = 1.0 - rest;
+    if (identity) {
+        all = culled;
+    } else if (reuse) {
+        all = earlier->shadedAll;
+        carried = earlier->shadedAllCarried;
+    } else if (update) {
         if (pixelsAgain > 0) {
             double againMs = 0;
-            const std::vector<float> fresh = shadeImage(backend, again, out.lights, nullptr, align, sliceMs, cancel,
-                                                        againMs, part(0.94, 0.06));
+            const std::vector<float> fresh =
+                shadeImage(backend, again, out.lights, nullptr, align, sliceMs, cancel, againMs, part(rest, restShare));
             throwIfCancelled(cancel);
             for (std::size_t i = 0; i < again.list.size(); ++i) {
                 if (again.list[i] == ShadeInputs::kNoList) continue;
@@ -242,7 +272,7 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
         }
         out.allLightsUpdate = RunOutput::AllLightsUpdate{diff.gone.size(), diff.come.size(), pixelsAgain};
     } else {
-        all = shadeImage(backend, allIn, out.lights, nullptr, align, sliceMs, cancel, allMs, part(0.5, 0.5));
+        all = shadeImage(backend, allIn, out.lights, nullptr, align, sliceMs, cancel, allMs, part(rest, restShare));
         throwIfCancelled(cancel);
     }
     const ImageError e = compareShadedImages(out.depth, culled, all);

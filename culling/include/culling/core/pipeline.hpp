@@ -84,15 +84,18 @@ void judgeRun(RunOutput& out, const Projection& proj, CullBackend& shadeBackend,
 // slice, not a whole image), with the same pixels as whole images; shadeMs is
 // then the sum of the slices'. `progress` gets the fraction of rows shaded
 // over both images after each slice. `earlier`: a run shaded before on the
-// same backend with the same pixels (samePixels) and its images kept. Where
+// same backend with the same camera (samePixels) and its images kept. Where
 // its lights equal this run's in order (sameAllLightsImage), its all-lights
 // image is taken as it is (out.allLightsReused). Where the lights that
 // changed (moved, recoloured, added or removed: their old and new terms) are
-// at most half as many as the lights, its image is updated: the old terms
-// shaded alone and subtracted, the new ones added, and every pixel whose
-// carried magnitudes exceed kCarryLimit times its value shaded again from
-// every light (out.allLightsUpdate, out.shadedAllCarried). Otherwise the
-// image is shaded from every light.
+// at most half as many as the lights and the others keep their order, its
+// image is updated: the old terms shaded alone and subtracted, the new ones
+// added, and every pixel whose carried magnitudes (starting from sqrt(n)
+// times a value shaded from n lights: that sum's own rounding) exceed
+// kCarryLimit times its value shaded again from every light
+// (out.allLightsUpdate, out.shadedAllCarried). Otherwise, or where more than
+// half the pixels would be shaded again, the image is shaded from every
+// light. `earlier` with other depth pixels is not used.
 void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& proj, bool keepImages,
                      const CancelToken* cancel = nullptr, double sliceMs = 0,
                      const Progress& progress = {}, const RunOutput* earlier = nullptr);
