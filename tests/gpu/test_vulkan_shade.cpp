@@ -176,17 +176,12 @@ TEST_F(VulkanShade, PipelineImageErrorAgreesWithTheCpuBackendOnTheSameDepth) {
 // The studio's update of the all-lights image on the device: a dragged
 // light's and a turned spot's old and new terms shaded alone by the Vulkan
 // pass, and the pixels where dimming a spot that outshone the rest
-// cancelled too much shaded again by the same pass, each image within 2^-14 of the device's fresh one
-// (bitwise where nothing was carried).
+// cancelled too much shaded again by the same pass, each image within
+// 2^-14 of the device's fresh one (bitwise where nothing was carried).
 TEST_F(VulkanShade, EditedLightsUpdateTheAllLightsImageCloseToAFreshOne) {
     CullBackend& gpu = gputest::vulkan();
     Scene scene = smallScene("atrium", 96, 54, 24);
-    Light& spot = scene.lights[4]; // at the camera, outshining the rest in the middle of the view
-    spot.kind = LightKind::Spot;
-    spot.position = scene.camera.position;
-    spot.direction = scene.camera.target - scene.camera.position;
-    spot.outerAngleDeg = 12.0;
-    spot.intensity *= 1e6;
+    lc::testutil::makeOutshiningSpot(scene.lights[4], scene.camera);
     scene.lights[9].kind = LightKind::Spot; // a cone among the moved lights
     scene.lights[9].outerAngleDeg = 50.0;
     const Projection proj(scene.camera);

@@ -44,4 +44,16 @@ inline double expectCloseToFresh(const RunOutput& updated, const RunOutput& fres
     return worst;
 }
 
+// Makes `light` a narrow spot at the camera, aimed at its target and a
+// million times as bright: it outshines the other lights in the middle of
+// the view and reaches no other pixel, so dimming it again cancels most of
+// those pixels' sums and leaves the rest untouched.
+inline void makeOutshiningSpot(Light& light, const Camera& camera) {
+    light.kind = LightKind::Spot;
+    light.position = camera.position;
+    light.direction = camera.target - camera.position;
+    light.outerAngleDeg = 12.0;
+    light.intensity *= 1e6;
+}
+
 } // namespace lc::testutil

@@ -362,12 +362,7 @@ TEST(Shade, EditedLightsUpdateTheAllLightsImageCloseToAFreshOne) {
 // most to shade again: then every light is shaded, as costly and exact.
 TEST(Shade, PixelsWhereAnUpdateCancelsTooMuchAreShadedAgain) {
     Scene scene = smallScene("atrium", 96, 54, 16, 24);
-    Light& spot = scene.lights[4];
-    spot.kind = LightKind::Spot; // at the camera, lighting the middle of the view
-    spot.position = scene.camera.position;
-    spot.direction = scene.camera.target - scene.camera.position;
-    spot.outerAngleDeg = 12.0;
-    spot.intensity *= 1e6;
+    lc::testutil::makeOutshiningSpot(scene.lights[4], scene.camera);
     auto cpu = makeCpuBackend();
     const Projection proj(scene.camera);
     RunOutput bright = cpuRun(scene, Algorithm::TwoPointFiveD);

@@ -84,10 +84,6 @@ std::vector<float> shadeImage(CullBackend& backend, const ShadeInputs& in, const
     return rgb;
 }
 
-} // namespace
-
-namespace {
-
 // What shades a light: its position, power and cone (not its range).
 using ShadingKey = std::array<double, 10>;
 ShadingKey shadingKey(const ViewLights& l, std::size_t i) {
@@ -188,8 +184,9 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
             if (l != ShadeInputs::kNoList) l = 0;
     }
     std::vector<float> all, carried;
-    // An update: the pixels to shade again from every light, kNoList elsewhere.
-    ShadeInputs again;
+    // An update: per pixel, list 0 where it is shaded again from every
+    // light, kNoList elsewhere (allIn's lists, once the update stands).
+    std::vector<std::uint32_t> again;
     std::uint64_t pixelsAgain = 0, lit = 0;
     double base = 0; // progress so far
     if (update) {
@@ -217,9 +214,9 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
         // outshone the rest moved away), the pixel is shaded again from
         // every light.
         const float freshUlps = float(std::sqrt(double(earlier->lights.size())));
-        again = allIn;
-        for (std::size_t i = 0; i < again.list.size(); ++i) {
-            if (again.list[i] == ShadeInputs::kNoList) continue;
+        again = allIn.list;
+        for (std::size_t i = 0; i < again.size(); ++i) {
+            if (again[i] == ShadeInputs::kNoList) continue;
             ++lit;
             bool redo = false;
             for (std::size_t k = 3 * i; k < 3 * i + 3; ++k) {
@@ -231,7 +228,7 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
                 redo = redo || !(carried[k] <= kCarryLimit * std::fabs(v));
             }
             if (redo) ++pixelsAgain;
-            else again.list[i] = ShadeInputs::kNoList;
+            else again[i] = ShadeInputs::kNoList;
         }
         // Most pixels to shade again costs about what shading every light does.
         if (2 * pixelsAgain > lit) {
@@ -243,9 +240,8 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
     // The all-lights image costs more (every light at every pixel), but the
     // split by images is what a user can follow: half each, unless one is
     // all there is to shade; an update's pixels shaded again by their share.
-    const double culledShare = (1.0 - base) * (identity || reuse ? 1.0
-                                                : update     ? 1.0 / (1.0 + double(pixelsAgain) / double(std::max<std::uint64_t>(lit, 1)))
-                                                             : 0.5);
+    const double againShare = double(pixelsAgain) / double(std::max<std::uint64_t>(lit, 1));
+    const double culledShare = (1.0 - base) * (identity || reuse ? 1.0 : update ? 1.0 / (1.0 + againShare) : 0.5);
     std::vector<float> culled =
         shadeImage(backend, culledIn, out.lights, &r, align, sliceMs, cancel, culledMs, part(base, culledShare));
     out.result.timings.shadeMs = culledMs;
@@ -258,12 +254,13 @@ void shadeAndCompare(CullBackend& backend, RunOutput& out, const Projection& pro
         carried = earlier->shadedAllCarried;
     } else if (update) {
         if (pixelsAgain > 0) {
+            allIn.list = std::move(again);
             double againMs = 0;
             const std::vector<float> fresh =
-                shadeImage(backend, again, out.lights, nullptr, align, sliceMs, cancel, againMs, part(rest, restShare));
+                shadeImage(backend, allIn, out.lights, nullptr, align, sliceMs, cancel, againMs, part(rest, restShare));
             throwIfCancelled(cancel);
-            for (std::size_t i = 0; i < again.list.size(); ++i) {
-                if (again.list[i] == ShadeInputs::kNoList) continue;
+            for (std::size_t i = 0; i < allIn.list.size(); ++i) {
+                if (allIn.list[i] == ShadeInputs::kNoList) continue;
                 for (std::size_t k = 3 * i; k < 3 * i + 3; ++k) {
                     all[k] = fresh[k];
                     carried[k] = 0.0f;
