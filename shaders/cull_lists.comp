@@ -13,9 +13,14 @@
 // P.bins.z entries (cull_common.glsl, binding 10); WRITE_PASS == 1 copies a
 // list the stash holds whole, else tests again and writes the indices at the
 // scanned offset and checks that the count matches; a list that would end
-// beyond the index array is left out (the host sees the total and reruns). `all` has
-// one list of every light: its count pass is one invocation, its write pass
-// one invocation per light.
+// beyond the index array is left out (the host sees the total and reruns).
+// WRITE_PASS == 2 (GPUs, a subgroup per list) does both in one dispatch: the
+// count pass, then the list takes its range of the index array with one
+// atomic add on the total (listOffset[lists]) and is written there at once,
+// from the stash or by a second walk; the ranges come in no fixed order (the
+// host reads each list at its offset), the entries of each list ascending
+// as ever. `all` has one list of every light: its count pass is one
+// invocation, its write pass one invocation per light.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
@@ -104,6 +109,67 @@ bool lightKept(uint l, Chunk ch, uint spotMode, vec3 cellCentre, float cellRadiu
         pass = (cells & geomMask) != 0u;
     }
     return pass;
+}
+
+// What a subgroup's walk over one list's candidates needs (GPUs).
+struct ListWalk {
+    Chunk ch;
+    uint spotMode;
+    vec3 cellCentre;
+    float cellRadius;
+    bool cellLog;
+    float cellLog0, cellScale, maskLo, maskHi;
+    uint geomMask, words, columnBase, rowBase;
+    bool depthBins;
+    uint nearBase, farBase;
+};
+
+// A subgroup's walk over a list's candidates (GPUs): lane i takes words i,
+// i + LANES, ... The kept lights go, ascending, to lightIndices[base ..]
+// when writing, else the first P.bins.z of them to the stash. Returns the
+// list's count (the same in every lane); the lane's tests add to tested.
+uint subgroupListWalk(ListWalk wk, uint list, uint lane, bool writing, uint base, inout uint tested, inout bool cut) {
+    uint stashSlots = P.bins.z;
+    uint n = 0u, w0 = 0u;
+    for (; w0 < wk.words; w0 += LANES) {
+        uint w = w0 + lane;
+        uint m = w < wk.words ? binMask[wk.columnBase + w] & binMask[wk.rowBase + w] : 0u;
+        if (wk.depthBins && w < wk.words) m &= binMask[wk.nearBase + w] & binMask[wk.farBase + w];
+        uint passMask = 0u;
+        tested += uint(bitCount(m));
+        while (m != 0u) {
+            uint bit = uint(findLSB(m));
+            m &= m - 1u;
+            if (lightKept(w * 32u + bit, wk.ch, wk.spotMode, wk.cellCentre, wk.cellRadius, wk.cellLog, wk.cellLog0,
+                          wk.cellScale, wk.maskLo, wk.maskHi, wk.geomMask))
+                passMask |= 1u << bit;
+        }
+        cut = cut || m != 0u;
+        uint cnt = uint(bitCount(passMask));
+        uint at = n + subgroupExclusiveAdd(cnt);
+        if (!writing && n < stashSlots) {
+            // After the scan. At most 32 iterations a word, as the write
+            // loop below.
+            uint stashMask = passMask;
+            for (uint a = at; stashMask != 0u && a < stashSlots; ++a) {
+                uint bit = uint(findLSB(stashMask));
+                stashMask &= stashMask - 1u;
+                stash[list * stashSlots + a] = w * 32u + bit;
+            }
+        }
+        if (writing) {
+            while (passMask != 0u) {
+                uint bit = uint(findLSB(passMask));
+                passMask &= passMask - 1u;
+                lightIndices[base + at] = w * 32u + bit;
+                ++at;
+            }
+            cut = cut || passMask != 0u;
+        }
+        n += subgroupAdd(cnt);
+    }
+    cut = cut || w0 < wk.words;
+    return n;
 }
 
 // Clustered on a CPU device (TILE_WALK slices an invocation): the lists of
@@ -240,7 +306,7 @@ void main() {
     }
     // Uniform per list (so per subgroup): the early exits keep subgroups whole.
     if (list >= P.counts.z) return;
-    if (WRITE_PASS != 0u) {
+    if (WRITE_PASS == 1u) {
         uint count = listCount[list];
         // The index array may be smaller than the lists (a first submission
         // sized from the previous cull): then the host writes them again.
@@ -281,7 +347,7 @@ void main() {
         zlo = sliceBoundary(P.cluster.x, P.cluster.y, sub);
         zhi = sliceBoundary(P.cluster.x, P.cluster.y, sub + 1u);
     }
-    uint n = 0u, tested = 0u;
+    uint n = 0u, tested = 0u, base = 0u;
     if (listLive) {
         float chunkLo = max(widenDown(zlo), isOrtho() ? -3.4e38 : 0.0), chunkHi = widenUp(zhi);
         Chunk ch = makeChunk(tile, chunkLo, chunkHi);
@@ -302,7 +368,7 @@ void main() {
         bool cellLog = SLICING == LC_SLICING_LOG && maskLo > 0.0 && maskHi > maskLo;
         float cellLog0 = cellLog ? log2(maskLo) : 0.0;
         float cellScale = cellLog ? float(CELLS) / log2(maskHi / maskLo) : 0.0;
-        uint base = (WRITE_PASS != 0u) ? listOffset[list] : 0u;
+        if (WRITE_PASS == 1u) base = listOffset[list];
         uint tilesX = P.size.z, words = P.bins.x;
         uint tx = tile % tilesX, ty = tile / tilesX;
         uint columnBase = tx * words, rowBase = P.bins.y + ty * words;
@@ -340,53 +406,36 @@ void main() {
             }
             cut = w < words || m != 0u; // a loop ended by the driver's cap, not by the list
         } else {
-            // A subgroup per list (GPUs): lane i takes words i, i + LANES, ...
-            uint w0 = 0u;
-            for (; w0 < words; w0 += LANES) {
-                uint w = w0 + lane;
-                uint m = w < words ? binMask[columnBase + w] & binMask[rowBase + w] : 0u;
-                if (depthBins && w < words) m &= binMask[nearBase + w] & binMask[farBase + w];
-                uint passMask = 0u;
-                tested += uint(bitCount(m));
-                while (m != 0u) {
-                    uint bit = uint(findLSB(m));
-                    m &= m - 1u;
-                    if (lightKept(w * 32u + bit, ch, spotMode, cellCentre, cellRadius, cellLog, cellLog0, cellScale,
-                                  maskLo, maskHi, geomMask))
-                        passMask |= 1u << bit;
-                }
-                cut = cut || m != 0u;
-                uint cnt = uint(bitCount(passMask));
-                uint at = n + subgroupExclusiveAdd(cnt);
-                if (WRITE_PASS == 0u && n < stashSlots) {
-                    // After the scan. At most 32 iterations a word, as the
-                    // write loop below.
-                    uint stashMask = passMask;
-                    for (uint a = at; stashMask != 0u && a < stashSlots; ++a) {
-                        uint bit = uint(findLSB(stashMask));
-                        stashMask &= stashMask - 1u;
-                        stash[list * stashSlots + a] = w * 32u + bit;
+            // A subgroup per list (GPUs).
+            ListWalk wk = ListWalk(ch, spotMode, cellCentre, cellRadius, cellLog, cellLog0, cellScale, maskLo, maskHi,
+                                   geomMask, words, columnBase, rowBase, depthBins, nearBase, farBase);
+            n = subgroupListWalk(wk, list, lane, WRITE_PASS == 1u, base, tested, cut);
+            if (WRITE_PASS == 2u && n != 0u) {
+                // The list's range: one atomic add on the total, by one lane.
+                uint at = lane == 0u ? atomicAdd(listOffset[P.counts.z], n) : 0u;
+                base = subgroupMax(at);
+                // Ranges beyond the index array are left out, as in the write
+                // pass (the host reruns into one sized exactly).
+                if (base + n <= uint(lightIndices.length())) {
+                    if (n <= stashSlots) {
+                        // The lanes read what other lanes stashed.
+                        subgroupBarrier();
+                        for (uint i = lane; i < n; i += LANES) lightIndices[base + i] = stash[list * stashSlots + i];
+                    } else {
+                        uint testedAgain = 0u;
+                        if (subgroupListWalk(wk, list, lane, true, base, testedAgain, cut) != n)
+                            atomicOr(status, STATUS_COUNT_MISMATCH);
                     }
                 }
-                if (WRITE_PASS != 0u) {
-                    while (passMask != 0u) {
-                        uint bit = uint(findLSB(passMask));
-                        passMask &= passMask - 1u;
-                        lightIndices[base + at] = w * 32u + bit;
-                        ++at;
-                    }
-                    cut = cut || passMask != 0u;
-                }
-                n += subgroupAdd(cnt);
             }
-            cut = cut || w0 < words;
         }
         if (cut) atomicOr(status, STATUS_LOOP_LIMIT);
     }
-    if (WRITE_PASS == 0u) {
+    if (WRITE_PASS != 1u) {
         if (LANES != 1u) tested = subgroupAdd(tested);
         if (lane == 0u) {
             listCount[list] = n;
+            if (WRITE_PASS == 2u) listOffset[list] = base;
             if (tested != 0u && atomicAdd(candidateTests, tested) + tested < tested)
                 atomicOr(status, STATUS_TESTS_OVERFLOW);
         }
