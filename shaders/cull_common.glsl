@@ -24,7 +24,7 @@ layout(constant_id = 2) const uint CELLS = 32u;
 layout(constant_id = 3) const uint SLICING = 0u;      // LC_SLICING_*
 layout(constant_id = 4) const uint ALGORITHM = 0u;    // LC_ALG_*
 layout(constant_id = 5) const uint SPHERE_TEST = 0u;  // LC_TEST_*
-layout(constant_id = 6) const uint WRITE_PASS = 0u;   // cull_lists: 0 count, 1 write, 2 both (GPUs)
+layout(constant_id = 6) const uint WRITE_PASS = 0u;   // cull_lists: 0 count, 1 write, 2 both (GPUs), 3 write by atomic ranges
 // Lanes sharing one tile (tile_bounds) or one list (cull_lists): 1 (an
 // invocation each: CPU devices), or the subgroup size (a subgroup each: GPUs).
 layout(constant_id = 7) const uint LANES = 1u;

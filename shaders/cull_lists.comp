@@ -14,6 +14,9 @@
 // list the stash holds whole, else tests again and writes the indices at the
 // scanned offset and checks that the count matches; a list that would end
 // beyond the index array is left out (the host sees the total and reruns).
+// WRITE_PASS == 3 (clustered's tile walk, CPU devices) is the write pass
+// without a scan before it: a tile walk's lists take their ranges with one
+// atomic add on the total, as below.
 // WRITE_PASS == 2 (GPUs, a subgroup per list) does both in one dispatch: the
 // count pass, then the list takes its range of the index array with one
 // atomic add on the total (listOffset[lists]) and is written there at once,
@@ -198,6 +201,17 @@ void clusteredTileWalk(uint id) {
     uint n[32]; // the counts of slices firstCell .. endCell - 1
     for (uint k = 0u; k < TILE_WALK; ++k) n[k] = 0u;
     if (WRITE_PASS != 0u) {
+        if (WRITE_PASS == 3u) {
+            // No scan before: the invocation's lists take their ranges, in
+            // slice order, with one atomic add on the total (listOffset[lists]).
+            uint sum = 0u;
+            for (uint c = firstCell; c < endCell; ++c) sum += listCount[firstList + c];
+            uint at = sum != 0u ? atomicAdd(listOffset[P.counts.z], sum) : 0u;
+            for (uint c = firstCell; c < endCell; ++c) {
+                listOffset[firstList + c] = at;
+                at += listCount[firstList + c];
+            }
+        }
         // Lists that do not fit the index array are left to the host (as the
         // per-list walk); lists the stash holds whole are copied.
         uint lists = walk;
@@ -431,7 +445,7 @@ void main() {
         }
         if (cut) atomicOr(status, STATUS_LOOP_LIMIT);
     }
-    if (WRITE_PASS != 1u) {
+    if (WRITE_PASS == 0u || WRITE_PASS == 2u) {
         if (LANES != 1u) tested = subgroupAdd(tested);
         if (lane == 0u) {
             listCount[list] = n;

@@ -907,7 +907,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     std::uint32_t walk = 0;
     if (algo == Algorithm::Clustered && ctx_.isCpuDevice() && lanes == 1)
         for (std::uint32_t s : {32u, 16u, 8u, 4u}) {
-            const std::uint64_t iters = std::uint64_t(binWords) + (2ull * s + 3) * n + 4ull * s + std::uint64_t(s) * stashCap;
+            const std::uint64_t iters = std::uint64_t(binWords) + (2ull * s + 3) * n + 6ull * s + std::uint64_t(s) * stashCap;
             if (iters <= kLoopLimit) {
                 walk = std::min(s, cells);
                 break;
@@ -949,6 +949,14 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     // scan of 261,120 counts 400 of 582 us). The ranges come in no fixed
     // order; the host reads each list at its range.
     const bool fused = writeFirst && !ctx_.isCpuDevice() && subgroupLanes && !all;
+    // clustered's tile walk (CPU devices) keeps its write pass but drops the
+    // scan before it the same way: a walk's lists take their ranges by one
+    // atomic add (P1 on lavapipe: the scan of 261,120 counts cost 1.1 ms).
+    const bool atomicWrite = writeFirst && walk != 0;
+    const bool atomicRanges = fused || atomicWrite;
+    VkPipeline atomicWritePipe =
+        atomicWrite ? computePipeline("cull_lists.write.atomic", cullShader_, spec(kLocal, 3, lanes, 2, walk), false)
+                    : VK_NULL_HANDLE;
     VkPipeline fusedPipe =
         fused ? computePipeline("cull_lists.fused", cullShader_, spec(kLocal, 2, lanes, 2, walk), true)
               : VK_NULL_HANDLE;
@@ -992,14 +1000,20 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
             }
             // The count pass reads the tile bounds and bins the two passes above wrote
             // (and ORs status after the bounds pass did).
-            if (fused) {
+            if (atomicRanges) {
                 // The total the lists' atomic adds start from (after the
                 // barrier the uploads end with).
                 vkCmdFillBuffer(cmd, offsetBuf.buffer, VkDeviceSize(listTotal) * 4, 4, 0);
                 memoryBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                               VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+            }
+            if (fused) {
                 dispatchAfter(cmd, fusedPipe, countGroups);
+            } else if (atomicWrite) {
+                dispatchAfter(cmd, countPipe, countGroups);
+                // The write pass reads the counts the count pass wrote.
+                dispatchAfter(cmd, atomicWritePipe, writeGroups);
             } else {
                 dispatchAfter(cmd, countPipe, countGroups);
                 // The scan reads the counts the count pass wrote.
@@ -1024,17 +1038,17 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     res.volumeTests = (status[0] & 4u) ? 0 : status[1]; // wrapped: not counted
     std::uint64_t total64 = 0;
     std::uint32_t longest = 0;
-    // fused: the offsets of the lists in order come from here (a second
+    // Ranges by atomic add: the offsets of the lists in order come from here (a second
     // submission that writes the lists scans the same counts).
-    std::vector<std::uint32_t> hostOffs(fused ? std::size_t(listTotal) + 1 : 0);
+    std::vector<std::uint32_t> hostOffs(atomicRanges ? std::size_t(listTotal) + 1 : 0);
     for (std::uint32_t l = 0; l < listTotal; ++l) {
-        if (fused) hostOffs[l] = std::uint32_t(total64);
+        if (atomicRanges) hostOffs[l] = std::uint32_t(total64);
         total64 += counts[l];
         longest = std::max(longest, counts[l]);
     }
-    // fused: the device's ranges, and the total its atomic adds reached.
-    const std::uint32_t* fusedOffs = fused ? offs : nullptr;
-    if (fused) {
+    // The device's ranges, and the total its atomic adds reached.
+    const std::uint32_t* rangeOffs = atomicRanges ? offs : nullptr;
+    if (atomicRanges) {
         hostOffs[listTotal] = std::uint32_t(total64);
         if (total64 != offs[listTotal])
             throw DeviceError("Vulkan culling's lists took " + std::to_string(offs[listTotal]) +
@@ -1058,15 +1072,15 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         res.lightIndices.resize(total);
         for (std::uint32_t l = 0; l < listTotal; ++l)
             std::copy_n(stashed + std::size_t(l) * stashSlots, counts[l], res.lightIndices.begin() + offs[l]);
-    } else if (total > 0 && fused && total <= firstCapacity) {
-        // The fused pass wrote every list, each at the range it took.
+    } else if (total > 0 && atomicRanges && total <= firstCapacity) {
+        // Every list was written, each at the range it took.
         res.lightIndices.resize(total);
         for (std::uint32_t l = 0; l < listTotal; ++l) {
             if (counts[l] == 0) continue;
-            if (fusedOffs[l] > total - counts[l])
+            if (rangeOffs[l] > total - counts[l])
                 throw DeviceError("Vulkan culling placed list " + std::to_string(l) +
                                   " beyond the index array");
-            std::copy_n(firstIdx + fusedOffs[l], counts[l], res.lightIndices.begin() + offs[l]);
+            std::copy_n(firstIdx + rangeOffs[l], counts[l], res.lightIndices.begin() + offs[l]);
         }
     } else if (total > 0 && writeFirst && total <= firstCapacity) {
         // The first submission wrote every list.
@@ -1090,7 +1104,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                 if (gpuClock) stamps.begin(cmd, 1);
                 vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, computeLayout_, 0, 1, &set2, 0,
                                         nullptr);
-                if (!fused) {
+                if (!atomicRanges) {
                     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, writePipe);
                     vkCmdDispatch(cmd, writeGroups.x, writeGroups.y, 1);
                 } else {
