@@ -1148,7 +1148,12 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         // The masks hold sorted positions: back to light indices, ascending.
         for (std::uint32_t l = 0; l < listTotal; ++l) {
             auto b = res.lightIndices.begin() + offs[l], e = b + counts[l];
-            for (auto it = b; it != e; ++it) *it = res.zbinOrder[*it];
+            for (auto it = b; it != e; ++it) {
+                if (*it >= n)
+                    throw DeviceError("Vulkan culling put position " + std::to_string(*it) + " in list " +
+                                      std::to_string(l) + " of " + std::to_string(n) + " lights");
+                *it = res.zbinOrder[*it];
+            }
             std::sort(b, e);
         }
         res.zbinLo.assign(binWordsOut + planeBinWords, binWordsOut + planeBinWords + 2 * std::size_t(settings.bins));
