@@ -179,9 +179,9 @@ uint walkWords(ListWalk wk, uint list, uint w0, uint lane, bool writing, uint ba
 // Words per lane whose masks a subgroup's walk keeps in registers (the
 // first KEPT_WORDS x LANES words: 4,096 lights with 32 lanes). The fused
 // pass writes such a list from them once it has its range, instead of
-// walking it again where the stash cannot hold it (on the H100 the
-// Live scene's 73 entries per list: 0.029 against 0.036 ms; P3, 256 per
-// list: 0.164 against 0.249).
+// walking it again where the stash cannot hold it (on the H100, against
+// the build before: the Live scene, 73 entries a list, 0.030 against 0.035
+// ms; P3, 256 a list, 0.173 against 0.249).
 const uint KEPT_WORDS = 4u;
 
 // A subgroup's walk over a list's candidates (GPUs): lane i takes words i,
