@@ -1050,7 +1050,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const std::uint32_t* rangeOffs = atomicRanges ? offs : nullptr;
     if (atomicRanges) {
         hostOffs[listTotal] = std::uint32_t(total64);
-        if (total64 != offs[listTotal])
+        // (A total beyond 32 bits fails the size check below.)
+        if (total64 <= std::numeric_limits<std::uint32_t>::max() && total64 != offs[listTotal])
             throw DeviceError("Vulkan culling's lists took " + std::to_string(offs[listTotal]) +
                               " entries of the index array for " + std::to_string(total64) + " counted");
         offs = hostOffs.data();
