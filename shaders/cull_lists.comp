@@ -128,6 +128,13 @@ struct ListWalk {
     uint nearBase, farBase;
 };
 
+// Copies a list the stash holds whole (count entries) to lightIndices[base ..]:
+// entries first, first + step, ... (step LANES for a subgroup, 1 alone).
+void copyStashed(uint list, uint base, uint count, uint first, uint step) {
+    uint stashSlots = P.bins.z;
+    for (uint i = first; i < count; i += step) lightIndices[base + i] = stash[list * stashSlots + i];
+}
+
 // Writes the lights of word w set in mask at lightIndices[at ..], ascending.
 void writeWord(uint w, uint mask, uint at, inout bool cut) {
     while (mask != 0u) {
@@ -261,7 +268,7 @@ void clusteredTileWalk(uint id) {
             if (base + count > uint(lightIndices.length())) {
                 walk &= ~(1u << c);
             } else if (count <= stashSlots) {
-                for (uint i = 0u; i < count; ++i) lightIndices[base + i] = stash[list * stashSlots + i];
+                copyStashed(list, base, count, 0u, 1u);
                 walk &= ~(1u << c);
             }
         }
@@ -365,8 +372,7 @@ void main() {
         // sized from the previous cull): then the host writes them again.
         if (listOffset[list] + count > uint(lightIndices.length())) return;
         if (count <= stashSlots) { // the count pass stashed the whole list
-            uint base = listOffset[list];
-            for (uint i = lane; i < count; i += LANES) lightIndices[base + i] = stash[list * stashSlots + i];
+            copyStashed(list, listOffset[list], count, lane, LANES);
             return;
         }
     }
@@ -477,7 +483,7 @@ void main() {
                     } else if (n <= stashSlots) {
                         // The lanes read what other lanes stashed.
                         subgroupBarrier();
-                        for (uint i = lane; i < n; i += LANES) lightIndices[base + i] = stash[list * stashSlots + i];
+                        copyStashed(list, base, n, lane, LANES);
                     } else {
                         uint testedAgain = 0u;
                         if (subgroupListWalk(wk, list, lane, true, base, kept, testedAgain, cut) != n)
