@@ -28,6 +28,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -296,11 +297,17 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
         const lc::Projection proj(scene.camera);
         const lc::TileGrid grid = lc::TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
         const lc::ViewLights lights = lc::makeViewLights(scene);
-        std::vector<double> depthMs, depthWallMs, cullMs, cullWallMs;
+        std::vector<double> depthMs, depthWallMs, depthCallMs, cullMs, cullWallMs, cullCallMs;
         std::size_t peakDeviceBytes = 0;
         lc::CullResult last;
+        using Clock = std::chrono::steady_clock;
+        const auto msSince = [](Clock::time_point t0) {
+            return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+        };
         for (int i = 0; i < opt.warmup + opt.repeat; ++i) {
+            const Clock::time_point d0 = Clock::now();
             const lc::DepthImage depth = backend->renderDepth(scene, proj);
+            const double dc = msSince(d0);
             const double d = backend->lastDepthMs(), dw = backend->lastDepthWallMs();
             // Peak device memory of the culling pass alone: what it allocates
             // beyond what is alive before it (its buffers, the staging copies
@@ -308,21 +315,29 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
             // when the backend rendered it).
             backend->resetPeakDeviceBytes();
             const std::size_t alive = backend->peakDeviceBytes();
+            last = lc::CullResult();
+            const Clock::time_point c0 = Clock::now();
             last = backend->cull(depth, proj, grid, lights, settings);
+            const double cc = msSince(c0);
             peakDeviceBytes = std::max(peakDeviceBytes, backend->peakDeviceBytes() - alive);
             if (i >= opt.warmup) {
                 depthMs.push_back(d);
                 depthWallMs.push_back(dw);
+                depthCallMs.push_back(dc);
                 cullMs.push_back(last.timings.cullMs);
                 cullWallMs.push_back(backend->lastCullWallMs());
+                cullCallMs.push_back(cc);
             }
         }
-        const Stats ds = stats(depthMs), dws = stats(depthWallMs), cs = stats(cullMs), ws = stats(cullWallMs);
+        const Stats ds = stats(depthMs), dws = stats(depthWallMs), dcs = stats(depthCallMs),
+                    cs = stats(cullMs), ws = stats(cullWallMs), ccs = stats(cullCallMs);
         std::cout << label << ": depth " << fmt("%.3f", ds.median) << " [" << fmt("%.3f", ds.min) << ".."
-                  << fmt("%.3f", ds.max) << "] (wall " << fmt("%.3f", dws.median) << "), cull " << fmt("%.3f", cs.median) << " [" << fmt("%.3f", cs.min)
-                  << ".." << fmt("%.3f", cs.max) << "] (wall " << fmt("%.3f", ws.median) << "), "
-                  << last.entries() << " entries, " << last.listCountTotal() << " lists, " << last.bytes()
-                  << " bytes (+" << last.diagnosticBytes() << " diagnostic), " << last.volumeTests
+                  << fmt("%.3f", ds.max) << "] (wall " << fmt("%.3f", dws.median) << ", call "
+                  << fmt("%.3f", dcs.median) << "), cull " << fmt("%.3f", cs.median) << " ["
+                  << fmt("%.3f", cs.min) << ".." << fmt("%.3f", cs.max) << "] (wall "
+                  << fmt("%.3f", ws.median) << ", call " << fmt("%.3f", ccs.median) << "), " << last.entries()
+                  << " entries, " << last.listCountTotal() << " lists, " << last.bytes() << " bytes (+"
+                  << last.diagnosticBytes() << " diagnostic), " << last.volumeTests
                   << " volume tests, peak device " << peakDeviceBytes << " bytes\n";
         configs.push_back({{"params", params},
                            {"algorithm", lc::toString(settings.algorithm)},
@@ -335,8 +350,10 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
                            {"lights", lights.size()},
                            {"depth_ms", statsJson(ds)},
                            {"depth_wall_ms", statsJson(dws)},
+                           {"depth_call_ms", statsJson(dcs)},
                            {"cull_ms", statsJson(cs)},
                            {"cull_wall_ms", statsJson(ws)},
+                           {"cull_call_ms", statsJson(ccs)},
                            {"list_entries", last.entries()},
                            {"lists", last.listCountTotal()},
                            {"result_bytes", last.bytes()},

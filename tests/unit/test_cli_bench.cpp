@@ -31,8 +31,10 @@ TEST(CliBench, SweepCrossProductWritesEveryConfiguration) {
         seen.insert({c["algorithm"].get<std::string>(), c["lights"].get<std::size_t>()});
         EXPECT_EQ(c["width"], 160);
         EXPECT_EQ(c["height"], 90);
-        // The wall clocks too: on the CPU backend the same clock as the times.
-        for (const char* phase : {"depth_ms", "depth_wall_ms", "cull_ms", "cull_wall_ms"}) {
+        // The wall clocks too (on the CPU backend the same clock as the
+        // times), and the whole calls around them.
+        for (const char* phase :
+             {"depth_ms", "depth_wall_ms", "depth_call_ms", "cull_ms", "cull_wall_ms", "cull_call_ms"}) {
             const auto& st = c[phase];
             EXPECT_LE(st["min"].get<double>(), st["median"].get<double>()) << phase;
             EXPECT_LE(st["median"].get<double>(), st["max"].get<double>()) << phase;
@@ -44,6 +46,9 @@ TEST(CliBench, SweepCrossProductWritesEveryConfiguration) {
         if (c["lights"] == 0) EXPECT_EQ(c["list_entries"], 0);
         EXPECT_EQ(c["depth_wall_ms"], c["depth_ms"]);
         EXPECT_EQ(c["cull_wall_ms"], c["cull_ms"]);
+        // A call's clock runs around its pass's, run by run.
+        EXPECT_GE(c["depth_call_ms"]["median"].get<double>(), c["depth_wall_ms"]["median"].get<double>());
+        EXPECT_GE(c["cull_call_ms"]["median"].get<double>(), c["cull_wall_ms"]["median"].get<double>());
     }
     EXPECT_EQ(seen.size(), 6u);
     // One stdout line per configuration plus the header and the "wrote" line.

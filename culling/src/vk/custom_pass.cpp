@@ -271,8 +271,8 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
     st->lightBuf = ctx.createBuffer(std::max<std::size_t>(gl.size(), 1) * sizeof(CustomLight),
                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "custom.lights");
     if (!gl.empty()) std::memcpy(st->lightBuf.mapped, gl.data(), gl.size() * sizeof(CustomLight));
-    st->out = ctx.createBuffer(outWords * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                               "custom.lists");
+    st->out = ctx.createReadbackBuffer(
+        outWords * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, "custom.lists");
 
     // The depth texture, from the depth buffer through a copy.
     st->depthImage = ctx.createImage(depth.width, depth.height, VK_FORMAT_R32_SFLOAT,

@@ -108,7 +108,7 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     Buffer offsetBuf = ctx_.createBuffer(culled ? listTotal * 4 : 4, usage, "shade.listOffsets");
     Buffer countBuf = ctx_.createBuffer(culled ? listTotal * 4 : 4, usage, "shade.listCounts");
     Buffer indexBuf = ctx_.createBuffer(culled ? culled->lightIndices.size() * 4 : 4, usage, "shade.lightIndices");
-    Buffer outBuf = ctx_.createBuffer(pixels * 3 * 4, usage, "shade.rgb");
+    Buffer outBuf = ctx_.createReadbackBuffer(pixels * 3 * 4, usage, "shade.rgb");
     // The lights again as uniform blocks of blockLights_ each (the last one
     // padded): every chunk of the all-lights image, and a list image's lights
     // when one block holds them all.

@@ -406,16 +406,21 @@ bool Context::hasMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags want) 
 }
 
 Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& n) const {
-    return allocateBuffer(size, usage, n, false);
+    return allocateBuffer(size, usage, n, Placement::Host);
+}
+
+Buffer Context::createReadbackBuffer(VkDeviceSize size, VkBufferUsageFlags usage,
+                                     const std::string& n) const {
+    return allocateBuffer(size, usage, n, Placement::HostRead);
 }
 
 Buffer Context::createDeviceBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& n) const {
-    return allocateBuffer(size, usage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, n,
-                          true);
+    return allocateBuffer(size, usage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                          n, Placement::Device);
 }
 
 Buffer Context::allocateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& n,
-                               bool deviceLocal) const {
+                               Placement where) const {
     Buffer b;
     b.size = std::max<VkDeviceSize>(size, 4);
     VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
@@ -431,7 +436,10 @@ Buffer Context::allocateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, cons
     const VkMemoryPropertyFlags hostFlags = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
     VkMemoryPropertyFlags want = hostFlags;
     bool map = true;
-    if (deviceLocal) {
+    if (where == Placement::HostRead &&
+        hasMemoryType(req.memoryTypeBits, hostFlags | VK_MEMORY_PROPERTY_HOST_CACHED_BIT))
+        want = hostFlags | VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+    if (where == Placement::Device) {
         // A CPU device's memory is the host's: keep it mapped. A GPU's
         // device-local memory is never mapped (see createDeviceBuffer).
         const VkMemoryPropertyFlags both = hostFlags | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;

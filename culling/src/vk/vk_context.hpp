@@ -195,6 +195,10 @@ public:
 
     // Host-visible, coherent, persistently mapped buffer (size 0 -> 4 bytes).
     Buffer createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name) const;
+    // createBuffer for data the host reads back: host-cached memory where the
+    // device has a coherent type of it (a GPU's plain host-visible memory is
+    // write-combined, and the host reads it uncached).
+    Buffer createReadbackBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name) const;
     // Buffer for work on the device: device-local memory. On a CPU device
     // (lavapipe: device memory is host memory) it is mapped and used in
     // place; on a GPU `mapped` is null and data moves through staging copies
@@ -234,8 +238,9 @@ private:
     void release(); // destroys everything, in reverse order of creation
     std::uint32_t findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags want) const;
     bool hasMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags want) const;
+    enum class Placement { Host, HostRead, Device };
     Buffer allocateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name,
-                          bool deviceLocal) const;
+                          Placement where) const;
 
     VkInstance instance_ = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;

@@ -138,7 +138,7 @@ public:
             mappedReads_ = true;
             return src.mapped;
         }
-        Buffer st = ctx_.createBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "staging.download");
+        Buffer st = ctx_.createReadbackBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "staging.download");
         copies_.push_back({src.buffer, st.buffer, bytes, false});
         staging_.push_back(std::move(st));
         return staging_.back().mapped;
