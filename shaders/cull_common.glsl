@@ -50,7 +50,15 @@ layout(std430, binding = 2) buffer TileBuf { GpuTileBounds tiles[]; };
 layout(std430, binding = 3) readonly buffer LightBuf { GpuLight lights[]; };
 layout(std430, binding = 4) buffer CountBuf { uint listCount[]; };
 layout(std430, binding = 5) buffer OffsetBuf { uint listOffset[]; };    // listCount + 1 (total)
+#ifdef LC_INDEX16
+// cull_lists.comp built with LC_INDEX16 (the GPU's fused pass while the
+// lights fit 16 bits): the index array holds 16-bit light indices.
+layout(std430, binding = 6) buffer IndexBuf { uint16_t lightIndices[]; };
+#define LC_INDEX(l) uint16_t(l)
+#else
 layout(std430, binding = 6) buffer IndexBuf { uint lightIndices[]; };
+#define LC_INDEX(l) (l)
+#endif
 // status: STATUS_* bits; candidateTests: light-versus-volume tests the count
 // pass performed (the write pass repeats them), for the benchmarks.
 layout(std430, binding = 7) buffer StatusBuf { uint status; uint candidateTests; };

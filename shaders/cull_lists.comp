@@ -28,6 +28,9 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#ifdef LC_INDEX16
+#extension GL_EXT_shader_16bit_storage : require
+#endif
 #include "cull_common.glsl"
 
 float sliceBoundary(float lo, float hi, uint i) {
@@ -132,7 +135,7 @@ struct ListWalk {
 // entries first, first + step, ... (step LANES for a subgroup, 1 alone).
 void copyStashed(uint list, uint base, uint count, uint first, uint step) {
     uint stashSlots = P.bins.z;
-    for (uint i = first; i < count; i += step) lightIndices[base + i] = stash[list * stashSlots + i];
+    for (uint i = first; i < count; i += step) lightIndices[base + i] = LC_INDEX(stash[list * stashSlots + i]);
 }
 
 // Writes the lights of word w set in mask at lightIndices[at ..], ascending.
@@ -140,7 +143,7 @@ void writeWord(uint w, uint mask, uint at, inout bool cut) {
     while (mask != 0u) {
         uint bit = uint(findLSB(mask));
         mask &= mask - 1u;
-        lightIndices[at] = w * 32u + bit;
+        lightIndices[at] = LC_INDEX(w * 32u + bit);
         ++at;
     }
     cut = cut || mask != 0u;
@@ -318,7 +321,7 @@ void clusteredTileWalk(uint id) {
                 if (spotMode == LC_FLAG_SPOT_CONE_SPHERE) chunkSphere(ch, cellCentre, cellRadius);
                 if (lightKept(l, ch, spotMode, cellCentre, cellRadius, false, 0.0, 0.0, 0.0, 0.0, 0u)) {
                     uint list = firstList + c, k = n[c - firstCell];
-                    if (WRITE_PASS != 0u) lightIndices[listOffset[list] + k] = l;
+                    if (WRITE_PASS != 0u) lightIndices[listOffset[list] + k] = LC_INDEX(l);
                     else if (k < stashSlots) stash[list * stashSlots + k] = l;
                     n[c - firstCell] = k + 1u;
                 }
@@ -349,7 +352,7 @@ void main() {
         if (WRITE_PASS == 0u) {
             if (id == 0u) listCount[0] = lightCount;
         } else if (id < lightCount && id < uint(lightIndices.length())) {
-            lightIndices[id] = id;
+            lightIndices[id] = LC_INDEX(id);
         }
         return;
     }
@@ -458,7 +461,7 @@ void main() {
                 ++tested;
                 if (lightKept(l, ch, spotMode, cellCentre, cellRadius, cellLog, cellLog0, cellScale, maskLo, maskHi,
                               geomMask)) {
-                    if (WRITE_PASS != 0u) lightIndices[base + n] = l;
+                    if (WRITE_PASS != 0u) lightIndices[base + n] = LC_INDEX(l);
                     else if (n < stashSlots) stash[list * stashSlots + n] = l;
                     ++n;
                 }

@@ -1,6 +1,7 @@
 #include "embedded_spirv.hpp"
 
 #include "cull_lists_comp.spv.h"
+#include "cull_lists_index16_comp.spv.h"
 #include "depth_vert.spv.h"
 #include "fine_prune_comp.spv.h"
 #include "light_bins_comp.spv.h"
@@ -18,6 +19,7 @@ LC_SPV(tileBounds, lc_spv_tile_bounds_comp)
 LC_SPV(tileBoundsWide, lc_spv_tile_bounds_wide_comp)
 LC_SPV(lightBins, lc_spv_light_bins_comp)
 LC_SPV(cullLists, lc_spv_cull_lists_comp)
+LC_SPV(cullListsIndex16, lc_spv_cull_lists_index16_comp)
 LC_SPV(prefixSum, lc_spv_prefix_sum_comp)
 LC_SPV(finePrune, lc_spv_fine_prune_comp)
 LC_SPV(zbin, lc_spv_zbin_comp)

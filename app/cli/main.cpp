@@ -354,6 +354,7 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
                            {"cull_ms", statsJson(cs)},
                            {"cull_wall_ms", statsJson(ws)},
                            {"cull_call_ms", statsJson(ccs)},
+                           {"device_index_bits", backend->lastDeviceIndexBits()},
                            {"list_entries", last.entries()},
                            {"lists", last.listCountTotal()},
                            {"result_bytes", last.bytes()},

@@ -728,6 +728,40 @@ TEST_F(GpuTest, WideDepthLoadsMatchSinglePixelLoads) {
     }
 }
 
+// A GPU's fused pass writes 16-bit light indices while the lights fit them
+// (at most 65,536) and 32-bit ones beyond. On both sides of the bound the
+// emulated GPU layout gives the CPU layout's lists bit for bit; the last
+// light (index 65,535, then 65,536: written in 16 bits it would come back as
+// 0) lights the whole frame, so it is in every list.
+TEST_F(GpuTest, SixteenBitIndicesUpTo65536Lights) {
+    setenv("LIGHTCULL_VK_EMULATE_GPU", "1", 1);
+    std::unique_ptr<CullBackend> emulated = makeVulkanBackend("");
+    unsetenv("LIGHTCULL_VK_EMULATE_GPU");
+    auto cpuBackend = makeCpuBackend();
+    for (const std::size_t n : {std::size_t(65536), std::size_t(65537)}) {
+        Scene scene = sized("atrium", 96, 64);
+        scene.lights = generateLights(defaultLightGen(scene, n, 6));
+        ASSERT_EQ(scene.lights.size(), n);
+        scene.lights.back().position = 0.5 * (scene.bounds().first + scene.bounds().second);
+        scene.lights.back().explicitRadius = 1e3;
+        const gputest::Frame f(scene, nullptr);
+        for (Algorithm a : {Algorithm::TwoPointFiveD, Algorithm::ZBin}) {
+            CullSettings st;
+            st.algorithm = a;
+            const std::string label = std::to_string(n) + " lights " + toString(a);
+            checkCase(label, f, st, *cpuBackend, *emulated);
+            const CullResult g = emulated->cull(f.depth, f.proj, f.grid, f.lights, st);
+            EXPECT_EQ(emulated->lastDeviceIndexBits(), n <= 65536 ? 16u : 32u) << label;
+            const CullResult c = f.cull(gputest::vulkan(), st);
+            EXPECT_EQ(g.listCount, c.listCount) << label;
+            EXPECT_EQ(g.listOffset, c.listOffset) << label;
+            EXPECT_EQ(g.lightIndices, c.lightIndices) << label;
+            ASSERT_FALSE(g.lightIndices.empty()) << label;
+            EXPECT_EQ(*std::max_element(g.lightIndices.begin(), g.lightIndices.end()), n - 1) << label;
+        }
+    }
+}
+
 // The depth bins (light_bins.comp) spare the count pass the lights in front
 // of or behind a list's depth range: on the forest (depths from a few metres
 // to the horizon) most candidates of the column and row bins alone miss the

@@ -290,16 +290,20 @@ Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
         // Full subgroups for compute (Vulkan 1.3 core feature): with the local
         // size equal to the subgroup size a workgroup is then exactly one subgroup.
         VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+        VkPhysicalDevice16BitStorageFeatures f16{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_16BIT_STORAGE_FEATURES};
         VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
         bool v13 = props_.apiVersion >= VK_API_VERSION_1_3;
-        if (v13) {
-            f2.pNext = &f13;
-            vkGetPhysicalDeviceFeatures2(physical_, &f2);
-        }
+        f2.pNext = &f16;
+        if (v13) f16.pNext = &f13;
+        vkGetPhysicalDeviceFeatures2(physical_, &f2);
         fullSubgroups_ = v13 && f13.computeFullSubgroups;
+        index16_ = f16.storageBuffer16BitAccess == VK_TRUE;
         VkPhysicalDeviceVulkan13Features enable13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
         enable13.computeFullSubgroups = fullSubgroups_ ? VK_TRUE : VK_FALSE;
         enable13.subgroupSizeControl = (v13 && f13.subgroupSizeControl) ? VK_TRUE : VK_FALSE;
+        VkPhysicalDevice16BitStorageFeatures enable16{
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_16BIT_STORAGE_FEATURES};
+        enable16.storageBuffer16BitAccess = index16_ ? VK_TRUE : VK_FALSE;
 
         VkPhysicalDeviceFeatures f10{};
         vkGetPhysicalDeviceFeatures(physical_, &f10);
@@ -321,7 +325,8 @@ Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
         dci.queueCreateInfoCount = 1;
         dci.pQueueCreateInfos = &qci;
         dci.pEnabledFeatures = &enable10;
-        if (v13) dci.pNext = &enable13;
+        dci.pNext = &enable16;
+        if (v13) enable16.pNext = &enable13;
         LC_VK(vkCreateDevice(physical_, &dci, nullptr, &device_));
         vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
         name(VK_OBJECT_TYPE_DEVICE, device_, "device");

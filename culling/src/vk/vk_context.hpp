@@ -172,6 +172,9 @@ public:
     bool fullSubgroupsSupported() const { return fullSubgroups_; }
     // shaderInt64, enabled when the device has it (tile_bounds' pixel-pair loads).
     bool int64Supported() const { return int64_; }
+    // storageBuffer16BitAccess (Vulkan 1.1), enabled when the device has it:
+    // the GPU culling pass writes 16-bit light indices where they fit.
+    bool index16Supported() const { return index16_; }
     // A CPU implementation (lavapipe): device memory is host memory, so
     // buffers stay host-visible and mapped, and compute timestamps are not
     // trusted (DESIGN.md). Elsewhere: device-local buffers, GPU timestamps.
@@ -253,6 +256,7 @@ private:
     std::uint32_t subgroupSize_ = 1;
     bool fullSubgroups_ = false;
     bool int64_ = false;
+    bool index16_ = false;
     bool timestamps_ = false;
     bool emulateGpu_ = false;
     std::uint32_t timestampValidBits_ = 0;

@@ -266,8 +266,8 @@ private:
     Context ctx_;
     DescriptorSetLayoutHandle setLayout_;
     PipelineLayoutHandle computeLayout_;
-    ShaderModuleHandle boundsShader_, boundsWideShader_, binsShader_, cullShader_, scanShader_, pruneShader_,
-        zbinShader_, vertShader_;
+    ShaderModuleHandle boundsShader_, boundsWideShader_, binsShader_, cullShader_, cullShader16_, scanShader_,
+        pruneShader_, zbinShader_, vertShader_;
     std::uint32_t lastLongestList_ = 0; // of the previous cull: sizes a CPU device's stash
     // Of the previous cull: its lists and entries size the next one's index array.
     std::uint32_t lastListTotal_ = 0, lastEntries_ = 0;
@@ -317,6 +317,7 @@ void VulkanBackend::createComputeObjects() {
     if (ctx_.int64Supported()) boundsWideShader_ = mk(spirv::tileBoundsWide(), "shader.tile_bounds_wide");
     binsShader_ = mk(spirv::lightBins(), "shader.light_bins");
     cullShader_ = mk(spirv::cullLists(), "shader.cull_lists");
+    if (ctx_.index16Supported()) cullShader16_ = mk(spirv::cullListsIndex16(), "shader.cull_lists_index16");
     scanShader_ = mk(spirv::prefixSum(), "shader.prefix_sum");
     pruneShader_ = mk(spirv::finePrune(), "shader.fine_prune");
     zbinShader_ = mk(spirv::zbin(), "shader.zbin");
@@ -814,10 +815,6 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                               : nullptr;
     const bool writeFirst = !fptl && !(stashed && lastLongestList_ <= stashSlots) &&
                             firstCapacity * 4 <= lim.maxStorageBufferRange;
-    Buffer firstIndices =
-        writeFirst ? ctx_.createDeviceBuffer(firstCapacity * 4, ssbo, "cull.indices.first") : Buffer();
-    const auto* firstIdx =
-        writeFirst ? static_cast<const std::uint32_t*>(staging.download(firstIndices, firstCapacity * 4)) : nullptr;
     const auto* binWordsOut =
         zbin ? static_cast<const std::uint32_t*>(staging.download(binBuf, binTotal64 * 4)) : nullptr;
 
@@ -858,7 +855,6 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         vkUpdateDescriptorSets(dev, kBindings, writes.data(), 0, nullptr);
         return set;
     };
-    VkDescriptorSet set1 = makeSet(writeFirst ? firstIndices : placeholder, "cull.set.count");
 
     const std::uint32_t sg = ctx_.subgroupSize();
     const std::uint32_t algoId = std::uint32_t(algo), testId = std::uint32_t(settings.test),
@@ -957,9 +953,23 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     VkPipeline atomicWritePipe =
         atomicWrite ? computePipeline("cull_lists.write.atomic", cullShader_, spec(kLocal, 3, lanes, 2, walk), false)
                     : VK_NULL_HANDLE;
+    // The fused pass writes 16-bit light indices while the lights fit them
+    // (zbin's sorted positions too: below the light count): half the bytes
+    // to write and to read back (P3 on the H100: 33 MB of lists).
+    const bool index16 = fused && n <= 65536 && ctx_.index16Supported();
     VkPipeline fusedPipe =
-        fused ? computePipeline("cull_lists.fused", cullShader_, spec(kLocal, 2, lanes, 2, walk), true)
-              : VK_NULL_HANDLE;
+        !fused    ? VK_NULL_HANDLE
+        : index16 ? computePipeline("cull_lists.fused.index16", cullShader16_,
+                                    spec(kLocal, 2, lanes, 2, walk), true)
+                  : computePipeline("cull_lists.fused", cullShader_, spec(kLocal, 2, lanes, 2, walk), true);
+    const std::size_t entryBytes = index16 ? 2 : 4;
+    Buffer firstIndices = writeFirst ? ctx_.createDeviceBuffer((firstCapacity * entryBytes + 3) / 4 * 4, ssbo,
+                                                               "cull.indices.first")
+                                     : Buffer();
+    const void* firstOut = writeFirst ? staging.download(firstIndices, firstCapacity * entryBytes) : nullptr;
+    const auto* firstIdx = index16 ? nullptr : static_cast<const std::uint32_t*>(firstOut);
+    const auto* firstIdx16 = index16 ? static_cast<const std::uint16_t*>(firstOut) : nullptr;
+    VkDescriptorSet set1 = makeSet(writeFirst ? firstIndices : placeholder, "cull.set.count");
     // One bins invocation per plane word and per pair of depth-bin words.
     const Grid binGroups = groupsFor(planeBinWords + depthBinWords, lim);
     const Grid countGroups = groupsFor(all ? 1 : listItems, lim);
@@ -1081,7 +1091,10 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
             if (rangeOffs[l] > total - counts[l])
                 throw DeviceError("Vulkan culling placed list " + std::to_string(l) +
                                   " beyond the index array");
-            std::copy_n(firstIdx + rangeOffs[l], counts[l], res.lightIndices.begin() + offs[l]);
+            if (index16)
+                std::copy_n(firstIdx16 + rangeOffs[l], counts[l], res.lightIndices.begin() + offs[l]);
+            else
+                std::copy_n(firstIdx + rangeOffs[l], counts[l], res.lightIndices.begin() + offs[l]);
         }
     } else if (total > 0 && writeFirst && total <= firstCapacity) {
         // The first submission wrote every list.
@@ -1192,6 +1205,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     lastLongestList_ = longest;
     lastListTotal_ = listTotal;
     lastEntries_ = total;
+    lastIndexBits_ = total > 0 && index16 && atomicRanges && total <= firstCapacity ? 16 : 32;
     return res;
 }
 

@@ -60,6 +60,10 @@ public:
     // CPU wall-clock milliseconds of the last cull() around its submissions
     // (equal to its cullMs where that is the timing method; -1: not run).
     double lastCullWallMs() const { return lastCullWallMs_; }
+    // Bits per light index in which the last cull's lists came back from the
+    // device: 16 where a GPU wrote them so (at most 65,536 lights), else 32.
+    // The result holds 32-bit indices either way.
+    unsigned lastDeviceIndexBits() const { return lastIndexBits_; }
     // Most device memory (buffers and images, as allocated) alive at once
     // since the last resetPeakDeviceBytes(); 0 for backends without a device.
     virtual std::size_t peakDeviceBytes() const { return 0; }
@@ -76,6 +80,7 @@ protected:
     double lastDepthMs_ = -1;
     double lastDepthWallMs_ = -1; // -1: the same as lastDepthMs_
     double lastCullWallMs_ = -1;
+    unsigned lastIndexBits_ = 32;
     double lastShadeMs_ = -1;
 };
 
