@@ -387,6 +387,7 @@ TrackedBytes::TrackedBytes(std::shared_ptr<MemoryStats> stats, std::uint64_t byt
     : stats_(std::move(stats)), bytes_(bytes) {
     stats_->live += bytes_;
     stats_->peak = std::max(stats_->peak, stats_->live);
+    ++stats_->allocations;
 }
 
 TrackedBytes& TrackedBytes::operator=(TrackedBytes&& o) noexcept {
@@ -464,6 +465,26 @@ Buffer Context::allocateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, cons
     const VkMemoryPropertyFlags got = memProps_.memoryTypes[ai.memoryTypeIndex].propertyFlags;
     if (map && (got & hostFlags) == hostFlags) LC_VK(vkMapMemory(device_, mem, 0, VK_WHOLE_SIZE, 0, &b.mapped));
     return b;
+}
+
+const Buffer& BufferCache::get(const std::string& role, VkDeviceSize bytes, VkBufferUsageFlags usage,
+                               Kind kind) {
+    bytes = std::max<VkDeviceSize>(bytes, 4);
+    auto it = entries_.find(role);
+    if (it != entries_.end()) {
+        const Entry& e = it->second;
+        if (e.kind == kind && e.usage == usage && e.buffer.size >= bytes && e.buffer.size / 4 <= bytes)
+            return e.buffer;
+        entries_.erase(it); // freed before its successor is made
+    }
+    const VkDeviceSize size = bytes + bytes / 4;
+    Entry e;
+    e.usage = usage;
+    e.kind = kind;
+    e.buffer = kind == Kind::Device     ? ctx_.createDeviceBuffer(size, usage, role)
+               : kind == Kind::HostRead ? ctx_.createReadbackBuffer(size, usage, role)
+                                        : ctx_.createBuffer(size, usage, role);
+    return entries_.emplace(role, std::move(e)).first->second.buffer;
 }
 
 TimestampPool::TimestampPool(const Context& ctx, std::uint32_t spans, const std::string& n)

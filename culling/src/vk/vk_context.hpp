@@ -4,14 +4,14 @@
 // compute+graphics queue). Nothing here leaks into culling/include.
 #include "culling/core/errors.hpp"
 
-#include <vulkan/vulkan.h>
-
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
+#include <vulkan/vulkan.h>
 
 namespace lc::vk {
 
@@ -85,6 +85,7 @@ class Context;
 // alignment padding counts).
 struct MemoryStats {
     std::uint64_t live = 0, peak = 0;
+    std::uint64_t allocations = 0; // vkAllocateMemory calls, all told
 };
 
 // Move-only share of MemoryStats.live held by one allocation: added when the
@@ -270,5 +271,36 @@ private:
 
 // Names of the physical devices the loader reports (empty when none / no ICD).
 std::vector<std::string> physicalDeviceNames();
+
+// Buffers kept from one call to the next, one per role ("cull.tiles",
+// "staging.download.cull.counts"): a call gets its role's buffer back while
+// it is of the same kind and usage and holds the bytes asked for without
+// holding more than four times them, else a new one with a quarter more
+// (the old one freed first). Creating and freeing device memory on every
+// call was most of what a cull cost a caller on a GPU (the H100: 6.8 ms a
+// P1 cull for 0.08 ms of submission). Every pass writes what it reads
+// (nothing relies on fresh memory), and a buffer's bytes beyond what was
+// asked are never bound (descriptor ranges are the asked sizes).
+class BufferCache {
+  public:
+    enum class Kind { Host, HostRead, Device };
+    explicit BufferCache(const Context& ctx) : ctx_(ctx) {}
+    BufferCache(const BufferCache&) = delete;
+    BufferCache& operator=(const BufferCache&) = delete;
+    // Kind::Host: createBuffer, HostRead: createReadbackBuffer, Device:
+    // createDeviceBuffer. The buffer lives until the role asks again with a
+    // size or kind it does not fit, or clear().
+    const Buffer& get(const std::string& role, VkDeviceSize bytes, VkBufferUsageFlags usage, Kind kind);
+    void clear() { entries_.clear(); }
+
+  private:
+    struct Entry {
+        Buffer buffer;
+        VkBufferUsageFlags usage = 0;
+        Kind kind = Kind::Host;
+    };
+    const Context& ctx_;
+    std::map<std::string, Entry> entries_;
+};
 
 } // namespace lc::vk

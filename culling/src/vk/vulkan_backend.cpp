@@ -115,34 +115,35 @@ void computeBarrier(VkCommandBuffer cmd, VkAccessFlags dstAccess, VkPipelineStag
 
 // Host <-> device data of one submission. Buffers the host can map are
 // written and read in place (lavapipe: no copies at all); others go through
-// host-visible staging buffers copied at the start / end of the commands.
+// host-visible staging buffers (the cache's "staging.upload.<role>" and
+// "staging.download.<role>") copied at the start / end of the commands.
 class Staging {
 public:
-    explicit Staging(const Context& ctx) : ctx_(ctx) {}
-    // Writes `bytes` of `data` into `dst`: now when mapped, else at recordUploads().
-    void upload(const Buffer& dst, const void* data, std::size_t bytes) {
-        if (bytes == 0) return;
-        if (dst.mapped) {
-            std::memcpy(dst.mapped, data, bytes);
-            return;
-        }
-        Buffer st = ctx_.createBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "staging.upload");
-        std::memcpy(st.mapped, data, bytes);
-        copies_.push_back({dst.buffer, st.buffer, bytes, true});
-        staging_.push_back(std::move(st));
-    }
-    // Host pointer to `src`'s first `bytes`, valid once the submission that
-    // ran recordDownloads() has completed.
-    const void* download(const Buffer& src, std::size_t bytes) {
-        if (src.mapped) {
-            mappedReads_ = true;
-            return src.mapped;
-        }
-        Buffer st = ctx_.createReadbackBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "staging.download");
-        copies_.push_back({src.buffer, st.buffer, bytes, false});
-        staging_.push_back(std::move(st));
-        return staging_.back().mapped;
-    }
+  explicit Staging(BufferCache& cache) : cache_(cache) {}
+  // Writes `bytes` of `data` into `dst`: now when mapped, else at recordUploads().
+  void upload(const Buffer& dst, const void* data, std::size_t bytes, const std::string& role) {
+      if (bytes == 0) return;
+      if (dst.mapped) {
+          std::memcpy(dst.mapped, data, bytes);
+          return;
+      }
+      const Buffer& st = cache_.get("staging.upload." + role, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                    BufferCache::Kind::Host);
+      std::memcpy(st.mapped, data, bytes);
+      copies_.push_back({dst.buffer, st.buffer, bytes, true});
+  }
+  // Host pointer to `src`'s first `bytes`, valid once the submission that
+  // ran recordDownloads() has completed (until the role is staged again).
+  const void* download(const Buffer& src, std::size_t bytes, const std::string& role) {
+      if (src.mapped) {
+          mappedReads_ = true;
+          return src.mapped;
+      }
+      const Buffer& st = cache_.get("staging.download." + role, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                    BufferCache::Kind::HostRead);
+      copies_.push_back({src.buffer, st.buffer, bytes, false});
+      return st.mapped;
+  }
     // Records the staged copies and a barrier making them visible to
     // `dstAccess` at `dstStage` (by default: the compute passes).
     void recordUploads(VkCommandBuffer cmd, VkPipelineStageFlags dstStage = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
@@ -183,9 +184,8 @@ private:
         VkDeviceSize bytes;
         bool up;
     };
-    const Context& ctx_;
+    BufferCache& cache_;
     std::vector<Copy> copies_;
-    std::vector<Buffer> staging_;
     bool mappedReads_ = false;
 };
 
@@ -243,6 +243,7 @@ public:
     }
     std::size_t peakDeviceBytes() const override { return std::size_t(ctx_.memoryStats().peak); }
     void resetPeakDeviceBytes() override { ctx_.resetPeakMemory(); }
+    std::uint64_t deviceAllocations() const override { return ctx_.memoryStats().allocations; }
 
     DepthImage renderDepth(const Scene& scene, const Projection& proj) override;
     CullResult cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
@@ -264,6 +265,9 @@ private:
     VkRenderPass depthRenderPass(bool reversed);
 
     Context ctx_;
+    // The buffers of the depth pre-pass and the cull, kept between calls
+    // (after ctx_: freed before the device).
+    BufferCache cache_{ctx_};
     DescriptorSetLayoutHandle setLayout_;
     PipelineLayoutHandle computeLayout_;
     ShaderModuleHandle boundsShader_, boundsWideShader_, binsShader_, cullShader_, cullShader16_, scanShader_,
@@ -521,9 +525,11 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
         indexCount += m.triangleCount() * 3;
     }
     // Device-local vertex and index buffers (staged on a discrete GPU).
-    Buffer vbuf = ctx_.createDeviceBuffer(vertexFloats * 4, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "depth.vertices");
-    Buffer ibuf = ctx_.createDeviceBuffer(indexCount * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "depth.indices");
-    Staging staging(ctx_);
+    const Buffer& vbuf = cache_.get("depth.vertices", vertexFloats * 4, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+                                    BufferCache::Kind::Device);
+    const Buffer& ibuf = cache_.get("depth.indices", indexCount * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+                                    BufferCache::Kind::Device);
+    Staging staging(cache_);
     {
         std::vector<float> v;
         std::vector<std::uint32_t> ix;
@@ -537,8 +543,8 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
                 v.push_back(float(double(m.positions[i]) - c[int(i % 3)]));
             ix.insert(ix.end(), m.indices.data(), m.indices.data() + m.triangleCount() * 3);
         }
-        staging.upload(vbuf, v.data(), v.size() * 4);
-        staging.upload(ibuf, ix.data(), ix.size() * 4);
+        staging.upload(vbuf, v.data(), v.size() * 4, "depth.vertices");
+        staging.upload(ibuf, ix.data(), ix.size() * 4, "depth.indices");
     }
     VkRenderPass rp = depthRenderPass(reversed);
     VkPipeline pipe = depthPipeline(reversed);
@@ -574,8 +580,8 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
     const Buffer& resident = depthTarget_.depth;
     const Image& img = depthTarget_.image;
     VkFramebuffer fb = depthTarget_.framebuffer;
-    Staging back(ctx_);
-    const void* pixels = back.download(resident, std::size_t(W) * H * 4);
+    Staging back(cache_);
+    const void* pixels = back.download(resident, std::size_t(W) * H * 4, "depth.resident");
 
     const bool gpuClock = useGpuTimestamps();
     TimestampPool stamps = gpuClock ? TimestampPool(ctx_, 1, "depth.timestamps") : TimestampPool();
@@ -770,33 +776,44 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
 
     // Device buffers (sizes from the inputs; the index array comes after the count).
     const VkBufferUsageFlags ssbo = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    Buffer params = ctx_.createDeviceBuffer(sizeof(GpuCullParams), ssbo, "cull.params");
+    // Descriptor ranges: the bytes each buffer was asked for (a kept buffer
+    // may be larger; the passes see only this call's part).
+    std::map<VkBuffer, VkDeviceSize> asked;
+    auto deviceBuffer = [&](const std::string& role, std::size_t bytes) -> const Buffer& {
+        const Buffer& b = cache_.get(role, bytes, ssbo, BufferCache::Kind::Device);
+        asked[b.buffer] = std::max<VkDeviceSize>(bytes, 4);
+        return b;
+    };
+    const Buffer& params = deviceBuffer("cull.params", sizeof(GpuCullParams));
     // The depth this backend rendered is on the device already.
     const bool residentDepth = isResident(depth);
-    Buffer uploadedDepth =
-        residentDepth ? Buffer() : ctx_.createDeviceBuffer(depth.depth.size() * 4, ssbo, "cull.depth");
-    const Buffer& depthBuf = residentDepth ? depthTarget_.depth : uploadedDepth;
-    Buffer tileBuf = ctx_.createDeviceBuffer(std::size_t(tiles) * sizeof(GpuTileBounds), ssbo, "cull.tiles");
-    Buffer lightBuf = ctx_.createDeviceBuffer(std::size_t(n) * sizeof(GpuLight), ssbo, "cull.lights");
-    Buffer binBuf = ctx_.createDeviceBuffer(binTotal64 * 4, ssbo, "cull.bins");
-    Buffer countBuf = ctx_.createDeviceBuffer(std::size_t(listTotal) * 4, ssbo, "cull.counts");
-    Buffer offsetBuf = ctx_.createDeviceBuffer((std::size_t(listTotal) + 1) * 4, ssbo, "cull.offsets");
-    Buffer statusBuf = ctx_.createDeviceBuffer(8, ssbo, "cull.status"); // status bits, candidate tests
-    Buffer placeholder = ctx_.createDeviceBuffer(4, ssbo, "cull.indices.placeholder");
-    Buffer spotBuf = ctx_.createDeviceBuffer(gpuSpots.size() * sizeof(GpuSpotCone), ssbo, "cull.spots");
+    const Buffer& depthBuf =
+        residentDepth ? depthTarget_.depth : deviceBuffer("cull.depth", depth.depth.size() * 4);
+    if (residentDepth) asked[depthBuf.buffer] = depthBuf.size;
+    const Buffer& tileBuf = deviceBuffer("cull.tiles", std::size_t(tiles) * sizeof(GpuTileBounds));
+    const Buffer& lightBuf = deviceBuffer("cull.lights", std::size_t(n) * sizeof(GpuLight));
+    const Buffer& binBuf = deviceBuffer("cull.bins", binTotal64 * 4);
+    const Buffer& countBuf = deviceBuffer("cull.counts", std::size_t(listTotal) * 4);
+    const Buffer& offsetBuf = deviceBuffer("cull.offsets", (std::size_t(listTotal) + 1) * 4);
+    const Buffer& statusBuf = deviceBuffer("cull.status", 8); // status bits, candidate tests
+    const Buffer& placeholder = deviceBuffer("cull.indices.placeholder", 4);
+    const Buffer& spotBuf = deviceBuffer("cull.spots", gpuSpots.size() * sizeof(GpuSpotCone));
     const std::size_t stashBytes = std::size_t(listTotal) * stashSlots * 4;
-    Buffer stashBuf = ctx_.createDeviceBuffer(std::max<std::size_t>(stashBytes, 4), ssbo, "cull.stash");
+    const Buffer& stashBuf = deviceBuffer("cull.stash", stashBytes);
 
-    Staging staging(ctx_);
-    staging.upload(params, &p, sizeof p);
-    if (!residentDepth) staging.upload(depthBuf, depth.depth.data(), depth.depth.size() * 4);
-    staging.upload(lightBuf, gpuLights.data(), gpuLights.size() * sizeof(GpuLight));
-    staging.upload(spotBuf, gpuSpots.data(), gpuSpots.size() * sizeof(GpuSpotCone));
-    staging.upload(statusBuf, statusZero, 8);
-    const auto* counts = static_cast<const std::uint32_t*>(staging.download(countBuf, std::size_t(listTotal) * 4));
-    const auto* offs = static_cast<const std::uint32_t*>(staging.download(offsetBuf, (std::size_t(listTotal) + 1) * 4));
-    const auto* tb = static_cast<const GpuTileBounds*>(staging.download(tileBuf, std::size_t(tiles) * sizeof(GpuTileBounds)));
-    const auto* status = static_cast<const std::uint32_t*>(staging.download(statusBuf, 8));
+    Staging staging(cache_);
+    staging.upload(params, &p, sizeof p, "cull.params");
+    if (!residentDepth) staging.upload(depthBuf, depth.depth.data(), depth.depth.size() * 4, "cull.depth");
+    staging.upload(lightBuf, gpuLights.data(), gpuLights.size() * sizeof(GpuLight), "cull.lights");
+    staging.upload(spotBuf, gpuSpots.data(), gpuSpots.size() * sizeof(GpuSpotCone), "cull.spots");
+    staging.upload(statusBuf, statusZero, 8, "cull.status");
+    const auto* counts = static_cast<const std::uint32_t*>(
+        staging.download(countBuf, std::size_t(listTotal) * 4, "cull.counts"));
+    const auto* offs = static_cast<const std::uint32_t*>(
+        staging.download(offsetBuf, (std::size_t(listTotal) + 1) * 4, "cull.offsets"));
+    const auto* tb = static_cast<const GpuTileBounds*>(
+        staging.download(tileBuf, std::size_t(tiles) * sizeof(GpuTileBounds), "cull.tiles"));
+    const auto* status = static_cast<const std::uint32_t*>(staging.download(statusBuf, 8, "cull.status"));
     // The write pass runs in the same submission (no read-back between the
     // passes) into an index array sized from the previous cull's entries with
     // as many lists, with a margin (else the stash's size); only when the
@@ -810,13 +827,15 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     // On a CPU device the stash is host memory: when the previous cull's
     // lists fitted it, the host takes the lists from there (a write pass
     // copying them cost lavapipe more, 4.2-4.3 against 3.8-4.5 ms at P1).
-    const auto* stashed = ctx_.isCpuDevice() && stashBytes
-                              ? static_cast<const std::uint32_t*>(staging.download(stashBuf, stashBytes))
-                              : nullptr;
+    const auto* stashed =
+        ctx_.isCpuDevice() && stashBytes
+            ? static_cast<const std::uint32_t*>(staging.download(stashBuf, stashBytes, "cull.stash"))
+            : nullptr;
     const bool writeFirst = !fptl && !(stashed && lastLongestList_ <= stashSlots) &&
                             firstCapacity * 4 <= lim.maxStorageBufferRange;
     const auto* binWordsOut =
-        zbin ? static_cast<const std::uint32_t*>(staging.download(binBuf, binTotal64 * 4)) : nullptr;
+        zbin ? static_cast<const std::uint32_t*>(staging.download(binBuf, binTotal64 * 4, "cull.bins"))
+             : nullptr;
 
     // Descriptor sets: one for passes 1-3, one with the sized index array for pass 4.
     VkDevice dev = ctx_.device();
@@ -844,7 +863,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         std::array<VkDescriptorBufferInfo, kBindings> infos{};
         std::array<VkWriteDescriptorSet, kBindings> writes{};
         for (std::uint32_t i = 0; i < kBindings; ++i) {
-            infos[i] = {bufs[i]->buffer, 0, VK_WHOLE_SIZE};
+            infos[i] = {bufs[i]->buffer, 0, asked.at(bufs[i]->buffer)};
             writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
             writes[i].dstSet = set;
             writes[i].dstBinding = i;
@@ -963,13 +982,15 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                                     spec(kLocal, 2, lanes, 2, walk), true)
                   : computePipeline("cull_lists.fused", cullShader_, spec(kLocal, 2, lanes, 2, walk), true);
     const std::size_t entryBytes = index16 ? 2 : 4;
-    Buffer firstIndices = writeFirst ? ctx_.createDeviceBuffer((firstCapacity * entryBytes + 3) / 4 * 4, ssbo,
-                                                               "cull.indices.first")
-                                     : Buffer();
-    const void* firstOut = writeFirst ? staging.download(firstIndices, firstCapacity * entryBytes) : nullptr;
+    const Buffer& firstIndices =
+        writeFirst ? deviceBuffer("cull.indices.first", (firstCapacity * entryBytes + 3) / 4 * 4)
+                   : placeholder;
+    const void* firstOut =
+        writeFirst ? staging.download(firstIndices, firstCapacity * entryBytes, "cull.indices.first")
+                   : nullptr;
     const auto* firstIdx = index16 ? nullptr : static_cast<const std::uint32_t*>(firstOut);
     const auto* firstIdx16 = index16 ? static_cast<const std::uint16_t*>(firstOut) : nullptr;
-    VkDescriptorSet set1 = makeSet(writeFirst ? firstIndices : placeholder, "cull.set.count");
+    VkDescriptorSet set1 = makeSet(firstIndices, "cull.set.count");
     // One bins invocation per plane word and per pair of depth-bin words.
     const Grid binGroups = groupsFor(planeBinWords + depthBinWords, lim);
     const Grid countGroups = groupsFor(all ? 1 : listItems, lim);
@@ -1100,15 +1121,18 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         // The first submission wrote every list.
         res.lightIndices.assign(firstIdx, firstIdx + total);
     } else if (total > 0) {
-        Buffer indexBuf = ctx_.createDeviceBuffer(std::size_t(total) * 4, ssbo, "cull.indices");
+        const Buffer& indexBuf = deviceBuffer("cull.indices", std::size_t(total) * 4);
         const std::uint32_t* idx = nullptr;
         VkDescriptorSet set2 = makeSet(indexBuf, "cull.set.write");
-        Staging back(ctx_);
-        idx = static_cast<const std::uint32_t*>(back.download(indexBuf, std::size_t(total) * 4));
-        const auto* status2 = static_cast<const std::uint32_t*>(back.download(statusBuf, 4));
+        Staging back(cache_);
+        idx = static_cast<const std::uint32_t*>(
+            back.download(indexBuf, std::size_t(total) * 4, "cull.indices"));
+        const auto* status2 =
+            static_cast<const std::uint32_t*>(back.download(statusBuf, 4, "cull.status.write"));
         // fptl: the packed counts (mapped: the same memory as `counts`).
-        const auto* packed =
-            fptl ? static_cast<const std::uint32_t*>(back.download(countBuf, std::size_t(listTotal) * 4)) : nullptr;
+        const auto* packed = fptl ? static_cast<const std::uint32_t*>(back.download(
+                                        countBuf, std::size_t(listTotal) * 4, "cull.counts.packed"))
+                                  : nullptr;
         const Grid pruneGroups = groupsFor(total, lim);
         wallMs += ctx_.submitAndWait(
             [&](VkCommandBuffer cmd) {

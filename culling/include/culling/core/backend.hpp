@@ -68,6 +68,8 @@ public:
     // since the last resetPeakDeviceBytes(); 0 for backends without a device.
     virtual std::size_t peakDeviceBytes() const { return 0; }
     virtual void resetPeakDeviceBytes() {}
+    // Device memory allocations made so far (0 for backends without a device).
+    virtual std::uint64_t deviceAllocations() const { return 0; }
     // Lambert shading pass (culling/truth/shade.hpp) over a G-buffer built by
     // makeShadeInputs: each geometry pixel shaded from the lights of its list
     // in `culled` (null: every light in index order). Returns RGB, 3 floats per
