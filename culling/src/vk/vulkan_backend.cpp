@@ -1105,17 +1105,20 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         for (std::uint32_t l = 0; l < listTotal; ++l)
             std::copy_n(stashed + std::size_t(l) * stashSlots, counts[l], res.lightIndices.begin() + offs[l]);
     } else if (total > 0 && atomicRanges && total <= firstCapacity) {
-        // Every list was written, each at the range it took.
-        res.lightIndices.resize(total);
+        // Every list was written, each at the range it took; appended in list
+        // order (offs: the counts added up), so no zero fill first.
+        res.lightIndices.reserve(total);
         for (std::uint32_t l = 0; l < listTotal; ++l) {
             if (counts[l] == 0) continue;
             if (rangeOffs[l] > total - counts[l])
                 throw DeviceError("Vulkan culling placed list " + std::to_string(l) +
                                   " beyond the index array");
             if (index16)
-                std::copy_n(firstIdx16 + rangeOffs[l], counts[l], res.lightIndices.begin() + offs[l]);
+                res.lightIndices.insert(res.lightIndices.end(), firstIdx16 + rangeOffs[l],
+                                        firstIdx16 + rangeOffs[l] + counts[l]);
             else
-                std::copy_n(firstIdx + rangeOffs[l], counts[l], res.lightIndices.begin() + offs[l]);
+                res.lightIndices.insert(res.lightIndices.end(), firstIdx + rangeOffs[l],
+                                        firstIdx + rangeOffs[l] + counts[l]);
         }
     } else if (total > 0 && writeFirst && total <= firstCapacity) {
         // The first submission wrote every list.
