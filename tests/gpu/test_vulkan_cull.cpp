@@ -738,6 +738,35 @@ TEST_F(GpuTest, WideDepthLoadsMatchSinglePixelLoads) {
     }
 }
 
+// zbin's lists come back as depth-sorted positions; the host maps them to
+// light indices and puts each list in ascending order: lists of more than
+// one light in 512 through a bitmask of the lights, shorter ones by a sort.
+// A frame with lists of both kinds (several entries each) matches the CPU
+// reference: ascending, no false negatives.
+TEST_F(GpuTest, ZBinListsComeBackAscendingShortAndLong) {
+    auto cpuBackend = makeCpuBackend();
+    Scene scene = sized("forest", 320, 180);
+    // Small lights (radius 0.14 to 0.45) and a few hundred large ones.
+    LightGenSettings gen = defaultLightGen(scene, 20000, 21);
+    gen.intensityMin = 0.001;
+    gen.intensityMax = 0.01;
+    scene.lights = generateLights(gen);
+    for (std::size_t i = 0; i < scene.lights.size(); i += 50)
+        scene.lights[i].explicitRadius = 4.0;
+    const gputest::Frame f(scene);
+    CullSettings st;
+    st.algorithm = Algorithm::ZBin;
+    checkCase("zbin short and long lists", f, st, *cpuBackend);
+    const CullResult r = f.cull(gputest::vulkan(), st);
+    std::size_t sorted = 0, masked = 0;
+    for (std::uint32_t c : r.listCount) {
+        if (c >= 2 && std::size_t(c) * 512 <= scene.lights.size()) ++sorted;
+        if (std::size_t(c) * 512 > scene.lights.size()) ++masked;
+    }
+    EXPECT_GT(sorted, 0u) << "no list takes the sort";
+    EXPECT_GT(masked, 0u) << "no list takes the bitmask";
+}
+
 // A GPU's fused pass writes 16-bit light indices while the lights fit them
 // (at most 65,536) and 32-bit ones beyond. On both sides of the bound the
 // emulated GPU layout gives the CPU layout's lists bit for bit; the last

@@ -39,18 +39,18 @@
 #include "culling/core/errors.hpp"
 #include "culling/vk/gpu_shared.h"
 #include "embedded_spirv.hpp"
-#include "vk/vk_context.hpp"
 #include "vk/shade_pass.hpp"
-
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/gtc/type_ptr.hpp>
+#include "vk/vk_context.hpp"
 
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
 #include <limits>
 #include <map>
 
@@ -1186,16 +1186,37 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     }
 
     if (zbin) {
-        // The masks hold sorted positions: back to light indices, ascending.
+        // The masks hold sorted positions, ascending: back to light indices,
+        // ascending. A list of more than one light in 512 is read out of a
+        // bitmask of the lights (its bits set, then the words read in order:
+        // one pass over n / 64 words, where sorting P3's 21 million zbin
+        // entries, 650 a list, took the host 880 ms on the H100's machine);
+        // shorter lists are sorted.
+        const std::size_t maskWords = (std::size_t(n) + 63) / 64;
+        std::vector<std::uint64_t> seen(maskWords, 0);
         for (std::uint32_t l = 0; l < listTotal; ++l) {
             auto b = res.lightIndices.begin() + offs[l], e = b + counts[l];
+            std::uint64_t next = 0; // the least position the next entry may hold
             for (auto it = b; it != e; ++it) {
-                if (*it >= n)
+                if (*it >= n || *it < next)
                     throw DeviceError("Vulkan culling put position " + std::to_string(*it) + " in list " +
-                                      std::to_string(l) + " of " + std::to_string(n) + " lights");
+                                      std::to_string(l) + " of " + std::to_string(n) +
+                                      " lights, not in ascending order below the light count");
+                next = std::uint64_t(*it) + 1;
                 *it = res.zbinOrder[*it];
             }
-            std::sort(b, e);
+            if (std::size_t(counts[l]) * 512 <= n) {
+                std::sort(b, e);
+                continue;
+            }
+            for (auto it = b; it != e; ++it)
+                seen[*it >> 6] |= std::uint64_t(1) << (*it & 63);
+            auto out = b;
+            for (std::size_t w = 0; w < maskWords; ++w) {
+                for (std::uint64_t m = seen[w]; m != 0; m &= m - 1)
+                    *out++ = std::uint32_t(w * 64 + std::size_t(std::countr_zero(m)));
+                seen[w] = 0;
+            }
         }
         res.zbinLo.assign(binWordsOut + planeBinWords, binWordsOut + planeBinWords + 2 * std::size_t(settings.bins));
         res.zbinHi.resize(settings.bins);
