@@ -412,21 +412,22 @@ bool Context::hasMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags want) 
 }
 
 Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& n) const {
-    return allocateBuffer(size, usage, n, Placement::Host);
+    return createBuffer(size, usage, n, Placement::Host);
 }
 
 Buffer Context::createReadbackBuffer(VkDeviceSize size, VkBufferUsageFlags usage,
                                      const std::string& n) const {
-    return allocateBuffer(size, usage, n, Placement::HostRead);
+    return createBuffer(size, usage, n, Placement::HostRead);
 }
 
 Buffer Context::createDeviceBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& n) const {
-    return allocateBuffer(size, usage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                          n, Placement::Device);
+    return createBuffer(size, usage, n, Placement::Device);
 }
 
-Buffer Context::allocateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& n,
-                               Placement where) const {
+Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& n,
+                             Placement where) const {
+    // A device buffer moves through staging copies (createDeviceBuffer).
+    if (where == Placement::Device) usage |= VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     Buffer b;
     b.size = std::max<VkDeviceSize>(size, 4);
     VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
@@ -481,9 +482,7 @@ const Buffer& BufferCache::get(const std::string& role, VkDeviceSize bytes, VkBu
     Entry e;
     e.usage = usage;
     e.kind = kind;
-    e.buffer = kind == Kind::Device     ? ctx_.createDeviceBuffer(size, usage, role)
-               : kind == Kind::HostRead ? ctx_.createReadbackBuffer(size, usage, role)
-                                        : ctx_.createBuffer(size, usage, role);
+    e.buffer = ctx_.createBuffer(size, usage, role, kind);
     return entries_.emplace(role, std::move(e)).first->second.buffer;
 }
 

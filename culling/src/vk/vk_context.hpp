@@ -4,6 +4,8 @@
 // compute+graphics queue). Nothing here leaks into culling/include.
 #include "culling/core/errors.hpp"
 
+#include <vulkan/vulkan.h>
+
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -11,7 +13,6 @@
 #include <string>
 #include <utility>
 #include <vector>
-#include <vulkan/vulkan.h>
 
 namespace lc::vk {
 
@@ -197,6 +198,12 @@ public:
         name(type, reinterpret_cast<std::uint64_t>(handle), n);
     }
 
+    // Where a buffer's memory lies: Host (createBuffer), HostRead
+    // (createReadbackBuffer), Device (createDeviceBuffer).
+    enum class Placement { Host, HostRead, Device };
+    // The create function of `where`.
+    Buffer createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name,
+                        Placement where) const;
     // Host-visible, coherent, persistently mapped buffer (size 0 -> 4 bytes).
     Buffer createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name) const;
     // createBuffer for data the host reads back: host-cached memory where the
@@ -242,9 +249,6 @@ private:
     void release(); // destroys everything, in reverse order of creation
     std::uint32_t findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags want) const;
     bool hasMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags want) const;
-    enum class Placement { Host, HostRead, Device };
-    Buffer allocateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const std::string& name,
-                          Placement where) const;
 
     VkInstance instance_ = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
@@ -283,12 +287,11 @@ std::vector<std::string> physicalDeviceNames();
 // asked are never bound (descriptor ranges are the asked sizes).
 class BufferCache {
   public:
-    enum class Kind { Host, HostRead, Device };
+    using Kind = Context::Placement;
     explicit BufferCache(const Context& ctx) : ctx_(ctx) {}
     BufferCache(const BufferCache&) = delete;
     BufferCache& operator=(const BufferCache&) = delete;
-    // Kind::Host: createBuffer, HostRead: createReadbackBuffer, Device:
-    // createDeviceBuffer. The buffer lives until the role asks again with a
+    // Made by Context::createBuffer(..., kind). The buffer lives until the role asks again with a
     // size or kind it does not fit, or clear().
     const Buffer& get(const std::string& role, VkDeviceSize bytes, VkBufferUsageFlags usage, Kind kind);
     void clear() { entries_.clear(); }

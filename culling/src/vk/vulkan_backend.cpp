@@ -39,8 +39,11 @@
 #include "culling/core/errors.hpp"
 #include "culling/vk/gpu_shared.h"
 #include "embedded_spirv.hpp"
-#include "vk/shade_pass.hpp"
 #include "vk/vk_context.hpp"
+#include "vk/shade_pass.hpp"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
 #include <array>
@@ -49,8 +52,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/gtc/type_ptr.hpp>
 #include <limits>
 #include <map>
 
@@ -119,31 +120,31 @@ void computeBarrier(VkCommandBuffer cmd, VkAccessFlags dstAccess, VkPipelineStag
 // "staging.download.<role>") copied at the start / end of the commands.
 class Staging {
 public:
-  explicit Staging(BufferCache& cache) : cache_(cache) {}
-  // Writes `bytes` of `data` into `dst`: now when mapped, else at recordUploads().
-  void upload(const Buffer& dst, const void* data, std::size_t bytes, const std::string& role) {
-      if (bytes == 0) return;
-      if (dst.mapped) {
-          std::memcpy(dst.mapped, data, bytes);
-          return;
-      }
-      const Buffer& st = cache_.get("staging.upload." + role, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                    BufferCache::Kind::Host);
-      std::memcpy(st.mapped, data, bytes);
-      copies_.push_back({dst.buffer, st.buffer, bytes, true});
-  }
-  // Host pointer to `src`'s first `bytes`, valid once the submission that
-  // ran recordDownloads() has completed (until the role is staged again).
-  const void* download(const Buffer& src, std::size_t bytes, const std::string& role) {
-      if (src.mapped) {
-          mappedReads_ = true;
-          return src.mapped;
-      }
-      const Buffer& st = cache_.get("staging.download." + role, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                    BufferCache::Kind::HostRead);
-      copies_.push_back({src.buffer, st.buffer, bytes, false});
-      return st.mapped;
-  }
+    explicit Staging(BufferCache& cache) : cache_(cache) {}
+    // Writes `bytes` of `data` into `dst`: now when mapped, else at recordUploads().
+    void upload(const Buffer& dst, const void* data, std::size_t bytes, const std::string& role) {
+        if (bytes == 0) return;
+        if (dst.mapped) {
+            std::memcpy(dst.mapped, data, bytes);
+            return;
+        }
+        const Buffer& st = cache_.get("staging.upload." + role, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                      BufferCache::Kind::Host);
+        std::memcpy(st.mapped, data, bytes);
+        copies_.push_back({dst.buffer, st.buffer, bytes, true});
+    }
+    // Host pointer to `src`'s first `bytes`, valid once the submission that
+    // ran recordDownloads() has completed (until the role is staged again).
+    const void* download(const Buffer& src, std::size_t bytes, const std::string& role) {
+        if (src.mapped) {
+            mappedReads_ = true;
+            return src.mapped;
+        }
+        const Buffer& st = cache_.get("staging.download." + role, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                      BufferCache::Kind::HostRead);
+        copies_.push_back({src.buffer, st.buffer, bytes, false});
+        return st.mapped;
+    }
     // Records the staged copies and a barrier making them visible to
     // `dstAccess` at `dstStage` (by default: the compute passes).
     void recordUploads(VkCommandBuffer cmd, VkPipelineStageFlags dstStage = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
@@ -989,7 +990,6 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         writeFirst ? staging.download(firstIndices, firstCapacity * entryBytes, "cull.indices.first")
                    : nullptr;
     const auto* firstIdx = index16 ? nullptr : static_cast<const std::uint32_t*>(firstOut);
-    const auto* firstIdx16 = index16 ? static_cast<const std::uint16_t*>(firstOut) : nullptr;
     VkDescriptorSet set1 = makeSet(firstIndices, "cull.set.count");
     // One bins invocation per plane word and per pair of depth-bin words.
     const Grid binGroups = groupsFor(planeBinWords + depthBinWords, lim);
@@ -1099,6 +1099,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                                                     : std::vector<std::uint32_t>();
     const std::vector<std::uint32_t> offs0 = fptl ? std::vector<std::uint32_t>(offs, offs + listTotal)
                                                   : std::vector<std::uint32_t>();
+    lastIndexBits_ = 32; // unless the lists come from the 16-bit index array below
     if (total > 0 && stashed && !writeFirst && longest <= stashSlots && !fptl) {
         // The stash holds every list whole: the entries are in, no write pass.
         res.lightIndices.resize(total);
@@ -1107,18 +1108,23 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     } else if (total > 0 && atomicRanges && total <= firstCapacity) {
         // Every list was written, each at the range it took; appended in list
         // order (offs: the counts added up), so no zero fill first.
-        res.lightIndices.reserve(total);
-        for (std::uint32_t l = 0; l < listTotal; ++l) {
-            if (counts[l] == 0) continue;
-            if (rangeOffs[l] > total - counts[l])
-                throw DeviceError("Vulkan culling placed list " + std::to_string(l) +
-                                  " beyond the index array");
-            if (index16)
-                res.lightIndices.insert(res.lightIndices.end(), firstIdx16 + rangeOffs[l],
-                                        firstIdx16 + rangeOffs[l] + counts[l]);
-            else
-                res.lightIndices.insert(res.lightIndices.end(), firstIdx + rangeOffs[l],
-                                        firstIdx + rangeOffs[l] + counts[l]);
+        // (16-bit entries widened on the way.)
+        auto appendLists = [&](const auto* written) {
+            res.lightIndices.reserve(total);
+            for (std::uint32_t l = 0; l < listTotal; ++l) {
+                if (counts[l] == 0) continue;
+                if (rangeOffs[l] > total - counts[l])
+                    throw DeviceError("Vulkan culling placed list " + std::to_string(l) +
+                                      " beyond the index array");
+                res.lightIndices.insert(res.lightIndices.end(), written + rangeOffs[l],
+                                        written + rangeOffs[l] + counts[l]);
+            }
+        };
+        if (index16) {
+            appendLists(static_cast<const std::uint16_t*>(firstOut));
+            lastIndexBits_ = 16;
+        } else {
+            appendLists(firstIdx);
         }
     } else if (total > 0 && writeFirst && total <= firstCapacity) {
         // The first submission wrote every list.
@@ -1253,7 +1259,6 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     lastLongestList_ = longest;
     lastListTotal_ = listTotal;
     lastEntries_ = total;
-    lastIndexBits_ = total > 0 && index16 && atomicRanges && total <= firstCapacity ? 16 : 32;
     return res;
 }
 
