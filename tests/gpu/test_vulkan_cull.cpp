@@ -404,6 +404,34 @@ TEST_F(GpuTest, GpuWorkLayoutEmulatedOnLavapipe) {
     }
 }
 
+// Staged downloads go back in copy commands of at most 512 KiB each
+// (vulkan_backend.cpp, kDownloadRegion). On the emulated GPU layout a depth
+// image of 2.4 MB (four whole regions and part of a fifth) and lists of more
+// than 512 KiB must come back whole: the same as the CPU layout's, which
+// reads its buffers in place.
+TEST_F(GpuTest, DownloadsLargerThanOneCopyRegionComeBackWhole) {
+    setenv("LIGHTCULL_VK_EMULATE_GPU", "1", 1);
+    std::unique_ptr<CullBackend> emulated = makeVulkanBackend("");
+    unsetenv("LIGHTCULL_VK_EMULATE_GPU");
+    Scene scene = sized("atrium", 1000, 600);
+    scene.lights = generateLights(defaultLightGen(scene, 2000, 11));
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(1000, 600, 16);
+    const ViewLights lights = makeViewLights(scene);
+    const DepthImage depth = emulated->renderDepth(scene, proj);
+    EXPECT_EQ(depth.depth, gputest::vulkan().renderDepth(scene, proj).depth);
+    CullSettings st;
+    st.algorithm = Algorithm::Naive; // every light in every tile its sphere covers on screen
+    for (int run = 0; run < 2; ++run) { // the second into the buffers the first sized
+        const CullResult g = emulated->cull(depth, proj, grid, lights, st);
+        const CullResult c = gputest::vulkan().cull(depth, proj, grid, lights, st);
+        ASSERT_GT(g.entries() * (emulated->lastDeviceIndexBits() / 8), 3u * 512 * 1024) << run;
+        EXPECT_EQ(g.listCount, c.listCount) << run;
+        EXPECT_EQ(g.lightIndices, c.lightIndices) << run;
+        EXPECT_EQ(g.tileDepthMin, c.tileDepthMin) << run;
+    }
+}
+
 // clustered on lavapipe walks a tile's slices in one invocation per 8 slices
 // (cull_lists.comp, clusteredTileWalk); the emulated GPU layout walks each
 // list alone. Their lists must be identical wherever the slice range of a

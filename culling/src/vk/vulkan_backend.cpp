@@ -93,6 +93,8 @@ constexpr std::uint32_t kMaxStashSlotsCpu = 128;
 // a multiple of every subgroup size in practice (8 on lavapipe, 32 on NVIDIA,
 // 64 on AMD), so no partial subgroups.
 constexpr std::uint32_t kLocal = 64;
+// The largest region of one staged download copy (Staging::recordDownloads).
+constexpr VkDeviceSize kDownloadRegion = 512 * 1024;
 // lavapipe (gallivm) ends every loop of a shader invocation after this many
 // iterations in all, without an error; work per invocation is sized below it.
 constexpr std::uint64_t kLoopLimit = 65535;
@@ -169,11 +171,15 @@ public:
         if (anyCopy) {
             // The copies read what the compute passes wrote.
             computeBarrier(cmd, VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+            // A copy command per kDownloadRegion bytes: NVIDIA's driver
+            // copied P3's 17.6 MB of lists to the host at 24 GB/s in one
+            // command, at 46 GB/s in 512 KiB ones (H100, PCIe 5 x16).
             for (const Copy& c : copies_)
-                if (!c.up) {
-                    VkBufferCopy region{0, 0, c.bytes};
-                    vkCmdCopyBuffer(cmd, c.device, c.staging, 1, &region);
-                }
+                if (!c.up)
+                    for (VkDeviceSize at = 0; at < c.bytes; at += kDownloadRegion) {
+                        VkBufferCopy region{at, at, std::min(kDownloadRegion, c.bytes - at)};
+                        vkCmdCopyBuffer(cmd, c.device, c.staging, 1, &region);
+                    }
             // The host reads the staging buffers the copies wrote.
             memoryBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
                           VK_ACCESS_HOST_READ_BIT);
