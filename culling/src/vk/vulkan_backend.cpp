@@ -648,8 +648,8 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
     out.width = W;
     out.height = H;
     out.clearDepth = clearDepth;
-    out.depth.resize(std::size_t(W) * H);
-    std::memcpy(out.depth.data(), pixels, out.depth.size() * 4);
+    const float* px = static_cast<const float*>(pixels);
+    out.depth.assign(px, px + std::size_t(W) * H);
     residentId_ = out.deviceCopy = nextDepthId();
     residentSample_ = depthSample(out);
     return out;
