@@ -234,6 +234,12 @@ void writeKept(uint kept[KEPT_WORDS], uint words, uint lane, uint base, inout bo
 // ascending order. The slice range of a light is found from the chunks'
 // own widened bounds (the chunk test's near and far planes can keep no
 // slice outside it), so it is exact whatever the slicing.
+// The count pass stashes a walk's entries in one pool, its lists' stash slots
+// together ((endCell - firstCell) x P.bins.z from list firstList + firstCell's
+// slot 0 on), each entry (slice << 24) | light in walk order, so a slice's
+// entries come ascending. A walk whose entries all fit is written from there
+// (the host does it when every walk fitted, without a write pass); else
+// walked again. (Lights stay below 2^24: a CPU device takes at most ~258,000.)
 float walkChunkLo(uint c) { return max(widenDown(sliceBoundary(P.cluster.x, P.cluster.y, c)), isOrtho() ? -3.4e38 : 0.0); }
 float walkChunkHi(uint c) { return widenUp(sliceBoundary(P.cluster.x, P.cluster.y, c + 1u)); }
 
@@ -249,12 +255,14 @@ void clusteredTileWalk(uint id) {
     if ((P.counts.w & LC_FLAG_SKIP_EMPTY) != 0u) walk = tb.depthMin <= tb.depthMax ? walk & tb.cellMask : 0u;
     uint n[32]; // the counts of slices firstCell .. endCell - 1
     for (uint k = 0u; k < TILE_WALK; ++k) n[k] = 0u;
+    uint poolBase = (firstList + firstCell) * stashSlots, poolSlots = (endCell - firstCell) * stashSlots;
+    uint pooled = 0u; // entries the count pass met (and pooled while they fit)
     if (WRITE_PASS != 0u) {
+        uint sum = 0u;
+        for (uint c = firstCell; c < endCell; ++c) sum += listCount[firstList + c];
         if (WRITE_PASS == 3u) {
             // No scan before: the invocation's lists take their ranges, in
             // slice order, with one atomic add on the total (listOffset[lists]).
-            uint sum = 0u;
-            for (uint c = firstCell; c < endCell; ++c) sum += listCount[firstList + c];
             uint at = sum != 0u ? atomicAdd(listOffset[P.counts.z], sum) : 0u;
             for (uint c = firstCell; c < endCell; ++c) {
                 listOffset[firstList + c] = at;
@@ -262,17 +270,31 @@ void clusteredTileWalk(uint id) {
             }
         }
         // Lists that do not fit the index array are left to the host (as the
-        // per-list walk); lists the stash holds whole are copied.
+        // per-list walk); a pool that holds the walk's entries is written out.
         uint lists = walk;
         while (lists != 0u) {
             uint c = uint(findLSB(lists));
             lists &= lists - 1u;
-            uint list = firstList + c, count = listCount[list], base = listOffset[list];
-            if (base + count > uint(lightIndices.length())) {
-                walk &= ~(1u << c);
-            } else if (count <= stashSlots) {
-                copyStashed(list, base, count, 0u, 1u);
-                walk &= ~(1u << c);
+            uint list = firstList + c;
+            if (listOffset[list] + listCount[list] > uint(lightIndices.length())) walk &= ~(1u << c);
+        }
+        if (sum <= poolSlots) {
+            for (uint i = 0u; i < sum; ++i) {
+                uint e = stash[poolBase + i], c = e >> 24u;
+                if (((walk >> c) & 1u) != 0u) {
+                    lightIndices[listOffset[firstList + c] + n[c - firstCell]] = LC_INDEX(e & 0xffffffu);
+                    n[c - firstCell] += 1u;
+                }
+            }
+            walk = 0u; // written (the counts checked below)
+            lists = ((endCell - firstCell >= 32u) ? 0xffffffffu : ((1u << (endCell - firstCell)) - 1u)) << firstCell;
+            while (lists != 0u) {
+                uint c = uint(findLSB(lists));
+                lists &= lists - 1u;
+                uint list = firstList + c;
+                if (listOffset[list] + listCount[list] <= uint(lightIndices.length()) &&
+                    n[c - firstCell] != listCount[list])
+                    atomicOr(status, STATUS_COUNT_MISMATCH);
             }
         }
     }
@@ -322,7 +344,8 @@ void clusteredTileWalk(uint id) {
                 if (lightKept(l, ch, spotMode, cellCentre, cellRadius, false, 0.0, 0.0, 0.0, 0.0, 0u)) {
                     uint list = firstList + c, k = n[c - firstCell];
                     if (WRITE_PASS != 0u) lightIndices[listOffset[list] + k] = LC_INDEX(l);
-                    else if (k < stashSlots) stash[list * stashSlots + k] = l;
+                    else if (pooled < poolSlots) stash[poolBase + pooled] = (c << 24u) | l;
+                    pooled += 1u;
                     n[c - firstCell] = k + 1u;
                 }
             }

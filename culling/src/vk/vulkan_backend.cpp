@@ -283,6 +283,7 @@ private:
     ShaderModuleHandle boundsShader_, boundsWideShader_, binsShader_, cullShader_, cullShader16_, scanShader_,
         pruneShader_, zbinShader_, vertShader_;
     std::uint32_t lastLongestList_ = 0; // of the previous cull: sizes a CPU device's stash
+    bool lastPoolsFitted_ = false;       // of the previous cull: a tile walk's pools held every entry
     // Of the previous cull: its lists and entries size the next one's index array.
     std::uint32_t lastListTotal_ = 0, lastEntries_ = 0;
     std::map<std::string, PipelineHandle> computePipelines_;
@@ -841,8 +842,6 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         ctx_.isCpuDevice() && stashBytes
             ? static_cast<const std::uint32_t*>(staging.download(stashBuf, stashBytes, "cull.stash"))
             : nullptr;
-    const bool writeFirst = !fptl && !(stashed && lastLongestList_ <= stashSlots) &&
-                            firstCapacity * 4 <= lim.maxStorageBufferRange;
     const auto* binWordsOut =
         zbin ? static_cast<const std::uint32_t*>(staging.download(binBuf, binTotal64 * 4, "cull.bins"))
              : nullptr;
@@ -940,6 +939,14 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         }
     const std::uint64_t listItems =
         walk ? std::uint64_t(tiles) * ((cells + walk - 1) / walk) : std::uint64_t(listTotal) * lanes;
+    // A write pass in the first submission unless the previous cull's lists
+    // all fitted the stash (a tile walk's: its pools, cull_lists.comp).
+    const bool stashHeldLast = walk ? lastPoolsFitted_ : lastLongestList_ <= stashSlots;
+    const bool writeFirst = !fptl && !(stashed && stashHeldLast) && firstCapacity * 4 <= lim.maxStorageBufferRange;
+    // A tile walk taking its lists from the pools needs no scan on the
+    // device: the host adds up the counts (the scan of P1 / clustered's
+    // 261,120 counts took lavapipe about 1 ms).
+    const bool hostScan = walk != 0 && !writeFirst;
     // Wide depth loads (tile_bounds.comp, LC_WIDE_DEPTH_LOADS): an invocation
     // per tile, 8 or 2 pixels a load where the width and the tile size are
     // multiples of it, so every tile row starts on a whole load.
@@ -1054,10 +1061,12 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                 dispatchAfter(cmd, atomicWritePipe, writeGroups);
             } else {
                 dispatchAfter(cmd, countPipe, countGroups);
-                // The scan reads the counts the count pass wrote.
-                dispatchAfter(cmd, scanPipe, Grid{1, 1});
-                // The write pass reads the offsets the scan wrote.
-                if (writeFirst) dispatchAfter(cmd, writePipe, writeGroups);
+                if (!hostScan) {
+                    // The scan reads the counts the count pass wrote.
+                    dispatchAfter(cmd, scanPipe, Grid{1, 1});
+                    // The write pass reads the offsets the scan wrote.
+                    if (writeFirst) dispatchAfter(cmd, writePipe, writeGroups);
+                }
             }
             if (gpuClock) stamps.end(cmd, 0);
             staging.recordDownloads(cmd);
@@ -1076,24 +1085,35 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     res.volumeTests = (status[0] & 4u) ? 0 : status[1]; // wrapped: not counted
     std::uint64_t total64 = 0;
     std::uint32_t longest = 0;
-    // Ranges by atomic add: the offsets of the lists in order come from here (a second
-    // submission that writes the lists scans the same counts).
-    std::vector<std::uint32_t> hostOffs(atomicRanges ? std::size_t(listTotal) + 1 : 0);
+    // Ranges by atomic add, or no scan on the device: the offsets of the
+    // lists in order come from here (a second submission that writes the
+    // lists scans the same counts).
+    const bool hostOffsets = atomicRanges || hostScan;
+    std::vector<std::uint32_t> hostOffs(hostOffsets ? std::size_t(listTotal) + 1 : 0);
     for (std::uint32_t l = 0; l < listTotal; ++l) {
-        if (atomicRanges) hostOffs[l] = std::uint32_t(total64);
+        if (hostOffsets) hostOffs[l] = std::uint32_t(total64);
         total64 += counts[l];
         longest = std::max(longest, counts[l]);
     }
     // The device's ranges, and the total its atomic adds reached.
     const std::uint32_t* rangeOffs = atomicRanges ? offs : nullptr;
-    if (atomicRanges) {
-        hostOffs[listTotal] = std::uint32_t(total64);
+    if (hostOffsets) {
         // (A total beyond 32 bits fails the size check below.)
-        if (total64 <= std::numeric_limits<std::uint32_t>::max() && total64 != offs[listTotal])
+        hostOffs[listTotal] = std::uint32_t(total64);
+        if (atomicRanges && total64 <= std::numeric_limits<std::uint32_t>::max() && total64 != offs[listTotal])
             throw DeviceError("Vulkan culling's lists took " + std::to_string(offs[listTotal]) +
                               " entries of the index array for " + std::to_string(total64) + " counted");
         offs = hostOffs.data();
     }
+    // A tile walk's pools (cull_lists.comp): whether each held its walk's
+    // entries, so that the host can take the lists from there.
+    bool poolsFitted = walk != 0 && stashed;
+    const std::uint32_t walkGroups = walk ? (cells + walk - 1) / walk : 0;
+    for (std::uint32_t t = 0; poolsFitted && t < tiles; ++t)
+        for (std::uint32_t q = 0; q < walkGroups; ++q) {
+            const std::uint32_t first = t * cells + q * walk, end = std::min(first + walk, (t + 1) * cells);
+            if (offs[end] - offs[first] > (end - first) * stashSlots) poolsFitted = false;
+        }
     const std::uint32_t total = offs[listTotal];
     if (total64 != total || total64 * 4 > lim.maxStorageBufferRange)
         throw DeviceError("culling produced " + std::to_string(total64) +
@@ -1107,7 +1127,23 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const std::vector<std::uint32_t> offs0 = fptl ? std::vector<std::uint32_t>(offs, offs + listTotal)
                                                   : std::vector<std::uint32_t>();
     lastIndexBits_ = 32; // unless the lists come from the 16-bit index array below
-    if (total > 0 && stashed && !writeFirst && longest <= stashSlots && !fptl) {
+    if (total > 0 && walk && !writeFirst && poolsFitted) {
+        // Every walk's pool holds its entries, (slice << 24) | light in walk
+        // order: each goes to the end of its slice's list.
+        res.lightIndices.resize(total);
+        std::vector<std::uint32_t> at(offs, offs + listTotal);
+        for (std::uint32_t t = 0; t < tiles; ++t)
+            for (std::uint32_t q = 0; q < walkGroups; ++q) {
+                const std::uint32_t first = t * cells + q * walk, end = std::min(first + walk, (t + 1) * cells);
+                const std::uint32_t* pool = stashed + std::size_t(first) * stashSlots;
+                for (std::uint32_t i = 0, m = offs[end] - offs[first]; i < m; ++i) {
+                    const std::uint32_t slice = pool[i] >> 24, list = t * cells + slice;
+                    if (list < first || list >= end || at[list] >= offs[list] + counts[list])
+                        throw DeviceError("Vulkan clustered walk pooled an entry outside its lists");
+                    res.lightIndices[at[list]++] = pool[i] & 0xffffffu;
+                }
+            }
+    } else if (total > 0 && stashed && !walk && !writeFirst && longest <= stashSlots && !fptl) {
         // The stash holds every list whole: the entries are in, no write pass.
         res.lightIndices.resize(total);
         for (std::uint32_t l = 0; l < listTotal; ++l)
@@ -1158,7 +1194,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                 if (gpuClock) stamps.begin(cmd, 1);
                 vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, computeLayout_, 0, 1, &set2, 0,
                                         nullptr);
-                if (!atomicRanges) {
+                if (!hostOffsets) {
                     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, writePipe);
                     vkCmdDispatch(cmd, writeGroups.x, writeGroups.y, 1);
                 } else {
@@ -1264,6 +1300,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     res.timings.depthMs = lastDepthMs_;
     lastCullWallMs_ = wallMs;
     lastLongestList_ = longest;
+    lastPoolsFitted_ = poolsFitted;
     lastListTotal_ = listTotal;
     lastEntries_ = total;
     return res;
