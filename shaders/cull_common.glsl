@@ -28,7 +28,8 @@ layout(constant_id = 6) const uint WRITE_PASS = 0u;   // cull_lists: 0 count, 1 
 // Lanes sharing one tile (tile_bounds) or one list (cull_lists): 1 (an
 // invocation each: CPU devices), or the subgroup size (a subgroup each: GPUs).
 layout(constant_id = 7) const uint LANES = 1u;
-// tile_bounds with LC_WIDE_DEPTH_LOADS: pixels per depth load, 2 or 8.
+// tile_bounds: pixels per depth load, 2 or 8 with LC_WIDE_DEPTH_LOADS (an
+// invocation per tile), 4 or 1 without (4: a vec4 a lane, on GPUs).
 layout(constant_id = 8) const uint DEPTH_LOAD = 2u;
 // light_bins and cull_lists: 1 when the lists filter their candidates through
 // the depth bins (binding 8, after the row masks).

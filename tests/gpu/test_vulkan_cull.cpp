@@ -731,16 +731,20 @@ TEST_F(GpuTest, GrownStashHoldsListsOfUpTo128Entries) {
 
 // On lavapipe tile_bounds reads the depth 8 pixels a load where the width
 // and the tile size are multiples of 8, else 2 where both are even
-// (LC_WIDE_DEPTH_LOADS); the GPU work layout, emulated, reads single pixels.
-// The two must agree exactly: the same depth bounds and cell / slice masks,
-// the same lists. Partial edge tiles in both: 330 = 20 x 16 + 10 across (pairs),
-// 328 = 20 x 16 + 8 and 13 x 24 + 16 (8 pixels a load), 186 = 11 x 16 + 10
-// down; and a tile size that is not a multiple of 8 (10 px: pairs).
+// (LC_WIDE_DEPTH_LOADS); the GPU work layout, emulated, reads 4 pixels a
+// lane (a vec4) where both are multiples of 4, else single pixels.
+// They must agree exactly: the same depth bounds and cell / slice masks,
+// the same lists. Partial edge tiles in all: 330 = 20 x 16 + 10 across (pairs;
+// single pixels), 328 = 20 x 16 + 8 and 13 x 24 + 16 (8 pixels a load; 4),
+// 332 = 27 x 12 + 8 and 16 x 20 + 12 (pairs; 4), 186 = 11 x 16 + 10 down;
+// and tile sizes that are not multiples of 8 (10 px: pairs, single pixels;
+// 12 and 20 px: pairs, 4).
 TEST_F(GpuTest, WideDepthLoadsMatchSinglePixelLoads) {
     setenv("LIGHTCULL_VK_EMULATE_GPU", "1", 1);
     std::unique_ptr<CullBackend> emulated = makeVulkanBackend("");
     unsetenv("LIGHTCULL_VK_EMULATE_GPU");
-    const std::pair<std::uint32_t, std::uint32_t> cases[] = {{330, 16}, {330, 10}, {328, 16}, {328, 24}};
+    const std::pair<std::uint32_t, std::uint32_t> cases[] = {{330, 16}, {330, 10}, {328, 16},
+                                                             {328, 24}, {332, 12}, {332, 20}};
     for (const auto& [width, tile] : cases) {
         Scene scene = sized("forest", width, 186, tile);
         scene.lights = generateLights(defaultLightGen(scene, 300, 4));

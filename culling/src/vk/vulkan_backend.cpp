@@ -947,15 +947,20 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     // device: the host adds up the counts (the scan of P1 / clustered's
     // 261,120 counts took lavapipe about 1 ms).
     const bool hostScan = walk != 0 && !writeFirst;
-    // Wide depth loads (tile_bounds.comp, LC_WIDE_DEPTH_LOADS): an invocation
-    // per tile, 8 or 2 pixels a load where the width and the tile size are
-    // multiples of it, so every tile row starts on a whole load.
+    // Wide depth loads (tile_bounds.comp): an invocation per tile
+    // (LC_WIDE_DEPTH_LOADS), 8 or 2 pixels a load; a subgroup per tile, 4 a
+    // load; where the width and the tile size are multiples of it, so every
+    // tile row starts on a whole load.
     auto loadsOf = [&](std::uint32_t px) { return grid.width % px == 0 && grid.tileSize % px == 0; };
-    const std::uint32_t depthLoad =
-        !ctx_.int64Supported() || lanes != 1 ? 1 : loadsOf(8) ? 8 : loadsOf(2) ? 2 : 1;
+    const std::uint32_t depthLoad = lanes != 1             ? (loadsOf(4) ? 4 : 1)
+                                    : !ctx_.int64Supported() ? 1
+                                    : loadsOf(8)             ? 8
+                                    : loadsOf(2)             ? 2
+                                                             : 1;
     VkPipeline boundsPipe =
-        depthLoad > 1 ? computePipeline("tile_bounds.wide", boundsWideShader_, spec(kLocal, 0, lanes, depthLoad), false)
-                      : computePipeline("tile_bounds", boundsShader_, spec(kLocal, 0, lanes), subgroupLanes);
+        lanes == 1 && depthLoad > 1
+            ? computePipeline("tile_bounds.wide", boundsWideShader_, spec(kLocal, 0, lanes, depthLoad), false)
+            : computePipeline("tile_bounds", boundsShader_, spec(kLocal, 0, lanes, depthLoad), subgroupLanes);
     const Grid boundsGroups = Grid{(grid.tilesX + itemsPerGroup - 1) / itemsPerGroup, grid.tilesY};
     VkPipeline binsPipe = computePipeline("light_bins", binsShader_, spec(kLocal, 0), false);
     VkPipeline countPipe =
