@@ -251,7 +251,9 @@ void clusteredTileWalk(uint id) {
     uint firstList = tile * P.counts.y;
     uint stashSlots = P.bins.z;
     GpuTileBounds tb = tiles[tile];
-    uint walk = ((endCell - firstCell >= 32u) ? 0xffffffffu : ((1u << (endCell - firstCell)) - 1u)) << firstCell;
+    // The invocation's slices, and those it walks.
+    uint slices = ((endCell - firstCell >= 32u) ? 0xffffffffu : ((1u << (endCell - firstCell)) - 1u)) << firstCell;
+    uint walk = slices;
     if ((P.counts.w & LC_FLAG_SKIP_EMPTY) != 0u) walk = tb.depthMin <= tb.depthMax ? walk & tb.cellMask : 0u;
     uint n[32]; // the counts of slices firstCell .. endCell - 1
     for (uint k = 0u; k < TILE_WALK; ++k) n[k] = 0u;
@@ -287,7 +289,7 @@ void clusteredTileWalk(uint id) {
                 }
             }
             walk = 0u; // written (the counts checked below)
-            lists = ((endCell - firstCell >= 32u) ? 0xffffffffu : ((1u << (endCell - firstCell)) - 1u)) << firstCell;
+            lists = slices;
             while (lists != 0u) {
                 uint c = uint(findLSB(lists));
                 lists &= lists - 1u;

@@ -106,6 +106,16 @@ CaseReport checkCase(const std::string& label, const gputest::Frame& f, const Cu
     return checkCase(label, f.depth, f.proj, f.grid, f.lights, settings, cpuBackend, gpuBackend);
 }
 
+// A Vulkan backend on the GPU work layout even on lavapipe
+// (LIGHTCULL_VK_EMULATE_GPU=1 while it is made): device-local buffers
+// behind staging copies, a subgroup per tile and list, GPU timestamps.
+std::unique_ptr<CullBackend> makeEmulatedGpuBackend() {
+    setenv("LIGHTCULL_VK_EMULATE_GPU", "1", 1);
+    std::unique_ptr<CullBackend> b = makeVulkanBackend("");
+    unsetenv("LIGHTCULL_VK_EMULATE_GPU");
+    return b;
+}
+
 Scene sized(const std::string& name, std::uint32_t w, std::uint32_t h, std::uint32_t tile = 16) {
     Scene s = makeBuiltinScene(name);
     s.camera.width = w;
@@ -357,9 +367,7 @@ TEST_F(GpuTest, ResultsAreDeterministic) {
 // runs: the same lists as the CPU layout, bit for bit (same float tests, exact
 // min/max/or reductions), hence the same superset of the CPU reference.
 TEST_F(GpuTest, GpuWorkLayoutEmulatedOnLavapipe) {
-    setenv("LIGHTCULL_VK_EMULATE_GPU", "1", 1);
-    std::unique_ptr<CullBackend> emulated = makeVulkanBackend("");
-    unsetenv("LIGHTCULL_VK_EMULATE_GPU");
+    std::unique_ptr<CullBackend> emulated = makeEmulatedGpuBackend();
     // On a GPU (the device tool's H100) both backends take the GPU layout.
     if (gputest::vulkan().timingMethod().find("cpu-wall-clock") != std::string::npos)
         EXPECT_NE(emulated->timingMethod(), gputest::vulkan().timingMethod());
@@ -410,9 +418,7 @@ TEST_F(GpuTest, GpuWorkLayoutEmulatedOnLavapipe) {
 // than 512 KiB must come back whole: the same as the CPU layout's, which
 // reads its buffers in place.
 TEST_F(GpuTest, DownloadsLargerThanOneCopyRegionComeBackWhole) {
-    setenv("LIGHTCULL_VK_EMULATE_GPU", "1", 1);
-    std::unique_ptr<CullBackend> emulated = makeVulkanBackend("");
-    unsetenv("LIGHTCULL_VK_EMULATE_GPU");
+    std::unique_ptr<CullBackend> emulated = makeEmulatedGpuBackend();
     Scene scene = sized("atrium", 1000, 600);
     scene.lights = generateLights(defaultLightGen(scene, 2000, 11));
     const Projection proj(scene.camera);
@@ -441,9 +447,7 @@ TEST_F(GpuTest, DownloadsLargerThanOneCopyRegionComeBackWhole) {
 // longer than the stash (the write pass walks again) and an index array
 // sized from a smaller cull (lists left to the second submission).
 TEST_F(GpuTest, ClusteredTileWalkMatchesTheListWalk) {
-    setenv("LIGHTCULL_VK_EMULATE_GPU", "1", 1);
-    std::unique_ptr<CullBackend> listWalk = makeVulkanBackend("");
-    unsetenv("LIGHTCULL_VK_EMULATE_GPU");
+    std::unique_ptr<CullBackend> listWalk = makeEmulatedGpuBackend();
     std::unique_ptr<CullBackend> tileWalk = makeVulkanBackend("");
     auto cpuBackend = makeCpuBackend();
     struct Case {
@@ -740,9 +744,7 @@ TEST_F(GpuTest, GrownStashHoldsListsOfUpTo128Entries) {
 // and tile sizes that are not multiples of 8 (10 px: pairs, single pixels;
 // 12 and 20 px: pairs, 4).
 TEST_F(GpuTest, WideDepthLoadsMatchSinglePixelLoads) {
-    setenv("LIGHTCULL_VK_EMULATE_GPU", "1", 1);
-    std::unique_ptr<CullBackend> emulated = makeVulkanBackend("");
-    unsetenv("LIGHTCULL_VK_EMULATE_GPU");
+    std::unique_ptr<CullBackend> emulated = makeEmulatedGpuBackend();
     const std::pair<std::uint32_t, std::uint32_t> cases[] = {{330, 16}, {330, 10}, {328, 16},
                                                              {328, 24}, {332, 12}, {332, 20}};
     for (const auto& [width, tile] : cases) {
@@ -805,9 +807,7 @@ TEST_F(GpuTest, ZBinListsComeBackAscendingShortAndLong) {
 // light (index 65,535, then 65,536: written in 16 bits it would come back as
 // 0) lights the whole frame, so it is in every list.
 TEST_F(GpuTest, SixteenBitIndicesUpTo65536Lights) {
-    setenv("LIGHTCULL_VK_EMULATE_GPU", "1", 1);
-    std::unique_ptr<CullBackend> emulated = makeVulkanBackend("");
-    unsetenv("LIGHTCULL_VK_EMULATE_GPU");
+    std::unique_ptr<CullBackend> emulated = makeEmulatedGpuBackend();
     auto cpuBackend = makeCpuBackend();
     for (const std::size_t n : {std::size_t(65536), std::size_t(65537)}) {
         Scene scene = sized("atrium", 96, 64);

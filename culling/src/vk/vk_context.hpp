@@ -292,9 +292,8 @@ class BufferCache {
     BufferCache(const BufferCache&) = delete;
     BufferCache& operator=(const BufferCache&) = delete;
     // Made by Context::createBuffer(..., kind). The buffer lives until the role asks again with a
-    // size or kind it does not fit, or clear().
+    // size or kind it does not fit, or the cache goes.
     const Buffer& get(const std::string& role, VkDeviceSize bytes, VkBufferUsageFlags usage, Kind kind);
-    void clear() { entries_.clear(); }
 
   private:
     struct Entry {

@@ -1111,12 +1111,17 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         offs = hostOffs.data();
     }
     // A tile walk's pools (cull_lists.comp): whether each held its walk's
-    // entries, so that the host can take the lists from there.
-    bool poolsFitted = walk != 0 && stashed;
+    // entries, so that the host can take the lists from there. Walk q of
+    // tile t takes lists [first, end).
     const std::uint32_t walkGroups = walk ? (cells + walk - 1) / walk : 0;
+    auto walkLists = [&](std::uint32_t t, std::uint32_t q) {
+        const std::uint32_t first = t * cells + q * walk;
+        return std::pair{first, std::min(first + walk, (t + 1) * cells)};
+    };
+    bool poolsFitted = walk != 0 && stashed;
     for (std::uint32_t t = 0; poolsFitted && t < tiles; ++t)
         for (std::uint32_t q = 0; q < walkGroups; ++q) {
-            const std::uint32_t first = t * cells + q * walk, end = std::min(first + walk, (t + 1) * cells);
+            const auto [first, end] = walkLists(t, q);
             if (offs[end] - offs[first] > (end - first) * stashSlots) poolsFitted = false;
         }
     const std::uint32_t total = offs[listTotal];
@@ -1139,7 +1144,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
         std::vector<std::uint32_t> at(offs, offs + listTotal);
         for (std::uint32_t t = 0; t < tiles; ++t)
             for (std::uint32_t q = 0; q < walkGroups; ++q) {
-                const std::uint32_t first = t * cells + q * walk, end = std::min(first + walk, (t + 1) * cells);
+                const auto [first, end] = walkLists(t, q);
                 const std::uint32_t* pool = stashed + std::size_t(first) * stashSlots;
                 for (std::uint32_t i = 0, m = offs[end] - offs[first]; i < m; ++i) {
                     const std::uint32_t slice = pool[i] >> 24, list = t * cells + slice;
