@@ -324,22 +324,25 @@ void clusteredTileWalk(uint id) {
             vec4 L = lights[l].centerRadius;
             float r = widenedRadius(L);
             float a = widenDown(-L.z - r), b = widenUp(-L.z + r);
-            // A first guess of the slices from the slicing's inverse, then
-            // moved out while a neighbour's chunk still reaches [a, b].
+            // The first slice whose chunk reaches a: a guess from the
+            // slicing's inverse, moved down by one where the slice below
+            // still reaches a, or to cLo where the guess is off by more. The
+            // walk goes up from there until a chunk starts beyond b: one loop
+            // of at most the walk's slices, no loop to find the range
+            // (lavapipe's cap counts every loop turn: so 32 slices a walk fit
+            // it at 1,024 lights).
             float ta = logSlices ? (a > P.cluster.x ? (log2(a) - log2(P.cluster.x)) * sliceScale : 0.0)
                                  : (a - P.cluster.x) * sliceScale;
-            float tb2 = logSlices ? (b > P.cluster.x ? (log2(b) - log2(P.cluster.x)) * sliceScale : 0.0)
-                                  : (b - P.cluster.x) * sliceScale;
-            uint c0 = uint(clamp(ta, float(cLo), float(cHi))), c1 = uint(clamp(tb2, float(cLo), float(cHi)));
-            c1 = max(c1, c0);
-            while (c0 > cLo && walkChunkHi(c0 - 1u) >= a) --c0;
-            while (c1 < cHi && walkChunkLo(c1 + 1u) <= b) ++c1;
-            uint cand = walk & ((((c1 - c0 + 1u) >= 32u) ? 0xffffffffu : ((1u << (c1 - c0 + 1u)) - 1u)) << c0);
+            uint c0 = uint(clamp(ta, float(cLo), float(cHi)));
+            if (c0 > cLo && walkChunkHi(c0 - 1u) >= a) c0 = c0 - 1u > cLo && walkChunkHi(c0 - 2u) >= a ? cLo : c0 - 1u;
+            uint cand = walk & (0xffffffffu << c0);
             while (cand != 0u) {
                 uint c = uint(findLSB(cand));
                 cand &= cand - 1u;
+                float chunkLo = walkChunkLo(c);
+                if (chunkLo > b) break;
                 ++tested;
-                Chunk ch = makeChunk(tile, walkChunkLo(c), walkChunkHi(c));
+                Chunk ch = makeChunk(tile, chunkLo, walkChunkHi(c));
                 vec3 cellCentre = vec3(0.0);
                 float cellRadius = 0.0;
                 if (spotMode == LC_FLAG_SPOT_CONE_SPHERE) chunkSphere(ch, cellCentre, cellRadius);

@@ -438,11 +438,13 @@ TEST_F(GpuTest, DownloadsLargerThanOneCopyRegionComeBackWhole) {
     }
 }
 
-// clustered on lavapipe walks a tile's slices in one invocation per 8 slices
-// (cull_lists.comp, clusteredTileWalk); the emulated GPU layout walks each
-// list alone. Their lists must be identical wherever the slice range of a
-// light could go wrong: log and linear slices, a slice count that is not a
-// multiple of 8, skip-empty on and off, spot cones by sphere and by planes,
+// clustered on lavapipe walks a tile's slices in one invocation per up to 32
+// slices (cull_lists.comp, clusteredTileWalk; fewer where the lights would
+// take the walk's loops past the driver's cap); the emulated GPU layout walks
+// each list alone. Their lists must be identical wherever the slice range of
+// a light could go wrong: log and linear slices, slice counts that are not
+// powers of 2, a tile's 32 slices split over two walks (2,000 lights),
+// skip-empty on and off, spot cones by sphere and by planes,
 // every sphere test, an orthographic and a reversed-Z infinite camera; lists
 // longer than the stash (the write pass walks again) and an index array
 // sized from a smaller cull (lists left to the second submission).
@@ -467,6 +469,9 @@ TEST_F(GpuTest, ClusteredTileWalkMatchesTheListWalk) {
          SphereTest::PlanesAabb},
         {"forest", ProjectionKind::Orthographic, 600, 20, Slicing::Linear, true, SpotTest::ConeSphere,
          SphereTest::Planes},
+        // 2,000 lights: 16 slices a walk (vulkan_backend.cpp), two walks a tile.
+        {"forest", ProjectionKind::Perspective, 2000, 32, Slicing::Log, true, SpotTest::ApexSphere,
+         SphereTest::PlanesAabb},
         // One slice over the whole range: lists far longer than the stash.
         {"atrium", ProjectionKind::Perspective, 1500, 1, Slicing::Log, false, SpotTest::ApexSphere,
          SphereTest::Planes},

@@ -925,13 +925,13 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const std::uint32_t itemsPerGroup = kLocal / lanes;
     // clustered on a CPU device: an invocation per tile and `walk` slices
     // (cull_lists.comp, clusteredTileWalk), as many as its loops fit the cap:
-    // the words, per candidate at most 2 x walk + 3 iterations (its slice
-    // range found and walked), the slices' counts and checks, and the
+    // the words, per candidate at most walk + 3 iterations (its slice range,
+    // found without a loop, walked), the slices' counts and checks, and the
     // stashed lists copied. Fewer invocations walk the words fewer times.
     std::uint32_t walk = 0;
     if (algo == Algorithm::Clustered && ctx_.isCpuDevice() && lanes == 1)
         for (std::uint32_t s : {32u, 16u, 8u, 4u}) {
-            const std::uint64_t iters = std::uint64_t(binWords) + (2ull * s + 3) * n + 6ull * s + std::uint64_t(s) * stashCap;
+            const std::uint64_t iters = std::uint64_t(binWords) + (s + 3ull) * n + 6ull * s + std::uint64_t(s) * stashCap;
             if (iters <= kLoopLimit) {
                 walk = std::min(s, cells);
                 break;
