@@ -1042,14 +1042,18 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
             if (gpuClock) stamps.begin(cmd, 0);
             vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, computeLayout_, 0, 1, &set1, 0, nullptr);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, boundsPipe);
-            vkCmdDispatch(cmd, boundsGroups.x, boundsGroups.y, 1);
             if (!all && n > 0) {
-                // No barrier before: the bins pass reads only params and lights and
-                // writes only the bins, which the bounds pass never touches.
+                // The bins pass first, with no barrier between it and the
+                // bounds pass: it reads only params and lights and writes only
+                // the bins, which the bounds pass never touches. Dispatched
+                // first, its few workgroups (a loop of 32 lights each) start
+                // before the bounds pass's fill the GPU, instead of waiting
+                // for them (P1 on the H100: 0.024-0.025 -> 0.022 ms).
                 vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, binsPipe);
                 vkCmdDispatch(cmd, binGroups.x, binGroups.y, 1);
             }
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, boundsPipe);
+            vkCmdDispatch(cmd, boundsGroups.x, boundsGroups.y, 1);
             if (zbin) {
                 // The bins' words follow the plane bins' in one buffer: ordered
                 // after light_bins, then the empty ranges before the lights.
