@@ -43,21 +43,26 @@ bool spotConeOutsideChunkPlane(GpuSpotCone s, vec4 plane, float eps) {
     return spotConeOutsidePlane(s.apexRange.xyz, s.axisCos.xyz, s.apexRange.w, s.axisCos.w, s.sinAngle.x, plane, eps);
 }
 
-// An invocation's walk over its bins' candidates (CPU devices): while the
-// current word m has no candidate left, the next word of the column, row and
-// depth bins ANDed (fetched four words a load into quad; w counts the words
-// taken). Returns the word to take candidates from, 0 when none is left.
-uint nextCandidateWord(inout uint w, uint m, inout uvec4 quad, uint words, uint columnBase, uint rowBase,
-                       bool depthBins, uint nearBase, uint farBase) {
-    while (m == 0u && w < words) {
-        if ((w & 3u) == 0u) {
-            quad = binQuads[(columnBase + w) >> 2u] & binQuads[(rowBase + w) >> 2u];
-            if (depthBins) quad &= binQuads[(nearBase + w) >> 2u] & binQuads[(farBase + w) >> 2u];
-        }
-        m = quad[w & 3u];
-        ++w;
+// An invocation's walk over its bins' candidates (CPU devices), four words
+// at a time: while quad (the candidates left of quad q - 1) is empty, the next
+// four words of the column, row and depth bins ANDed (q counts the quads
+// taken; the bins' words are padded to whole quads). Returns the next
+// candidate's light and clears it from quad; ~0u when none is left. Four
+// words a turn, not one: gallivm runs an if's body whatever its condition
+// (masked), so a quad loaded "every fourth word" was loaded on every word.
+const uint NO_CANDIDATE = 0xffffffffu;
+uint nextCandidate(inout uint q, inout uvec4 quad, uint quads, uint columnBase, uint rowBase, bool depthBins,
+                   uint nearBase, uint farBase) {
+    while (all(equal(quad, uvec4(0u))) && q < quads) {
+        quad = binQuads[(columnBase >> 2u) + q] & binQuads[(rowBase >> 2u) + q];
+        if (depthBins) quad &= binQuads[(nearBase >> 2u) + q] & binQuads[(farBase >> 2u) + q];
+        ++q;
     }
-    return m;
+    if (all(equal(quad, uvec4(0u)))) return NO_CANDIDATE;
+    uint i = quad.x != 0u ? 0u : (quad.y != 0u ? 1u : (quad.z != 0u ? 2u : 3u));
+    uint m = quad[i];
+    quad[i] = m & (m - 1u);
+    return ((q - 1u) * 4u + i) * 32u + uint(findLSB(m));
 }
 
 // The chunk's bounding sphere for the spot cone-sphere test: centroid of the
@@ -314,13 +319,11 @@ void clusteredTileWalk(uint id) {
         bool logSlices = SLICING == LC_SLICING_LOG && P.cluster.x > 0.0 && P.cluster.y > P.cluster.x;
         float sliceScale = logSlices ? float(CELLS) / log2(P.cluster.y / P.cluster.x)
                                      : float(CELLS) / max(P.cluster.y - P.cluster.x, 1e-30);
-        uint w = 0u, m = 0u;
+        uint q = 0u, quads = words / 4u;
         uvec4 quad = uvec4(0u);
         while (true) { // as the per-list walk (LANES == 1 in main)
-            m = nextCandidateWord(w, m, quad, words, columnBase, rowBase, depthBins, nearBase, farBase);
-            if (m == 0u) break;
-            uint l = (w - 1u) * 32u + uint(findLSB(m));
-            m &= m - 1u;
+            uint l = nextCandidate(q, quad, quads, columnBase, rowBase, depthBins, nearBase, farBase);
+            if (l == NO_CANDIDATE) break;
             vec4 L = lights[l].centerRadius;
             float r = widenedRadius(L);
             float a = widenDown(-L.z - r), b = widenUp(-L.z + r);
@@ -355,7 +358,7 @@ void clusteredTileWalk(uint id) {
                 }
             }
         }
-        cut = w < words || m != 0u; // a loop ended by the driver's cap, not by the candidates
+        cut = q < quads || any(notEqual(quad, uvec4(0u))); // a loop ended by the driver's cap, not by the candidates
     }
     if (cut) atomicOr(status, STATUS_LOOP_LIMIT);
     if (WRITE_PASS == 0u) {
@@ -479,13 +482,11 @@ void main() {
             // more than the tests.) lavapipe loads a storage buffer lane by
             // lane in a loop, one pass of it per load whatever its width, so
             // the words come four at a time.
-            uint w = 0u, m = 0u;
+            uint q = 0u, quads = words / 4u;
             uvec4 quad = uvec4(0u);
             while (true) {
-                m = nextCandidateWord(w, m, quad, words, columnBase, rowBase, depthBins, nearBase, farBase);
-                if (m == 0u) break;
-                uint l = (w - 1u) * 32u + uint(findLSB(m));
-                m &= m - 1u;
+                uint l = nextCandidate(q, quad, quads, columnBase, rowBase, depthBins, nearBase, farBase);
+                if (l == NO_CANDIDATE) break;
                 ++tested;
                 if (lightKept(l, ch, spotMode, cellCentre, cellRadius, cellLog, cellLog0, cellScale, maskLo, maskHi,
                               geomMask)) {
@@ -494,7 +495,7 @@ void main() {
                     ++n;
                 }
             }
-            cut = w < words || m != 0u; // a loop ended by the driver's cap, not by the list
+            cut = q < quads || any(notEqual(quad, uvec4(0u))); // a loop ended by the driver's cap, not by the list
         } else {
             // A subgroup per list (GPUs).
             ListWalk wk = ListWalk(ch, spotMode, cellCentre, cellRadius, cellLog, cellLog0, cellScale, maskLo, maskHi,
