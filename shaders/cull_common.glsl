@@ -38,6 +38,8 @@ layout(constant_id = 9) const uint DEPTH_BINS = 0u;
 // invocation takes: an invocation per tile and TILE_WALK slices instead of
 // one per list.
 layout(constant_id = 10) const uint TILE_WALK = 0u;
+// cull_lists: the spot cone refinement after the sphere test (LC_SPOT_*).
+layout(constant_id = 11) const uint SPOT_TEST = 0u;
 
 layout(std430, binding = 0) readonly buffer Params { GpuCullParams params; };
 // A private copy of the parameters, filled by loadParams() at the top of every

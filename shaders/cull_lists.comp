@@ -82,16 +82,16 @@ void chunkSphere(Chunk ch, out vec3 cellCentre, out float cellRadius) {
 // Whether light l (a candidate of the list's bins) goes into the list: the
 // sphere against the list's chunk, then the spot cone refinements and the
 // 2.5d cell test, as the CPU reference.
-bool lightKept(uint l, Chunk ch, uint spotMode, vec3 cellCentre, float cellRadius, bool cellLog, float cellLog0,
+bool lightKept(uint l, Chunk ch, vec3 cellCentre, float cellRadius, bool cellLog, float cellLog0,
                float cellScale, float maskLo, float maskHi, uint geomMask) {
     vec4 L = lights[l].centerRadius;
     float r = widenedRadius(L);
     bool pass = sphereHitsChunk(ch, L.xyz, r);
-    if (pass && spotMode != 0u) {
+    if (pass && SPOT_TEST != LC_SPOT_NONE) {
         GpuSpotCone s = spots[l];
         if (s.apexRange.w > 0.0) {
             float eps = (length(s.apexRange.xyz) + s.apexRange.w) * P.cluster.z + P.cluster.w;
-            if (spotMode == LC_FLAG_SPOT_CONE_SPHERE) {
+            if (SPOT_TEST == LC_SPOT_CONE_SPHERE) {
                 pass = spotConeHitsSphere(s.apexRange.xyz, s.axisCos.xyz, s.apexRange.w, s.axisCos.w,
                                           s.sinAngle.x, cellCentre, cellRadius, eps);
             } else {
@@ -126,7 +126,6 @@ bool lightKept(uint l, Chunk ch, uint spotMode, vec3 cellCentre, float cellRadiu
 // What a subgroup's walk over one list's candidates needs (GPUs).
 struct ListWalk {
     Chunk ch;
-    uint spotMode;
     vec3 cellCentre;
     float cellRadius;
     bool cellLog;
@@ -170,7 +169,7 @@ uint walkWords(ListWalk wk, uint list, uint w0, uint lane, bool writing, uint ba
     while (m != 0u) {
         uint bit = uint(findLSB(m));
         m &= m - 1u;
-        if (lightKept(w * 32u + bit, wk.ch, wk.spotMode, wk.cellCentre, wk.cellRadius, wk.cellLog, wk.cellLog0,
+        if (lightKept(w * 32u + bit, wk.ch, wk.cellCentre, wk.cellRadius, wk.cellLog, wk.cellLog0,
                       wk.cellScale, wk.maskLo, wk.maskHi, wk.geomMask))
             passMask |= 1u << bit;
     }
@@ -315,7 +314,6 @@ void clusteredTileWalk(uint id) {
         bool depthBins = DEPTH_BINS != 0u;
         uint nearBase = P.bins.w + depthBinOf(rangeHi) * words;
         uint farBase = P.bins.w + (LC_DEPTH_BINS + depthBinOf(rangeLo)) * words;
-        uint spotMode = P.counts.w & (LC_FLAG_SPOT_CONE_SPHERE | LC_FLAG_SPOT_CONE_PLANES);
         bool logSlices = SLICING == LC_SLICING_LOG && P.cluster.x > 0.0 && P.cluster.y > P.cluster.x;
         float sliceScale = logSlices ? float(CELLS) / log2(P.cluster.y / P.cluster.x)
                                      : float(CELLS) / max(P.cluster.y - P.cluster.x, 1e-30);
@@ -348,8 +346,8 @@ void clusteredTileWalk(uint id) {
                 Chunk ch = makeChunk(tile, chunkLo, walkChunkHi(c));
                 vec3 cellCentre = vec3(0.0);
                 float cellRadius = 0.0;
-                if (spotMode == LC_FLAG_SPOT_CONE_SPHERE) chunkSphere(ch, cellCentre, cellRadius);
-                if (lightKept(l, ch, spotMode, cellCentre, cellRadius, false, 0.0, 0.0, 0.0, 0.0, 0u)) {
+                if (SPOT_TEST == LC_SPOT_CONE_SPHERE) chunkSphere(ch, cellCentre, cellRadius);
+                if (lightKept(l, ch, cellCentre, cellRadius, false, 0.0, 0.0, 0.0, 0.0, 0u)) {
                     uint list = firstList + c, k = n[c - firstCell];
                     if (WRITE_PASS != 0u) lightIndices[listOffset[list] + k] = LC_INDEX(l);
                     else if (pooled < poolSlots) stash[poolBase + pooled] = (c << 24u) | l;
@@ -447,10 +445,9 @@ void main() {
         // Spot cone refinements (spot_tests.glsl), as the CPU reference runs
         // them after the (tight) sphere test. The chunk's bounding sphere once
         // per list: centroid of the corners, farthest corner, widened.
-        uint spotMode = P.counts.w & (LC_FLAG_SPOT_CONE_SPHERE | LC_FLAG_SPOT_CONE_PLANES);
         vec3 cellCentre = vec3(0.0);
         float cellRadius = 0.0;
-        if (spotMode == LC_FLAG_SPOT_CONE_SPHERE) {
+        if (SPOT_TEST == LC_SPOT_CONE_SPHERE) {
             chunkSphere(ch, cellCentre, cellRadius);
         }
         // 2.5d: the cell of view depth d is (log2(d) - cellLog0) * cellScale
@@ -488,7 +485,7 @@ void main() {
                 uint l = nextCandidate(q, quad, quads, columnBase, rowBase, depthBins, nearBase, farBase);
                 if (l == NO_CANDIDATE) break;
                 ++tested;
-                if (lightKept(l, ch, spotMode, cellCentre, cellRadius, cellLog, cellLog0, cellScale, maskLo, maskHi,
+                if (lightKept(l, ch, cellCentre, cellRadius, cellLog, cellLog0, cellScale, maskLo, maskHi,
                               geomMask)) {
                     if (WRITE_PASS != 0u) lightIndices[base + n] = LC_INDEX(l);
                     else if (n < stashSlots) stash[list * stashSlots + n] = l;
@@ -498,7 +495,7 @@ void main() {
             cut = q < quads || any(notEqual(quad, uvec4(0u))); // a loop ended by the driver's cap, not by the list
         } else {
             // A subgroup per list (GPUs).
-            ListWalk wk = ListWalk(ch, spotMode, cellCentre, cellRadius, cellLog, cellLog0, cellScale, maskLo, maskHi,
+            ListWalk wk = ListWalk(ch, cellCentre, cellRadius, cellLog, cellLog0, cellScale, maskLo, maskHi,
                                    geomMask, words, columnBase, rowBase, depthBins, nearBase, farBase);
             uint kept[KEPT_WORDS];
             n = subgroupListWalk(wk, list, lane, WRITE_PASS == 1u, base, kept, tested, cut);

@@ -59,8 +59,12 @@ const uint LC_FLAG_ORTHO = 1u;         // orthographic projection
 const uint LC_FLAG_REVERSED = 2u;      // reversed-Z (nearer = larger window depth)
 const uint LC_FLAG_FAR_INFINITE = 4u;  // camera far plane at +infinity: no far plane
 const uint LC_FLAG_SKIP_EMPTY = 8u;    // clustered: clusters without geometry get no lights
-const uint LC_FLAG_SPOT_CONE_SPHERE = 16u; // spot lights: cone vs the chunk's bounding sphere
-const uint LC_FLAG_SPOT_CONE_PLANES = 32u; // spot lights: cone vs each of the chunk's planes
+// The spot cone refinement cull_lists runs (specialisation constant
+// SPOT_TEST): none, or after the sphere test the cone against the chunk's
+// bounding sphere or against each of its planes.
+const uint LC_SPOT_NONE = 0u;
+const uint LC_SPOT_CONE_SPHERE = 1u;
+const uint LC_SPOT_CONE_PLANES = 2u;
 
 // Per-dispatch parameters of the culling passes (one read-only storage buffer,
 // std430). Sizes and modes that shape the code (tile size, cells, slicing,
@@ -105,7 +109,7 @@ struct GpuLight {
 };
 
 // A spot light's cone for the cone refinements (binding 9, one per light, read
-// only under LC_FLAG_SPOT_CONE_*; docs/SPOT_LIGHTS.md). A separate buffer so
+// only under LC_SPOT_CONE_*; docs/SPOT_LIGHTS.md). A separate buffer so
 // that GpuLight, which every pass streams, stays 16 bytes.
 struct GpuSpotCone {
     vec4 apexRange; // xyz: view-space apex, w: range; w = 0 marks a point light (no cone)
