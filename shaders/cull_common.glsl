@@ -40,6 +40,9 @@ layout(constant_id = 9) const uint DEPTH_BINS = 0u;
 layout(constant_id = 10) const uint TILE_WALK = 0u;
 // cull_lists: the spot cone refinement after the sphere test (LC_SPOT_*).
 layout(constant_id = 11) const uint SPOT_TEST = 0u;
+// light_bins: invocations sharing one mask word (1; a power of 2 up to 32 in
+// the build with subgroup shuffles), each testing 32 / BIN_LANES of its lights.
+layout(constant_id = 12) const uint BIN_LANES = 1u;
 
 layout(std430, binding = 0) readonly buffer Params { GpuCullParams params; };
 // A private copy of the parameters, filled by loadParams() at the top of every

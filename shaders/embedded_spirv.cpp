@@ -4,6 +4,7 @@
 #include "cull_lists_index16_comp.spv.h"
 #include "depth_vert.spv.h"
 #include "fine_prune_comp.spv.h"
+#include "light_bins_shuffle_comp.spv.h"
 #include "light_bins_comp.spv.h"
 #include "prefix_sum_comp.spv.h"
 #include "shade_comp.spv.h"
@@ -18,6 +19,7 @@ LC_SPV(depthVert, lc_spv_depth_vert)
 LC_SPV(tileBounds, lc_spv_tile_bounds_comp)
 LC_SPV(tileBoundsWide, lc_spv_tile_bounds_wide_comp)
 LC_SPV(lightBins, lc_spv_light_bins_comp)
+LC_SPV(lightBinsShuffle, lc_spv_light_bins_shuffle_comp)
 LC_SPV(cullLists, lc_spv_cull_lists_comp)
 LC_SPV(cullListsIndex16, lc_spv_cull_lists_index16_comp)
 LC_SPV(prefixSum, lc_spv_prefix_sum_comp)

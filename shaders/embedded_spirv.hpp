@@ -16,6 +16,7 @@ Code depthVert();   // depth pre-pass vertex shader (no fragment shader)
 Code tileBounds();  // per-tile depth bounds, halfz split, cell / slice masks
 Code tileBoundsWide();  // the same, depth read 2 or 8 pixels a load (needs shaderInt64)
 Code lightBins();  // per tile column / row bitmask of the lights not outside its side planes
+Code lightBinsShuffle(); // the same, several invocations a mask word (needs subgroup shuffles)
 Code cullLists();   // per-list light tests: count pass and write pass
 Code cullListsIndex16(); // the same, writing 16-bit light indices (needs storageBuffer16BitAccess)
 Code prefixSum();   // exclusive scan of the list counts into offsets

@@ -20,6 +20,9 @@
 // depths clamped into them). No subgroup operations, no barrier(): any local
 // size.
 #extension GL_GOOGLE_include_directive : require
+#ifdef LC_WORD_SHUFFLE
+#extension GL_KHR_shader_subgroup_shuffle : require
+#endif
 #include "cull_common.glsl"
 
 // A light's radius as the bins take it: twice the chunk test's widening, as
@@ -27,10 +30,25 @@
 // (contraction), never by 2e-5.
 float binRadius(vec4 L) { return widenedRadius(L) + (length(L.xyz) + L.w) * P.cluster.z; }
 
+// The OR of a mask over the BIN_LANES (a power of 2) invocations sharing its
+// word: neighbours in the subgroup, all active or all returned. Built without
+// LC_WORD_SHUFFLE, BIN_LANES is 1.
+uint wordOr(uint m) {
+#ifdef LC_WORD_SHUFFLE
+    for (uint s = 1u; s < BIN_LANES; s <<= 1u) m |= subgroupShuffleXor(m, s);
+#endif
+    return m;
+}
+
 void main() {
     loadParams();
     uint idx = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
                gl_LocalInvocationIndex;
+    // BIN_LANES neighbouring invocations share a word, part p testing its
+    // lights p x 32 / BIN_LANES ..; their masks are ORed (whole clusters
+    // return together: the exits below depend on idx only).
+    uint part = idx % BIN_LANES, partLights = 32u / BIN_LANES;
+    idx /= BIN_LANES;
     uint words = P.bins.x, tilesX = P.size.z, tilesY = P.size.w;
     uint columnWords = words * tilesX, planeWords = columnWords + words * tilesY;
     uint lightCount = P.counts.x;
@@ -41,13 +59,16 @@ void main() {
         uint first = w * 32u, end = min(first + 32u, lightCount);
         uint nearMask = 0u, farMask = 0u;
         float binF = float(bin);
-        for (uint i = first; i < end; ++i) {
+        for (uint i = first + part * partLights; i < min(first + (part + 1u) * partLights, end); ++i) {
             vec4 L = lights[i].centerRadius;
             float r = binRadius(L);
             float depth = -L.z;
             if (depthBinCoord(depth - r) - DEPTH_BIN_MARGIN < binF + 1.0) nearMask |= 1u << (i - first);
             if (depthBinCoord(depth + r) + DEPTH_BIN_MARGIN >= binF) farMask |= 1u << (i - first);
         }
+        nearMask = wordOr(nearMask);
+        farMask = wordOr(farMask);
+        if (part != 0u) return;
         uint all = end > first ? (0xffffffffu >> (32u - (end - first))) : 0u;
         binMask[P.bins.w + j] = bin == LC_DEPTH_BINS - 1u ? all : nearMask;
         binMask[P.bins.w + LC_DEPTH_BINS * words + j] = bin == 0u ? all : farMask;
@@ -66,11 +87,12 @@ void main() {
     else rowPlanes(rowNdc(line), a, b);
     uint first = w * 32u, end = min(first + 32u, lightCount);
     uint mask = 0u;
-    for (uint i = first; i < end; ++i) {
+    for (uint i = first + part * partLights; i < min(first + (part + 1u) * partLights, end); ++i) {
         vec4 L = lights[i].centerRadius;
         float r = binRadius(L);
         float da = dot(a.xyz, L.xyz) + a.w, db = dot(b.xyz, L.xyz) + b.w;
         if (da >= -r && db >= -r) mask |= 1u << (i - first);
     }
-    binMask[at] = mask;
+    mask = wordOr(mask);
+    if (part == 0u) binMask[at] = mask;
 }

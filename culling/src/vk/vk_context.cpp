@@ -268,6 +268,7 @@ Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
             throw DeviceError(std::string("Vulkan device '") + props_.deviceName +
                               "' lacks subgroup basic/arithmetic/ballot operations in compute shaders");
         subgroupSize_ = std::max<std::uint32_t>(1, sg.subgroupSize);
+        shuffle_ = (sg.supportedOperations & VK_SUBGROUP_FEATURE_SHUFFLE_BIT) != 0;
 
         std::uint32_t qn = 0;
         vkGetPhysicalDeviceQueueFamilyProperties(physical_, &qn, nullptr);

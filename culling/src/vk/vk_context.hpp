@@ -174,6 +174,8 @@ public:
     bool fullSubgroupsSupported() const { return fullSubgroups_; }
     // shaderInt64, enabled when the device has it (tile_bounds' pixel-pair loads).
     bool int64Supported() const { return int64_; }
+    // Subgroup shuffles in compute shaders (subgroupShuffleXor).
+    bool subgroupShuffleSupported() const { return shuffle_; }
     // storageBuffer16BitAccess (Vulkan 1.1), enabled when the device has it:
     // the GPU culling pass writes 16-bit light indices where they fit.
     bool index16Supported() const { return index16_; }
@@ -261,6 +263,7 @@ private:
     std::uint32_t subgroupSize_ = 1;
     bool fullSubgroups_ = false;
     bool int64_ = false;
+    bool shuffle_ = false;
     bool index16_ = false;
     bool timestamps_ = false;
     bool emulateGpu_ = false;
