@@ -96,7 +96,7 @@ struct CellMap {
 };
 CellMap cellMapOf(float lo, float hi) {
     CellMap m;
-    m.useLog = SLICING == LC_SLICING_LOG && lo > 0.0;
+    m.useLog = SLICING == LC_SLICING_LOG && (CELL_LOG != 0u || lo > 0.0);
     m.lo = lo;
     m.k = float(CELLS) / (m.useLog ? log2(hi / lo) : (hi - lo));
     m.dc = m.useLog ? m.k * ((P.cluster.z + P.cluster.w / lo) * 2.17 + 2e-5) + 1e-4
@@ -190,13 +190,15 @@ void main() {
         tb.depthMax = max(va, vb);
         tb.split = (tb.depthMin + tb.depthMax) * 0.5;
         if (slicesInWalk) {
-            tb.cellMask = walkMask;
+            tb.cellMask = CELL_LOG != 0u && !(P.cluster.x > 0.0) ? 0xffffffffu : walkMask;
         } else if (ALGORITHM == LC_ALG_25D || ALGORITHM == LC_ALG_CLUSTERED) {
             float lo = (ALGORITHM == LC_ALG_25D) ? tb.depthMin : P.cluster.x;
             float hi = (ALGORITHM == LC_ALG_25D) ? tb.depthMax : P.cluster.y;
             uint mask = 0u;
             if (!(hi > lo)) {
                 mask = 1u; // one depth: every pixel in cell 0 (as sliceOf)
+            } else if (CELL_LOG != 0u && !(lo > 0.0)) {
+                mask = 0xffffffffu;
             } else {
                 CellMap cells = cellMapOf(lo, hi);
                 for (uint y = ly; y < th; y += laneRows) {
