@@ -49,6 +49,10 @@ layout(constant_id = 12) const uint BIN_LANES = 1u;
 // varying branch, and the linear one's division cost P1 0.3 ms. A tile whose
 // range does not start beyond 0 all the same is marked whole (conservative).
 layout(constant_id = 13) const uint CELL_LOG = 0u;
+// 1 for an orthographic camera (the flag LC_FLAG_ORTHO records the same):
+// compiled in, so lavapipe, which runs both sides of a varying branch, does
+// not build every chunk's planes and corners for both projections.
+layout(constant_id = 14) const uint ORTHO = 0u;
 
 layout(std430, binding = 0) readonly buffer Params { GpuCullParams params; };
 // A private copy of the parameters, filled by loadParams() at the top of every
@@ -100,7 +104,7 @@ const uint STATUS_TESTS_OVERFLOW = 4u;  // candidateTests wrapped around 2^32
 // sizes the work per invocation below that and turns this bit into an error.
 const uint STATUS_LOOP_LIMIT = 8u;
 
-bool isOrtho() { return (P.counts.w & LC_FLAG_ORTHO) != 0u; }
+bool isOrtho() { return ORTHO != 0u; }
 
 // Depth-bin coordinate of view depth d (GpuCullParams.depthBins): its bin is
 // the floor, clamped to [0, LC_DEPTH_BINS - 1]. Non-decreasing in d up to

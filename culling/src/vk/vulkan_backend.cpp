@@ -73,7 +73,7 @@ constexpr float kRelEps = 2e-5f;
 constexpr float kAbsEps = 1e-6f;
 
 constexpr std::uint32_t kBindings = 11; // cull_common.glsl bindings 0..10
-constexpr std::uint32_t kSpecConstants = 14; // cull_common.glsl constant_id 0..13
+constexpr std::uint32_t kSpecConstants = 15; // cull_common.glsl constant_id 0..14
 using SpecConstants = std::array<std::uint32_t, kSpecConstants>;
 enum Binding : std::uint32_t { bParams, bDepth, bTiles, bLights, bCounts, bOffsets, bIndices, bStatus, bBins };
 // Stash slots per list at most (cull_common.glsl binding 10): the count pass
@@ -901,7 +901,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     auto spec = [&](std::uint32_t local, std::uint32_t write, std::uint32_t lanesPerTile = 1,
                     std::uint32_t depthLoad = 2, std::uint32_t tileWalk = 0, std::uint32_t binLanes = 1) {
         return SpecConstants{local,      grid.tileSize, cells,    slicingId,  algoId,   testId,  write,
-                             lanesPerTile, depthLoad, depthBins ? 1u : 0u, tileWalk, spotTestId, binLanes, cellLog};
+                             lanesPerTile, depthLoad, depthBins ? 1u : 0u, tileWalk, spotTestId, binLanes, cellLog,
+                             proj.orthographic() ? 1u : 0u};
     };
     // Work layout per device kind (the LANES constant): on a CPU device
     // (lavapipe) an invocation per tile and per list, so SIMD lanes are tiles /
