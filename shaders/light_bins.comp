@@ -1,6 +1,7 @@
 #version 450
 // Pass 1b of the culling: bins the lights by tile column and tile row. One
-// invocation per (mask word, column) or (mask word, row) tests that word's 32
+// invocation per (mask word, column) or (mask word, row) (BIN_LANES of them,
+// on GPUs, each with 32 / BIN_LANES of the lights) tests that word's 32
 // lights against the column's left/right (row's top/bottom) side planes, the
 // same planes and the same reject rule (signed distance < -radius) as the
 // chunk test, with the radius widened once more so that a light the chunk
