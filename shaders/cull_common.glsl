@@ -43,9 +43,9 @@ layout(constant_id = 11) const uint SPOT_TEST = 0u;
 // light_bins: invocations sharing one mask word (1; a power of 2 up to 32 in
 // the build with subgroup shuffles), each testing 32 / BIN_LANES of its lights.
 layout(constant_id = 12) const uint BIN_LANES = 1u;
-// tile_bounds: 1 where the host knows every cell range a pixel is mapped into
+// tile_bounds and 2.5d's light test: 1 where the host knows every cell range
 // starts beyond 0 (log slicing, a perspective camera, clustered's near > 0),
-// so the pixels take the log cell formula alone: lavapipe runs both sides of a
+// so pixels and lights take the log cell formula alone: lavapipe runs both sides of a
 // varying branch, and the linear one's division cost P1 0.3 ms. A tile whose
 // range does not start beyond 0 all the same is marked whole (conservative).
 layout(constant_id = 13) const uint CELL_LOG = 0u;

@@ -115,6 +115,9 @@ bool lightKept(uint l, Chunk ch, vec3 cellCentre, float cellRadius, bool cellLog
             uint c0 = a > maskLo ? uint(clamp((log2(a) - cellLog0) * cellScale, 0.0, cellMax)) : 0u;
             uint c1 = b > maskLo ? uint(clamp((log2(b) - cellLog0) * cellScale, 0.0, cellMax)) : 0u;
             cells = (b < maskLo || a > maskHi) ? 0u : ((2u << (c1 - c0)) - 1u) << c0;
+            // (CELL_LOG: a range that does not start beyond 0 all the same
+            // has every cell, as tile_bounds marks it.)
+            if (CELL_LOG != 0u && !(maskLo > 0.0)) cells = (b < maskLo || a > maskHi) ? 0u : 0xffffffffu;
         } else {
             cells = sliceRangeMask(maskLo, maskHi, a, b);
         }
@@ -455,9 +458,12 @@ void main() {
         // per-list terms taken out of the light loop; the rounding of the two
         // logs, ~1e-6 in log2 units, is far inside the light's 2e-5 relative
         // widening, as for tile_bounds' 2e-5 allowance), else sliceOf's own.
-        bool cellLog = SLICING == LC_SLICING_LOG && maskLo > 0.0 && maskHi > maskLo;
+        // With CELL_LOG (ranges start beyond 0) always the log form, so that
+        // lavapipe does not run sliceOf's beside it: a tile of one depth
+        // takes scale 0, cell 0, as sliceOf.
+        bool cellLog = SLICING == LC_SLICING_LOG && (CELL_LOG != 0u || (maskLo > 0.0 && maskHi > maskLo));
         float cellLog0 = cellLog ? log2(maskLo) : 0.0;
-        float cellScale = cellLog ? float(CELLS) / log2(maskHi / maskLo) : 0.0;
+        float cellScale = cellLog && maskLo > 0.0 && maskHi > maskLo ? float(CELLS) / log2(maskHi / maskLo) : 0.0;
         if (WRITE_PASS == 1u) base = listOffset[list];
         uint tilesX = P.size.z, words = P.bins.x;
         uint tx = tile % tilesX, ty = tile / tilesX;
