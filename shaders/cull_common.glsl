@@ -53,6 +53,9 @@ layout(constant_id = 13) const uint CELL_LOG = 0u;
 // compiled in, so lavapipe, which runs both sides of a varying branch, does
 // not build every chunk's planes and corners for both projections.
 layout(constant_id = 14) const uint ORTHO = 0u;
+// cull_lists on GPUs: mask words per lane a list's walk keeps in registers
+// (1 to 4; see KEPT_WORDS' use there).
+layout(constant_id = 15) const uint KEPT_WORDS = 4u;
 
 layout(std430, binding = 0) readonly buffer Params { GpuCullParams params; };
 // A private copy of the parameters, filled by loadParams() at the top of every

@@ -193,13 +193,13 @@ uint walkWords(ListWalk wk, uint list, uint w0, uint lane, bool writing, uint ba
     return passMask;
 }
 
-// Words per lane whose masks a subgroup's walk keeps in registers (the
-// first KEPT_WORDS x LANES words: 4,096 lights with 32 lanes). The fused
-// pass writes such a list from them once it has its range, instead of
-// walking it again where the stash cannot hold it (on the H100, against
-// the build before: the Live scene, 73 entries a list, 0.030 against 0.035
-// ms; P3, 256 a list, 0.173 against 0.249).
-const uint KEPT_WORDS = 4u;
+// KEPT_WORDS (cull_common.glsl, 1 to 4): words per lane whose masks a
+// subgroup's walk keeps in registers (the first KEPT_WORDS x LANES words: up
+// to 4,096 lights with 32 lanes); the host sets as many as the bins have per
+// lane. The fused pass writes such a list from them once it has its range,
+// instead of walking it again where the stash cannot hold it (on the H100,
+// against the build before: the Live scene, 73 entries a list, 0.030
+// against 0.035 ms; P3, 256 a list, 0.173 against 0.249).
 
 // A subgroup's walk over a list's candidates (GPUs): lane i takes words i,
 // i + LANES, ... (walkWords). Returns the list's count (the same in every
