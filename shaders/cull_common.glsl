@@ -79,8 +79,9 @@ layout(std430, binding = 6) buffer IndexBuf { uint lightIndices[]; };
 #define LC_INDEX(l) (l)
 #endif
 // status: STATUS_* bits; candidateTests: light-versus-volume tests the count
-// pass performed (the write pass repeats them), for the benchmarks.
-layout(std430, binding = 7) buffer StatusBuf { uint status; uint candidateTests; };
+// pass performed (the write pass repeats them), for the benchmarks, in
+// LC_TEST_COUNTERS counters (countTests in cull_lists.comp).
+layout(std430, binding = 7) buffer StatusBuf { uint status; uint candidateTests[]; };
 // Light bins (light_bins.comp): one bit per light, P.bins.x words per bin
 // (padded with zero words to a multiple of 4). Column tx's words start at
 // binMask[tx * P.bins.x], row ty's at binMask[P.bins.y + ty * P.bins.x]; a

@@ -782,7 +782,9 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
             gpuSpots[k].axisCos = glm::vec4(glm::vec3(c.axis), float(c.cosAngle));
             gpuSpots[k].sinAngle = glm::vec4(float(c.sinAngle), 0.0f, 0.0f, 0.0f);
         }
-    const std::uint32_t statusZero[2] = {0, 0};
+    // The status word and the test counters (gpu_shared.h), zeroed.
+    constexpr std::size_t kStatusWords = 1 + std::size_t(LC_TEST_COUNTERS) * LC_TEST_COUNTER_STRIDE;
+    static const std::array<std::uint32_t, kStatusWords> statusZero{};
 
     // Device buffers (sizes from the inputs; the index array comes after the count).
     const VkBufferUsageFlags ssbo = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
@@ -805,7 +807,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     const Buffer& binBuf = deviceBuffer("cull.bins", binTotal64 * 4);
     const Buffer& countBuf = deviceBuffer("cull.counts", std::size_t(listTotal) * 4);
     const Buffer& offsetBuf = deviceBuffer("cull.offsets", (std::size_t(listTotal) + 1) * 4);
-    const Buffer& statusBuf = deviceBuffer("cull.status", 8); // status bits, candidate tests
+    const Buffer& statusBuf = deviceBuffer("cull.status", kStatusWords * 4); // status bits, test counters
     const Buffer& placeholder = deviceBuffer("cull.indices.placeholder", 4);
     const Buffer& spotBuf = deviceBuffer("cull.spots", gpuSpots.size() * sizeof(GpuSpotCone));
     const std::size_t stashBytes = std::size_t(listTotal) * stashSlots * 4;
@@ -816,14 +818,15 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     if (!residentDepth) staging.upload(depthBuf, depth.depth.data(), depth.depth.size() * 4, "cull.depth");
     staging.upload(lightBuf, gpuLights.data(), gpuLights.size() * sizeof(GpuLight), "cull.lights");
     staging.upload(spotBuf, gpuSpots.data(), gpuSpots.size() * sizeof(GpuSpotCone), "cull.spots");
-    staging.upload(statusBuf, statusZero, 8, "cull.status");
+    staging.upload(statusBuf, statusZero.data(), kStatusWords * 4, "cull.status");
     const auto* counts = static_cast<const std::uint32_t*>(
         staging.download(countBuf, std::size_t(listTotal) * 4, "cull.counts"));
     const auto* offs = static_cast<const std::uint32_t*>(
         staging.download(offsetBuf, (std::size_t(listTotal) + 1) * 4, "cull.offsets"));
     const auto* tb = static_cast<const GpuTileBounds*>(
         staging.download(tileBuf, std::size_t(tiles) * sizeof(GpuTileBounds), "cull.tiles"));
-    const auto* status = static_cast<const std::uint32_t*>(staging.download(statusBuf, 8, "cull.status"));
+    const auto* status =
+        static_cast<const std::uint32_t*>(staging.download(statusBuf, kStatusWords * 4, "cull.status"));
     // The write pass runs in the same submission (no read-back between the
     // passes) into an index array sized from the previous cull's entries with
     // as many lists, with a margin (else the stash's size); only when the
@@ -1115,7 +1118,9 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     if (*status & 8u) throw DeviceError(loopLimitError);
     const std::string countMismatchError = "Vulkan write pass found a different entry count than the count pass";
     if (*status & 2u) throw DeviceError(countMismatchError);
-    res.volumeTests = (status[0] & 4u) ? 0 : status[1]; // wrapped: not counted
+    std::uint64_t tests = 0;
+    for (std::uint32_t c = 0; c < LC_TEST_COUNTERS; ++c) tests += status[1 + c * LC_TEST_COUNTER_STRIDE];
+    res.volumeTests = (status[0] & 4u) ? 0 : tests; // wrapped: not counted
     std::uint64_t total64 = 0;
     std::uint32_t longest = 0;
     // Ranges by atomic add, or no scan on the device: the offsets of the

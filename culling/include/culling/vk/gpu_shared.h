@@ -54,6 +54,11 @@ const uint LC_SLICING_LINEAR = 1u;
 // Depth bins (light_bins.comp, cull_lists.comp): slices of the lights' depth
 // range, and two bin families of one bit per light each.
 const uint LC_DEPTH_BINS = 32u;
+// The count pass's test counters (status buffer, after the status word):
+// list i adds its tests to counter i % LC_TEST_COUNTERS, the counters
+// LC_TEST_COUNTER_STRIDE words (128 bytes) apart; the host adds them up.
+const uint LC_TEST_COUNTERS = 32u;
+const uint LC_TEST_COUNTER_STRIDE = 32u;
 // GpuCullParams.flags bits.
 const uint LC_FLAG_ORTHO = 1u;         // orthographic projection
 const uint LC_FLAG_REVERSED = 2u;      // reversed-Z (nearer = larger window depth)
