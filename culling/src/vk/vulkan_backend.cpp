@@ -280,8 +280,8 @@ private:
     BufferCache cache_{ctx_};
     DescriptorSetLayoutHandle setLayout_;
     PipelineLayoutHandle computeLayout_;
-    ShaderModuleHandle boundsShader_, boundsWideShader_, binsShader_, binsShuffleShader_, cullShader_, cullShader16_, scanShader_,
-        pruneShader_, zbinShader_, vertShader_;
+    ShaderModuleHandle boundsShader_, boundsWideShader_, binsShader_, binsShuffleShader_, cullShader_, cullShader16_,
+        scanShader_, pruneShader_, zbinShader_, vertShader_;
     std::uint32_t lastLongestList_ = 0; // of the previous cull: sizes a CPU device's stash
     bool lastPoolsFitted_ = false;       // of the previous cull: a tile walk's pools held every entry
     // Of the previous cull: its lists and entries size the next one's index array.
@@ -986,7 +986,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     // their masks ORed by a subgroup shuffle: half the loop on the path to
     // the list pass (P1 on the H100: 0.023 -> 0.021 ms, the Live scene 0.025
     // -> 0.022; four or eight a word: P2 0.326 -> 0.341-0.344).
-    const std::uint32_t binLanes = !ctx_.isCpuDevice() && binsShuffleShader_ ? 2 : 1;
+    // (Whole subgroups in a workgroup, as the list passes ask.)
+    const std::uint32_t binLanes = !ctx_.isCpuDevice() && binsShuffleShader_ && kLocal % sg == 0 ? 2 : 1;
     VkPipeline binsPipe = binLanes > 1 ? computePipeline("light_bins.shuffle", binsShuffleShader_,
                                                          spec(kLocal, 0, 1, 2, 0, binLanes), true)
                                        : computePipeline("light_bins", binsShader_, spec(kLocal, 0), false);
@@ -1073,7 +1074,7 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
                 // The bins pass first, with no barrier between it and the
                 // bounds pass: it reads only params and lights and writes only
                 // the bins, which the bounds pass never touches. Dispatched
-                // first, its few workgroups (a loop of 32 lights each) start
+                // first, its few workgroups (a loop over a word's lights) start
                 // before the bounds pass's fill the GPU, instead of waiting
                 // for them (P1 on the H100: 0.024-0.025 -> 0.022 ms).
                 vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, binsPipe);
