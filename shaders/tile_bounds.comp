@@ -155,7 +155,7 @@ void main() {
     // depth instead of two: P1 / clustered on lavapipe, the cull 5.3-5.4 -> 4.8 ms);
     // 2.5d's cells span the tile's own bounds and take a second walk below.
     bool slicesInWalk = ALGORITHM == LC_ALG_CLUSTERED && P.cluster.y > P.cluster.x;
-    CellMap slices = cellMapOf(P.cluster.x, slicesInWalk ? P.cluster.y : P.cluster.x + 1.0);
+    CellMap slices = cellMapOf(P.cluster.x, P.cluster.y); // used only when slicesInWalk
     uint walkMask = 0u;
     float wLo = 2.0, wHi = -1.0;
     for (uint y = ly; y < th; y += laneRows) {
@@ -189,11 +189,13 @@ void main() {
         tb.depthMin = min(va, vb);
         tb.depthMax = max(va, vb);
         tb.split = (tb.depthMin + tb.depthMax) * 0.5;
-        if (slicesInWalk) {
-            tb.cellMask = CELL_LOG != 0u && !(P.cluster.x > 0.0) ? 0xffffffffu : walkMask;
-        } else if (ALGORITHM == LC_ALG_25D || ALGORITHM == LC_ALG_CLUSTERED) {
-            float lo = (ALGORITHM == LC_ALG_25D) ? tb.depthMin : P.cluster.x;
-            float hi = (ALGORITHM == LC_ALG_25D) ? tb.depthMax : P.cluster.y;
+        if (ALGORITHM == LC_ALG_CLUSTERED) {
+            // (A range of one depth: every pixel in slice 0, as sliceOf.)
+            tb.cellMask = !slicesInWalk                             ? 1u
+                          : CELL_LOG != 0u && !(P.cluster.x > 0.0) ? 0xffffffffu
+                                                                   : walkMask;
+        } else if (ALGORITHM == LC_ALG_25D) {
+            float lo = tb.depthMin, hi = tb.depthMax;
             uint mask = 0u;
             if (!(hi > lo)) {
                 mask = 1u; // one depth: every pixel in cell 0 (as sliceOf)
