@@ -51,7 +51,9 @@ struct Builder {
         quad(p[0], p[1], p[5], p[4]); // -y
         quad(p[3], p[7], p[6], p[2]); // +y
     }
-    // Vertical cylinder or cone frustum around `base`, with caps.
+    // Vertical cylinder or cone frustum around `base`, with caps: a closed
+    // solid wound counter-clockwise seen from outside, as every closed shape
+    // here (the depth pre-pass leaves out faces turned away from the camera).
     void cylinder(glm::dvec3 base, double r0, double r1, double h, int seg) {
         const std::uint32_t first = std::uint32_t(mesh.positions.size() / 3);
         for (int i = 0; i < seg; ++i) {
@@ -65,17 +67,20 @@ struct Builder {
             const std::uint32_t b0 = first + 2 * i, t0 = b0 + 1, b1 = first + 2 * j, t1 = b1 + 1;
             tri(b0, t0, t1);
             tri(b0, t1, b1);
-            tri(bc, b1, b0);
-            if (r1 > 0) tri(tc, t0, t1);
+            tri(bc, b0, b1);
+            if (r1 > 0) tri(tc, t1, t0);
         }
     }
     void sphere(glm::dvec3 c, double r, int rings, int seg) {
         const std::uint32_t first = std::uint32_t(mesh.positions.size() / 3);
         for (int i = 0; i <= rings; ++i) {
             const double th = kPi * i / rings;
+            // The poles exactly on the axis (sin(pi) is not 0 in double), so
+            // that each pole's ring is one position and the sphere is closed.
+            const double sinTh = i == 0 || i == rings ? 0.0 : std::sin(th), cosTh = std::cos(th);
             for (int j = 0; j < seg; ++j) {
                 const double ph = 2 * kPi * j / seg;
-                vertex(c + r * glm::dvec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)));
+                vertex(c + r * glm::dvec3(sinTh * std::cos(ph), cosTh, sinTh * std::sin(ph)));
             }
         }
         for (int i = 0; i < rings; ++i)
