@@ -333,7 +333,8 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
                     cs = stats(cullMs), ws = stats(cullWallMs), ccs = stats(cullCallMs);
         std::cout << label << ": depth " << fmt("%.3f", ds.median) << " [" << fmt("%.3f", ds.min) << ".."
                   << fmt("%.3f", ds.max) << "] (wall " << fmt("%.3f", dws.median) << ", call "
-                  << fmt("%.3f", dcs.median) << "), cull " << fmt("%.3f", cs.median) << " ["
+                  << fmt("%.3f", dcs.median) << ", " << backend->lastDepthTrianglesDrawn() << " of "
+                  << backend->lastDepthTriangles() << " triangles), cull " << fmt("%.3f", cs.median) << " ["
                   << fmt("%.3f", cs.min) << ".." << fmt("%.3f", cs.max) << "] (wall "
                   << fmt("%.3f", ws.median) << ", call " << fmt("%.3f", ccs.median) << "), " << last.entries()
                   << " entries, " << last.listCountTotal() << " lists, " << last.bytes() << " bytes (+"
@@ -361,6 +362,8 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
                            {"diagnostic_bytes", last.diagnosticBytes()},
                            {"volume_tests", last.volumeTests},
                            {"depth_bytes", std::uint64_t(scene.camera.width) * scene.camera.height * 4},
+                           {"depth_triangles", backend->lastDepthTriangles()},
+                           {"depth_triangles_drawn", backend->lastDepthTrianglesDrawn()},
                            {"peak_device_bytes", peakDeviceBytes}});
 
         std::size_t k = 0;

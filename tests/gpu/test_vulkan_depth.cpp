@@ -7,6 +7,8 @@
 #include "culling/core/depth.hpp"
 #include "culling/scene/scene_io.hpp"
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -65,16 +67,9 @@ struct DepthCase {
 
 class VulkanDepth : public GpuTest, public ::testing::WithParamInterface<DepthCase> {};
 
-TEST_P(VulkanDepth, AgreesWithCpuRasteriser) {
-    const DepthCase dc = GetParam();
-    Scene scene = makeBuiltinScene(dc.scene);
-    scene.camera.projection = dc.kind;
-    scene.camera.width = 320;
-    scene.camera.height = 180;
-    scene.camera.farPlane = dc.far;
-    if (isOrthographic(dc.kind)) scene.camera.orthoHeight = 40.0;
-    const Projection proj(scene.camera);
-
+// The Vulkan pre-pass of `scene` against the CPU rasteriser's: the same
+// surface wins every pixel but on triangle edges.
+void expectAgreesWithCpuRasteriser(const Scene& scene, const Projection& proj, const std::string& label) {
     const DepthImage cpu = rasterizeDepthCpu(scene, proj);
     const DepthImage gpu = gputest::vulkan().renderDepth(scene, proj);
     ASSERT_EQ(gpu.width, cpu.width);
@@ -138,11 +133,23 @@ TEST_P(VulkanDepth, AgreesWithCpuRasteriser) {
     std::printf("[ depth    ] %s %s: %zu pixels both cover, max |depth diff| %.3g (%.3g where the same "
                 "surface won: view depth rel %.3g); %zu coverage and %zu winner differences, all within "
                 "%.3g px of an edge: %s\n",
-                dc.scene, toString(dc.kind), both, maxDiff, maxSameDiff, maxViewRel,
+                label.c_str(), toString(proj.kind()), both, maxDiff, maxSameDiff, maxViewRel,
                 coverageDiffers, depthWinnerDiffers, maxEdgeDist, notOnEdge ? "NO" : "yes");
     EXPECT_GT(both, 0u);
     EXPECT_EQ(notOnEdge, 0u);
     EXPECT_LE(coverageDiffers + depthWinnerDiffers, both / 100) << "edge differences should be rare";
+}
+
+
+TEST_P(VulkanDepth, AgreesWithCpuRasteriser) {
+    const DepthCase dc = GetParam();
+    Scene scene = makeBuiltinScene(dc.scene);
+    scene.camera.projection = dc.kind;
+    scene.camera.width = 320;
+    scene.camera.height = 180;
+    scene.camera.farPlane = dc.far;
+    if (isOrthographic(dc.kind)) scene.camera.orthoHeight = 40.0;
+    expectAgreesWithCpuRasteriser(scene, Projection(scene.camera), dc.scene);
 }
 
 const double kInfFar = std::numeric_limits<double>::infinity();
@@ -179,6 +186,59 @@ TEST_F(GpuTest, DepthImageIsTopRowFirst) {
             (y < gpu.height / 2 ? top : bottom) += gpu.hasGeometry(x, y);
     EXPECT_GT(top, 0u);
     EXPECT_EQ(bottom, 0u);
+}
+
+// A box wound counter-clockwise seen from outside (reversed: from inside).
+Mesh boxMesh(glm::dvec3 lo, glm::dvec3 hi, bool reversed = false) {
+    Mesh m;
+    const glm::dvec3 p[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
+                             {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
+    for (const glm::dvec3& v : p) m.positions.insert(m.positions.end(), {float(v.x), float(v.y), float(v.z)});
+    const std::uint32_t faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 7, 6, 2}};
+    for (const auto& f : faces) {
+        if (reversed)
+            m.indices.insert(m.indices.end(), {f[0], f[2], f[1], f[0], f[3], f[2]});
+        else
+            m.indices.insert(m.indices.end(), {f[0], f[1], f[2], f[0], f[2], f[3]});
+    }
+    return m;
+}
+
+// The pre-pass leaves out the faces of closed solids turned away from the
+// camera, and only where no view ray can meet them first: a room around the
+// camera and a box the near plane cuts open keep every face (inside them the
+// faces turned away are the ones seen), boxes wound either way, mirrored or
+// not, lose theirs. The depth is the CPU rasteriser's, which draws every
+// triangle, in each projection.
+TEST_F(GpuTest, ClosedSolidsLoseOnlyFacesNoRayMeetsFirst) {
+    Scene scene;
+    scene.camera.position = {0, 1.7, 8};
+    scene.camera.target = {0, 1.2, 0};
+    scene.camera.width = 320;
+    scene.camera.height = 180;
+    scene.camera.nearPlane = 0.1;
+    scene.camera.farPlane = 100;
+    scene.camera.orthoHeight = 6;
+    scene.meshes.push_back(boxMesh({-20, 0, -30}, {20, 12, 20}));   // the room, around the camera
+    scene.meshes.push_back(boxMesh({-3, 0, -2}, {-1, 2.5, 0}));      // a plain box
+    scene.meshes.push_back(boxMesh({1, 0, -3}, {2.5, 1.5, -1}, true)); // wound inside out
+    Mesh mirrored = boxMesh({0, 0, 0}, {1, 3, 1});
+    mirrored.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(0.5, 0, -6)) *
+                         glm::scale(glm::dmat4(1.0), glm::dvec3(-1.5, 1, 1));
+    scene.meshes.push_back(mirrored);
+    // Off to the right of the view axis, from 0.05 to 0.6 in front of the eye:
+    // the near plane (0.1) cuts it, and its inside shows there.
+    scene.meshes.push_back(boxMesh({0.03, 1.69, 7.4}, {0.3, 2.0, 7.95}));
+    std::size_t total = 0;
+    for (const Mesh& m : scene.meshes) total += m.triangleCount();
+    for (ProjectionKind kind : {ProjectionKind::Perspective, ProjectionKind::ReversedZ, ProjectionKind::Orthographic}) {
+        scene.camera.projection = kind;
+        const Projection proj(scene.camera);
+        expectAgreesWithCpuRasteriser(scene, proj, "closed solids");
+        EXPECT_EQ(gputest::vulkan().lastDepthTriangles(), total);
+        // The three boxes in the room show at most three faces each.
+        EXPECT_LE(gputest::vulkan().lastDepthTrianglesDrawn(), total - 3 * 6) << toString(kind);
+    }
 }
 
 } // namespace

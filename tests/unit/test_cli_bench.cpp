@@ -4,6 +4,8 @@
 // beyond ordering (min <= median <= max): speed belongs to benchmarks.
 #include "cli_support.hpp"
 
+#include "culling/scene/scene_io.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -27,6 +29,9 @@ TEST(CliBench, SweepCrossProductWritesEveryConfiguration) {
     EXPECT_EQ(doc["repeat"], 3);
     ASSERT_EQ(doc["configs"].size(), 6u);
     std::set<std::pair<std::string, std::size_t>> seen;
+    std::size_t wallTriangles = 0;
+    for (const lc::Mesh& m : lc::makeBuiltinScene("wall").meshes) wallTriangles += m.triangleCount();
+    ASSERT_GT(wallTriangles, 0u);
     for (const auto& c : doc["configs"]) {
         seen.insert({c["algorithm"].get<std::string>(), c["lights"].get<std::size_t>()});
         EXPECT_EQ(c["width"], 160);
@@ -46,6 +51,9 @@ TEST(CliBench, SweepCrossProductWritesEveryConfiguration) {
         if (c["lights"] == 0) EXPECT_EQ(c["list_entries"], 0);
         EXPECT_EQ(c["depth_wall_ms"], c["depth_ms"]);
         EXPECT_EQ(c["cull_wall_ms"], c["cull_ms"]);
+        // The CPU rasteriser draws every triangle.
+        EXPECT_EQ(c["depth_triangles"], wallTriangles);
+        EXPECT_EQ(c["depth_triangles_drawn"], wallTriangles);
         // A call's clock runs around its pass's, run by run.
         EXPECT_GE(c["depth_call_ms"]["median"].get<double>(), c["depth_wall_ms"]["median"].get<double>());
         EXPECT_GE(c["cull_call_ms"]["median"].get<double>(), c["cull_wall_ms"]["median"].get<double>());

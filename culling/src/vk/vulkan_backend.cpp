@@ -36,6 +36,8 @@
 // tiles x lights x cells allocation.
 #include "vk/vulkan_backend.hpp"
 
+#include "scene/closed_solids.hpp"
+
 #include "culling/core/errors.hpp"
 #include "culling/vk/gpu_shared.h"
 #include "embedded_spirv.hpp"
@@ -235,6 +237,29 @@ void depthConstants(const Projection& proj, double& a, double& b) {
     }
 }
 
+// A 64-bit digest of a mesh's positions and indices (not its transform):
+// the key of its closed solids, which depend on nothing else.
+std::uint64_t meshContentKey(const Mesh& m) {
+    std::uint64_t h = 0x243F6A8885A308D3ull ^ (m.positions.size() * 0x9E3779B97F4A7C15ull) ^ m.indices.size();
+    auto mix = [&h](const void* data, std::size_t bytes) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        std::size_t i = 0;
+        for (; i + 8 <= bytes; i += 8) {
+            std::uint64_t w;
+            std::memcpy(&w, p + i, 8);
+            h = (h ^ (w * 0xC2B2AE3D27D4EB4Full)) * 0x9E3779B97F4A7C15ull;
+            h ^= h >> 31;
+        }
+        std::uint64_t w = 0;
+        std::memcpy(&w, p + i, bytes - i);
+        h = (h ^ (w * 0xC2B2AE3D27D4EB4Full)) * 0x9E3779B97F4A7C15ull;
+        h ^= h >> 29;
+    };
+    mix(m.positions.data(), m.positions.size() * sizeof(float));
+    mix(m.indices.data(), m.indices.size() * sizeof(std::uint32_t));
+    return h;
+}
+
 class VulkanBackend final : public CullBackend {
 public:
     explicit VulkanBackend(const std::string& device) : ctx_(ContextOptions{device, "lc"}) {
@@ -309,6 +334,9 @@ private:
         Buffer depth; // the storage buffer the image is copied to
     } depthTarget_;
     std::vector<float> residentSample_;
+    // The closed solids of the meshes the last depth pre-pass drew, by
+    // meshContentKey.
+    std::map<std::uint64_t, std::shared_ptr<const ClosedSolids>> solids_;
     static std::vector<float> depthSample(const DepthImage& d) {
         std::vector<float> s;
         const std::size_t n = d.depth.size(), step = std::max<std::size_t>(1, n / 256);
@@ -501,7 +529,10 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
     const float clearDepth = float(proj.clearDepth());
     VkDevice dev = ctx_.device();
 
-    // All meshes in one vertex and one index buffer; one draw per mesh.
+    // All meshes in one vertex and one index buffer; one draw per mesh. The
+    // index buffer leaves out the faces of closed solids turned away from the
+    // camera (scene/closed_solids.hpp): they never win a pixel, and lavapipe
+    // pays per fragment rasterised.
     struct Draw {
         glm::mat4 clipFromModel;
         std::uint32_t firstIndex, indexCount;
@@ -509,8 +540,11 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
     };
     std::vector<Draw> draws;
     std::vector<glm::dvec3> centres; // per drawn mesh, model space
-    std::size_t vertexFloats = 0, indexCount = 0;
-    const glm::dmat4 clipFromWorld = proj.clipFromView() * scene.camera.viewFromWorld();
+    std::vector<std::uint32_t> ix;
+    std::size_t vertexFloats = 0, meshIndices = 0;
+    const glm::dmat4 viewFromWorld = scene.camera.viewFromWorld();
+    const glm::dmat4 clipFromWorld = proj.clipFromView() * viewFromWorld;
+    std::map<std::uint64_t, std::shared_ptr<const ClosedSolids>> solidsInUse;
     for (const Mesh& m : scene.meshes) {
         if (m.triangleCount() == 0) continue;
         // A mesh that sits farther from its model origin than its own size
@@ -529,31 +563,40 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
         glm::dvec3 c = m.vertexCount() ? 0.5 * (lo + hi) : glm::dvec3(0.0);
         if (!(glm::length(c) > glm::length(hi - lo))) c = glm::dvec3(0.0);
         centres.push_back(c);
+        // The mesh's solids, found once per mesh content.
+        const std::uint64_t key = meshContentKey(m);
+        auto known = solids_.find(key);
+        std::shared_ptr<const ClosedSolids> solids =
+            known != solids_.end() ? known->second : std::make_shared<const ClosedSolids>(findClosedSolids(m));
+        solidsInUse.emplace(key, solids);
+        const std::size_t first = ix.size();
+        appendDepthTriangles(m, *solids, viewFromWorld * m.transform, proj, ix);
         // Composed in double, rounded once to float.
         draws.push_back({glm::mat4(clipFromWorld * m.transform * glm::translate(glm::dmat4(1.0), c)),
-                         std::uint32_t(indexCount), std::uint32_t(m.triangleCount() * 3),
-                         std::int32_t(vertexFloats / 3)});
+                         std::uint32_t(first), std::uint32_t(ix.size() - first), std::int32_t(vertexFloats / 3)});
         vertexFloats += m.vertexCount() * 3;
-        indexCount += m.triangleCount() * 3;
+        meshIndices += m.triangleCount() * 3;
     }
-    // Device-local vertex and index buffers (staged on a discrete GPU).
+    solids_ = std::move(solidsInUse); // the analyses of meshes no longer drawn go
+    lastDepthTriangles_ = meshIndices / 3;
+    lastDepthTrianglesDrawn_ = ix.size() / 3;
+    // Device-local vertex and index buffers (staged on a discrete GPU), the
+    // index buffer sized for every triangle so that turning the camera does
+    // not resize it.
     const Buffer& vbuf = cache_.get("depth.vertices", vertexFloats * 4, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                                     BufferCache::Kind::Device);
-    const Buffer& ibuf = cache_.get("depth.indices", indexCount * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+    const Buffer& ibuf = cache_.get("depth.indices", meshIndices * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
                                     BufferCache::Kind::Device);
     Staging staging(cache_);
     {
         std::vector<float> v;
-        std::vector<std::uint32_t> ix;
         v.reserve(vertexFloats);
-        ix.reserve(indexCount);
         std::size_t drawn = 0;
         for (const Mesh& m : scene.meshes) {
             if (m.triangleCount() == 0) continue;
             const glm::dvec3 c = centres[drawn++];
             for (std::size_t i = 0; i < m.vertexCount() * 3; ++i)
                 v.push_back(float(double(m.positions[i]) - c[int(i % 3)]));
-            ix.insert(ix.end(), m.indices.data(), m.indices.data() + m.triangleCount() * 3);
         }
         staging.upload(vbuf, v.data(), v.size() * 4, "depth.vertices");
         staging.upload(ibuf, ix.data(), ix.size() * 4, "depth.indices");
@@ -623,6 +666,7 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
                 vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &off);
                 vkCmdBindIndexBuffer(cmd, ibuf.buffer, 0, VK_INDEX_TYPE_UINT32);
                 for (const Draw& d : draws) {
+                    if (d.indexCount == 0) continue;
                     vkCmdPushConstants(cmd, depthLayout_, VK_SHADER_STAGE_VERTEX_BIT, 0, 64,
                                        glm::value_ptr(d.clipFromModel));
                     vkCmdDrawIndexed(cmd, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);

@@ -56,6 +56,11 @@ public:
     // submission (its readback included); where the depth time is a wall
     // clock already, that.
     double lastDepthWallMs() const { return lastDepthWallMs_ >= 0 ? lastDepthWallMs_ : lastDepthMs_; }
+    // Triangles of the scene and those the last renderDepth() rasterised (the
+    // Vulkan backend leaves out the faces of closed solids turned away from
+    // the camera; the CPU rasteriser draws every triangle).
+    std::size_t lastDepthTriangles() const { return lastDepthTriangles_; }
+    std::size_t lastDepthTrianglesDrawn() const { return lastDepthTrianglesDrawn_; }
     virtual std::string timingMethod() const = 0;
     // CPU wall-clock milliseconds of the last cull() around its submissions
     // (equal to its cullMs where that is the timing method; -1: not run).
@@ -81,6 +86,7 @@ public:
 protected:
     double lastDepthMs_ = -1;
     double lastDepthWallMs_ = -1; // -1: the same as lastDepthMs_
+    std::size_t lastDepthTriangles_ = 0, lastDepthTrianglesDrawn_ = 0;
     double lastCullWallMs_ = -1;
     unsigned lastIndexBits_ = 32;
     double lastShadeMs_ = -1;
