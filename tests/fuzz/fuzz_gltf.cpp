@@ -3,9 +3,11 @@
 // into a scene that validates or throw lc::InputError; a crash, a sanitizer
 // report, a hang, an allocation past the RSS limit or any other exception is
 // a bug. Loaded scenes are also written back as GLB (the writer must accept
-// whatever the reader produced).
+// whatever the reader produced), and the depth pre-pass's host side (its
+// closed solids) runs on every mesh.
 #include "culling/core/errors.hpp"
 #include "culling/scene/gltf_io.hpp"
+#include "fuzz_solids.hpp"
 
 #include <unistd.h>
 
@@ -33,6 +35,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     try {
         const lc::Scene scene = lc::loadGltfScene(path);
         scene.validate(); // by contract: a loaded scene is valid
+        for (const lc::Mesh& m : scene.meshes) fuzzClosedSolids(m);
         const std::string glb = lc::serializeGltf(scene, true);
         if (glb.size() < 12) std::abort();
     } catch (const lc::InputError&) {

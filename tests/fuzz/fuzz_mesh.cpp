@@ -2,9 +2,11 @@
 // file with the extension LC_FUZZ_EXT ("obj", "ply" and "off" exercise the
 // project's own readers; "stl" goes through OpenMesh's). Any input must
 // load into a mesh that validates or throw lc::InputError; a crash, a
-// sanitizer report or any other exception is a bug.
+// sanitizer report or any other exception is a bug. The depth pre-pass's
+// host side (its closed solids) runs on every mesh loaded.
 #include "culling/core/errors.hpp"
 #include "culling/scene/scene_io.hpp"
+#include "fuzz_solids.hpp"
 
 #include <unistd.h>
 
@@ -42,6 +44,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         const lc::Mesh mesh = lc::loadMesh(path, &report);
         // A loaded mesh is valid by contract: finite coordinates, indices in range.
         if (!mesh.validate().empty() || mesh.indices.empty()) std::abort();
+        fuzzClosedSolids(mesh);
     } catch (const lc::InputError&) {
     }
     std::remove(path.c_str());
