@@ -204,6 +204,31 @@ Mesh boxMesh(glm::dvec3 lo, glm::dvec3 hi, bool reversed = false) {
     return m;
 }
 
+// The solids are found once per mesh content: a mesh edited in place, its
+// sizes kept, is looked at again (a box opened by one index draws all its
+// faces; closed again, it loses its back faces again).
+TEST_F(GpuTest, ClosedSolidsFollowTheMeshContent) {
+    Scene scene;
+    scene.camera.position = {3, 4, 6};
+    scene.camera.target = {0, 0, 0};
+    scene.camera.width = 64;
+    scene.camera.height = 36;
+    scene.meshes.push_back(boxMesh({-1, -1, -1}, {1, 1, 1}));
+    const Projection proj(scene.camera);
+    std::unique_ptr<CullBackend> vk = makeVulkanBackend("");
+    const Mesh closed = scene.meshes[0];
+    vk->renderDepth(scene, proj);
+    EXPECT_EQ(vk->lastDepthTrianglesDrawn(), 6u) << "three faces of a box seen from a corner's direction";
+    scene.meshes[0].indices[0] = scene.meshes[0].indices[1]; // a triangle that repeats a corner: not closed
+    vk->renderDepth(scene, proj);
+    EXPECT_EQ(vk->lastDepthTrianglesDrawn(), 12u);
+    scene.meshes[0] = closed;
+    scene.meshes[0].positions[0] += 0.5f; // moved corner: still closed, other planes
+    vk->renderDepth(scene, proj);
+    EXPECT_LT(vk->lastDepthTrianglesDrawn(), 12u);
+    expectAgreesWithCpuRasteriser(scene, proj, "closed solids, edited box");
+}
+
 // The pre-pass leaves out the faces of closed solids turned away from the
 // camera, and only where no view ray can meet them first: a room around the
 // camera keeps every face (inside it the faces turned away are the ones

