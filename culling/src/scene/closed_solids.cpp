@@ -207,18 +207,27 @@ std::size_t appendDepthTriangles(const Mesh& mesh, const ClosedSolids& solids,
         culled[s] = dMin > nearPlane + margin;
     }
 
+    // Runs of triangles of one solid (or open): a run drawn whole is one copy.
     std::size_t drawn = 0;
-    for (std::size_t t = 0; t < T; ++t) {
+    for (std::size_t t = 0; t < T;) {
         const std::int32_t s = solids.solidOf[t];
-        if (s >= 0 && culled[std::size_t(s)]) {
-            const glm::dvec4& p = solids.planes[t];
-            const glm::dvec3 n(p);
-            const double towards = ortho ? -glm::dot(n, forward) : glm::dot(n, eye) - p.w;
-            if (!(towards > 0)) continue;
+        std::size_t end = t + 1;
+        while (end < T && solids.solidOf[end] == s) ++end;
+        const auto first = mesh.indices.begin();
+        if (s < 0 || !culled[std::size_t(s)]) {
+            out.insert(out.end(), first + std::ptrdiff_t(3 * t), first + std::ptrdiff_t(3 * end));
+            drawn += end - t;
+        } else {
+            for (std::size_t u = t; u < end; ++u) {
+                const glm::dvec4& p = solids.planes[u];
+                const glm::dvec3 n(p);
+                const double towards = ortho ? -glm::dot(n, forward) : glm::dot(n, eye) - p.w;
+                if (!(towards > 0)) continue;
+                out.insert(out.end(), first + std::ptrdiff_t(3 * u), first + std::ptrdiff_t(3 * u + 3));
+                ++drawn;
+            }
         }
-        out.insert(out.end(), mesh.indices.begin() + std::ptrdiff_t(3 * t),
-                   mesh.indices.begin() + std::ptrdiff_t(3 * t + 3));
-        ++drawn;
+        t = end;
     }
     return drawn;
 }

@@ -551,10 +551,13 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
     std::vector<Draw> draws;
     std::vector<glm::dvec3> centres; // per drawn mesh, model space
     std::vector<std::uint32_t> ix;
-    std::size_t vertexFloats = 0, meshIndices = 0;
+    std::size_t vertexFloats = 0;
     const glm::dmat4 viewFromWorld = scene.camera.viewFromWorld();
     const glm::dmat4 clipFromWorld = proj.clipFromView() * viewFromWorld;
     std::map<std::uint64_t, std::shared_ptr<const ClosedSolids>> solidsInUse;
+    std::size_t sceneIndices = 0;
+    for (const Mesh& m : scene.meshes) sceneIndices += m.triangleCount() * 3;
+    ix.reserve(sceneIndices);
     for (const Mesh& m : scene.meshes) {
         if (m.triangleCount() == 0) continue;
         // A mesh that sits farther from its model origin than its own size
@@ -585,17 +588,16 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
         draws.push_back({glm::mat4(clipFromWorld * m.transform * glm::translate(glm::dmat4(1.0), c)),
                          std::uint32_t(first), std::uint32_t(ix.size() - first), std::int32_t(vertexFloats / 3)});
         vertexFloats += m.vertexCount() * 3;
-        meshIndices += m.triangleCount() * 3;
     }
     solids_ = std::move(solidsInUse); // the analyses of meshes no longer drawn go
-    lastDepthTriangles_ = meshIndices / 3;
+    lastDepthTriangles_ = sceneIndices / 3;
     lastDepthTrianglesDrawn_ = ix.size() / 3;
     // Device-local vertex and index buffers (staged on a discrete GPU), the
     // index buffer sized for every triangle so that turning the camera does
     // not resize it.
     const Buffer& vbuf = cache_.get("depth.vertices", vertexFloats * 4, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                                     BufferCache::Kind::Device);
-    const Buffer& ibuf = cache_.get("depth.indices", meshIndices * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+    const Buffer& ibuf = cache_.get("depth.indices", sceneIndices * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
                                     BufferCache::Kind::Device);
     Staging staging(cache_);
     {
