@@ -587,14 +587,23 @@ void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::Run
             c.overflowLists > 0 || c.invalidIndices > 0 || !c.validationMessages.empty());
         for (const std::string& m : c.validationMessages) log(QString::fromStdString(m), true);
     }
-    if (out->truthComputed) log(tr("run %1: %2, %3 lights, depth %4 ms, cull %5 ms, false negatives %6, efficiency %7")
+    // The pre-pass's triangles, where it ran (the Vulkan backend draws only
+    // the faces of closed solids turned towards the camera).
+    const QString depthTriangles =
+        out->result.depthTriangles == 0
+            ? QString()
+            : tr(" (%1 of %2 triangles)")
+                  .arg(qulonglong(out->result.depthTrianglesDrawn))
+                  .arg(qulonglong(out->result.depthTriangles));
+    if (out->truthComputed) log(tr("run %1: %2, %3 lights, depth %4 ms%8, cull %5 ms, false negatives %6, efficiency %7")
             .arg(generation)
             .arg(out->custom ? QStringLiteral("custom") : QString(lc::toString(out->result.algorithm)))
             .arg(out->lights.size())
             .arg(out->result.timings.depthMs, 0, 'f', 2)
             .arg(out->result.timings.cullMs, 0, 'f', 2)
             .arg(m.falseNegatives)
-            .arg(m.efficiency, 0, 'f', 4),
+            .arg(m.efficiency, 0, 'f', 4)
+            .arg(depthTriangles),
         m.falseNegatives > 0);
     statusBar()->showMessage(tr("culling done (run %1)").arg(generation), 4000);
     emit runFinished(generation);

@@ -5,6 +5,7 @@
 #include "gpu_test_env.hpp"
 
 #include "culling/core/depth.hpp"
+#include "culling/core/pipeline.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -227,6 +228,24 @@ TEST_F(GpuTest, ClosedSolidsFollowTheMeshContent) {
     vk->renderDepth(scene, proj);
     EXPECT_LT(vk->lastDepthTrianglesDrawn(), 12u);
     expectAgreesWithCpuRasteriser(scene, proj, "closed solids, edited box");
+}
+
+// A run on the Vulkan backend reports the triangles its pre-pass drew
+// (summary.json's depth_triangles, the studio's message log): forest's
+// trunks and crowns lose their back faces, its ground and blades do not.
+TEST_F(GpuTest, ARunReportsTheTrianglesItsPrePassDrew) {
+    Scene scene = makeBuiltinScene("forest");
+    scene.camera.width = 320;
+    scene.camera.height = 180;
+    std::size_t triangles = 0;
+    for (const Mesh& m : scene.meshes) triangles += m.triangleCount();
+    RunOptions options;
+    options.truthOptions.imageError = false;
+    const RunOutput out = runPipeline(scene, CullSettings{}, gputest::vulkan(), options);
+    EXPECT_EQ(out.result.depthTriangles, triangles);
+    EXPECT_LT(out.result.depthTrianglesDrawn, triangles * 2 / 3);
+    EXPECT_GT(out.result.depthTrianglesDrawn, triangles / 3);
+    EXPECT_EQ(out.truth.metrics.falseNegatives, 0u);
 }
 
 // The pre-pass leaves out the faces of closed solids turned away from the

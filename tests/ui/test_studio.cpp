@@ -513,12 +513,20 @@ private slots:
         openSmall();
         const quint64 gen = doc()->runGeneration();
         QVERIFY(!doc()->runOutput()->depthReused);
+        // The run that rendered depth says how many triangles it drew (the CPU
+        // rasteriser: all), in its result and in the message log.
+        std::size_t triangles = 0;
+        for (const lc::Mesh& m : doc()->scene().meshes) triangles += m.triangleCount();
+        QCOMPARE(doc()->runOutput()->result.depthTriangles, triangles);
+        QCOMPARE(doc()->runOutput()->result.depthTrianglesDrawn, triangles);
+        QVERIFY(w_->messageLog()->toPlainText().contains(QString("(%1 of %1 triangles)").arg(triangles)));
         w_->setLive(true);
         QVERIFY(waitRun(gen + 1));
         const std::vector<float> depth = doc()->runOutput()->depth.depth;
         doc()->moveLight(1, doc()->scene().lights[1].position + glm::dvec3(0.5, 0, 0), doc()->newDragId());
         QVERIFY(waitRun(gen + 2));
         QVERIFY(doc()->runOutput()->depthReused);
+        QCOMPARE(doc()->runOutput()->result.depthTriangles, std::size_t(0));
         QVERIFY(doc()->runOutput()->depth.depth == depth);
         bool saysReused = false;
         for (QLabel* l : w_->statusBar()->findChildren<QLabel*>())

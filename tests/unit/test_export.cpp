@@ -123,6 +123,11 @@ TEST(Export, SummaryJsonHasEveryKeyConsistentWithTheRun) {
     EXPECT_EQ(j["tiles_y"], 4);
     EXPECT_EQ(j["cells"], 8);
     EXPECT_EQ(j["lights"], r.scene.lights.size());
+    std::size_t triangles = 0;
+    for (const Mesh& m : r.scene.meshes) triangles += m.triangleCount();
+    ASSERT_GT(triangles, 0u);
+    EXPECT_EQ(j["depth_triangles"]["scene"], triangles); // the CPU rasteriser draws every one
+    EXPECT_EQ(j["depth_triangles"]["drawn"], triangles);
     EXPECT_EQ(m["false_negatives"], 0);
     const auto W = m["shading_work"].get<std::uint64_t>(), E = m["exact_work"].get<std::uint64_t>();
     EXPECT_GT(W, 0u);

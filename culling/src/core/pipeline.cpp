@@ -337,6 +337,10 @@ RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBack
                                  : backend.lastDepthMs() >= 0 ? backend.lastDepthMs()
                                                               : depthWallMs;
     if (out.result.timings.cullMs < 0) out.result.timings.cullMs = cullWallMs;
+    if (!out.depthReused) {
+        out.result.depthTriangles = backend.lastDepthTriangles();
+        out.result.depthTrianglesDrawn = backend.lastDepthTrianglesDrawn();
+    }
     if (out.result.backend.empty()) out.result.backend = backend.name();
     if (out.result.device.empty()) out.result.device = backend.deviceName();
     if (out.result.timingMethod.empty()) out.result.timingMethod = backend.timingMethod();

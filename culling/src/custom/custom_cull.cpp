@@ -349,6 +349,10 @@ RunOutput runCustomPipeline(const Scene& scene, const CustomShaderOptions& optio
     }
     out.result = runCustomShader(options, out.depth, proj, grid, out.lights, report);
     out.result.timings.depthMs = depthOverride ? 0.0 : depthBackend.lastDepthMs();
+    if (!depthOverride) {
+        out.result.depthTriangles = depthBackend.lastDepthTriangles();
+        out.result.depthTrianglesDrawn = depthBackend.lastDepthTrianglesDrawn();
+    }
     judge(out, proj, &depthBackend, runOptions);
     out.custom = std::make_shared<CustomCullReport>(report);
     return out;

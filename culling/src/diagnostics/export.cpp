@@ -161,6 +161,7 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
                        {"cull", msOrNull(r.timings.cullMs)},
                        {"ground_truth", msOrNull(r.timings.groundTruthMs)},
                        {"shade", msOrNull(r.timings.shadeMs)}};
+    j["depth_triangles"] = {{"scene", r.depthTriangles}, {"drawn", r.depthTrianglesDrawn}};
     nlohmann::ordered_json mj;
     mj["false_negatives"] = m.falseNegatives;
     mj["shading_work"] = m.shadingWork;

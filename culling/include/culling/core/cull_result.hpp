@@ -72,6 +72,11 @@ struct CullResult {
     std::string device;       // physical device name, or the CPU's
     std::string timingMethod; // how cullMs/depthMs were taken
     Timings timings;
+    // The depth pre-pass that made the depth this cull read (runPipeline): the
+    // scene's triangles and those it rasterised (the Vulkan backend leaves out
+    // faces of closed solids turned away from the camera); 0 and 0 where the
+    // depth was reused or came from elsewhere.
+    std::size_t depthTriangles = 0, depthTrianglesDrawn = 0;
 
     std::uint32_t listCountTotal() const { return std::uint32_t(listCount.size()); }
     std::uint64_t entries() const { return lightIndices.size(); }
