@@ -237,8 +237,7 @@ TEST_F(GpuTest, ARunReportsTheTrianglesItsPrePassDrew) {
     Scene scene = makeBuiltinScene("forest");
     scene.camera.width = 320;
     scene.camera.height = 180;
-    std::size_t triangles = 0;
-    for (const Mesh& m : scene.meshes) triangles += m.triangleCount();
+    const std::size_t triangles = scene.triangleCount();
     RunOptions options;
     options.truthOptions.imageError = false;
     const RunOutput out = runPipeline(scene, CullSettings{}, gputest::vulkan(), options);
@@ -278,8 +277,7 @@ TEST_F(GpuTest, ClosedSolidsLoseOnlyFacesNoRayMeetsFirst) {
     cut.meshes.push_back(boxMesh({-8, -3, 7.4}, {8, 7, 7.95}));
     for (Scene* scene : {&room, &cut}) {
         const bool isRoom = scene == &room;
-        std::size_t total = 0;
-        for (const Mesh& m : scene->meshes) total += m.triangleCount();
+        const std::size_t total = scene->triangleCount();
         for (ProjectionKind kind :
              {ProjectionKind::Perspective, ProjectionKind::ReversedZ, ProjectionKind::Orthographic}) {
             scene->camera.projection = kind;

@@ -368,9 +368,7 @@ public:
         const auto t0 = std::chrono::steady_clock::now();
         DepthImage img = rasterizeDepthCpu(scene, proj);
         lastDepthMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-        lastDepthTriangles_ = 0;
-        for (const Mesh& m : scene.meshes) lastDepthTriangles_ += m.triangleCount();
-        lastDepthTrianglesDrawn_ = lastDepthTriangles_;
+        lastDepthTriangles_ = lastDepthTrianglesDrawn_ = scene.triangleCount();
         return img;
     }
 

@@ -555,8 +555,7 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
     const glm::dmat4 viewFromWorld = scene.camera.viewFromWorld();
     const glm::dmat4 clipFromWorld = proj.clipFromView() * viewFromWorld;
     std::map<std::uint64_t, std::shared_ptr<const ClosedSolids>> solidsInUse;
-    std::size_t sceneIndices = 0;
-    for (const Mesh& m : scene.meshes) sceneIndices += m.triangleCount() * 3;
+    const std::size_t sceneIndices = 3 * scene.triangleCount();
     ix.reserve(sceneIndices);
     for (const Mesh& m : scene.meshes) {
         if (m.triangleCount() == 0) continue;
