@@ -56,6 +56,11 @@ layout(constant_id = 14) const uint ORTHO = 0u;
 // cull_lists on GPUs: mask words per lane a list's walk keeps in registers
 // (1 to 4; see KEPT_WORDS' use there).
 layout(constant_id = 15) const uint KEPT_WORDS = 4u;
+// cull_lists: 1 when a test counter could wrap around 2^32 (the host's bound:
+// the items adding to one counter x the lights each tests): the add then
+// returns the old value to check it; else a plain add, which nothing waits
+// for (P1 on the H100: 0.0201 -> 0.0200 ms).
+layout(constant_id = 16) const uint TESTS_WRAP = 1u;
 
 layout(std430, binding = 0) readonly buffer Params { GpuCullParams params; };
 // A private copy of the parameters, filled by loadParams() at the top of every

@@ -39,7 +39,11 @@
 void countTests(uint item, uint tested) {
     if (tested == 0u) return;
     uint at = (item % LC_TEST_COUNTERS) * LC_TEST_COUNTER_STRIDE;
-    if (atomicAdd(candidateTests[at], tested) + tested < tested) atomicOr(status, STATUS_TESTS_OVERFLOW);
+    if (TESTS_WRAP == 0u) {
+        atomicAdd(candidateTests[at], tested);
+    } else if (atomicAdd(candidateTests[at], tested) + tested < tested) {
+        atomicOr(status, STATUS_TESTS_OVERFLOW);
+    }
 }
 
 float sliceBoundary(float lo, float hi, uint i) {

@@ -75,7 +75,7 @@ constexpr float kRelEps = 2e-5f;
 constexpr float kAbsEps = 1e-6f;
 
 constexpr std::uint32_t kBindings = 11; // cull_common.glsl bindings 0..10
-constexpr std::uint32_t kSpecConstants = 16; // cull_common.glsl constant_id 0..15
+constexpr std::uint32_t kSpecConstants = 17; // cull_common.glsl constant_id 0..16
 using SpecConstants = std::array<std::uint32_t, kSpecConstants>;
 enum Binding : std::uint32_t { bParams, bDepth, bTiles, bLights, bCounts, bOffsets, bIndices, bStatus, bBins };
 // Stash slots per list at most (cull_common.glsl binding 10): the count pass
@@ -378,10 +378,10 @@ void VulkanBackend::createComputeObjects() {
     vertShader_ = mk(spirv::depthVert(), "shader.depth_vert");
 }
 
-// Specialisation constants, ids as in cull_common.glsl: 0 local size, 1 tile
+// Specialisation constants, ids as in cull_common.glsl (0 local size, 1 tile
 // size, 2 cells, 3 slicing, 4 algorithm, 5 sphere test, 6 write pass, 7 lanes
-// per tile or list, 8 pixels per depth load, 9 depth bins. Pipelines are
-// cached per combination.
+// per tile or list, 8 pixels per depth load, 9 depth bins, ... 16 tests
+// wrap). Pipelines are cached per combination.
 VkPipeline VulkanBackend::computePipeline(const char* what, VkShaderModule module,
                                           const SpecConstants& spec, bool oneSubgroup) {
     std::string key = what;
@@ -961,11 +961,16 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     // registers where the lights are few (P1 on the H100: 0.0205-0.0206 ->
     // 0.0203 ms against 4).
     const std::uint32_t keptWords = std::clamp<std::uint32_t>((binWords + sg - 1) / sg, 1, 4);
+    // Whether a test counter could wrap around 2^32: a counter takes the
+    // tests of every LC_TEST_COUNTERS-th list (or tile walk, fewer than the
+    // lists), each at most every light, counted at most twice.
+    const std::uint64_t perCounter = (std::uint64_t(listTotal) + LC_TEST_COUNTERS - 1) / LC_TEST_COUNTERS;
+    const std::uint32_t testsWrap = 2 * perCounter * n > std::numeric_limits<std::uint32_t>::max() ? 1u : 0u;
     auto spec = [&](std::uint32_t local, std::uint32_t write, std::uint32_t lanesPerTile = 1,
                     std::uint32_t depthLoad = 2, std::uint32_t tileWalk = 0, std::uint32_t binLanes = 1) {
         return SpecConstants{local,      grid.tileSize, cells,    slicingId,  algoId,   testId,  write,
                              lanesPerTile, depthLoad, depthBins ? 1u : 0u, tileWalk, spotTestId, binLanes, cellLog,
-                             proj.orthographic() ? 1u : 0u, keptWords};
+                             proj.orthographic() ? 1u : 0u, keptWords, testsWrap};
     };
     // Work layout per device kind (the LANES constant): on a CPU device
     // (lavapipe) an invocation per tile and per list, so SIMD lanes are tiles /
