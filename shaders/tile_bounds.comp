@@ -179,8 +179,7 @@ void main() {
     uint x0 = tx * TILE_SIZE, y0 = ty * TILE_SIZE;
     uint tw = min(x0 + TILE_SIZE, W) - x0, th = min(y0 + TILE_SIZE, P.size.y) - y0;
     // Lanes across a row (each taking STEP pixels a load) and rows at a time.
-    uint laneCols = LANE_COLS, laneRows = LANE_ROWS;
-    uint lx = lane % laneCols, ly = lane / laneCols;
+    uint lx = lane % LANE_COLS, ly = lane / LANE_COLS;
     float clearDepth = P.depth.w;
 
     // Window depth extremes: linearising only the two extremes is exact
@@ -196,20 +195,20 @@ void main() {
     Pixels kept[KEEP_MAX];
     if (KEEP) {
         for (uint i = 0u; i < KEEP_ROWS; ++i) {
-            uint y = ly + i * laneRows;
+            uint y = ly + i * LANE_ROWS;
             for (uint j = 0u; j < KEEP_COLS; ++j) {
                 Pixels px;
                 px.a = vec4(clearDepth);
                 px.b = vec4(clearDepth);
-                if (y < th) px = depthAt((y0 + y) * W + x0, (lx + j * laneCols) * STEP, tw, clearDepth);
+                if (y < th) px = depthAt((y0 + y) * W + x0, (lx + j * LANE_COLS) * STEP, tw, clearDepth);
                 kept[i * KEEP_COLS + j] = px;
                 addBounds(px, clearDepth, slicesInWalk, slices, wLo, wHi, walkMask);
             }
         }
     } else {
-        for (uint y = ly; y < th; y += laneRows) {
+        for (uint y = ly; y < th; y += LANE_ROWS) {
             uint row = (y0 + y) * W + x0;
-            for (uint x = lx * STEP; x < TILE_SIZE; x += laneCols * STEP)
+            for (uint x = lx * STEP; x < TILE_SIZE; x += LANE_COLS * STEP)
                 addBounds(depthAt(row, x, tw, clearDepth), clearDepth, slicesInWalk, slices, wLo, wHi, walkMask);
         }
     }
@@ -247,9 +246,9 @@ void main() {
                 if (KEEP) {
                     for (uint k = 0u; k < KEEP_ROWS * KEEP_COLS; ++k) mask |= cellsOfLoad(kept[k], clearDepth, cells);
                 } else {
-                    for (uint y = ly; y < th; y += laneRows) {
+                    for (uint y = ly; y < th; y += LANE_ROWS) {
                         uint row = (y0 + y) * W + x0;
-                        for (uint x = lx * STEP; x < TILE_SIZE; x += laneCols * STEP)
+                        for (uint x = lx * STEP; x < TILE_SIZE; x += LANE_COLS * STEP)
                             mask |= cellsOfLoad(depthAt(row, x, tw, clearDepth), clearDepth, cells);
                     }
                 }
