@@ -87,8 +87,9 @@ struct GltfBuilder {
     }
     // .gltf with the buffer inline as a data: URI.
     std::string gltfText() const { return withBuffer("data:application/octet-stream;base64," + base64(bin)).dump(); }
-    std::string glb() const {
-        std::string js = withBuffer("").dump();
+    std::string glb() const { return glbWithJson(withBuffer("").dump()); }
+    // A GLB of this binary chunk around JSON text given as it is.
+    std::string glbWithJson(std::string js) const {
         while (js.size() % 4) js += ' ';
         std::string b = bin;
         while (b.size() % 4) b.push_back('\0');
@@ -515,6 +516,30 @@ TEST(GltfHostile, EveryDefectIsOneLineNamingFileAndPath) {
                      }),
                      "meshes[0].primitives[0].indices: index 1065353216 at element 0 is outside the 3 vertices"});
     cases.push_back({"{ not json", "not valid glTF"});
+    // Nesting that would take tinygltf's recursive parser past the stack
+    // (20,000 levels in `extras`, 40 KB), as text and as a GLB's JSON chunk.
+    {
+        const std::string deep = std::string(20000, '[') + std::string(20000, ']');
+        json d = good.withBuffer("data:application/octet-stream;base64," + GltfBuilder::base64(good.bin));
+        d["extras"] = "X";
+        std::string text = d.dump();
+        text.replace(text.find("\"X\""), 3, deep);
+        cases.push_back({text, ":1: arrays and objects nested more than 256 deep"});
+        GltfBuilder b = good;
+        b.doc["extras"] = "X";
+        std::string chunk = b.withBuffer("").dump();
+        chunk.replace(chunk.find("\"X\""), 3, deep);
+        const std::string glbDeep = b.glbWithJson(chunk);
+        cases.push_back({glbDeep, "arrays and objects nested more than 256 deep"});
+    }
+    // A data: URI that does not decode to the buffer's byteLength: tinygltf
+    // quotes the whole URI; the message keeps its head.
+    cases.push_back({patched([](json& d) {
+                         d["buffers"][0]["byteLength"] = d["buffers"][0]["byteLength"].get<int>() + 4;
+                         std::string uri = d["buffers"][0]["uri"];
+                         d["buffers"][0]["uri"] = uri + std::string(4000, 'A');
+                     }),
+                     "data:application/octet-stream;base64,... ("});
     {
         // NaN in the position data.
         GltfBuilder b;
@@ -544,6 +569,7 @@ TEST(GltfHostile, EveryDefectIsOneLineNamingFileAndPath) {
         EXPECT_EQ(msg.rfind(p.string(), 0), 0u) << msg;            // names the file first
         EXPECT_NE(msg.find(cases[i].second), std::string::npos) << msg;
         EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;        // one line
+        EXPECT_LT(msg.size(), 500u) << msg;
     }
 }
 

@@ -260,6 +260,17 @@ TEST(SceneJson, FileLevelErrors) {
     } catch (const InputError& e) {
         EXPECT_EQ(e.line(), 1);
     }
+    // Nesting is bounded before the parser builds a path per level (100,000
+    // levels in 200 KB took the whole machine's memory).
+    try {
+        parseScene("{\"format\": \"lightcull-scene\",\n\"name\": " + std::string(100000, '[') +
+                       std::string(100000, ']') + "}",
+                   "deep.json");
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.line(), 2);
+        EXPECT_NE(std::string(e.what()).find("nested more than 256 deep"), std::string::npos) << e.what();
+    }
     // Saving into a folder that does not exist fails cleanly.
     EXPECT_THROW(saveSceneFile(makeBuiltinScene("sky"), dir + "/no/such/dir/s.json"), InputError);
     fs::remove_all(dir);

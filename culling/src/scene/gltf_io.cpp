@@ -2,6 +2,7 @@
 
 #include "culling/core/errors.hpp"
 #include "culling/core/file_io.hpp"
+#include "scene/json_nesting.hpp"
 
 #include <tiny_gltf.h>
 
@@ -36,10 +37,20 @@ std::string withCommas(std::uint64_t v) {
     }
     return s;
 }
+// A loader's message as one line of reasonable length: the first line, each
+// data: URI in it cut to its head (tinygltf quotes the whole URI, megabytes
+// of base64), and at most 300 characters.
 std::string firstLine(std::string s) {
     while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
     const auto nl = s.find('\n');
     if (nl != std::string::npos) s = s.substr(0, nl) + " (and more)";
+    for (std::size_t at = s.find("data:"); at != std::string::npos; at = s.find("data:", at + 1)) {
+        const std::size_t comma = s.find(',', at), end = s.find_first_of(" '\"", at);
+        const std::size_t stop = end == std::string::npos ? s.size() : end;
+        if (comma == std::string::npos || comma >= stop || stop - comma <= 24) continue;
+        s.replace(comma + 1, stop - comma - 1, "... (" + withCommas(stop - comma - 1) + " characters)");
+    }
+    if (s.size() > 300) s = s.substr(0, 300) + "...";
     return s;
 }
 
@@ -513,6 +524,12 @@ tinygltf::Model parseModel(const std::string& path, GltfReadReport& rep) {
     const std::string bytes = readWholeFile(path, path);
     const bool binary = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
     if (lowerExt(path) == ".glb" || binary) checkGlbHeader(path, bytes);
+    // The JSON (a GLB's first chunk, checked above) before tinygltf recurses into it.
+    const std::string_view json =
+        binary ? std::string_view(bytes).substr(20, readU32(bytes, 12)) : std::string_view(bytes);
+    if (const int line = jsonNestingTooDeep(json))
+        throw InputError(path, "", binary ? 0 : line,
+                         "arrays and objects nested more than " + std::to_string(kMaxJsonNesting) + " deep");
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(ignoreImage, nullptr);
     loader.SetFsCallbacks(fileCallbacks());
@@ -529,7 +546,12 @@ tinygltf::Model parseModel(const std::string& path, GltfReadReport& rep) {
         // nlohmann's parse or type errors escape tinygltf on some inputs.
         throw InputError(path, "", 0, std::string("not valid glTF JSON: ") + firstLine(e.what()));
     }
-    if (!ok) throw InputError(path, "", 0, "not valid glTF: " + firstLine(err.empty() ? std::string("unreadable") : err));
+    if (!ok) {
+        std::string why = firstLine(err.empty() ? std::string("unreadable") : err);
+        if (why.find("Failed to decode 'uri'") != std::string::npos)
+            why += " (a buffer's data: URI that is not base64 of its byteLength bytes)";
+        throw InputError(path, "", 0, "not valid glTF: " + why);
+    }
     if (!warn.empty()) rep.warnings.push_back(path + ": " + firstLine(warn));
     return model;
 }

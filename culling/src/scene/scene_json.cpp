@@ -13,6 +13,7 @@
 #include "culling/core/errors.hpp"
 #include "culling/scene/scene_io.hpp"
 #include "culling/core/file_io.hpp"
+#include "scene/json_nesting.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -452,6 +453,8 @@ Scene parseSceneImpl(const std::string& text, const std::string& file, const Can
     json root;
     LineState ls;
     LineMap lines;
+    if (const int line = jsonNestingTooDeep(text))
+        throw InputError(file, "", line, "arrays and objects nested more than " + std::to_string(kMaxJsonNesting) + " deep");
     {
         LineSax sax(root, ls, lines, file);
         LineCountingIterator first(text.data(), &ls), last(text.data() + text.size(), &ls);
