@@ -9,6 +9,9 @@ namespace lcui {
 
 Document::Document(QObject* parent) : QObject(parent) {
     connect(&undo_, &QUndoStack::cleanChanged, this, [this](bool clean) { emit dirtyChanged(!clean); });
+    // First among sceneEdited's receivers: a Live re-run asked for in another
+    // receiver is asked for this revision.
+    connect(this, &Document::sceneEdited, this, [this] { ++sceneRevision_; });
 }
 
 void Document::resetScene(lc::Scene scene, const QString& path) {
@@ -21,6 +24,7 @@ void Document::resetScene(lc::Scene scene, const QString& path) {
     cameraSelected_ = false;
     selectedTile_ = -1;
     selectedCell_ = -1;
+    explainedList_ = -1;
     run_.reset();
     emit sceneReset();
     emit selectionChanged();
@@ -68,12 +72,14 @@ void Document::setSelectedTile(int tile) {
     if (tile == selectedTile_) return;
     selectedTile_ = tile;
     selectedCell_ = -1;
+    explainedList_ = -1;
     emit tileSelectionChanged(tile);
 }
 
 void Document::setSelectedCell(int cell) {
     if (cell == selectedCell_) return;
     selectedCell_ = cell;
+    explainedList_ = -1;
     emit tileSelectionChanged(selectedTile_);
 }
 
@@ -140,10 +146,37 @@ void Document::importMesh(lc::Mesh mesh) { undo_.push(new AddMeshCommand(this, s
 
 bool Document::setRunOutput(std::shared_ptr<const lc::RunOutput> run, quint64 generation) {
     if (generation < runGeneration_) return false;
+    // A run nobody noted (a test's) counts as made from the scene as it is.
+    runRevision_ = sceneRevision_;
+    for (const auto& [g, revision] : pending_)
+        if (g == generation) runRevision_ = revision;
+    // A generation answers twice (lists, then truth); older ones never will.
+    std::erase_if(pending_, [generation](const auto& p) { return p.first < generation; });
+    if (generation != runGeneration_) explainedList_ = -1;
     run_ = std::move(run);
     runGeneration_ = generation;
     emit runOutputChanged();
     return true;
+}
+
+void Document::noteRunRequested(quint64 generation) { pending_.emplace_back(generation, sceneRevision_); }
+
+void Document::noteRunFailed(quint64 generation) {
+    std::erase_if(pending_, [generation](const auto& p) { return p.first == generation; });
+    emit runOutputChanged(); // the scene may now be without a run on its way
+}
+
+bool Document::runIsStale() const {
+    if (!run_ || runRevision_ == sceneRevision_) return false;
+    for (const auto& p : pending_)
+        if (p.second == sceneRevision_) return false;
+    return true;
+}
+
+void Document::setExplainedList(int list) {
+    if (list == explainedList_) return;
+    explainedList_ = list;
+    emit selectionChanged();
 }
 
 // --- applied by the commands --------------------------------------------------

@@ -102,6 +102,23 @@ public:
     quint64 runGeneration() const { return runGeneration_; }
     // Returns false (and ignores it) when `generation` is older than the shown one.
     bool setRunOutput(std::shared_ptr<const lc::RunOutput> run, quint64 generation);
+    // A run asked for the scene as it is now (its result, when it comes,
+    // belongs to this scene), or that run failed.
+    void noteRunRequested(quint64 generation);
+    void noteRunFailed(quint64 generation);
+    // The shown run was made from an earlier scene (an edit since), and no run
+    // of the scene as it is now is on its way: its lists, truth and light
+    // indices no longer describe the scene, so what reads them per light (the
+    // tile inspector, Explain, the export) must not. A Live edit's run is on
+    // its way at once, so Live does not go stale.
+    bool runIsStale() const;
+
+    // The list the user picked for Explain (a tile inspector row: halfz and
+    // clustered tiles have several), or -1: the panel then takes the tile's
+    // first list that holds or needs the current light. Cleared with the tile
+    // or cell selection and by a new run.
+    int explainedList() const { return explainedList_; }
+    void setExplainedList(int list);
 
     // --- used by the undo commands only --------------------------------------
     void applyLightPosition(int index, const glm::dvec3& p);
@@ -143,6 +160,11 @@ private:
     int dragCounter_ = 0;
     std::shared_ptr<const lc::RunOutput> run_;
     quint64 runGeneration_ = 0;
+    // Scene edits counted (every sceneEdited), the count the shown run was
+    // asked for, and the runs asked for and not yet answered.
+    quint64 sceneRevision_ = 0, runRevision_ = 0;
+    std::vector<std::pair<quint64, quint64>> pending_; // generation, scene revision
+    int explainedList_ = -1;
 };
 
 } // namespace lcui

@@ -28,6 +28,9 @@ ExplainPanel::ExplainPanel(Document* doc, QWidget* parent) : QWidget(parent), do
     connect(doc_, &Document::selectionChanged, this, &ExplainPanel::refresh);
     connect(doc_, &Document::tileSelectionChanged, this, &ExplainPanel::refresh);
     connect(doc_, &Document::runOutputChanged, this, &ExplainPanel::refresh);
+    connect(doc_, &Document::sceneEdited, this, [this] {
+        if (doc_->runIsStale()) refresh();
+    });
     refresh();
 }
 
@@ -35,14 +38,34 @@ std::optional<lc::Explanation> explainSelection(const Document& doc) {
     const auto run = doc.runOutput();
     const int tile = doc.selectedTile();
     const int light = doc.currentLight();
-    if (!run || !run->truthComputed || tile < 0 || light < 0 || std::size_t(light) >= run->lights.size())
+    if (!run || !run->truthComputed || doc.runIsStale() || tile < 0 || light < 0 ||
+        std::size_t(light) >= run->lights.size())
         return std::nullopt;
     const lc::CullResult& r = run->result;
+    const lc::Projection proj(doc.scene().camera);
     int sub = doc.selectedCell();
     if (r.listsPerTile <= 1) sub = -1;
-    else if (sub < 0) sub = 0; // a tile of several lists without a cell: its first
-    const std::uint32_t list = lc::listOf(r, std::uint32_t(tile), sub);
-    return lc::explainLight(*run, lc::Projection(doc.scene().camera), list, std::uint32_t(light));
+    std::uint32_t list = 0;
+    if (sub >= 0 || r.listsPerTile <= 1) {
+        list = lc::listOf(r, std::uint32_t(tile), sub);
+    } else {
+        // A tile of several lists without a cell: the list picked in the
+        // tile inspector, else the first that holds or needs the light, else
+        // the first.
+        const std::uint32_t first = std::uint32_t(tile) * r.listsPerTile;
+        const int picked = doc.explainedList();
+        list = first;
+        if (picked >= 0 && std::uint32_t(picked) >= first && std::uint32_t(picked) < first + r.listsPerTile) {
+            list = std::uint32_t(picked);
+        } else {
+            for (const lc::TileLightRow& row : lc::tileLightRows(*run, proj, std::uint32_t(tile), -1))
+                if (row.light == std::uint32_t(light)) {
+                    list = row.list;
+                    break;
+                }
+        }
+    }
+    return lc::explainLight(*run, proj, list, std::uint32_t(light));
 }
 
 void ExplainPanel::refresh() {
@@ -55,8 +78,10 @@ void ExplainPanel::refresh() {
         error = QString::fromStdString(ex.what());
     }
     if (!e) {
-        verdict_->setText(!error.isEmpty() ? error
-                                           : tr("Select a tile (click the camera view) and a light (the scene tree or "
+        verdict_->setText(!error.isEmpty()       ? error
+                          : doc_->runIsStale() ? tr("The scene changed since the last run: run culling again (F5) "
+                                                    "to explain it.")
+                                               : tr("Select a tile (click the camera view) and a light (the scene tree or "
                                                 "a row of the tile inspector) to see why the light is, or is not, in "
                                                 "that tile's list."));
         verdict_->setStyleSheet({});

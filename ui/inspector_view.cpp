@@ -247,6 +247,13 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
         updateOverlays();
         scheduleRender();
     });
+    // An edit without a run on its way: the run's overlays go (the light
+    // indices they use may have moved).
+    connect(doc_, &Document::sceneEdited, this, [this] {
+        if (!doc_->runIsStale()) return;
+        updateOverlays();
+        scheduleRender();
+    });
     rebuildMeshes();
     rebuildLights();
     updateFrustum();

@@ -132,6 +132,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     });
     connect(doc_, &Document::sceneEdited, this, [this] {
         if (isLive()) runCulling(/*liveEdit=*/true);
+        updateStatus();
     });
     connect(doc_, &Document::settingsChanged, this, [this] {
         syncParamWidgets();
@@ -538,6 +539,7 @@ quint64 MainWindow::runCulling(bool liveEdit) {
                                           deviceEdit_->text(), liveEdit,
                                           CameraView::needsShading(cameraView_->imageMode()),
                                           doc_->geometryRevision(), customShader_);
+    doc_->noteRunRequested(gen);
     statusBar()->showMessage(tr("culling (run %1)...").arg(gen));
     return gen;
 }
@@ -610,6 +612,7 @@ void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::Run
 }
 
 void MainWindow::onRunFailed(quint64 generation, const QString& message) {
+    doc_->noteRunFailed(generation);
     log(tr("run %1 failed: %2").arg(generation).arg(message), true);
     statusBar()->showMessage(tr("culling failed: %1").arg(message), 10000);
     emit runFailed(generation, message);
@@ -633,6 +636,10 @@ void MainWindow::updateStatus() {
     const QString depth = run->depthReused ? tr("depth reused")
                                            : tr("depth %1 ms").arg(run->result.timings.depthMs, 0, 'f', 2);
     statusTimes_->setText(tr("%1 | cull %2 ms").arg(depth).arg(run->result.timings.cullMs, 0, 'f', 2));
+    // The figures stay (they describe the run shown) but say they are old.
+    statusTimes_->setStyleSheet(doc_->runIsStale() ? "color: white; background: #b9770e; padding: 0 4px" : "");
+    statusTimes_->setToolTip(doc_->runIsStale() ? tr("The scene changed since this run: F5 runs it again.") : QString());
+    if (doc_->runIsStale()) statusTimes_->setText(tr("stale: %1").arg(statusTimes_->text()));
     if (!run->truthComputed) {
         // Live edit: ground truth is still being computed (or was superseded).
         const auto& counts = run->result.listCount;

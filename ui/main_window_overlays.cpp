@@ -104,6 +104,14 @@ bool MainWindow::exportDiagnostics(const QString& dir) {
         prompts.showError(this, tr("Export diagnostics"), tr("There is no culling run to export yet: press F5."));
         return false;
     }
+    // The export pairs the scene with the run's lists and truth light by light.
+    if (doc_->runIsStale()) {
+        log(tr("export diagnostics: the scene changed since the last run (F5 runs it again); nothing exported"), true);
+        prompts.showError(this, tr("Export diagnostics"),
+                          tr("The scene changed since the last culling run: press F5 to run it again, then export. "
+                             "Nothing was exported."));
+        return false;
+    }
     // shaded_culled.png, shaded_all.png and shaded_diff.png come with it:
     // shaded on the worker now if the run was not shaded yet.
     const auto run = shadedRunOutput();

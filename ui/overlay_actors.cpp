@@ -251,7 +251,7 @@ void InspectorOverlays::update(const Document& doc) {
     const auto run = doc.runOutput();
     const lc::Camera& cam = doc.scene().camera;
     const auto& opt = doc.overlays();
-    const bool usable = run && run->result.grid.width == cam.width && run->result.grid.height == cam.height &&
+    const bool usable = run && !doc.runIsStale() && run->result.grid.width == cam.width && run->result.grid.height == cam.height &&
                         run->result.grid.tileSize == cam.tileSize && cam.validate().empty();
     auto show = [](vtkActor* a, bool on) { a->SetVisibility(on); };
     if (!usable) {

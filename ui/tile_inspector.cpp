@@ -101,10 +101,16 @@ TileInspector::TileInspector(Document* doc, QWidget* parent) : QWidget(parent), 
     l->addWidget(table_, 1);
     connect(doc_, &Document::tileSelectionChanged, this, &TileInspector::refresh);
     connect(doc_, &Document::runOutputChanged, this, &TileInspector::refresh);
+    connect(doc_, &Document::sceneEdited, this, [this] {
+        if (doc_->runIsStale()) refresh();
+    });
     connect(table_, &QTableView::doubleClicked, this, [this](const QModelIndex& shown) {
         const QModelIndex i = proxy_->mapToSource(shown);
-        if (i.isValid() && i.row() < int(model_->rows().size()))
-            doc_->setSelectedLights({int(model_->rows()[std::size_t(i.row())].light)});
+        if (!i.isValid() || i.row() >= int(model_->rows().size())) return;
+        const lc::TileLightRow& row = model_->rows()[std::size_t(i.row())];
+        // The row's own list: a halfz or clustered tile has several.
+        doc_->setExplainedList(int(row.list));
+        doc_->setSelectedLights({int(row.light)});
     });
     refresh();
 }
@@ -125,6 +131,12 @@ void TileInspector::refresh() {
     if (!run || tile < 0 || std::uint32_t(tile) >= run->result.grid.tileCount()) {
         model_->setRows({}, run);
         summary_->setText(run ? tr("Click a tile in the camera view.") : tr("No culling run yet (F5)."));
+        return;
+    }
+    if (doc_->runIsStale()) {
+        model_->setRows({}, run);
+        summary_->setText(tr("The scene changed since the last run: run culling again (F5)."));
+        summary_->setStyleSheet({});
         return;
     }
     if (run->result.grid.width != cam.width || run->result.grid.height != cam.height || !cam.validate().empty()) {

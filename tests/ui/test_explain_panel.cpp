@@ -30,7 +30,9 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QSortFilterProxyModel>
+#include <QFileInfo>
 #include <QPlainTextEdit>
+#include <QTableView>
 #include <QUndoStack>
 
 using namespace lcui;
@@ -328,6 +330,130 @@ private slots:
         const std::vector<int> byTiles = tree->lightOrder();
         auto tilesOf = [&](int light) { return lc::tilesHoldingLight(run->result, std::uint32_t(light)).size(); };
         for (std::size_t k = 1; k < byTiles.size(); k += 37) QVERIFY(tilesOf(byTiles[k - 1]) >= tilesOf(byTiles[k]));
+    }
+
+    // An edit with Live off leaves the last run describing another scene: a
+    // deleted light shifts every later index, so its rows and verdicts would
+    // land on other lights. The inspector, Explain and the export say so
+    // until the next run; a run of the edited scene brings them back.
+    void anEditLeavesTheRunStaleUntilTheNextRun() {
+        auto run = doc()->runOutput();
+        std::uint32_t tile = 0;
+        for (std::uint32_t t = 0; t < run->result.grid.tileCount(); ++t)
+            if (run->result.listCount[t] > run->result.listCount[tile]) tile = t;
+        doc()->setSelectedTile(int(tile));
+        TileInspector* ti = w_->tileInspector();
+        QVERIFY(ti->model()->rows().size() >= 2);
+        const int second = int(ti->model()->rows()[1].light);
+        doc()->setSelectedLights({second});
+        ExplainPanel* panel = w_->explainPanel();
+        QVERIFY(panel->explanation());
+        QVERIFY(!doc()->runIsStale());
+
+        doc()->deleteLights({int(ti->model()->rows()[0].light)}); // an earlier light: `second` moves down one
+        QVERIFY(doc()->runIsStale());
+        QVERIFY(ti->model()->rows().empty());
+        QVERIFY2(ti->summaryText().contains("changed since the last run"), qPrintable(ti->summaryText()));
+        QVERIFY(!panel->explanation());
+        auto* verdict = panel->findChild<QLabel*>("explainVerdict");
+        QVERIFY2(verdict->text().contains("changed since the last run"), qPrintable(verdict->text()));
+        QVERIFY(!w_->inspectorView()->overlays()->explanation());
+        QDir().mkpath(LC_RENDER_OUT_DIR); // for a person to look at: the stale state
+        QVERIFY(w_->grabWindow().save(LC_RENDER_OUT_DIR "/stale_run.png"));
+        QString refused;
+        w_->prompts.showError = [&](QWidget*, const QString&, const QString& m) { refused = m; };
+        const QString dir = QDir::tempPath() + "/lightcull-stale-export";
+        QDir(dir).removeRecursively();
+        QVERIFY(!w_->exportDiagnostics(dir));
+        QVERIFY2(refused.contains("press F5"), qPrintable(refused));
+        QVERIFY(!QFileInfo::exists(dir + "/summary.json"));
+
+        // The next run is of the edited scene: the same light, one index lower.
+        QVERIFY(waitTruth(w_->runCulling()));
+        QVERIFY(!doc()->runIsStale());
+        doc()->setSelectedLights({second - 1});
+        QVERIFY(panel->explanation());
+        const lc::Explanation expect = lc::explainLight(*doc()->runOutput(), lc::Projection(doc()->scene().camera),
+                                                        tile, std::uint32_t(second - 1));
+        QCOMPARE(panel->explanation()->text(), expect.text());
+        QVERIFY(!ti->model()->rows().empty());
+
+        // Undo is an edit too; with Live on an edit is never stale (its run
+        // is asked for at once), and a run that fails leaves it stale.
+        doc()->undoStack()->undo();
+        QVERIFY(doc()->runIsStale());
+        w_->setLive(true); // asks for a run of the scene as it is
+        QVERIFY(!doc()->runIsStale());
+        doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(0.5, 0, 0), doc()->newDragId());
+        QVERIFY(!doc()->runIsStale());
+        w_->setLive(false);
+        QVERIFY(waitTruth(w_->runCulling()));
+        lc::Camera bad = doc()->scene().camera;
+        bad.target = bad.position;
+        doc()->setCamera(bad);
+        QVERIFY(doc()->runIsStale());
+        const quint64 failing = w_->runCulling();
+        QVERIFY(!doc()->runIsStale()); // on its way
+        QVERIFY(!lctest::waitRun(*w_, failing));
+        QVERIFY(doc()->runIsStale());
+    }
+
+    // halfz and clustered tiles hold several lists: a tile inspector row
+    // explains its own list, and without a row or cell picked the panel takes
+    // the first list that holds the light, never one that says otherwise.
+    void aRowOfASeveralListTileExplainsItsOwnList() {
+        for (const char* algo : {"halfz", "clustered"}) {
+            QVERIFY(w_->setParamFromUi("algorithm", algo));
+            QVERIFY(waitTruth(w_->runCulling()));
+            auto run = doc()->runOutput();
+            const lc::Projection proj(doc()->scene().camera);
+            const std::uint32_t per = run->result.listsPerTile;
+            QVERIFY(per > 1);
+            // A tile whose later list holds a light its first list lacks.
+            std::uint32_t tile = 0;
+            std::optional<lc::TileLightRow> later;
+            for (std::uint32_t t = 0; t < run->result.grid.tileCount() && !later; ++t) {
+                const auto rows = lc::tileLightRows(*run, proj, t, -1);
+                for (const auto& r : rows) {
+                    bool inFirst = false;
+                    for (const auto& q : rows) inFirst = inFirst || (q.light == r.light && q.list == t * per);
+                    if (r.list > t * per && r.verdict != lc::Verdict::Missing && !inFirst) {
+                        tile = t;
+                        later = r;
+                        break;
+                    }
+                }
+            }
+            QVERIFY2(later, algo);
+            doc()->setSelectedTile(int(tile));
+            TileInspector* ti = w_->tileInspector();
+            int row = -1;
+            for (int r = 0; r < ti->proxy()->rowCount(); ++r) {
+                const auto& m = ti->model()->rows()[std::size_t(ti->proxy()->mapToSource(ti->proxy()->index(r, 0)).row())];
+                if (m.list == later->list && m.light == later->light) row = r;
+            }
+            QVERIFY(row >= 0);
+            QApplication::processEvents(); // the table lays its new rows out
+            ti->table()->scrollTo(ti->proxy()->index(row, 0));
+            QApplication::processEvents();
+            QVERIFY(ti->table()->viewport()->rect().contains(ti->table()->visualRect(ti->proxy()->index(row, 0)).center()));
+            // A press first: Qt Test's double click alone has no pressed index.
+            const QPoint at = ti->table()->visualRect(ti->proxy()->index(row, 0)).center();
+            QTest::mouseClick(ti->table()->viewport(), Qt::LeftButton, {}, at);
+            QTest::mouseDClick(ti->table()->viewport(), Qt::LeftButton, {}, at);
+            QCOMPARE(doc()->currentLight(), int(later->light));
+            ExplainPanel* panel = w_->explainPanel();
+            QVERIFY(panel->explanation());
+            const lc::Explanation expect = lc::explainLight(*run, proj, later->list, later->light);
+            QCOMPARE(panel->explanation()->text(), expect.text());
+            QVERIFY(panel->explanation()->listed);
+            // The same light chosen in the scene tree: its first listing list.
+            doc()->setSelectedTile(-1);
+            doc()->setSelectedTile(int(tile));
+            w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(later->light)));
+            QVERIFY(panel->explanation());
+            QVERIFY2(panel->explanation()->listed, algo);
+        }
     }
 };
 
