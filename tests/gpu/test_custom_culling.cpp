@@ -292,6 +292,44 @@ TEST_F(GpuTest, SpirvFromTheCompilerRunsToo) {
     fs::remove_all(dir);
 }
 
+// Engines differ on whether an empty froxel keeps its lights: a dump of
+// either built-in variant is judged equal to it, and named so.
+TEST_F(GpuTest, FroxelDumpsAreComparedWithTheNearerSkipEmptyVariant) {
+    const Scene s = atrium();
+    const Projection proj(s.camera);
+    const DepthImage depth = gputest::vulkan().renderDepth(s, proj);
+    const fs::path dir = fs::temp_directory_path() / ("lc_froxels_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    RunOptions ro;
+    ro.truthOptions.imageError = false;
+    for (const bool skip : {false, true}) {
+        CullSettings cs;
+        cs.algorithm = Algorithm::Clustered;
+        cs.cells = 16;
+        cs.slicing = Slicing::Log;
+        cs.skipEmpty = skip;
+        const CullResult ref = makeCpuBackend()->cull(
+            depth, proj, TileGrid::make(s.camera.width, s.camera.height, s.camera.tileSize), makeViewLights(s), cs);
+        {
+            std::ofstream csv(dir / "froxels.csv");
+            for (std::size_t l = 0; l < ref.listCount.size(); ++l) {
+                csv << l;
+                for (std::uint32_t k = 0; k < ref.listCount[l]; ++k) csv << "," << ref.lightIndices[ref.listOffset[l] + k];
+                csv << "\n";
+            }
+        }
+        CustomCullReport rep;
+        const RunOutput out = checkListDump(s, (dir / "froxels.csv").string(), parseLayout("fixed:64"),
+                                            parseListSpec("froxel:16:log"), depth, ro, rep);
+        SCOPED_TRACE(skip ? "skip-empty true" : "skip-empty false");
+        EXPECT_EQ(out.truth.metrics.falseNegatives, 0u);
+        EXPECT_EQ(rep.listsDifferingFromBuiltin, 0u);
+        EXPECT_EQ(rep.builtinEntries, ref.entries());
+        EXPECT_EQ(rep.builtinAlgorithm, skip ? "clustered, skip-empty true" : "clustered, skip-empty false");
+    }
+    fs::remove_all(dir);
+}
+
 TEST_F(GpuTest, EngineListDumpsAreJudgedLikeShaders) {
     const Scene s = atrium();
     const Projection proj(s.camera);

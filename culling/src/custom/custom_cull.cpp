@@ -116,15 +116,30 @@ void compareWithBuiltin(const CullResult& custom, const CullResult& builtin, Cus
         report.builtinAlgorithm = "none (no built-in algorithm has a list per cell)";
         return;
     }
-    report.builtinAlgorithm = toString(builtin.algorithm);
-    report.builtinEntries = builtin.entries();
-    report.listsDifferingFromBuiltin = 0;
-    for (std::size_t l = 0; l < custom.listCount.size() && l < builtin.listCount.size(); ++l) {
-        const auto a = custom.lightIndices.begin() + custom.listOffset[l];
+    // Froxel lists: the built-in is clustered without skipping empty froxels
+    // (ruleSkeleton); an engine that skips them (as `clustered` does by
+    // default) is compared with those lists emptied where no pixel lies,
+    // whichever of the two its lists are nearer.
+    const bool froxels = builtin.algorithm == Algorithm::Clustered && !builtin.cellMask.empty();
+    const std::uint32_t per = std::max(builtin.listsPerTile, 1u);
+    std::uint64_t differ[2] = {0, 0}, entries[2] = {0, 0};
+    for (std::size_t l = 0; l < builtin.listCount.size(); ++l) {
+        const bool occupied = !froxels || (builtin.cellMask[l / per] >> (l % per) & 1u);
+        const std::uint32_t n = builtin.listCount[l];
+        const bool customHas = l < custom.listCount.size();
+        const std::uint32_t m = customHas ? custom.listCount[l] : 0;
+        const auto a = custom.lightIndices.begin() + (customHas ? custom.listOffset[l] : 0);
         const auto b = builtin.lightIndices.begin() + builtin.listOffset[l];
-        if (custom.listCount[l] != builtin.listCount[l] || !std::equal(a, a + custom.listCount[l], b))
-            ++report.listsDifferingFromBuiltin;
+        const bool same = customHas && m == n && std::equal(a, a + m, b);
+        differ[0] += !same;
+        entries[0] += n;
+        differ[1] += occupied ? !same : m != 0;
+        entries[1] += occupied ? n : 0;
     }
+    const int k = froxels && differ[1] < differ[0] ? 1 : 0;
+    report.builtinAlgorithm = std::string(toString(builtin.algorithm)) + (!froxels ? "" : k ? ", skip-empty true" : ", skip-empty false");
+    report.builtinEntries = entries[k];
+    report.listsDifferingFromBuiltin = differ[k];
 }
 
 } // namespace detail
