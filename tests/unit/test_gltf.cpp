@@ -351,7 +351,7 @@ TEST(Gltf, LightsFollowTheirNodes) {
     const auto& ranged = sc.lights[0];
     EXPECT_EQ(ranged.name, "ranged");
     EXPECT_LT(glm::length(ranged.position - glm::dvec3(2, 4, 1)), 1e-12); // 2 x (1,2,3) + (0,0,-5)
-    EXPECT_DOUBLE_EQ(ranged.radius(), 6.0); // range 3 x node scale 2
+    EXPECT_DOUBLE_EQ(ranged.radius(), 3.0); // KHR_lights_punctual: the node's scale leaves the range
     EXPECT_LT(glm::length(ranged.color - glm::dvec3(1, 0.5, 0.25)), 1e-15);
     EXPECT_DOUBLE_EQ(ranged.intensity, 50.0);
     const auto& noRange = sc.lights[1];

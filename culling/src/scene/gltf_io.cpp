@@ -790,11 +790,9 @@ std::vector<PointLight> readLights(const std::string& path, const tinygltf::Mode
         l.intensity = gl.intensity;
         l.minIntensity = options.minIntensity;
         if (gl.range > 0.0) {
-            // The node's scale scales the range; a non-uniform scale takes its
-            // largest axis so the sphere still holds the scaled volume.
-            const double s = std::max({glm::length(columnDir(p.world, {1, 0, 0})), glm::length(columnDir(p.world, {0, 1, 0})),
-                                       glm::length(columnDir(p.world, {0, 0, 1}))});
-            l.explicitRadius = gl.range * s;
+            // KHR_lights_punctual: the node's scale moves the light but leaves
+            // its properties (range, intensity) as they are.
+            l.explicitRadius = gl.range;
         } else if (gl.range < 0.0) {
             throw InputError(path, lp + ".range", 0, "must be > 0");
         }
