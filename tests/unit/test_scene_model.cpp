@@ -51,6 +51,12 @@ TEST(PointLight, EveryValidationPathNamesTheField) {
     EXPECT_TRUE(startsWith(err([](PointLight& l) { l.color.b = -0.1; }), "color"));
     EXPECT_TRUE(startsWith(err([](PointLight& l) { l.intensity = kInf; }), "intensity"));
     EXPECT_TRUE(startsWith(err([](PointLight& l) { l.intensity = -1; }), "intensity"));
+    // Finite but past what the float passes hold: 1e39 cd became inf in the
+    // shading and the image error NaN; an inverse-square radius of 1e17 m.
+    EXPECT_TRUE(startsWith(err([](PointLight& l) { l.intensity = 1e39; l.minIntensity = 1e30; }), "intensity: intensity x colour"));
+    EXPECT_EQ(err([](PointLight& l) { l.intensity = 1e24; l.minIntensity = 1e20; }), "");
+    EXPECT_TRUE(startsWith(err([](PointLight& l) { l.intensity = 1e20; l.minIntensity = 1e-14; }), "radius: the inverse-square"));
+    EXPECT_TRUE(startsWith(err([](PointLight& l) { l.explicitRadius = 1e16; }), "radius: must be at most"));
     EXPECT_TRUE(startsWith(err([](PointLight& l) { l.minIntensity = 0; }), "min_intensity"));
     EXPECT_TRUE(startsWith(err([](PointLight& l) { l.minIntensity = -1; }), "min_intensity"));
     EXPECT_TRUE(startsWith(err([](PointLight& l) { l.minIntensity = kNaN; }), "min_intensity"));

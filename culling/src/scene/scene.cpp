@@ -72,6 +72,17 @@ std::string PointLight::validate() const {
     // kept valid in both cases so that clearing the radius never yields NaN.
     if (!std::isfinite(minIntensity)) return "min_intensity: must be finite";
     if (minIntensity <= 0) return "min_intensity: must be > 0 (got " + fmt(minIntensity) + ")";
+    // The shading passes sum intensity x colour / max(d^2, 1e-4) over up to a
+    // million lights in float: 1e24 per light keeps every sum finite.
+    if (const double peak = intensity * std::max({color.r, color.g, color.b}); peak > kMaxLightPower)
+        return "intensity: intensity x colour is " + fmt(peak) + ", past " + fmt(kMaxLightPower) +
+               " (the shading works in float)";
+    // The passes hold centres and radii in float and square the radius.
+    if (const double r = radius(); !(r <= kMaxLightRadius))
+        return explicitRadius > 0.0 ? "radius: must be at most " + fmt(kMaxLightRadius) + " (got " + fmt(r) + ")"
+                                    : "radius: the inverse-square radius sqrt(intensity x colour / min_intensity) is " +
+                                          fmt(r) + ", past " + fmt(kMaxLightRadius) +
+                                          ": give the light a radius or a larger min_intensity";
     if (kind == LightKind::Spot) {
         if (!finite3(direction)) return "direction: must be finite";
         if (glm::length(direction) == 0.0) return "direction: must not be zero";
