@@ -135,7 +135,7 @@ TEST(SceneJson, RoundTripIsLossless) {
     Scene s = parseScene(kBase, "/nowhere/base.json");
     // Values without short decimal forms, and an infinite far plane.
     s.lights[0].position = {0.1, 1.0 / 3.0, -2.718281828459045e-7};
-    s.lights[0].intensity = 1e300;
+    s.lights[0].intensity = 9.999999999999999e23; // near the largest valid (kMaxLightPower)
     s.camera.projection = ProjectionKind::ReversedZ;
     s.camera.farPlane = std::numeric_limits<double>::infinity();
     s.camera.fovYDeg = 59.99999999999999;

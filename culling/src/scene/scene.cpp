@@ -77,12 +77,11 @@ std::string PointLight::validate() const {
     if (const double peak = intensity * std::max({color.r, color.g, color.b}); peak > kMaxLightPower)
         return "intensity: intensity x colour is " + fmt(peak) + ", past " + fmt(kMaxLightPower) +
                " (the shading works in float)";
-    // The passes hold centres and radii in float and square the radius.
-    if (const double r = radius(); !(r <= kMaxLightRadius))
-        return explicitRadius > 0.0 ? "radius: must be at most " + fmt(kMaxLightRadius) + " (got " + fmt(r) + ")"
-                                    : "radius: the inverse-square radius sqrt(intensity x colour / min_intensity) is " +
-                                          fmt(r) + ", past " + fmt(kMaxLightRadius) +
-                                          ": give the light a radius or a larger min_intensity";
+    // Radii past float range are culled (hard case tiny_min_intensity); an
+    // infinite one is not a sphere.
+    if (!std::isfinite(radius()))
+        return "radius: the inverse-square radius sqrt(intensity x colour / min_intensity) is infinite: give the "
+               "light a radius or a larger min_intensity";
     if (kind == LightKind::Spot) {
         if (!finite3(direction)) return "direction: must be finite";
         if (glm::length(direction) == 0.0) return "direction: must not be zero";

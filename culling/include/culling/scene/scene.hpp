@@ -43,10 +43,9 @@ const char* toString(LightKind k); // "point", "spot"
 // (light lists index Scene::lights) and the same range rule: the bounding
 // sphere radius follows the inverse-square law,
 // r = sqrt(max(I*c.r, I*c.g, I*c.b) / I_min), unless `explicitRadius` > 0.
-// Bounds PointLight::validate keeps, for the float passes: intensity x the
-// brightest colour channel, and the culling radius (metres).
+// The bound PointLight::validate keeps on intensity x the brightest colour
+// channel: the float shading passes sum it over lights.
 constexpr double kMaxLightPower = 1e24;
-constexpr double kMaxLightRadius = 1e15;
 
 // A spot light lights the spherical sector of points within that range of its
 // position whose angle to `direction` is at most `outerAngleDeg`
