@@ -101,7 +101,7 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
         std::cout << "image error: rmse " << fmt("%.6g", m.imageRmse) << ", max " << fmt("%.6g", m.imageMaxError) << "\n";
     else
         std::cout << "image error: not computed (--no-image-error)\n";
-    std::cout << "times: depth " << ms(r.timings.depthMs);
+    std::cout << "times: depth " << (run.depthReused ? std::string("not run (depth image given)") : ms(r.timings.depthMs));
     if (r.depthTriangles) std::cout << " (" << r.depthTrianglesDrawn << " of " << r.depthTriangles << " triangles)";
     std::cout << ", cull " << ms(r.timings.cullMs)
               << ", shade " << ms(r.timings.shadeMs) << ", ground truth " << ms(r.timings.groundTruthMs) << " (" << r.timingMethod << ")\n"

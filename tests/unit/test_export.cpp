@@ -95,6 +95,22 @@ Png readPng(const fs::path& p) {
 
 } // namespace
 
+// A run on a depth image it was given ran no pre-pass: null, not 0 ms and
+// 0 of 0 triangles.
+TEST(Export, ARunOnAGivenDepthImageHasNoDepthTimeOrTriangles) {
+    const PipelineRun first = runBuiltin("atrium", Algorithm::MinMax);
+    auto backend = makeCpuBackend();
+    RunOptions opt;
+    opt.truthOptions.imageError = false;
+    opt.reuseDepth = &first.out.depth;
+    const RunOutput again = runPipeline(first.scene, first.settings, *backend, opt);
+    ASSERT_TRUE(again.depthReused);
+    const auto j = nlohmann::json::parse(summaryJson(first.scene, first.settings, again));
+    EXPECT_TRUE(j["timings_ms"]["depth"].is_null());
+    EXPECT_TRUE(j["depth_triangles"].is_null());
+    EXPECT_GE(j["timings_ms"]["cull"].get<double>(), 0.0);
+}
+
 TEST(Export, SummaryJsonHasEveryKeyConsistentWithTheRun) {
     const PipelineRun r = runBuiltin("atrium", Algorithm::TwoPointFiveD);
     const auto j = nlohmann::json::parse(summaryJson(r.scene, r.settings, r.out));

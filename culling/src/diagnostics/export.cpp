@@ -157,11 +157,16 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     std::size_t spots = 0;
     for (std::size_t i = 0; i < run.lights.size(); ++i) spots += run.lights.isSpot(i);
     j["spot_lights"] = spots;
-    j["timings_ms"] = {{"depth", msOrNull(r.timings.depthMs)},
+    // A run on a depth image it was given (an engine's, or the previous run's
+    // for a Live light edit) ran no pre-pass: no depth time, no triangles.
+    j["timings_ms"] = {{"depth", msOrNull(run.depthReused ? -1.0 : r.timings.depthMs)},
                        {"cull", msOrNull(r.timings.cullMs)},
                        {"ground_truth", msOrNull(r.timings.groundTruthMs)},
                        {"shade", msOrNull(r.timings.shadeMs)}};
-    j["depth_triangles"] = {{"scene", r.depthTriangles}, {"drawn", r.depthTrianglesDrawn}};
+    if (run.depthReused)
+        j["depth_triangles"] = nullptr;
+    else
+        j["depth_triangles"] = {{"scene", r.depthTriangles}, {"drawn", r.depthTrianglesDrawn}};
     nlohmann::ordered_json mj;
     mj["false_negatives"] = m.falseNegatives;
     mj["shading_work"] = m.shadingWork;
