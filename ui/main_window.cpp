@@ -697,7 +697,8 @@ void MainWindow::afterSceneOpened(const QString& what) {
             .arg(s.meshes.size())
             .arg(s.triangleCount())
             .arg(s.lights.size()));
-    if (runOnOpen) runCulling();
+    // With Live on, the new scene's sceneEdited has asked for its run already.
+    if (runOnOpen && !isLive()) runCulling();
 }
 
 bool MainWindow::openBuiltin(const QString& name) {

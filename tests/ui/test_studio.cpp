@@ -507,6 +507,21 @@ private slots:
         w_->setLive(false);
     }
 
+    // Opening a scene with Live on runs it once, with its own depth pass (a
+    // second run over the first one's depth showed "depth reused").
+    void openingWithLiveOnRunsOnce() {
+        openSmall();
+        w_->setLive(true);
+        w_->runOnOpen = true;
+        const quint64 before = w_->runCulling();
+        QVERIFY(w_->openBuiltin("sky"));
+        const quint64 after = w_->runCulling();
+        QCOMPARE(after, before + 2);
+        QVERIFY(waitRun(after));
+        w_->runOnOpen = false;
+        w_->setLive(false);
+    }
+
     // A light move re-culls over the previous depth image (the pre-pass is
     // skipped and the status bar says so); a camera edit renders depth again.
     void liveLightMoveReusesDepthCameraEditDoesNot() {
