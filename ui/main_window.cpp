@@ -390,6 +390,11 @@ void MainWindow::buildToolbar() {
     fileBar->addAction(action("actionRedo"));
     fileBar->addAction(action("actionAddLight"));
     fileBar->addAction(action("actionGenerate"));
+    // Run and Live on the first row: at the default 1600-pixel window the
+    // culling row's parameters fill its width and push its end out of sight.
+    fileBar->addSeparator();
+    fileBar->addAction(action("actionRun"));
+    fileBar->addAction(action("actionLive"));
 
     // Culling controls, generated from the one parameter table (lc::cullParams)
     // that also defines CullSettings and the CLI's flags.
@@ -454,9 +459,6 @@ void MainWindow::buildToolbar() {
     connect(deviceEdit_, &QLineEdit::editingFinished, this, [this] {
         if (isLive()) runCulling();
     });
-    bar->addSeparator();
-    bar->addAction(action("actionRun"));
-    bar->addAction(action("actionLive"));
 }
 
 void MainWindow::buildStatusBar() {

@@ -507,6 +507,18 @@ private slots:
         w_->setLive(false);
     }
 
+    // Run culling and Live are in sight at the window's size (they were at
+    // the end of the culling row, behind its overflow button below 1,700 px).
+    void runAndLiveButtonsAreInSight() {
+        for (const char* name : {"actionRun", "actionLive"}) {
+            QWidget* button = nullptr;
+            for (QToolBar* bar : w_->findChildren<QToolBar*>())
+                if (QWidget* b = bar->widgetForAction(w_->action(name))) button = b;
+            QVERIFY2(button && button->isVisible(), name);
+            QVERIFY2(w_->rect().contains(button->mapTo(w_.get(), button->rect().center())), name);
+        }
+    }
+
     // Opening a scene with Live on runs it once, with its own depth pass (a
     // second run over the first one's depth showed "depth reused").
     void openingWithLiveOnRunsOnce() {
