@@ -259,12 +259,12 @@ void MainWindow::buildActions() {
                 if (!p.isEmpty()) importMeshFile(p);
             });
     connect(make(tr("&Save"), "actionSave", QKeySequence::Save), &QAction::triggered, this, [this] { save(); });
-    connect(make(tr("Save &as..."), "actionSaveAs", QKeySequence::SaveAs), &QAction::triggered, this, [this] {
+    connect(make(tr("Save &as..."), "actionSaveAs", QKeySequence(tr("Ctrl+Shift+S"))), &QAction::triggered, this, [this] {
         const QString p = prompts.savePath(this, tr("Save scene as"),
                                            tr("Scene JSON (*.json);;Binary glTF (*.glb);;glTF 2.0 (*.gltf)"));
         if (!p.isEmpty()) saveAs(p);
     });
-    connect(make(tr("&Quit"), "actionQuit", QKeySequence::Quit), &QAction::triggered, this, &QWidget::close);
+    connect(make(tr("&Quit"), "actionQuit", QKeySequence(tr("Ctrl+Q"))), &QAction::triggered, this, &QWidget::close);
     connect(make(tr("glTF light &cut-off..."), "actionGltfCutoff"), &QAction::triggered, this, [this] {
         double v = gltfOptions.minIntensity;
         if (prompts.askNumber(this, tr("glTF light cut-off"),
