@@ -176,6 +176,10 @@ void MainWindow::buildDocks() {
     tree_ = new SceneTree(doc_);
     tree_->setObjectName("sceneTree");
     properties_ = new PropertyPanel(doc_);
+    connect(properties_, &PropertyPanel::editRefused, this, [this](const QString& why) {
+        log(why, true);
+        statusBar()->showMessage(why, 10000);
+    });
     properties_->setObjectName("propertyPanel");
     tileInspector_ = new TileInspector(doc_);
     tileInspector_->setObjectName("tileInspector");

@@ -267,7 +267,13 @@ void PropertyPanel::commitLight() {
                       l.intensity == before.intensity && l.minIntensity == before.minIntensity &&
                       l.explicitRadius == before.explicitRadius && l.kind == before.kind &&
                       l.direction == before.direction && l.outerAngleDeg == before.outerAngleDeg;
-    if (!same) doc_->setLight(cur, l);
+    if (same) return;
+    if (const std::string err = l.validate(); !err.empty()) {
+        refresh();
+        emit editRefused(tr("light %1 not changed: %2").arg(cur).arg(QString::fromStdString(err)));
+        return;
+    }
+    doc_->setLight(cur, l);
 }
 
 void PropertyPanel::commitCamera() {
@@ -293,7 +299,16 @@ void PropertyPanel::commitCamera() {
                       c.orthoHeight == before.orthoHeight && c.nearPlane == before.nearPlane &&
                       c.farPlane == before.farPlane && c.width == before.width &&
                       c.height == before.height && c.tileSize == before.tileSize;
-    if (!same) doc_->setCamera(c);
+    if (same) return;
+    // A camera that cannot be culled from (the target on the position, a
+    // far plane before the near one) is not stored: it would fail every run
+    // and save a file that does not open.
+    if (const std::string err = c.validate(); !err.empty()) {
+        refresh();
+        emit editRefused(tr("camera not changed: %1").arg(QString::fromStdString(err)));
+        return;
+    }
+    doc_->setCamera(c);
 }
 
 } // namespace lcui

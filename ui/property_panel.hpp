@@ -29,6 +29,11 @@ public:
     // Replaceable colour picker (tests substitute it; default QColorDialog).
     std::function<QColor(QWidget*, QColor)> pickColor;
 
+signals:
+    // An edit that would make the camera or the light invalid was not taken
+    // (the fields show the previous values again); `why` names the field.
+    void editRefused(const QString& why);
+
 private:
     void refresh();
     void commitLight();

@@ -519,6 +519,38 @@ private slots:
         }
     }
 
+    // Typing the camera's position into its target would make a camera no
+    // run can use (and a saved file that does not open): the edit is refused,
+    // the field shows the old value and the log says why.
+    void anInvalidCameraEditIsRefused() {
+        openSmall();
+        doc()->selectCamera();
+        auto* panel = w_->findChild<PropertyPanel*>();
+        QVERIFY(panel);
+        QSignalSpy refused(panel, &PropertyPanel::editRefused);
+        QList<QDoubleSpinBox*> target;
+        for (auto* spin : panel->findChildren<QDoubleSpinBox*>("cameraTarget")) target.push_back(spin);
+        QCOMPARE(target.size(), 3);
+        const lc::Camera before = doc()->scene().camera;
+        // Two axes to the position's; the last one would make them equal.
+        int differ = -1;
+        for (int i = 0; i < 3; ++i)
+            if (before.target[i] != before.position[i]) differ = i;
+        QVERIFY(differ >= 0);
+        for (int i = 0; i < 3; ++i)
+            if (i != differ) target[i]->setValue(before.position[i]);
+        QVERIFY(refused.isEmpty());
+        const int steps = doc()->undoStack()->count();
+        target[differ]->setValue(before.position[differ]);
+        QCOMPARE(refused.size(), 1);
+        QVERIFY2(refused.at(0).at(0).toString().contains("camera.target") ||
+                     refused.at(0).at(0).toString().contains("target"),
+                 qPrintable(refused.at(0).at(0).toString()));
+        QCOMPARE(doc()->undoStack()->count(), steps);
+        QVERIFY(doc()->scene().camera.validate().empty());
+        QCOMPARE(target[differ]->value(), before.target[differ]);
+    }
+
     // The keys docs/STUDIO.md lists reach their actions on any platform
     // theme (QKeySequence::SaveAs and ::Quit are empty under some, Xvfb's).
     void documentedShortcutsAreBound() {
