@@ -459,11 +459,16 @@ void CameraView::updateOverlay() {
         lut_->SetTableRange(0, 1);
         legend_->SetTitle("efficiency\nper tile");
         legend_->SetLabelFormat("%.2f");
+        legend_->SetNumberOfLabels(5);
     } else {
         lut_->SetHueRange(0.667, 0.0);
-        lut_->SetTableRange(0, std::max(1.0, maxHeat));
+        const double top = std::max(1.0, maxHeat);
+        lut_->SetTableRange(0, top);
         legend_->SetTitle(mode == lc::HeatMode::ListLength ? "lights\nper tile" : "false\npositives");
         legend_->SetLabelFormat("%.0f");
+        // Counts: below 5 a label per whole number (five evenly spaced labels
+        // over 0..2 would read 0, 0, 1, 2, 2).
+        legend_->SetNumberOfLabels(top < 5 ? int(top) + 1 : 5);
     }
     lut_->Build();
 

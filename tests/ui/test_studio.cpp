@@ -9,6 +9,7 @@
 #include "document.hpp"
 #include "inspector_view.hpp"
 #include "main_window.hpp"
+#include "culling/diagnostics/overlays.hpp"
 #include "property_panel.hpp"
 #include "scene_tree.hpp"
 #include "tile_inspector.hpp"
@@ -17,6 +18,8 @@
 #include "culling/core/pipeline.hpp"
 #include "culling/math/projection.hpp"
 #include "culling/scene/scene_io.hpp"
+
+#include <vtkScalarBarActor.h>
 
 #include <QAction>
 #include <QDoubleSpinBox>
@@ -549,6 +552,25 @@ private slots:
         QCOMPARE(doc()->undoStack()->count(), steps);
         QVERIFY(doc()->scene().camera.validate().empty());
         QCOMPARE(target[differ]->value(), before.target[differ]);
+    }
+
+    // The heat legend labels whole numbers once each: a scene whose longest
+    // list is short gets a label per count, not five rounded repeats.
+    void heatLegendLabelsEachCountOnce() {
+        for (const char* scene : {"sky", "atrium"}) {
+            openSmall(scene);
+            double top = 0;
+            for (double v : lc::tileHeat(*doc()->runOutput(), lc::HeatMode::ListLength))
+                if (!std::isnan(v)) top = std::max(top, v);
+            top = std::max(top, 1.0);
+            vtkScalarBarActor* legend = w_->cameraView()->legend();
+            const int labels = legend->GetNumberOfLabels();
+            QCOMPARE(labels, top < 5 ? int(top) + 1 : 5);
+            // Evenly spaced over 0..top, as printed ("%.0f"): no two alike.
+            QStringList printed;
+            for (int k = 0; k < labels; ++k) printed << QString::number(top * k / (labels - 1), 'f', 0);
+            QCOMPARE(QSet<QString>(printed.begin(), printed.end()).size(), labels);
+        }
     }
 
     // The keys docs/STUDIO.md lists reach their actions on any platform
