@@ -75,6 +75,7 @@ inline void printCustomReport(const lc::RunOutput& run, const lc::Scene& scene, 
               << c.validationMessages.size() << "\n  against built-in " << c.builtinAlgorithm << " (cpu): "
               << c.listsDifferingFromBuiltin << " lists differ, " << run.result.entries() << " entries vs "
               << c.builtinEntries << "\n";
+    for (const std::string& w : c.warnings) std::cout << "  warning: " << w << "\n";
     for (std::size_t i = 0; i < c.validationMessages.size() && i < 5; ++i)
         std::cout << "  validation: " << c.validationMessages[i].substr(0, 300) << "\n";
     const auto missed = lc::locateFalseNegatives(run, proj);

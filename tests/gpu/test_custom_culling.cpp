@@ -356,6 +356,19 @@ TEST_F(GpuTest, EngineListDumpsAreJudgedLikeShaders) {
     EXPECT_EQ(out.truth.metrics.falseNegatives, 0u);
     EXPECT_EQ(rep.listsDifferingFromBuiltin, 0u);
     EXPECT_EQ(out.result.lightIndices, ref.lightIndices);
+    EXPECT_TRUE(rep.warnings.empty());
+    // The same dump read as fixed:(N-1): longer than that layout needs, so
+    // read, but with a warning naming the words used (a wrong N otherwise
+    // looks like a broken engine).
+    {
+        CustomCullReport wrongRep;
+        const std::string wrongN = "fixed:" + std::to_string(n - 1);
+        checkListDump(s, (dir / "lists.bin").string(), parseLayout(wrongN), parseListSpec("tile"), depth, ro, wrongRep);
+        ASSERT_EQ(wrongRep.warnings.size(), 1u);
+        EXPECT_NE(wrongRep.warnings[0].find("reads the first " + std::to_string(ref.listCount.size() * n)),
+                  std::string::npos)
+            << wrongRep.warnings[0];
+    }
 
     // CSV with one light dropped from the busiest list: exactly that miss.
     std::size_t busiest = 0;
@@ -407,6 +420,18 @@ TEST_F(GpuTest, EngineListDumpsAreJudgedLikeShaders) {
         FAIL() << "no error";
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("bad.csv:2: list 99999 is outside"), std::string::npos) << e.what();
+    }
+    // A first line is a header only when it has a letter: "-1,0" is a bad
+    // list, not a header to skip; an empty file is no dump.
+    for (const auto& [text, expect] : {std::pair<std::string, std::string>{"-1,0\n", "bad.csv:1: '-1' is not a list index"},
+                                       {" \n", "bad.csv: empty"}}) {
+        std::ofstream(dir / "bad.csv") << text;
+        try {
+            checkListDump(s, (dir / "bad.csv").string(), parseLayout("fixed:32"), parseListSpec("tile"), depth, ro, csvRep);
+            ADD_FAILURE() << "no error for " << text;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+        }
     }
     std::ofstream(dir / "short.bin", std::ios::binary) << "abcd";
     EXPECT_THROW(checkListDump(s, (dir / "short.bin").string(), parseLayout("fixed:32"), parseListSpec("tile"), depth, ro,

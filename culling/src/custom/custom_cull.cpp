@@ -13,6 +13,7 @@
 #include <png.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -397,10 +398,16 @@ RunOutput checkListDump(const Scene& scene, const std::string& listsPath, const 
         std::istringstream in(bytes);
         std::string line;
         int lineNo = 0;
+        if (bytes.find_first_not_of(" \t\r\n") == std::string::npos)
+            throw InputError(listsPath, "", 0, "empty: not a list dump (a CSV holds a line per list: list,light,light,...)");
         while (std::getline(in, line)) {
             ++lineNo;
             if (!line.empty() && line.back() == '\r') line.pop_back();
-            if (line.empty() || (lineNo == 1 && line.find_first_of("0123456789") != 0)) continue; // header
+            // A header: a first line with a letter in it ("list,lights").
+            const bool header = lineNo == 1 && std::any_of(line.begin(), line.end(), [](unsigned char c) {
+                                    return std::isalpha(c) != 0;
+                                });
+            if (line.empty() || header) continue;
             const auto fields = splitOn(line, ',');
             std::uint64_t list = 0;
             if (!parseUint(fields[0], list))
@@ -425,6 +432,12 @@ RunOutput checkListDump(const Scene& scene, const std::string& listsPath, const 
             throw InputError(listsPath, "", 0, std::to_string(bytes.size() / 4) + " words, but " + toString(layout) +
                                                    " with " + std::to_string(r.listOffset.size()) + " lists (" + toString(lists) +
                                                    ") and " + std::to_string(lightCount) + " lights needs " + std::to_string(need));
+        if (bytes.size() / 4 > need)
+            report.warnings.push_back(
+                fs::path(listsPath).filename().string() + ": " + std::to_string(bytes.size() / 4) + " words, of which " +
+                toString(layout) + " with " + std::to_string(r.listOffset.size()) + " lists (" + toString(lists) +
+                ") reads the first " + std::to_string(need) +
+                ": a padded buffer is fine, but check the layout, --tile and the resolution");
         std::vector<std::uint32_t> words(bytes.size() / 4);
         for (std::size_t i = 0; i < words.size(); ++i) {
             const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + 4 * i);

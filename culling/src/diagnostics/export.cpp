@@ -197,6 +197,7 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
         cj["invalid_indices"] = c.invalidIndices;
         cj["duplicate_indices"] = c.duplicateIndices;
         cj["validation_messages"] = c.validationMessages;
+        cj["warnings"] = c.warnings;
         cj["builtin_algorithm"] = c.builtinAlgorithm;
         cj["builtin_entries"] = c.builtinEntries;
         cj["lists_differing_from_builtin"] = c.listsDifferingFromBuiltin;

@@ -86,6 +86,9 @@ struct CustomCullReport {
     // comparison: its entries, and lists where the two differ.
     std::string builtinAlgorithm;
     std::uint64_t builtinEntries = 0, listsDifferingFromBuiltin = 0;
+    // What was read but looks wrong without being an error (a dump longer
+    // than its layout needs: a padded buffer, or the wrong layout or grid).
+    std::vector<std::string> warnings;
 };
 
 // One false negative, located: in `tile`, `pixels` geometry pixels need
