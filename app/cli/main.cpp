@@ -611,6 +611,8 @@ int main(int argc, char** argv) {
         lc::exportDiagnostics(scene, settings, result, outDir);
         printSummary(scene, settings, result, outDir);
         return 0;
+    } catch (const lc::SettingsError& e) {
+        return fail(2, e.what()); // a bad value on the command line (docs/CLI.md: exit 2)
     } catch (const lc::Error& e) {
         return fail(1, e.what());
     } catch (const std::exception& e) {

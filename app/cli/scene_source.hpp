@@ -2,6 +2,7 @@
 // Where a CLI command's scene comes from: --scene FILE (scene JSON, .gltf or
 // .glb) or --builtin NAME, plus the glTF reading options. One definition
 // shared by run, bench, report and convert.
+#include "culling/core/errors.hpp"
 #include "culling/scene/gltf_io.hpp"
 #include "culling/scene/scene_io.hpp"
 
@@ -32,12 +33,12 @@ struct SceneSource {
                 cmd->add_option("--builtin", builtin, "Built-in scene to use (see `lightcull scenes`)")->type_name("NAME");
             optScene->excludes(optBuiltin);
         }
-        cmd->add_option("--camera", gltf.camera,
+        optCamera_ = cmd->add_option("--camera", gltf.camera,
                         "glTF: the culling camera, by camera or node name or by index into the file's cameras "
                         "(default: the first camera in the scene's node order; none: one framing the scene)")
             ->type_name("NAME|INDEX")
             ->needs(optScene);
-        cmd->add_option("--min-intensity", gltf.minIntensity,
+        optMinIntensity_ = cmd->add_option("--min-intensity", gltf.minIntensity,
                         "glTF: I_min in lux that sets the culling radius of a light without `range`, "
                         "r = sqrt(intensity x max colour / I_min) (default: 0.01)")
             ->type_name("LUX")
@@ -46,9 +47,22 @@ struct SceneSource {
 
     bool given() const { return !sceneFile.empty() || !builtin.empty(); }
 
+private:
+    CLI::Option* optCamera_ = nullptr;
+    CLI::Option* optMinIntensity_ = nullptr;
+
+public:
+
     // Loads it; glTF warnings go to stderr, one line each.
     lc::Scene load() const {
         if (sceneFile.empty()) return lc::makeBuiltinScene(builtin);
+        // A scene JSON holds its camera and each light's I_min: a glTF
+        // option given with one would be ignored without a word.
+        if (!lc::isGltfPath(sceneFile))
+            for (CLI::Option* o : {optCamera_, optMinIntensity_})
+                if (o && o->count())
+                    throw lc::SettingsError(o->get_name(), "applies to glTF scenes; " + sceneFile +
+                                                                         " is scene JSON, which holds its own");
         lc::GltfReadReport report;
         const auto t0 = std::chrono::steady_clock::now();
         lc::Scene s = lc::loadSceneAny(sceneFile, gltf, &report);

@@ -85,7 +85,9 @@ namespace {
 
 // Runs a command expected to fail: non-zero exit, exactly one line on stderr
 // mentioning `needle`, nothing on stdout, and the output folder not created.
-void expectCleanFailure(std::vector<std::string> args, const std::string& needle) {
+// `code`: the exit status expected (docs/CLI.md: 2 for a bad command line,
+// 1 for a failed run); -1: any failure.
+void expectCleanFailure(std::vector<std::string> args, const std::string& needle, int code = -1) {
     ScratchDir s;
     const fs::path out = s.path / "out";
     bool hasOut = false;
@@ -96,6 +98,7 @@ void expectCleanFailure(std::vector<std::string> args, const std::string& needle
     std::string joined;
     for (const auto& a : args) joined += a + " ";
     EXPECT_NE(r.code, 0) << joined;
+    if (code >= 0) EXPECT_EQ(r.code, code) << joined << "\nstderr: " << r.err;
     EXPECT_EQ(lineCount(r.err), 1u) << joined << "\nstderr: " << r.err;
     EXPECT_NE(r.err.find(needle), std::string::npos) << joined << "\nstderr: " << r.err;
     EXPECT_EQ(r.err.find("terminate"), std::string::npos) << r.err;
@@ -116,16 +119,20 @@ TEST(Cli, BadCommandLinesFailWithOneLineNamingTheProblem) {
         a.insert(a.end(), extra.begin(), extra.end());
         return a;
     };
-    expectCleanFailure(with({"--bogus", "3"}), "--bogus");
-    expectCleanFailure(with({"--cells", "99"}), "cells");
-    expectCleanFailure(with({"--cells", "many"}), "cells");
-    expectCleanFailure(with({"--algorithm", "quadtree"}), "algorithm");
-    expectCleanFailure(with({"--test", "sphere"}), "test");
-    expectCleanFailure(with({"--slicing", "cubic"}), "slicing");
-    expectCleanFailure(with({"--skip-empty", "maybe"}), "skip-empty");
-    expectCleanFailure(with({"--tile", "0"}), "tile");
-    expectCleanFailure(with({"--width", "-5"}), "width");
-    expectCleanFailure(with({"--lights", "-3"}), "lights");
+    // A bad value on the command line: exit 2, whichever layer finds it
+    // (the parser, the parameter table, the light generator).
+    expectCleanFailure(with({"--bogus", "3"}), "--bogus", 2);
+    expectCleanFailure(with({"--cells", "99"}), "cells", 2);
+    expectCleanFailure(with({"--cells", "many"}), "cells", 2);
+    expectCleanFailure(with({"--algorithm", "quadtree"}), "algorithm", 2);
+    expectCleanFailure(with({"--test", "sphere"}), "test", 2);
+    expectCleanFailure(with({"--slicing", "cubic"}), "slicing", 2);
+    expectCleanFailure(with({"--skip-empty", "maybe"}), "skip-empty", 2);
+    expectCleanFailure(with({"--tile", "0"}), "tile", 2);
+    expectCleanFailure(with({"--width", "-5"}), "width", 2);
+    expectCleanFailure(with({"--width", "0"}), "width", 2);
+    expectCleanFailure(with({"--lights", "-3"}), "lights", 2);
+    expectCleanFailure(with({"--lights", "1000001"}), "lights", 2);
     expectCleanFailure({"run", "--builtin", "wall", "--backend", "metal", "--out", "OUT"}, "metal");
     expectCleanFailure({"run", "--builtin", "nowhere", "--out", "OUT"}, "nowhere");
     expectCleanFailure({"run", "--scene", "/nonexistent/scene.json", "--out", "OUT"}, "/nonexistent/scene.json");
@@ -133,7 +140,15 @@ TEST(Cli, BadCommandLinesFailWithOneLineNamingTheProblem) {
     expectCleanFailure({"run", "--builtin", "wall"}, "--out");
     expectCleanFailure({"run", "--out", "OUT"}, "--builtin");
     expectCleanFailure({"run", "--builtin", "wall", "--out", "/nonexistent/parent/out"}, "/nonexistent/parent");
-    expectCleanFailure({"frobnicate"}, "frobnicate");
+    expectCleanFailure({"frobnicate"}, "frobnicate", 2);
+    // glTF's --camera and --min-intensity with a scene JSON would be ignored.
+    {
+        const fs::path scene = fs::path(LC_SOURCE_DIR) / "resources" / "scenes" / "stele_courtyard.json";
+        expectCleanFailure({"run", "--scene", scene.string(), "--camera", "Main", "--out", "OUT"},
+                           "--camera: applies to glTF scenes", 2);
+        expectCleanFailure({"run", "--scene", scene.string(), "--min-intensity", "0.5", "--out", "OUT"},
+                           "--min-intensity: applies to glTF scenes", 2);
+    }
     expectCleanFailure({}, "subcommand");
 }
 
