@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 #include <png.h>
 
+#include <tuple>
+
 #include <fstream>
 
 using namespace lc;
@@ -83,6 +85,21 @@ TEST(DepthFile, BadFilesAreOneLineErrors) {
         << errorOf((d.path / "range.f32").string(), proj);
     writePng16(d.path / "big.png", 8, 2, std::vector<std::uint16_t>(16, 0));
     EXPECT_NE(errorOf((d.path / "big.png").string(), proj).find("8x2 pixels, but the camera is 4x2"), std::string::npos);
+    // 8-bit grey (libpng would gamma-decode it) and colour: refused.
+    {
+        for (const auto& [format, name, expect] :
+             {std::tuple<png_uint_32, const char*, const char*>{PNG_FORMAT_GRAY, "grey8.png", "an 8-bit PNG"},
+              {PNG_FORMAT_LINEAR_RGB, "rgb16.png", "a colour PNG"}}) {
+            png_image img{};
+            img.version = PNG_IMAGE_VERSION;
+            img.width = 4;
+            img.height = 2;
+            img.format = format;
+            const std::vector<std::uint16_t> px(4 * 2 * 3, 1000);
+            ASSERT_TRUE(png_image_write_to_file(&img, (d.path / name).string().c_str(), 0, px.data(), 0, nullptr));
+            EXPECT_NE(errorOf((d.path / name).string(), proj).find(expect), std::string::npos) << name;
+        }
+    }
     std::ofstream(d.path / "not.png") << "not a png";
     EXPECT_NE(errorOf((d.path / "not.png").string(), proj).find("not a readable PNG"), std::string::npos);
 }

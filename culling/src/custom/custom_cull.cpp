@@ -476,6 +476,16 @@ DepthImage loadDepthFile(const std::string& path, const Projection& proj) {
                                               " pixels, but the camera is " + std::to_string(d.width) + "x" +
                                               std::to_string(d.height));
         }
+        // Depth is 16-bit grey: an 8-bit file holds 1/256 of the precision
+        // and libpng would gamma-decode it, a colour one is no depth at all.
+        if (!(img.format & PNG_FORMAT_FLAG_LINEAR) || (img.format & PNG_FORMAT_FLAG_COLOR)) {
+            const bool colour = img.format & PNG_FORMAT_FLAG_COLOR;
+            png_image_free(&img);
+            throw InputError(path, "", 0,
+                             std::string(colour ? "a colour" : "an 8-bit") +
+                                 " PNG; depth is read from 16-bit greyscale PNGs (0..65535 is window depth 0..1) "
+                                 "or raw float32");
+        }
         img.format = PNG_FORMAT_LINEAR_Y; // 16-bit grey, no gamma applied
         std::vector<std::uint16_t> px(n);
         if (!png_image_finish_read(&img, nullptr, px.data(), 0, nullptr))
