@@ -230,12 +230,17 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
         };
         // The one per-chunk test: the culling sphere, then for a spot light
         // under a cone test the cone refinement (spot_tests.hpp).
+        // Counted per tile row (the rows run on several threads), summed below.
+        std::vector<std::uint64_t> rowTests(grid.tilesY, 0);
+        static thread_local std::uint64_t* tests = nullptr;
         auto intersects = [&](const FrustumChunk& chunk, std::uint32_t l) {
+            ++*tests;
             if (!sphereIntersectsChunk(test, chunk, sphereCenter[l], sphereRadius[l])) return false;
             if (!coneRefines || !lights.isSpot(l)) return true;
             return spotIntersectsChunk(settings.spotTest, test, lights.spotCone(l), chunk);
         };
         parallelRows(grid.tilesY, [&](std::uint32_t ty) {
+            tests = &rowTests[ty];
             std::vector<std::uint32_t> candidates;
             for (std::size_t l = 0; l < n; ++l)
                 if (!ranges[l].empty() && ranges[l].ty0 <= ty && ty <= ranges[l].ty1)
@@ -313,6 +318,7 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
                 }
             }
         });
+        for (std::uint64_t t : rowTests) res.volumeTests += t;
     }
 
     if (algo == Algorithm::ZBin) {

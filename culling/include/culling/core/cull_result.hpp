@@ -65,7 +65,8 @@ struct CullResult {
     std::vector<std::uint32_t> listOffset, listCount, lightIndices;
 
     // Light-versus-volume tests one pass over the lists performed (Vulkan: the
-    // candidates left by the light bins); 0 when the backend does not count.
+    // candidates left by the light bins; cpu: the lights whose screen bounds
+    // reach the tile, per tile, half or froxel); 0 when nothing was tested.
     std::uint64_t volumeTests = 0;
 
     std::string backend;      // "cpu" or "vulkan"
