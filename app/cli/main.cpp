@@ -205,10 +205,11 @@ void addBenchOptions(CLI::App* cmd, BenchOptions& o) {
     cmd->add_option("--warmup", o.warmup, "Untimed runs before the repeats (default: 2)")
         ->type_name("N")
         ->check(CLI::Range(0, 100000));
+    std::string params; // from the parameter table, so the help names every one
+    for (const lc::ParamSpec& p : lc::cullParams()) params += std::string(params.empty() ? "" : ", ") + p.name;
     cmd->add_option("--sweep", o.sweeps,
                     "KEY=V1,V2,... run every value; several --sweep flags form a cross product. KEY: lights, "
-                    "resolution (WxH), or any culling parameter (algorithm, test, cells, slicing, skip-empty, "
-                    "tile, width, height)")
+                    "resolution (WxH), or any culling parameter (" + params + ")")
         ->type_name("KEY=V1,V2,...");
     cmd->add_option("--json", o.jsonFile, "Also write the results as JSON to FILE")->type_name("FILE");
 }
