@@ -68,6 +68,27 @@ TEST(Explain, TestsAgreeWithTheReferenceListsForEveryAlgorithm) {
     }
 }
 
+// A spot's false positive whose nearest pixel is within its range lies
+// outside its cone: the verdict says so, not "0 beyond its range".
+TEST(Explain, ASpotFalsePositiveWithinRangeIsOutsideItsCone) {
+    const Scene s = smallAtrium();
+    const Projection proj(s.camera);
+    CullSettings cs;
+    cs.algorithm = Algorithm::MinMax;
+    const RunOutput run = cpuRun(s, cs);
+    int seen = 0;
+    for (std::uint32_t l = 0; l < run.result.listCount.size(); ++l)
+        for (std::uint32_t i = 0; i < run.lights.size(); ++i) {
+            const Explanation e = explainLight(run, proj, l, i);
+            if (!e.listed || e.pixelsNeeding > 0 || e.nearestDistance < 0) continue;
+            const bool inCone = e.nearestDistance == 0.0 && run.lights.isSpot(i);
+            EXPECT_EQ(e.verdict.find("outside its cone") != std::string::npos, inCone) << e.verdict;
+            EXPECT_EQ(e.verdict.find(" 0 beyond") != std::string::npos, false) << e.verdict;
+            seen += inCone;
+        }
+    EXPECT_GT(seen, 0); // the scene has such spots
+}
+
 // The deciding plane: chunkFace's corners lie on the plane it names, and it
 // is the plane of least margin (a failed one when a plane rejects).
 TEST(Explain, TheDecidingPlaneIsTheOneOfLeastMargin) {

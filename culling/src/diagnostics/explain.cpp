@@ -270,8 +270,12 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
     } else if (e.listed) {
         e.verdict = e.listPixels == 0 ? "listed, but no pixel uses this list"
                                       : "false positive: listed, but none of the list's " + std::to_string(e.listPixels) +
-                                            " pixels is inside its volume; the nearest is " + num(e.nearestDistance) +
-                                            " beyond its range (pixel " + std::to_string(e.nearestX) + "," +
+                                            " pixels is inside its volume; the nearest is " +
+                                            // A spot's pixel within its range is outside its cone.
+                                            (e.nearestDistance == 0.0 && lights.isSpot(light)
+                                                 ? std::string("within its range but outside its cone")
+                                                 : num(e.nearestDistance) + " beyond its range") +
+                                            " (pixel " + std::to_string(e.nearestX) + "," +
                                             std::to_string(e.nearestY) + ")" +
                                             (e.testsPass ? ": the tests are conservative here (the sphere meets the "
                                                            "chunk, not the pixels' surfaces)"
