@@ -366,9 +366,19 @@ TEST(Gltf, LightsFollowTheirNodes) {
     bool warned = false;
     for (const auto& w : rep.warnings) warned |= w.find("directional light 'sun'") != std::string::npos;
     EXPECT_TRUE(warned);
+    EXPECT_EQ(rep.warnings.size(), 1u); // nothing else to say of this file
     // I_min must be usable.
     o.minIntensity = 0.0;
     EXPECT_THROW(lc::loadGltfScene(p.string(), o), lc::SettingsError);
+    // An inner cone past the outer one is taken as the outer, and said so.
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"][2]["spot"]["innerConeAngle"] = 0.7;
+    writeBytes(p, b.gltfText());
+    lc::GltfReadReport rep2;
+    const lc::Scene sc2 = lc::loadGltfScene(p.string(), {}, &rep2);
+    EXPECT_DOUBLE_EQ(sc2.lights[2].innerAngleDeg, sc2.lights[2].outerAngleDeg);
+    bool coneWarned = false;
+    for (const auto& w : rep2.warnings) coneWarned |= w.find("innerConeAngle of light 'spot' is past its outerConeAngle") != std::string::npos;
+    EXPECT_TRUE(coneWarned);
 }
 
 TEST(Gltf, CamerasAreChosenAndConverted) {
@@ -508,6 +518,11 @@ TEST(GltfHostile, EveryDefectIsOneLineNamingFileAndPath) {
     cases.push_back({patched([](json& d) { d["nodes"][0]["matrix"] = {1, 2, 3}; }), "nodes[0].matrix: must have 16 numbers"});
     cases.push_back({patched([](json& d) { d["nodes"][0]["rotation"] = {0, 0, 0, 0}; }), "nodes[0].rotation: is a zero quaternion"});
     cases.push_back({patched([](json& d) { d["scene"] = 4; }), "scene: 4 is not an index into scenes"});
+    cases.push_back({patched([](json& d) { d["asset"]["version"] = "3.0"; }), "asset.version: '3.0': this reads glTF 2.x"});
+    cases.push_back({patched([](json& d) {
+                         d["nodes"][0]["matrix"] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.5, 0, 0, 0, 1};
+                     }),
+                     "nodes[0].matrix: is not affine"});
     cases.push_back({patched([](json& d) { d["buffers"][0]["uri"] = "missing.bin"; }), "not valid glTF"});
     cases.push_back({patched([](json& d) {
                          d["meshes"][0]["primitives"][0]["indices"] = 1;
@@ -559,6 +574,18 @@ TEST(GltfHostile, EveryDefectIsOneLineNamingFileAndPath) {
         b.mesh(json::array({{{"attributes", {{"POSITION", acc}}}}}));
         b.scene({b.node({{"mesh", 0}})});
         cases.push_back({b.glb(), "accessors[0].count: 1,000,000,000 vertices without data"});
+    }
+    {
+        // Sparse indices must increase strictly (glTF 2.0, 3.6.2.3).
+        GltfBuilder b;
+        const int acc = b.accessor(-1, 5126, 3, "VEC3");
+        b.doc["accessors"][0]["sparse"] = {
+            {"count", 2},
+            {"indices", {{"bufferView", b.view(std::vector<std::uint32_t>{2, 1})}, {"componentType", 5125}}},
+            {"values", {{"bufferView", b.view(std::vector<float>{1, 0, 0, 0, 1, 0})}}}};
+        b.mesh(json::array({{{"attributes", {{"POSITION", acc}}}}}));
+        b.scene({b.node({{"mesh", 0}})});
+        cases.push_back({b.glb(), "accessors[0].sparse.indices: element 1 (1) is not greater than the one before"});
     }
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const bool binary = cases[i].first.rfind("glT", 0) == 0;

@@ -54,6 +54,12 @@ std::string firstLine(std::string s) {
     return s;
 }
 
+std::string shortNumber(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+}
+
 std::string lowerExt(const std::string& path) {
     std::string e = fs::path(path).extension().string();
     std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
@@ -273,6 +279,8 @@ public:
     }
 
     std::size_t dropped() const { return dropped_; }
+    // Vertices after a TRIANGLES primitive's last whole triangle.
+    std::size_t trailing() const { return trailing_; }
 
     const tinygltf::Accessor& accessor(int i, const std::string& field) const {
         if (i < 0 || std::size_t(i) >= m_.accessors.size())
@@ -298,6 +306,8 @@ private:
             finite(node.matrix, "matrix");
             glm::dmat4 m;
             for (int k = 0; k < 16; ++k) m[k / 4][k % 4] = node.matrix[std::size_t(k)]; // column-major, as glTF
+            if (m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 || m[3][3] != 1.0)
+                fail(np + ".matrix", "is not affine: its last row must be 0, 0, 0, 1 (elements 3, 7, 11, 15)");
             return m;
         }
         glm::dmat4 t(1.0), r(1.0), s(1.0);
@@ -458,6 +468,9 @@ private:
                 if (target >= count)
                     fail(sp + ".indices", "element " + std::to_string(k) + " is " + std::to_string(target) +
                                               ", outside 0.." + withCommas(count - 1));
+                if (k > 0 && target <= indexValue(is.data + (k - 1) * is.stride, it))
+                    fail(sp + ".indices", "element " + std::to_string(k) + " (" + std::to_string(target) +
+                                              ") is not greater than the one before: glTF's sparse indices increase strictly");
                 for (int c = 0; c < 3; ++c)
                     out[before + 3 * target + std::size_t(c)] = component(vs.data + k * vs.stride + std::size_t(c) * cb, a.componentType, a.normalized);
             }
@@ -499,6 +512,7 @@ private:
         };
         if (mode == TINYGLTF_MODE_TRIANGLES) {
             for (std::size_t k = 0; k + 2 < c.size(); k += 3) add(c[k], c[k + 1], c[k + 2]);
+            trailing_ += c.size() % 3;
         } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
             // Winding alternates; culling draws both faces, the order is kept
             // as the specification gives it anyway.
@@ -516,7 +530,7 @@ private:
     GltfReadReport& rep_;
     const CancelToken* cancel_;
     std::vector<ModelGeometry> geometry_;
-    std::size_t dropped_ = 0;
+    std::size_t dropped_ = 0, trailing_ = 0;
     bool warnedMorph_ = false;
 };
 
@@ -553,6 +567,8 @@ tinygltf::Model parseModel(const std::string& path, GltfReadReport& rep) {
         throw InputError(path, "", 0, "not valid glTF: " + why);
     }
     if (!warn.empty()) rep.warnings.push_back(path + ": " + firstLine(warn));
+    if (model.asset.version.rfind("2.", 0) != 0)
+        throw InputError(path, "asset.version", 0, "'" + model.asset.version + "': this reads glTF 2.x");
     return model;
 }
 
@@ -611,6 +627,10 @@ Loaded readGeometry(const std::string& path, const tinygltf::Model& model, GltfR
     rep.degenerateTrianglesDropped = r.dropped();
     if (r.dropped() > 0)
         rep.warnings.push_back(path + ": dropped " + std::to_string(r.dropped()) + " degenerate triangle(s) (repeated corner)");
+    if (r.trailing() > 0)
+        rep.warnings.push_back(path + ": " + std::to_string(r.trailing()) +
+                               " vertex(es) after the last whole triangle of TRIANGLES primitives ignored (count not a "
+                               "multiple of 3)");
     if (progress) progress(0.9);
     return out;
 }
@@ -724,8 +744,17 @@ Camera readCamera(const std::string& path, const tinygltf::Model& model, const s
     } else {
         throw InputError(path, cp + ".type", 0, "'" + gc.type + "' is not perspective or orthographic");
     }
-    if (aspect > 0.0 && std::isfinite(aspect))
-        cam.height = std::uint32_t(std::clamp(std::lround(double(cam.width) / aspect), 1L, 16384L));
+    if (aspect > 0.0 && std::isfinite(aspect)) {
+        const long h = std::lround(double(cam.width) / aspect);
+        cam.height = std::uint32_t(std::clamp(h, 1L, 16384L));
+        if (h < 1 || h > 16384)
+            rep.warnings.push_back(path + ": " + cp + " aspect ratio " + shortNumber(aspect) + " at width " +
+                                   std::to_string(cam.width) + " asks for a height of " + std::to_string(h) +
+                                   ": " + std::to_string(cam.height) + " used");
+    } else if (aspect < 0.0 || !std::isfinite(aspect)) {
+        rep.warnings.push_back(path + ": " + cp + ".perspective.aspectRatio " + shortNumber(aspect) +
+                               " is not > 0: ignored");
+    }
     if (const tinygltf::Value* x = lightcullExtras(gc.extras)) {
         double v = 0;
         if (x->Has("projection") && x->Get("projection").IsString()) {
@@ -802,6 +831,9 @@ std::vector<PointLight> readLights(const std::string& path, const tinygltf::Mode
             if (glm::length(l.direction) > 0.0) l.direction = glm::normalize(l.direction);
             l.outerAngleDeg = gl.spot.outerConeAngle * 180.0 / kPi;
             l.innerAngleDeg = std::min(std::max(gl.spot.innerConeAngle, 0.0) * 180.0 / kPi, l.outerAngleDeg);
+            if (gl.spot.innerConeAngle > gl.spot.outerConeAngle)
+                rep.warnings.push_back(path + ": " + lp + ".spot.innerConeAngle of light '" + name +
+                                       "' is past its outerConeAngle: taken as the outer angle");
         }
         if (const tinygltf::Value* x = lightcullExtras(gl.extras)) {
             // Written by serializeGltf: the light's own I_min, and whether its
