@@ -379,6 +379,11 @@ TEST(Gltf, LightsFollowTheirNodes) {
     bool coneWarned = false;
     for (const auto& w : rep2.warnings) coneWarned |= w.find("innerConeAngle of light 'spot' is past its outerConeAngle") != std::string::npos;
     EXPECT_TRUE(coneWarned);
+    // A spot under a zero scale has no direction: the error says why.
+    b.doc["nodes"][std::size_t(spot)]["scale"] = {0, 0, 0};
+    writeBytes(p, b.gltfText());
+    const std::string msg = loadError(p);
+    EXPECT_NE(msg.find("light 'spot': its direction, the node's -Z axis, is zero (a zero scale?)"), std::string::npos) << msg;
 }
 
 TEST(Gltf, CamerasAreChosenAndConverted) {

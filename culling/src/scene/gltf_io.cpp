@@ -564,6 +564,8 @@ tinygltf::Model parseModel(const std::string& path, GltfReadReport& rep) {
         std::string why = firstLine(err.empty() ? std::string("unreadable") : err);
         if (why.find("Failed to decode 'uri'") != std::string::npos)
             why += " (a buffer's data: URI that is not base64 of its byteLength bytes)";
+        if (why.find("Spot light description not found") != std::string::npos)
+            why += " (a KHR_lights_punctual light of type spot without its \"spot\" object)";
         throw InputError(path, "", 0, "not valid glTF: " + why);
     }
     if (!warn.empty()) rep.warnings.push_back(path + ": " + firstLine(warn));
@@ -852,6 +854,11 @@ std::vector<PointLight> readLights(const std::string& path, const tinygltf::Mode
             for (const auto& [k, suffix] : keys)
                 if (key == k) field += suffix;
             if (key == "position" || key == "direction") field = idx("nodes", std::size_t(p.node));
+            if (key == "direction")
+                throw InputError(path, field, 0, "light '" + l.name + "': its direction, the node's -Z axis, is " +
+                                                     (std::isfinite(l.direction.x + l.direction.y + l.direction.z) ? "zero (a zero scale?)" : "not finite"));
+            if (key == "position")
+                throw InputError(path, field, 0, "light '" + l.name + "': its position, from the node's transform, is not finite");
             if (key == "min_intensity")
                 throw SettingsError("min-intensity", e.substr(e.find(':') + 2));
             throw InputError(path, field, 0, "light '" + l.name + "': " + e.substr(e.find(':') + 2));
