@@ -53,6 +53,7 @@
 #include <vtkRenderer.h>
 
 #include <cmath>
+#include <set>
 
 namespace lcui {
 
@@ -868,6 +869,21 @@ bool MainWindow::generateLights(const lc::LightGenSettings& g) {
         log(tr("cannot generate lights: %1").arg(describe(e)), true);
         prompts.showError(this, tr("Generate lights"), describe(e));
         return false;
+    }
+    // The generator numbers from light_0; beside the scene's lights the
+    // numbering goes on past theirs, so names (explain --light NAME, the
+    // scene tree's filter) stay unique.
+    std::set<std::string> taken;
+    for (const lc::PointLight& l : doc_->scene().lights) taken.insert(l.name);
+    std::size_t next = doc_->scene().lights.size();
+    for (lc::PointLight& l : lights) {
+        if (!taken.count(l.name)) {
+            taken.insert(l.name);
+            continue;
+        }
+        while (taken.count("light_" + std::to_string(next))) ++next;
+        l.name = "light_" + std::to_string(next++);
+        taken.insert(l.name);
     }
     doc_->addLights(lights, tr("Generate %1 lights").arg(lights.size()), /*select=*/false);
     log(tr("generated %1 lights (seed %2)").arg(lights.size()).arg(g.seed));

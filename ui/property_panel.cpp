@@ -82,7 +82,7 @@ PropertyPanel::PropertyPanel(Document* doc, QWidget* parent) : QWidget(parent), 
     color_ = new QPushButton;
     color_->setObjectName("lightColor");
     lf->addRow(tr("Colour"), color_);
-    intensity_ = makeSpin(0, 1e9, 3, "lightIntensity");
+    intensity_ = makeSpin(0, 1e9, 6, "lightIntensity"); // small scenes light in millicandela
     lf->addRow(tr("Intensity"), intensity_);
     minIntensity_ = makeSpin(1e-6, 1e9, 6, "lightMinIntensity");
     lf->addRow(tr("Min intensity"), minIntensity_);
@@ -268,6 +268,12 @@ void PropertyPanel::commitLight() {
                       l.explicitRadius == before.explicitRadius && l.kind == before.kind &&
                       l.direction == before.direction && l.outerAngleDeg == before.outerAngleDeg;
     if (same) return;
+    // A light is found by its name (explain --light, the scene tree's filter).
+    if (l.name.empty()) {
+        refresh();
+        emit editRefused(tr("light %1 not changed: name: must not be empty").arg(cur));
+        return;
+    }
     if (const std::string err = l.validate(); !err.empty()) {
         refresh();
         emit editRefused(tr("light %1 not changed: %2").arg(cur).arg(QString::fromStdString(err)));

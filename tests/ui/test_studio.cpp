@@ -22,6 +22,7 @@
 #include <vtkScalarBarActor.h>
 
 #include <QAction>
+#include <set>
 #include <QDoubleSpinBox>
 #include <QFile>
 #include <QItemSelectionModel>
@@ -571,6 +572,40 @@ private slots:
             for (int k = 0; k < labels; ++k) printed << QString::number(top * k / (labels - 1), 'f', 0);
             QCOMPARE(QSet<QString>(printed.begin(), printed.end()).size(), labels);
         }
+    }
+
+    // A small scene's light (the Add spot light of a 10 cm model gets about
+    // 0.0004 cd) can be typed in: the field keeps six decimals.
+    void smallIntensitiesCanBeTyped() {
+        openSmall();
+        doc()->setSelectedLights({0});
+        auto* panel = w_->findChild<PropertyPanel*>();
+        auto* intensity = panel->findChild<QDoubleSpinBox*>("lightIntensity");
+        QVERIFY(intensity);
+        intensity->setValue(0.0004);
+        QCOMPARE(doc()->scene().lights[0].intensity, 0.0004);
+    }
+
+    // Lights are found by name: generating beside the scene's own lights
+    // numbers on past theirs, and an empty name is refused.
+    void lightNamesStayUniqueAndNonEmpty() {
+        openSmall();
+        const std::size_t before = doc()->scene().lights.size();
+        QVERIFY(w_->generateLights(lc::defaultLightGen(doc()->scene(), 30, 3)));
+        std::set<std::string> names;
+        for (const auto& l : doc()->scene().lights) names.insert(l.name);
+        QCOMPARE(names.size(), before + 30);
+        doc()->setSelectedLights({0});
+        auto* panel = w_->findChild<PropertyPanel*>();
+        QSignalSpy refused(panel, &PropertyPanel::editRefused);
+        auto* name = panel->findChild<QLineEdit*>("lightName");
+        QVERIFY(name);
+        const std::string old = doc()->scene().lights[0].name;
+        name->clear();
+        QTest::keyClick(name, Qt::Key_Return);
+        QCOMPARE(refused.size(), 1);
+        QCOMPARE(doc()->scene().lights[0].name, old);
+        QCOMPARE(name->text(), QString::fromStdString(old));
     }
 
     // The keys docs/STUDIO.md lists reach their actions on any platform
