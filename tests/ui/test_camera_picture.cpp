@@ -113,6 +113,29 @@ class CameraPictureTest : public QObject {
         QCOMPARE(differingPixels(resized, frame()), 0);
         QCOMPARE(view_->meshPictureCaptures(), after);
     }
+
+    // The image keeps the camera's aspect, fitted beside the legend band,
+    // whatever size the view had while it was hidden (a dock re-laid out
+    // while another tab showed, a window resized twice).
+    void aViewResizedWhileHiddenFitsItsNewSize() {
+        frame();
+        for (const QSize size : {QSize(300, 500), QSize(180, 120), QSize(900, 300)}) {
+            view_->hide();
+            view_->resize(size);
+            view_->show();
+            QVERIFY(QTest::qWaitForWindowExposed(view_.get()));
+            frame();
+            const double* vp = view_->sceneRenderer()->GetViewport();
+            const double w = view_->width(), h = view_->height();
+            const double vw = (vp[2] - vp[0]) * w, vh = (vp[3] - vp[1]) * h;
+            const double aspect = doc_->scene().camera.aspect();
+            QVERIFY2(std::abs(vw / vh - aspect) < 0.02 * aspect, qPrintable(QString("%1x%2").arg(vw).arg(vh)));
+            // Fitted: as wide as the room beside the legend, or as tall as the view.
+            const double room = w - 110;
+            QVERIFY2(std::abs(vw - room) < 1.5 || std::abs(vh - h) < 1.5,
+                     qPrintable(QString("%1x%2 in %3x%4").arg(vw).arg(vh).arg(w).arg(h)));
+        }
+    }
 };
 
 LC_STUDIO_TEST_MAIN(CameraPictureTest)
