@@ -1,9 +1,13 @@
 #include "generate_dialog.hpp"
 
+#include "culling/core/errors.hpp"
+#include "culling/scene/scene_io.hpp"
+
 #include <QDialogButtonBox>
 #include <QDoubleSpinBox>
 #include <QFormLayout>
 #include <QHBoxLayout>
+#include <QLabel>
 #include <QSpinBox>
 
 namespace lcui {
@@ -46,6 +50,8 @@ GenerateLightsDialog::GenerateLightsDialog(const lc::LightGenSettings& g, QWidge
     form->addRow(tr("Volume max"), triple(boxMax_, g.boxMax, -1e6, 1e6));
     intensityMin_ = spin(0, 1e9, g.intensityMin);
     intensityMax_ = spin(0, 1e9, g.intensityMax);
+    intensityMin_->setObjectName("genIntensityMin");
+    intensityMax_->setObjectName("genIntensityMax");
     form->addRow(tr("Intensity min"), intensityMin_);
     form->addRow(tr("Intensity max"), intensityMax_);
     form->addRow(tr("Colour min"), triple(colorMin_, g.colorMin, 0, 100));
@@ -71,8 +77,25 @@ GenerateLightsDialog::GenerateLightsDialog(const lc::LightGenSettings& g, QWidge
     connect(spotAngleMax_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, [this](double v) {
         if (spotAngleMin_->value() > v) spotAngleMin_->setValue(v);
     });
+    // Settings the generator refuses keep the dialog open with the reason,
+    // every value as typed.
+    error_ = new QLabel;
+    error_->setObjectName("genError");
+    error_->setStyleSheet("color: rgb(200,40,40)");
+    error_->setWordWrap(true);
+    error_->hide();
+    form->addRow(error_);
     auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
-    connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
+    connect(buttons, &QDialogButtonBox::accepted, this, [this] {
+        try {
+            lc::checkLightGen(settings());
+        } catch (const lc::Error& e) {
+            error_->setText(QString::fromStdString(e.what()));
+            error_->show();
+            return;
+        }
+        accept();
+    });
     connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
     form->addRow(buttons);
 }

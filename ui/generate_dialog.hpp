@@ -9,6 +9,7 @@
 #include <QDialog>
 
 class QDoubleSpinBox;
+class QLabel;
 class QSpinBox;
 
 namespace lcui {
@@ -32,6 +33,7 @@ private:
     QDoubleSpinBox* spotFraction_;
     QDoubleSpinBox* spotAngleMin_;
     QDoubleSpinBox* spotAngleMax_;
+    QLabel* error_;
 };
 
 } // namespace lcui

@@ -18,6 +18,8 @@
 #include <QAction>
 #include <QComboBox>
 #include <QDoubleSpinBox>
+#include <QPushButton>
+#include <QDialogButtonBox>
 #include <QElapsedTimer>
 #include <QImage>
 #include <QLabel>
@@ -69,6 +71,33 @@ private slots:
     // The Generate lights dialog's spot fields reach the generator: every
     // light a spot (fraction 1) with its outer angle in the chosen range, a
     // mixed fraction gives both kinds, and the range cannot be inverted.
+    // Settings the generator refuses (an intensity range upside down) keep
+    // the dialog open with the reason, every field as typed.
+    void generateDialogKeepsRefusedValues() {
+        GenerateLightsDialog dlg(lc::defaultLightGen(doc()->scene(), 200, 3), w_.get());
+        auto* fraction = dlg.findChild<QDoubleSpinBox*>("genSpotFraction");
+        fraction->setValue(0.5);
+        auto* iMin = dlg.findChild<QDoubleSpinBox*>("genIntensityMin");
+        auto* iMax = dlg.findChild<QDoubleSpinBox*>("genIntensityMax");
+        QVERIFY(iMin && iMax);
+        iMin->setValue(20);
+        iMax->setValue(10);
+        dlg.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&dlg));
+        auto* ok = dlg.findChild<QDialogButtonBox*>()->button(QDialogButtonBox::Ok);
+        QTest::mouseClick(ok, Qt::LeftButton);
+        QVERIFY(dlg.isVisible());
+        QCOMPARE(dlg.result(), 0);
+        auto* error = dlg.findChild<QLabel*>("genError");
+        QVERIFY(error && error->isVisible());
+        QVERIFY2(error->text().contains("lights.intensity"), qPrintable(error->text()));
+        QCOMPARE(fraction->value(), 0.5);
+        QCOMPARE(iMin->value(), 20.0);
+        iMax->setValue(30);
+        QTest::mouseClick(ok, Qt::LeftButton);
+        QCOMPARE(dlg.result(), int(QDialog::Accepted));
+    }
+
     void generateDialogMakesSpots() {
         GenerateLightsDialog dlg(lc::defaultLightGen(doc()->scene(), 200, 3), w_.get());
         auto* fraction = dlg.findChild<QDoubleSpinBox*>("genSpotFraction");

@@ -35,8 +35,7 @@ void checkRange(const char* field, double lo, double hi) {
 
 } // namespace
 
-std::vector<PointLight> generateLights(const LightGenSettings& s, const CancelToken* cancel,
-                                       const Progress& progress) {
+void checkLightGen(const LightGenSettings& s) {
     for (int k = 0; k < 3; ++k) {
         checkRange("lights.box", s.boxMin[k], s.boxMax[k]);
         checkRange("lights.color", s.colorMin[k], s.colorMax[k]);
@@ -53,7 +52,11 @@ std::vector<PointLight> generateLights(const LightGenSettings& s, const CancelTo
     checkRange("lights.spot_angle", s.spotAngleMinDeg, s.spotAngleMaxDeg);
     if (s.spotFraction > 0 && !(s.spotAngleMinDeg > 0.0 && s.spotAngleMaxDeg <= 90.0))
         throw SettingsError("lights.spot_angle", "must lie in (0, 90] degrees");
+}
 
+std::vector<PointLight> generateLights(const LightGenSettings& s, const CancelToken* cancel,
+                                       const Progress& progress) {
+    checkLightGen(s);
     SplitMix64 rng{s.seed};
     std::vector<PointLight> out;
     out.reserve(s.count);

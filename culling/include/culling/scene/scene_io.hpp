@@ -71,6 +71,9 @@ struct LightGenSettings {
 };
 // Deterministic in `s` (seed included). `progress` is told how far it got
 // every few thousand lights; a set `cancel` stops it with lc::Cancelled.
+// Throws SettingsError naming the field ("lights.intensity: ...") for
+// settings generateLights refuses.
+void checkLightGen(const LightGenSettings& s);
 std::vector<PointLight> generateLights(const LightGenSettings& s, const CancelToken* cancel = nullptr,
                                        const Progress& progress = {});
 // Settings suited to a scene: placed in its mesh bounds, slightly grown, with
