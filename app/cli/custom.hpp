@@ -72,9 +72,12 @@ inline void printCustomReport(const lc::RunOutput& run, const lc::Scene& scene, 
     if (c.passMs >= 0) std::cout << ", pass " << c.passMs << " ms on " << c.device;
     std::cout << "\n  overflowed lists " << c.overflowLists << " (" << c.overflowEntries << " entries lost), invalid indices "
               << c.invalidIndices << ", duplicates " << c.duplicateIndices << ", validation messages "
-              << c.validationMessages.size() << "\n  against built-in " << c.builtinAlgorithm << " (cpu): "
-              << c.listsDifferingFromBuiltin << " lists differ, " << run.result.entries() << " entries vs "
-              << c.builtinEntries << "\n";
+              << c.validationMessages.size() << "\n";
+    if (c.builtinAlgorithm.rfind("none", 0) == 0)
+        std::cout << "  against built-in: " << c.builtinAlgorithm.substr(6, c.builtinAlgorithm.size() - 7) << "\n";
+    else
+        std::cout << "  against built-in " << c.builtinAlgorithm << " (cpu): " << c.listsDifferingFromBuiltin
+                  << " lists differ, " << run.result.entries() << " entries vs " << c.builtinEntries << "\n";
     for (const std::string& w : c.warnings) std::cout << "  warning: " << w << "\n";
     for (std::size_t i = 0; i < c.validationMessages.size() && i < 5; ++i)
         std::cout << "  validation: " << c.validationMessages[i].substr(0, 300) << "\n";

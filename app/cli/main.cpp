@@ -518,9 +518,12 @@ int main(int argc, char** argv) {
             bool byName = false;
             for (std::size_t i = 0; i < scene.lights.size(); ++i)
                 if (scene.lights[i].name == explainLightText) {
+                    // Two lights of one name (glTF allows it): the index decides.
+                    if (byName)
+                        return fail(2, "--light: lights " + std::to_string(light) + " and " + std::to_string(i) +
+                                           " are both named '" + explainLightText + "': give the index");
                     light = std::uint32_t(i);
                     byName = true;
-                    break;
                 }
             if (!byName) {
                 char* end = nullptr;

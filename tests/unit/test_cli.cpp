@@ -7,6 +7,8 @@
 #include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
+
+#include <sys/stat.h>
 #include <nlohmann/json.hpp>
 
 using lc_test::CliResult;
@@ -69,6 +71,14 @@ TEST(Cli, RunFromASceneFileWritesTheDiagnostics) {
     EXPECT_EQ(j["metrics"]["lists"], 10 * 6 * 2);
     EXPECT_TRUE(fs::is_regular_file(out / "tiles.csv"));
     EXPECT_TRUE(fs::is_regular_file(out / "heatmap.png"));
+    // The folder gets the permissions mkdir would give it (not mkdtemp's 0700).
+    {
+        const mode_t mask = ::umask(0);
+        ::umask(mask);
+        struct stat st {};
+        ASSERT_EQ(::stat(out.c_str(), &st), 0);
+        EXPECT_EQ(st.st_mode & 0777, 0777 & ~mask);
+    }
 
     // --lights with the same seed is deterministic; another seed differs.
     const CliResult again = runCli({"run", "--scene", (s.path / "scene.json").string(), "--width", "80",

@@ -214,4 +214,13 @@ TEST(Explain, CliPrintsTheSameExplanation) {
                                      d.path);
     EXPECT_EQ(bad.code, 2);
     EXPECT_NE(bad.err.find("--tile: 9,9 is outside the 4x4 tiles"), std::string::npos) << bad.err;
+    // Two lights of one name: the name does not choose.
+    Scene twice = s;
+    twice.lights[9].name = twice.lights[light].name;
+    lc::saveSceneFile(twice, (d.path / "twice.json").string());
+    const auto ambiguous = lc_test::runCli({"explain", "--scene", (d.path / "twice.json").string(), "--backend", "cpu",
+                                            "--tile", "4,2", "--light", s.lights[light].name},
+                                           d.path);
+    EXPECT_EQ(ambiguous.code, 2);
+    EXPECT_NE(ambiguous.err.find("lights 7 and 9 are both named"), std::string::npos) << ambiguous.err;
 }

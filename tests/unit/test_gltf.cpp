@@ -192,10 +192,13 @@ TEST(Gltf, BuiltinScenesRoundTripThroughGlbAndGltf) {
         for (auto& l : scene.lights)
             if (l.isSpot()) l.innerAngleDeg = 0.5 * l.outerAngleDeg;
         for (const char* ext : {".glb", ".gltf"}) {
-            const fs::path p = s.path / (std::string(name) + ext);
+            // A file name other than the scene's: the name comes from scenes[].name.
+            const fs::path p = s.path / (std::string("copy_of_") + name + ext);
             lc::saveSceneAny(scene, p.string());
             SCOPED_TRACE(p.string());
-            expectSameScene(scene, lc::loadSceneAny(p.string()));
+            const lc::Scene back = lc::loadSceneAny(p.string());
+            expectSameScene(scene, back);
+            EXPECT_EQ(back.name, scene.name);
         }
     }
 }

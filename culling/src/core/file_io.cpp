@@ -5,6 +5,8 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <sys/stat.h>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +14,24 @@
 #include <filesystem>
 
 namespace lc {
+
+namespace {
+// The process's umask, read without setting it (umask(2) would change it
+// for every thread for a moment): Linux reports it in /proc/self/status.
+mode_t processUmask() {
+    std::FILE* f = std::fopen("/proc/self/status", "r");
+    mode_t mask = 022;
+    if (!f) return mask;
+    char line[256];
+    while (std::fgets(line, sizeof line, f))
+        if (std::strncmp(line, "Umask:", 6) == 0) {
+            mask = mode_t(std::strtoul(line + 6, nullptr, 8));
+            break;
+        }
+    std::fclose(f);
+    return mask;
+}
+} // namespace
 
 void writeFileSynced(const std::string& path, const std::string& text) {
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -97,6 +117,8 @@ void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outp
     if (!::mkdtemp(tmpl.data()))
         throw Error("cannot create a temporary folder beside " + target.string() + ": " + std::strerror(errno));
     const fs::path tmp = tmpl;
+    // mkdtemp makes 0700; the output folder gets what mkdir would give it.
+    ::chmod(tmp.c_str(), 0777 & ~processUmask());
     fs::path aside;
     try {
         fill(tmp.string());

@@ -926,6 +926,11 @@ Scene loadGltfScene(const std::string& path, const GltfReadOptions& options, Glt
     Loaded l = readGeometry(path, model, r, rep, cancel, progress);
     Scene s;
     s.name = fs::path(path).stem().string();
+    // The scene shown (walkScene's choice) names it, as serializeGltf writes it.
+    if (!model.scenes.empty()) {
+        const std::size_t shown = model.defaultScene >= 0 ? std::size_t(model.defaultScene) : 0;
+        if (shown < model.scenes.size() && !model.scenes[shown].name.empty()) s.name = model.scenes[shown].name;
+    }
     s.camera = readCamera(path, model, l.placed, options, l.mesh, rep);
     s.lights = readLights(path, model, l.placed, options, rep);
     if (!l.mesh.indices.empty()) s.meshes.push_back(std::move(l.mesh));
