@@ -21,7 +21,7 @@ int TileLightsModel::columnCount(const QModelIndex& parent) const { return paren
 
 QVariant TileLightsModel::headerData(int section, Qt::Orientation o, int role) const {
     if (o != Qt::Horizontal || role != Qt::DisplayRole) return {};
-    static const char* kNames[ColumnCount] = {"list", "light", "name", "position", "radius", "pixels", "verdict"};
+    static const char* kNames[ColumnCount] = {"light", "name", "verdict", "pixels", "list", "radius", "position"};
     return section >= 0 && section < ColumnCount ? tr(kNames[section]) : QVariant();
 }
 
@@ -147,6 +147,9 @@ void TileInspector::refresh() {
     const lc::Projection proj(cam);
     const int cell = doc_->selectedCell();
     model_->setRows(lc::tileLightRows(*run, proj, std::uint32_t(tile), cell), run);
+    // Columns as wide as what they hold: light, name, verdict and pixels fit
+    // the dock's first-start width.
+    table_->resizeColumnsToContents();
     int needed = 0, fp = 0, missing = 0;
     for (const auto& r : model_->rows())
         (r.verdict == lc::Verdict::Needed ? needed : r.verdict == lc::Verdict::FalsePositive ? fp : missing)++;

@@ -24,7 +24,9 @@ class Document;
 class TileLightsModel : public QAbstractTableModel {
     Q_OBJECT
 public:
-    enum Column { ColList, ColLight, ColName, ColPosition, ColRadius, ColPixels, ColVerdict, ColumnCount };
+    // What answers "why is it here" first: at the dock's first-start width
+    // the verdict and pixels show without scrolling.
+    enum Column { ColLight, ColName, ColVerdict, ColPixels, ColList, ColRadius, ColPosition, ColumnCount };
     explicit TileLightsModel(Document* doc, QObject* parent = nullptr);
     int rowCount(const QModelIndex& parent = {}) const override;
     int columnCount(const QModelIndex& parent = {}) const override;

@@ -442,6 +442,12 @@ private slots:
             QTest::mouseClick(ti->table()->viewport(), Qt::LeftButton, {}, at);
             QTest::mouseDClick(ti->table()->viewport(), Qt::LeftButton, {}, at);
             QCOMPARE(doc()->currentLight(), int(later->light));
+            // The answer shows without scrolling: light, name, verdict, pixels.
+            for (int c : {TileLightsModel::ColLight, TileLightsModel::ColName, TileLightsModel::ColVerdict,
+                          TileLightsModel::ColPixels})
+                QVERIFY2(ti->table()->columnViewportPosition(c) + ti->table()->columnWidth(c) / 2 <
+                             ti->table()->viewport()->width(),
+                         qPrintable(QString("column %1").arg(c)));
             ExplainPanel* panel = w_->explainPanel();
             QVERIFY(panel->explanation());
             const lc::Explanation expect = lc::explainLight(*run, proj, later->list, later->light);
