@@ -33,6 +33,12 @@ RunOutput cpuRun(const Scene& s, const CullSettings& cs) {
     return runPipeline(s, cs, *backend, o);
 }
 
+CullSettings minmax() {
+    CullSettings cs;
+    cs.algorithm = Algorithm::MinMax;
+    return cs;
+}
+
 } // namespace
 
 TEST(Explain, TestsAgreeWithTheReferenceListsForEveryAlgorithm) {
@@ -73,9 +79,7 @@ TEST(Explain, TestsAgreeWithTheReferenceListsForEveryAlgorithm) {
 TEST(Explain, ASpotFalsePositiveWithinRangeIsOutsideItsCone) {
     const Scene s = smallAtrium();
     const Projection proj(s.camera);
-    CullSettings cs;
-    cs.algorithm = Algorithm::MinMax;
-    const RunOutput run = cpuRun(s, cs);
+    const RunOutput run = cpuRun(s, minmax());
     int seen = 0;
     for (std::uint32_t l = 0; l < run.result.listCount.size(); ++l)
         for (std::uint32_t i = 0; i < run.lights.size(); ++i) {
@@ -94,9 +98,7 @@ TEST(Explain, ASpotFalsePositiveWithinRangeIsOutsideItsCone) {
 TEST(Explain, TheDecidingPlaneIsTheOneOfLeastMargin) {
     const Scene s = smallAtrium();
     const Projection proj(s.camera);
-    CullSettings cs;
-    cs.algorithm = Algorithm::MinMax;
-    const RunOutput run = cpuRun(s, cs);
+    const RunOutput run = cpuRun(s, minmax());
     std::uint32_t rejectedByPlane = 0, kept = 0;
     for (std::uint32_t t = 0; t < run.result.grid.tileCount(); t += 7) {
         const auto chunk = tileFrustum(run.result, proj, run.lights, t);
@@ -130,9 +132,7 @@ TEST(Explain, TheDecidingPlaneIsTheOneOfLeastMargin) {
 TEST(Explain, GroundTruthCountsMatchTheTileInspector) {
     const Scene s = smallAtrium();
     const Projection proj(s.camera);
-    CullSettings cs;
-    cs.algorithm = Algorithm::MinMax;
-    const RunOutput run = cpuRun(s, cs);
+    const RunOutput run = cpuRun(s, minmax());
     for (std::uint32_t t = 0; t < run.result.grid.tileCount(); t += 3) {
         const auto needing = pixelsNeedingLights(run.depth, proj, run.lights, run.result.grid, t);
         for (const auto& [light, count] : needing) {
