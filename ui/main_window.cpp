@@ -284,7 +284,13 @@ void MainWindow::buildActions() {
     undo->setShortcut(QKeySequence::Undo);
     QAction* redo = doc_->undoStack()->createRedoAction(this, tr("&Redo"));
     redo->setObjectName("actionRedo");
-    redo->setShortcuts({QKeySequence(tr("Ctrl+Shift+Z")), QKeySequence::Redo});
+    // Ctrl+Shift+Z and the platform's Redo keys, each once: a key bound twice
+    // to one action is ambiguous to Qt and does nothing (some platforms'
+    // Redo is Ctrl+Shift+Z).
+    QList<QKeySequence> redoKeys{QKeySequence(tr("Ctrl+Shift+Z"))};
+    for (const QKeySequence& k : QKeySequence::keyBindings(QKeySequence::Redo))
+        if (!redoKeys.contains(k)) redoKeys << k;
+    redo->setShortcuts(redoKeys);
 
     connect(make(tr("&Add light"), "actionAddLight", QKeySequence(tr("Ctrl+L"))), &QAction::triggered, this,
             [this] { addLightAt(inspectorView_->mapFromGlobal(QCursor::pos())); });

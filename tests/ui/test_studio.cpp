@@ -608,6 +608,28 @@ private slots:
         QCOMPARE(name->text(), QString::fromStdString(old));
     }
 
+    // After Enter the focus stays in the field; Ctrl+Z there undoes the
+    // scene edit (the field's own text undo took it, and nothing happened).
+    void ctrlZInAFieldUndoesTheEdit() {
+        openSmall();
+        doc()->setSelectedLights({0});
+        auto* panel = w_->findChild<PropertyPanel*>();
+        auto* intensity = panel->findChild<QDoubleSpinBox*>("lightIntensity");
+        const double before = doc()->scene().lights[0].intensity;
+        w_->activateWindow();
+        QApplication::setActiveWindow(w_.get()); // no window manager under Xvfb gives it
+        intensity->setFocus();
+        QTRY_VERIFY(intensity->hasFocus());
+        intensity->selectAll();
+        QTest::keyClicks(intensity, "7.5");
+        QTest::keyClick(intensity, Qt::Key_Return);
+        QCOMPARE(doc()->scene().lights[0].intensity, 7.5);
+        QTest::keyClick(intensity, Qt::Key_Z, Qt::ControlModifier);
+        QCOMPARE(doc()->scene().lights[0].intensity, before);
+        QTest::keyClick(intensity, Qt::Key_Z, Qt::ControlModifier | Qt::ShiftModifier);
+        QCOMPARE(doc()->scene().lights[0].intensity, 7.5);
+    }
+
     // The keys docs/STUDIO.md lists reach their actions on any platform
     // theme (QKeySequence::SaveAs and ::Quit are empty under some, Xvfb's).
     void documentedShortcutsAreBound() {
