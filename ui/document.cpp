@@ -9,9 +9,6 @@ namespace lcui {
 
 Document::Document(QObject* parent) : QObject(parent) {
     connect(&undo_, &QUndoStack::cleanChanged, this, [this](bool clean) { emit dirtyChanged(!clean); });
-    // First among sceneEdited's receivers: a Live re-run asked for in another
-    // receiver is asked for this revision.
-    connect(this, &Document::sceneEdited, this, [this] { ++sceneRevision_; });
 }
 
 void Document::resetScene(lc::Scene scene, const QString& path) {
@@ -32,7 +29,7 @@ void Document::resetScene(lc::Scene scene, const QString& path) {
     emit runOutputChanged();
     emit filePathChanged(path);
     emit dirtyChanged(false);
-    emit sceneEdited();
+    edited();
 }
 
 void Document::markSaved(const QString& path) {
@@ -159,11 +156,18 @@ bool Document::setRunOutput(std::shared_ptr<const lc::RunOutput> run, quint64 ge
     return true;
 }
 
+void Document::edited() {
+    ++sceneRevision_;
+    emit sceneEdited();
+    // After every receiver: a Live re-run asked for by one of them is on its way.
+    if (runIsStale()) emit runWentStale();
+}
+
 void Document::noteRunRequested(quint64 generation) { pending_.emplace_back(generation, sceneRevision_); }
 
 void Document::noteRunFailed(quint64 generation) {
     std::erase_if(pending_, [generation](const auto& p) { return p.first == generation; });
-    emit runOutputChanged(); // the scene may now be without a run on its way
+    if (runIsStale()) emit runWentStale(); // the scene may now be without a run on its way
 }
 
 bool Document::runIsStale() const {
@@ -184,19 +188,19 @@ void Document::setExplainedList(int list) {
 void Document::applyLightPosition(int index, const glm::dvec3& p) {
     scene_.lights[std::size_t(index)].position = p;
     emit lightChanged(index);
-    emit sceneEdited();
+    edited();
 }
 
 void Document::applyLightRadius(int index, double explicitRadius) {
     scene_.lights[std::size_t(index)].explicitRadius = explicitRadius;
     emit lightChanged(index);
-    emit sceneEdited();
+    edited();
 }
 
 void Document::applyLight(int index, const lc::PointLight& l) {
     scene_.lights[std::size_t(index)] = l;
     emit lightChanged(index);
-    emit sceneEdited();
+    edited();
 }
 
 void Document::applyInsertLights(const std::vector<int>& indices,
@@ -208,7 +212,7 @@ void Document::applyInsertLights(const std::vector<int>& indices,
     cameraSelected_ = false;
     emit lightsChanged();
     emit selectionChanged();
-    emit sceneEdited();
+    edited();
 }
 
 void Document::applyRemoveLights(const std::vector<int>& indices) {
@@ -217,7 +221,7 @@ void Document::applyRemoveLights(const std::vector<int>& indices) {
     selectedLights_.clear();
     emit lightsChanged();
     emit selectionChanged();
-    emit sceneEdited();
+    edited();
 }
 
 void Document::applyCamera(const lc::Camera& c) {
@@ -226,21 +230,21 @@ void Document::applyCamera(const lc::Camera& c) {
     selectedCell_ = -1;
     emit cameraChanged();
     emit tileSelectionChanged(-1);
-    emit sceneEdited();
+    edited();
 }
 
 void Document::applyAddMesh(const lc::Mesh& m) {
     scene_.meshes.push_back(m);
     ++geometryRevision_;
     emit meshesChanged();
-    emit sceneEdited();
+    edited();
 }
 
 void Document::applyRemoveLastMesh() {
     scene_.meshes.pop_back();
     ++geometryRevision_;
     emit meshesChanged();
-    emit sceneEdited();
+    edited();
 }
 
 } // namespace lcui

@@ -142,11 +142,17 @@ signals:
     void overlaysChanged();
     void settingsChanged();
     void sceneEdited();             // any scene edit (for Live re-runs)
+    // The shown run became stale (runIsStale): after an edit's receivers
+    // have all run, or when the run asked for the scene as it is failed.
+    void runWentStale();
     void runOutputChanged();
     void filePathChanged(const QString& path);
     void dirtyChanged(bool dirty);
 
 private:
+    // Counts the edit, tells sceneEdited's receivers, then runWentStale's.
+    void edited();
+
     lc::Scene scene_;
     quint64 geometryRevision_ = 1;
     lc::CullSettings settings_;
@@ -160,7 +166,7 @@ private:
     int dragCounter_ = 0;
     std::shared_ptr<const lc::RunOutput> run_;
     quint64 runGeneration_ = 0;
-    // Scene edits counted (every sceneEdited), the count the shown run was
+    // Scene edits counted (edited()), the count the shown run was
     // asked for, and the runs asked for and not yet answered.
     quint64 sceneRevision_ = 0, runRevision_ = 0;
     std::vector<std::pair<quint64, quint64>> pending_; // generation, scene revision

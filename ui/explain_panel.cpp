@@ -28,9 +28,7 @@ ExplainPanel::ExplainPanel(Document* doc, QWidget* parent) : QWidget(parent), do
     connect(doc_, &Document::selectionChanged, this, &ExplainPanel::refresh);
     connect(doc_, &Document::tileSelectionChanged, this, &ExplainPanel::refresh);
     connect(doc_, &Document::runOutputChanged, this, &ExplainPanel::refresh);
-    connect(doc_, &Document::sceneEdited, this, [this] {
-        if (doc_->runIsStale()) refresh();
-    });
+    connect(doc_, &Document::runWentStale, this, &ExplainPanel::refresh);
     refresh();
 }
 

@@ -237,20 +237,14 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
         updateOverlays();
         scheduleRender();
     });
+    // A stale run's overlays go (the light indices they use may have moved).
     for (auto sig : {&Document::runOutputChanged, &Document::overlaysChanged, &Document::selectionChanged,
-                     &Document::lightsChanged})
+                     &Document::lightsChanged, &Document::runWentStale})
         connect(doc_, sig, this, [this] {
             updateOverlays();
             scheduleRender();
         });
     connect(doc_, &Document::tileSelectionChanged, this, [this] {
-        updateOverlays();
-        scheduleRender();
-    });
-    // An edit without a run on its way: the run's overlays go (the light
-    // indices they use may have moved).
-    connect(doc_, &Document::sceneEdited, this, [this] {
-        if (!doc_->runIsStale()) return;
         updateOverlays();
         scheduleRender();
     });

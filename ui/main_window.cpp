@@ -133,7 +133,6 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     });
     connect(doc_, &Document::sceneEdited, this, [this] {
         if (isLive()) runCulling(/*liveEdit=*/true);
-        updateStatus();
     });
     connect(doc_, &Document::settingsChanged, this, [this] {
         syncParamWidgets();
@@ -144,6 +143,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     connect(doc_, &Document::dirtyChanged, this, &MainWindow::updateTitle);
     connect(doc_, &Document::filePathChanged, this, &MainWindow::updateTitle);
     connect(doc_, &Document::runOutputChanged, this, &MainWindow::updateStatus);
+    connect(doc_, &Document::runWentStale, this, &MainWindow::updateStatus);
 
     resize(1600, 900);
     // First start: views get the room, the log stays a strip at the bottom,

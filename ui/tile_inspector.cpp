@@ -101,9 +101,7 @@ TileInspector::TileInspector(Document* doc, QWidget* parent) : QWidget(parent), 
     l->addWidget(table_, 1);
     connect(doc_, &Document::tileSelectionChanged, this, &TileInspector::refresh);
     connect(doc_, &Document::runOutputChanged, this, &TileInspector::refresh);
-    connect(doc_, &Document::sceneEdited, this, [this] {
-        if (doc_->runIsStale()) refresh();
-    });
+    connect(doc_, &Document::runWentStale, this, &TileInspector::refresh);
     connect(table_, &QTableView::doubleClicked, this, [this](const QModelIndex& shown) {
         const QModelIndex i = proxy_->mapToSource(shown);
         if (!i.isValid() || i.row() >= int(model_->rows().size())) return;

@@ -384,8 +384,15 @@ private slots:
         QVERIFY(doc()->runIsStale());
         w_->setLive(true); // asks for a run of the scene as it is
         QVERIFY(!doc()->runIsStale());
+        QVERIFY(waitTruth(doc()->runGeneration() + 1));
+        QVERIFY(!ti->model()->rows().empty());
+        // A Live edit's run is asked for before anything hears of the edit:
+        // the inspector keeps its rows until the new ones come (no flicker).
+        QSignalSpy wentStale(doc(), &Document::runWentStale);
         doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(0.5, 0, 0), doc()->newDragId());
         QVERIFY(!doc()->runIsStale());
+        QVERIFY(wentStale.isEmpty());
+        QVERIFY(!ti->model()->rows().empty());
         w_->setLive(false);
         QVERIFY(waitTruth(w_->runCulling()));
         lc::Camera bad = doc()->scene().camera;
@@ -396,6 +403,7 @@ private slots:
         QVERIFY(!doc()->runIsStale()); // on its way
         QVERIFY(!lctest::waitRun(*w_, failing));
         QVERIFY(doc()->runIsStale());
+        QVERIFY(wentStale.size() >= 2); // the camera edit, then the failed run
     }
 
     // halfz and clustered tiles hold several lists: a tile inspector row
