@@ -230,17 +230,17 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
         };
         // The one per-chunk test: the culling sphere, then for a spot light
         // under a cone test the cone refinement (spot_tests.hpp).
-        // Counted per tile row (the rows run on several threads), summed below.
+        // Counted into the tile row's counter (the rows run on several
+        // threads), summed below.
         std::vector<std::uint64_t> rowTests(grid.tilesY, 0);
-        static thread_local std::uint64_t* tests = nullptr;
-        auto intersects = [&](const FrustumChunk& chunk, std::uint32_t l) {
-            ++*tests;
+        auto intersects = [&](const FrustumChunk& chunk, std::uint32_t l, std::uint64_t& tests) {
+            ++tests;
             if (!sphereIntersectsChunk(test, chunk, sphereCenter[l], sphereRadius[l])) return false;
             if (!coneRefines || !lights.isSpot(l)) return true;
             return spotIntersectsChunk(settings.spotTest, test, lights.spotCone(l), chunk);
         };
         parallelRows(grid.tilesY, [&](std::uint32_t ty) {
-            tests = &rowTests[ty];
+            std::uint64_t& tests = rowTests[ty];
             std::vector<std::uint32_t> candidates;
             for (std::size_t l = 0; l < n; ++l)
                 if (!ranges[l].empty() && ranges[l].ty0 <= ty && ty <= ranges[l].ty1)
@@ -278,21 +278,21 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
                     case Algorithm::Naive:
                     case Algorithm::ZBin: // the tile's mask: the screen-space test
                     case Algorithm::MinMax:
-                        if (intersects(chunkA, l)) lists[t].push_back(l);
+                        if (intersects(chunkA, l, tests)) lists[t].push_back(l);
                         break;
                     case Algorithm::Fptl:
                         // Coarse: minmax's test; fine: a pixel of the tile the light could reach.
-                        if (intersects(chunkA, l) && tilePixelKeeps(rect, l)) lists[t].push_back(l);
+                        if (intersects(chunkA, l, tests) && tilePixelKeeps(rect, l)) lists[t].push_back(l);
                         break;
                     case Algorithm::HalfZ:
-                        if (intersects(chunkA, l)) lists[2 * t].push_back(l);
-                        if (intersects(chunkB, l)) lists[2 * t + 1].push_back(l);
+                        if (intersects(chunkA, l, tests)) lists[2 * t].push_back(l);
+                        if (intersects(chunkB, l, tests)) lists[2 * t + 1].push_back(l);
                         break;
                     case Algorithm::TwoPointFiveD: {
                         const double cd = -c.z;
                         const std::uint32_t m =
                             sliceRangeMask(settings.slicing, tmin, tmax, cells, cd - r, cd + r);
-                        if ((m & res.cellMask[t]) && intersects(chunkA, l))
+                        if ((m & res.cellMask[t]) && intersects(chunkA, l, tests))
                             lists[t].push_back(l);
                         break;
                     }
@@ -308,7 +308,7 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
                                     sliceBoundary(settings.slicing, res.clusterNear, res.clusterFar, cells, k + 1));
                                 sliceBuilt[k] = 1;
                             }
-                            if (intersects(sliceChunk[k], l))
+                            if (intersects(sliceChunk[k], l, tests))
                                 lists[std::size_t(t) * cells + k].push_back(l);
                         }
                         break;
