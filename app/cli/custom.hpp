@@ -74,7 +74,7 @@ inline void printCustomReport(const lc::RunOutput& run, const lc::Scene& scene, 
               << c.invalidIndices << ", duplicates " << c.duplicateIndices << ", validation messages "
               << c.validationMessages.size() << "\n";
     if (c.builtinAlgorithm.rfind("none", 0) == 0)
-        std::cout << "  against built-in: " << c.builtinAlgorithm.substr(6, c.builtinAlgorithm.size() - 7) << "\n";
+        std::cout << "  against built-in: " << c.builtinAlgorithm << "\n"; // "none (why)": nothing to count
     else
         std::cout << "  against built-in " << c.builtinAlgorithm << " (cpu): " << c.listsDifferingFromBuiltin
                   << " lists differ, " << run.result.entries() << " entries vs " << c.builtinEntries << "\n";

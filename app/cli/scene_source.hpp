@@ -47,12 +47,6 @@ struct SceneSource {
 
     bool given() const { return !sceneFile.empty() || !builtin.empty(); }
 
-private:
-    CLI::Option* optCamera_ = nullptr;
-    CLI::Option* optMinIntensity_ = nullptr;
-
-public:
-
     // Loads it; glTF warnings go to stderr, one line each.
     lc::Scene load() const {
         if (sceneFile.empty()) return lc::makeBuiltinScene(builtin);
@@ -73,6 +67,10 @@ public:
                       << " lights, camera " << report.camera << "; loaded in " << std::lround(ms) << " ms\n";
         return s;
     }
+
+private:
+    CLI::Option* optCamera_ = nullptr;
+    CLI::Option* optMinIntensity_ = nullptr;
 };
 
 } // namespace lcli
