@@ -387,6 +387,13 @@ TEST(Gltf, LightsFollowTheirNodes) {
     writeBytes(p, b.gltfText());
     const std::string msg = loadError(p);
     EXPECT_NE(msg.find("light 'spot': its direction, the node's -Z axis, is zero (a zero scale?)"), std::string::npos) << msg;
+    // A written range of 0 is refused (KHR_lights_punctual: range > 0), not
+    // read as no range (tinygltf gives 0 for both).
+    b.doc["nodes"][std::size_t(spot)].erase("scale");
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"][1]["range"] = 0.0;
+    writeBytes(p, b.gltfText());
+    const std::string zero = loadError(p);
+    EXPECT_NE(zero.find("extensions.KHR_lights_punctual.lights[1].range: must be > 0"), std::string::npos) << zero;
 }
 
 TEST(Gltf, CamerasAreChosenAndConverted) {

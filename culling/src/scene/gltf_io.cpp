@@ -785,6 +785,16 @@ Camera readCamera(const std::string& path, const tinygltf::Model& model, const s
     return cam;
 }
 
+// Whether KHR_lights_punctual.lights[i] has a `range` key (tinygltf keeps
+// the root extensions' JSON beside the parsed lights).
+bool rangeGiven(const tinygltf::Model& model, std::size_t i) {
+    const auto ext = model.extensions.find("KHR_lights_punctual");
+    if (ext == model.extensions.end() || !ext->second.IsObject() || !ext->second.Has("lights")) return false;
+    const tinygltf::Value& lights = ext->second.Get("lights");
+    return lights.IsArray() && i < lights.ArrayLen() && lights.Get(int(i)).IsObject() &&
+           lights.Get(int(i)).Has("range");
+}
+
 std::vector<PointLight> readLights(const std::string& path, const tinygltf::Model& model,
                                    const std::vector<GltfReader::Placed>& placed, const GltfReadOptions& options,
                                    GltfReadReport& rep) {
@@ -824,8 +834,10 @@ std::vector<PointLight> readLights(const std::string& path, const tinygltf::Mode
             // KHR_lights_punctual: the node's scale moves the light but leaves
             // its properties (range, intensity) as they are.
             l.explicitRadius = gl.range;
-        } else if (gl.range < 0.0) {
-            throw InputError(path, lp + ".range", 0, "must be > 0");
+        } else if (gl.range < 0.0 || rangeGiven(model, std::size_t(li))) {
+            // tinygltf reads an absent range as 0; the raw extension tells a
+            // written 0 (which KHR_lights_punctual forbids) from none.
+            throw InputError(path, lp + ".range", 0, "must be > 0 (leave it out for an unbounded light)");
         }
         if (gl.type == "spot") {
             l.kind = LightKind::Spot;
