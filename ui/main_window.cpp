@@ -32,6 +32,7 @@
 #include <QFileDialog>
 #include <QHBoxLayout>
 #include <QScrollArea>
+#include <QScrollBar>
 #include <QTimer>
 #include <QInputDialog>
 #include <QFileInfo>
@@ -214,7 +215,17 @@ void MainWindow::buildDocks() {
         col->addWidget(tree_, 1);
     }
     dock(tr("Scene"), "sceneDock", scenePane, Qt::LeftDockWidgetArea);
-    dock(tr("Properties"), "propertiesDock", properties_, Qt::LeftDockWidgetArea);
+    // The properties scroll inside their dock: a spot light's fields are 400
+    // px tall, and as the dock's minimum they would keep the bottom area a
+    // strip on a laptop's screen.
+    auto* propertiesScroll = new QScrollArea;
+    propertiesScroll->setWidget(properties_);
+    propertiesScroll->setWidgetResizable(true);
+    propertiesScroll->setFrameShape(QFrame::NoFrame);
+    propertiesScroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+    propertiesScroll->setMinimumWidth(properties_->minimumSizeHint().width() +
+                                      propertiesScroll->verticalScrollBar()->sizeHint().width());
+    dock(tr("Properties"), "propertiesDock", propertiesScroll, Qt::LeftDockWidgetArea);
     auto* tileDock = dock(tr("Tile inspector"), "tileDock", tileInspector_, Qt::RightDockWidgetArea);
     explain_ = new ExplainPanel(doc_);
     explain_->setObjectName("explainPanel");
@@ -238,10 +249,37 @@ void MainWindow::buildDocks() {
     connect(report, &ReportDock::finished, this, [this] { statusProgress_->end("report"); });
     reportScroll->setWidgetResizable(true);
     reportScroll->setFrameShape(QFrame::NoFrame);
-    tabifyDockWidget(logDock, dock(tr("Report"), "reportDock", reportScroll, Qt::BottomDockWidgetArea));
+    auto* reportDock = dock(tr("Report"), "reportDock", reportScroll, Qt::BottomDockWidgetArea);
+    tabifyDockWidget(logDock, reportDock);
     // A first start shows the log; the Report tab is one click away (a saved
     // layout wins).
     logDock->raise();
+    // The log is a strip of a few lines; the Report's chart is not readable
+    // in one. Raising the Report tab grows the bottom area to a readable
+    // height, and raising the log again gives the strip back, unless the
+    // user has resized it in between. Deferred: while the tab bar switches,
+    // the dock layout has not yet taken the new tab.
+    connect(reportDock, &QDockWidget::visibilityChanged, this, [this, reportDock](bool visible) {
+        if (!visible || reportDock->isFloating()) return;
+        QTimer::singleShot(0, this, [this, reportDock] {
+            const int want = std::clamp(height() * 45 / 100, 120, 420);
+            if (!reportDock->isVisible() || reportDock->isFloating() || reportDock->height() >= want) return;
+            stripHeight_ = reportDock->height();
+            resizeDocks({reportDock}, {want}, Qt::Vertical);
+            // What the docks around let it have (the left and right columns'
+            // minimum heights bound it).
+            QTimer::singleShot(0, this, [this, reportDock] { grownHeight_ = reportDock->height(); });
+        });
+    });
+    connect(logDock, &QDockWidget::visibilityChanged, this, [this, logDock](bool visible) {
+        if (!visible || logDock->isFloating() || grownHeight_ == 0) return;
+        QTimer::singleShot(0, this, [this, logDock] {
+            // Only the height the Report tab set is given back.
+            if (logDock->isVisible() && std::abs(logDock->height() - grownHeight_) <= 2)
+                resizeDocks({logDock}, {stripHeight_}, Qt::Vertical);
+            grownHeight_ = 0;
+        });
+    });
 }
 
 void MainWindow::buildActions() {

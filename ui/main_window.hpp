@@ -174,6 +174,9 @@ private:
     CameraView* cameraView_;
     InspectorView* inspectorView_;
     QSplitter* viewSplitter_;
+    // The bottom area's height before the Report tab grew it, and what it grew
+    // it to (0: not grown).
+    int stripHeight_ = 0, grownHeight_ = 0;
     QTabBar* viewTabs_;
     SceneTree* tree_;
     PropertyPanel* properties_;

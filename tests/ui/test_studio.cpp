@@ -23,6 +23,7 @@
 
 #include <QAction>
 #include <set>
+#include <QDockWidget>
 #include <QDoubleSpinBox>
 #include <QFile>
 #include <QItemSelectionModel>
@@ -35,6 +36,7 @@
 #include <QProcessEnvironment>
 #include <QSet>
 #include <QStatusBar>
+#include <QTabBar>
 #include <QImage>
 #include <QPushButton>
 #include <QRegularExpression>
@@ -521,6 +523,32 @@ private slots:
             QVERIFY2(button && button->isVisible(), name);
             QVERIFY2(w_->rect().contains(button->mapTo(w_.get(), button->rect().center())), name);
         }
+    }
+
+    // The log is a strip of a few lines at the bottom; its Report tab grows
+    // the strip to a height where the chart reads, and the log tab gives the
+    // strip back.
+    void theReportTabGetsRoomAndTheLogGivesItBack() {
+        auto* logDock = w_->findChild<QDockWidget*>("logDock");
+        auto* reportDock = w_->findChild<QDockWidget*>("reportDock");
+        QVERIFY(logDock && reportDock);
+        QTRY_VERIFY(logDock->isVisible());
+        const int strip = logDock->height();
+        QVERIFY2(strip < 200, qPrintable(QString::number(strip)));
+        QTabBar* tabs = nullptr;
+        int reportTab = -1, logTab = -1;
+        for (QTabBar* bar : w_->findChildren<QTabBar*>())
+            for (int i = 0; i < bar->count(); ++i) {
+                if (bar->tabText(i) == "Report") tabs = bar, reportTab = i;
+                if (bar->tabText(i) == "Message log") logTab = i;
+            }
+        QVERIFY(tabs && reportTab >= 0 && logTab >= 0);
+        QTest::mouseClick(tabs, Qt::LeftButton, {}, tabs->tabRect(reportTab).center());
+        QTRY_VERIFY(reportDock->isVisible());
+        QTRY_VERIFY2(reportDock->height() >= 300, qPrintable(QString::number(reportDock->height())));
+        QTest::mouseClick(tabs, Qt::LeftButton, {}, tabs->tabRect(logTab).center());
+        QTRY_VERIFY(logDock->isVisible());
+        QTRY_COMPARE(logDock->height(), strip);
     }
 
     // Typing the camera's position into its target would make a camera no
