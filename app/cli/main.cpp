@@ -616,7 +616,15 @@ int main(int argc, char** argv) {
         printSummary(scene, settings, result, outDir);
         return 0;
     } catch (const lc::SettingsError& e) {
-        return fail(2, e.what()); // a bad value on the command line (docs/CLI.md: exit 2)
+        // A bad value on the command line (docs/CLI.md: exit 2), named by the
+        // flag that gave it where the parameter is one.
+        std::string message = e.what();
+        for (const CLI::App* sub : app.get_subcommands())
+            if (sub->get_option_no_throw("--" + e.field()) && message.rfind(e.field() + ": ", 0) == 0) {
+                message = "--" + message;
+                break;
+            }
+        return fail(2, message);
     } catch (const lc::Error& e) {
         return fail(1, e.what());
     } catch (const std::exception& e) {

@@ -132,17 +132,17 @@ TEST(Cli, BadCommandLinesFailWithOneLineNamingTheProblem) {
     // A bad value on the command line: exit 2, whichever layer finds it
     // (the parser, the parameter table, the light generator).
     expectCleanFailure(with({"--bogus", "3"}), "--bogus", 2);
-    expectCleanFailure(with({"--cells", "99"}), "cells", 2);
-    expectCleanFailure(with({"--cells", "many"}), "cells", 2);
-    expectCleanFailure(with({"--algorithm", "quadtree"}), "algorithm", 2);
-    expectCleanFailure(with({"--test", "sphere"}), "test", 2);
-    expectCleanFailure(with({"--slicing", "cubic"}), "slicing", 2);
-    expectCleanFailure(with({"--skip-empty", "maybe"}), "skip-empty", 2);
-    expectCleanFailure(with({"--tile", "0"}), "tile", 2);
-    expectCleanFailure(with({"--width", "-5"}), "width", 2);
-    expectCleanFailure(with({"--width", "0"}), "width", 2);
-    expectCleanFailure(with({"--lights", "-3"}), "lights", 2);
-    expectCleanFailure(with({"--lights", "1000001"}), "lights", 2);
+    expectCleanFailure(with({"--cells", "99"}), "--cells", 2);
+    expectCleanFailure(with({"--cells", "many"}), "--cells", 2);
+    expectCleanFailure(with({"--algorithm", "quadtree"}), "--algorithm", 2);
+    expectCleanFailure(with({"--test", "sphere"}), "--test", 2);
+    expectCleanFailure(with({"--slicing", "cubic"}), "--slicing", 2);
+    expectCleanFailure(with({"--skip-empty", "maybe"}), "--skip-empty", 2);
+    expectCleanFailure(with({"--tile", "0"}), "--tile", 2);
+    expectCleanFailure(with({"--width", "-5"}), "--width", 2);
+    expectCleanFailure(with({"--width", "0"}), "--width", 2);
+    expectCleanFailure(with({"--lights", "-3"}), "--lights", 2);
+    expectCleanFailure(with({"--lights", "1000001"}), "--lights", 2);
     expectCleanFailure({"run", "--builtin", "wall", "--backend", "metal", "--out", "OUT"}, "metal");
     expectCleanFailure({"run", "--builtin", "nowhere", "--out", "OUT"}, "nowhere");
     expectCleanFailure({"run", "--scene", "/nonexistent/scene.json", "--out", "OUT"}, "/nonexistent/scene.json");
