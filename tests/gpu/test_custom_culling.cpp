@@ -20,6 +20,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <regex>
 
 #include <unistd.h>
 
@@ -289,6 +290,64 @@ TEST_F(GpuTest, SpirvFromTheCompilerRunsToo) {
     CustomCullReport rep;
     const RunOutput out = runShader(s, o, rep);
     expectCorrect(out, rep, cpuReference(s, out.depth, Algorithm::MinMax), "t.spv");
+    // An entry point the module lacks is named before the device sees it
+    // (with validation on, the layer crashed creating the pipeline).
+    o.entry = "nope";
+    try {
+        runShader(s, o, rep);
+        FAIL() << "no error for a missing entry point";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("t.spv: no compute entry point 'nope' (the module has 'main'"),
+                  std::string::npos) << e.what();
+    }
+    fs::remove_all(dir);
+}
+
+// What the contract fixes is checked before the device sees the shader: a
+// binding outside it (which crashed the validation layer), push constants, an
+// HLSL entry point that is not in the file (glslang only warns, and emits an
+// empty function that writes no list).
+TEST_F(GpuTest, InterfaceMistakesAreOneLineErrors) {
+    const Scene s = atrium(64, 64);
+    const fs::path dir = fs::temp_directory_path() / ("lc_iface_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const std::string head = "#version 450\nlayout(local_size_x = 64) in;\n"
+                             "layout(set = 0, binding = 0, std140) uniform P { uvec4 size; uvec4 counts; } lc;\n"
+                             "layout(set = 0, binding = 4, std430) buffer O { uint outw[]; };\n";
+    const std::string body = "void main() { if (gl_LocalInvocationIndex == 0u) outw[0] = X; }\n";
+    struct Case {
+        std::string file, text, entry, expected;
+    };
+    const std::vector<Case> cases = {
+        {"binding5.comp", head + "layout(set = 0, binding = 5, std430) readonly buffer L { vec4 l[]; };\n" +
+                              std::regex_replace(body, std::regex("X"), "uint(l[0].w)"),
+         "", "binding5.comp: declares set 0 binding 5, which the contract does not bind"},
+        {"set1.comp", head + "layout(set = 1, binding = 0, std430) readonly buffer L { vec4 l[]; };\n" +
+                          std::regex_replace(body, std::regex("X"), "uint(l[0].w)"),
+         "", "set1.comp: declares set 1 binding 0"},
+        {"push.comp", head + "layout(push_constant) uniform PC { uint k; } pc;\n" +
+                          std::regex_replace(body, std::regex("X"), "pc.k"),
+         "", "push.comp: declares push constants"},
+        {"tiled.hlsl", "", "NoSuchFn", "tiled.hlsl: no function 'NoSuchFn' to use as the entry point"},
+    };
+    for (const Case& c : cases) {
+        const fs::path p = dir / c.file;
+        if (c.text.empty())
+            fs::copy_file(kExamples + "tiled_fixed.hlsl", p, fs::copy_options::overwrite_existing);
+        else
+            std::ofstream(p) << c.text;
+        CustomShaderOptions o = optionsFor(p.string());
+        if (!c.entry.empty()) o.entry = c.entry;
+        CustomCullReport rep;
+        try {
+            runShader(s, o, rep);
+            ADD_FAILURE() << c.file << ": no error";
+        } catch (const InputError& e) {
+            const std::string msg = e.what();
+            EXPECT_NE(msg.find(c.expected), std::string::npos) << msg;
+            EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+        }
+    }
     fs::remove_all(dir);
 }
 

@@ -23,6 +23,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <regex>
@@ -135,6 +136,11 @@ std::vector<std::uint32_t> compileSource(const std::string& path, const std::str
     glslang::TProgram program;
     program.addShader(&shader);
     if (!program.link(messages)) throwCompileError(path, program.getInfoLog(), "link error");
+    // glslang only warns of an HLSL entry point it did not find, and emits an
+    // empty function of that name: a shader that writes no list.
+    if (hlsl && std::string(program.getInfoLog()).find("Entry point not found") != std::string::npos)
+        throw InputError(path, "", 0, "no function '" + entry + "' to use as the entry point (--entry, or the file's "
+                                      "'// lightcull:' line; docs/CUSTOM_CULLING.md)");
     std::vector<std::uint32_t> spirv;
     spv::SpvBuildLogger logger;
     glslang::SpvOptions opts;
@@ -165,6 +171,61 @@ std::vector<std::uint32_t> loadSpirv(const std::string& path) {
     std::memcpy(words.data(), bytes.data(), bytes.size());
     if (words[0] != 0x07230203u) throw InputError(path, "", 0, "not SPIR-V: wrong magic number");
     return words;
+}
+
+// What the contract fixes that the device would otherwise be asked to accept
+// on trust: a compute entry point of the name the pipeline names, and only
+// the five bindings of set 0 (a resource the pipeline layout lacks is
+// undefined behaviour that crashes the validation layer; without it the
+// shader reads nothing). Read from the module's instructions: OpEntryPoint,
+// and the DescriptorSet / Binding decorations and storage class of its
+// variables.
+void checkInterface(const std::string& path, const std::vector<std::uint32_t>& words, const std::string& entry) {
+    constexpr std::uint32_t kOpEntryPoint = 15, kOpVariable = 59, kOpDecorate = 71;
+    constexpr std::uint32_t kGLCompute = 5, kDecBinding = 33, kDecDescriptorSet = 34, kPushConstant = 9;
+    std::vector<std::string> computeEntries;
+    std::map<std::uint32_t, std::uint32_t> bindingOf, setOf;
+    std::vector<std::uint32_t> pushConstants;
+    for (std::size_t i = 5; i < words.size();) {
+        const std::uint32_t count = words[i] >> 16, op = words[i] & 0xFFFFu;
+        if (count == 0 || count > words.size() - i)
+            throw InputError(path, "", 0, "not SPIR-V: instruction at word " + std::to_string(i) + " runs past the module");
+        const std::uint32_t* w = &words[i];
+        if (op == kOpEntryPoint && count >= 4 && w[1] == kGLCompute) {
+            // The name: a nul-terminated string packed into words from w[3].
+            std::string name;
+            for (std::size_t k = 3 * 4; k < std::size_t(count) * 4; ++k) {
+                const char c = char((w[k / 4] >> (8 * (k % 4))) & 0xFFu);
+                if (c == '\0') break;
+                name += c;
+            }
+            computeEntries.push_back(name);
+        } else if (op == kOpDecorate && count >= 4 && w[2] == kDecBinding) {
+            bindingOf[w[1]] = w[3];
+        } else if (op == kOpDecorate && count >= 4 && w[2] == kDecDescriptorSet) {
+            setOf[w[1]] = w[3];
+        } else if (op == kOpVariable && count >= 4 && w[3] == kPushConstant) {
+            pushConstants.push_back(w[2]);
+        }
+        i += count;
+    }
+    if (std::find(computeEntries.begin(), computeEntries.end(), entry) == computeEntries.end()) {
+        std::string have;
+        for (const auto& e : computeEntries) have += (have.empty() ? "'" : ", '") + e + "'";
+        throw InputError(path, "", 0, "no compute entry point '" + entry + "' (the module has " +
+                                          (have.empty() ? std::string("none") : have) + "; --entry)");
+    }
+    if (!pushConstants.empty())
+        throw InputError(path, "", 0, "declares push constants: the contract has none (the parameters are binding 0)");
+    static const char* const kBindings = "0 parameters, 1 depth texture, 2 depth buffer, 3 lights, 4 lists";
+    for (const auto& [id, binding] : bindingOf) {
+        const auto set = setOf.find(id);
+        const std::uint32_t s = set == setOf.end() ? 0 : set->second;
+        if (s != 0 || binding > 4)
+            throw InputError(path, "", 0, "declares set " + std::to_string(s) + " binding " + std::to_string(binding) +
+                                              ", which the contract does not bind (set 0: " + kBindings +
+                                              "; docs/CUSTOM_CULLING.md)");
+    }
 }
 
 // Everything created on the device for one run, owned together so that a
@@ -214,6 +275,8 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
         spirv = compileSource(o.path, detail::readWholeFile(o.path), hlsl, o.entry,
                               definesFor(o, grid, skeleton.listsPerTile, lightCount, compactEntries));
     }
+
+    checkInterface(o.path, spirv, entry);
 
     const std::size_t messagesBefore = vk::validationMessages().size();
     // Whatever the layer says during this run is the shader's report, not a
