@@ -78,7 +78,7 @@ std::string fmt(const char* f, double v) {
 std::string ms(double v) { return v < 0 ? std::string("n/a") : fmt("%.2f ms", v); }
 
 void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, const lc::RunOutput& run,
-                  const std::string& out) {
+                  const std::string& out, const std::string& noImageErrorWhy = "--no-image-error") {
     const lc::CullResult& r = run.result;
     const lc::Metrics& m = run.truth.metrics;
     std::cout << "scene " << scene.name << ": " << r.grid.width << "x" << r.grid.height << ", tile "
@@ -100,9 +100,14 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
     if (m.imageErrorComputed)
         std::cout << "image error: rmse " << fmt("%.6g", m.imageRmse) << ", max " << fmt("%.6g", m.imageMaxError) << "\n";
     else
-        std::cout << "image error: not computed (--no-image-error)\n";
-    std::cout << "times: depth " << (run.depthReused ? std::string("not run (depth image given)") : ms(r.timings.depthMs));
-    if (r.depthTriangles) std::cout << " (" << r.depthTrianglesDrawn << " of " << r.depthTriangles << " triangles)";
+        std::cout << "image error: not computed (" << noImageErrorWhy << ")\n";
+    std::cout << "times: depth "
+              << (run.depthReused ? "not run (" + (run.depthFrom.empty() ? std::string("depth image given") : run.depthFrom) + ")"
+                                  : ms(r.timings.depthMs));
+    if (r.depthTriangles) {
+        std::cout << " (" << (run.depthFrom.empty() ? "" : run.depthFrom + ", ") << r.depthTrianglesDrawn << " of "
+                  << r.depthTriangles << " triangles)";
+    }
     std::cout << ", cull " << ms(r.timings.cullMs)
               << ", shade " << ms(r.timings.shadeMs) << ", ground truth " << ms(r.timings.groundTruthMs) << " (" << r.timingMethod << ")\n"
               << "wrote " << out << "/summary.json, tiles.csv, heatmap.png"
@@ -556,19 +561,32 @@ int main(int argc, char** argv) {
             checkFlags.applyParams(settings, scene.camera);
             const lc::Projection proj(scene.camera);
             lc::DepthImage depth;
+            std::unique_ptr<lc::CullBackend> backend;
             if (!checkDepth.depthFile.empty()) {
                 depth = lc::loadDepthFile(checkDepth.depthFile, proj);
             } else {
                 scene.validate();
-                depth = checkFlags.openBackend()->renderDepth(scene, proj);
+                backend = checkFlags.openBackend();
+                depth = backend->renderDepth(scene, proj);
             }
             lc::CustomCullReport report;
             lc::RunOptions options;
             options.truthOptions.imageError = false;
-            const lc::RunOutput result = lc::checkListDump(scene, checkLists, lc::parseLayout(checkLayout),
-                                                           lc::parseListSpec(checkRule), depth, options, report);
+            lc::RunOutput result = lc::checkListDump(scene, checkLists, lc::parseLayout(checkLayout),
+                                                     lc::parseListSpec(checkRule), depth, options, report);
+            // The lists are judged on this depth: say whose it is (backends'
+            // rasterisers differ at a few edge pixels, and so can a verdict).
+            if (backend) {
+                result.depthReused = false;
+                result.depthFrom = "pre-pass on " + backend->name() + " (" + backend->deviceName() + ")";
+                result.result.timings.depthMs = backend->lastDepthMs();
+                result.result.depthTriangles = backend->lastDepthTriangles();
+                result.result.depthTrianglesDrawn = backend->lastDepthTrianglesDrawn();
+            } else {
+                result.depthFrom = "depth file " + checkDepth.depthFile;
+            }
             lc::exportDiagnostics(scene, settings, result, checkOut);
-            printSummary(scene, settings, result, checkOut);
+            printSummary(scene, settings, result, checkOut, "lists from a dump are not shaded");
             lcli::printCustomReport(result, scene, proj);
             return 0;
         }
@@ -603,15 +621,17 @@ int main(int argc, char** argv) {
         }
         if (!runCustom.shader.empty()) {
             lc::CustomCullReport report;
-            const lc::RunOutput result =
+            lc::RunOutput result =
                 lc::runCustomPipeline(scene, runCustom.shaderOptions(runFlags.device), *backend, options, report,
                                       options.reuseDepth);
+            if (options.reuseDepth) result.depthFrom = "depth file " + runCustom.depthFile;
             lc::exportDiagnostics(scene, settings, result, outDir);
             printSummary(scene, settings, result, outDir);
             lcli::printCustomReport(result, scene, lc::Projection(scene.camera));
             return 0;
         }
-        const lc::RunOutput result = lc::runPipeline(scene, settings, *backend, options);
+        lc::RunOutput result = lc::runPipeline(scene, settings, *backend, options);
+        if (options.reuseDepth) result.depthFrom = "depth file " + runCustom.depthFile;
         lc::exportDiagnostics(scene, settings, result, outDir);
         printSummary(scene, settings, result, outDir);
         return 0;

@@ -636,4 +636,11 @@ TEST_F(GpuTest, CliRunShaderAndCheckWriteTheDiagnostics) {
     const auto c = nlohmann::json::parse(lc_test::slurp(d.path / "engine" / "summary.json"));
     EXPECT_EQ(c["metrics"]["false_negatives"], 0);
     EXPECT_EQ(c["backend"], "dump");
+    // The lists were judged on the default backend's pre-pass: said, timed
+    // and counted, not "no pre-pass ran".
+    EXPECT_EQ(c["depth_source"].get<std::string>().rfind("pre-pass on vulkan (", 0), 0u) << c["depth_source"];
+    EXPECT_GE(c["timings_ms"]["depth"].get<double>(), 0.0);
+    EXPECT_EQ(c["depth_triangles"]["scene"], 11880);
+    EXPECT_NE(r.out.find("pre-pass on vulkan ("), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("--no-image-error"), std::string::npos) << r.out; // not a flag of check
 }

@@ -163,6 +163,10 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
                        {"cull", msOrNull(r.timings.cullMs)},
                        {"ground_truth", msOrNull(r.timings.groundTruthMs)},
                        {"shade", msOrNull(r.timings.shadeMs)}};
+    if (run.depthFrom.empty())
+        j["depth_source"] = run.depthReused ? "given" : "pre-pass on " + r.backend;
+    else
+        j["depth_source"] = run.depthFrom;
     if (run.depthReused)
         j["depth_triangles"] = nullptr;
     else

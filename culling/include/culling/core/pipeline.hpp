@@ -25,6 +25,11 @@ struct RunOutput {
     // True when the depth pre-pass was skipped for RunOptions::reuseDepth
     // (timings.depthMs is then 0).
     bool depthReused = false;
+    // Where the depth image came from when that is not this run's own
+    // pre-pass on its own backend (`check` judges a dump on another backend's
+    // pre-pass; a depth file): said in summary.json's depth_source. Empty
+    // otherwise.
+    std::string depthFrom;
     // Per channel of shadedAll, after shadeAndCompare updated an earlier
     // run's image: the magnitudes the value has carried through updates since
     // its pixel was last shaded from every light, which bound how far it may
