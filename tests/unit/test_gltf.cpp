@@ -189,8 +189,15 @@ TEST(Gltf, BuiltinScenesRoundTripThroughGlbAndGltf) {
         g.spotFraction = 0.5;
         scene.lights = lc::generateLights(g);
         scene.lights[0].explicitRadius = 2.5; // one explicit radius among inverse-square ones
-        for (auto& l : scene.lights)
-            if (l.isSpot()) l.innerAngleDeg = 0.5 * l.outerAngleDeg;
+        std::size_t hard = scene.lights.size();
+        for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+            auto& l = scene.lights[i];
+            if (!l.isSpot()) continue;
+            // One hard-edged spot: KHR_lights_punctual wants inner < outer.
+            if (hard == scene.lights.size()) hard = i;
+            l.innerAngleDeg = i == hard ? l.outerAngleDeg : 0.5 * l.outerAngleDeg;
+        }
+        ASSERT_LT(hard, scene.lights.size());
         for (const char* ext : {".glb", ".gltf"}) {
             // A file name other than the scene's: the name comes from scenes[].name.
             const fs::path p = s.path / (std::string("copy_of_") + name + ext);
@@ -199,6 +206,13 @@ TEST(Gltf, BuiltinScenesRoundTripThroughGlbAndGltf) {
             const lc::Scene back = lc::loadSceneAny(p.string());
             expectSameScene(scene, back);
             EXPECT_EQ(back.name, scene.name);
+            EXPECT_NEAR(back.lights[hard].innerAngleDeg, back.lights[hard].outerAngleDeg, 1e-12);
+            if (std::string(ext) == ".gltf") {
+                const json doc = json::parse(lc_test::slurp(p));
+                for (const auto& l : doc["extensions"]["KHR_lights_punctual"]["lights"])
+                    if (l.contains("spot"))
+                        EXPECT_LT(l["spot"].value("innerConeAngle", 0.0), l["spot"]["outerConeAngle"].get<double>()) << l;
+            }
         }
     }
 }

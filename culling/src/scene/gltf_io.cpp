@@ -1011,6 +1011,10 @@ std::string serializeGltf(const Scene& scene, bool binary) {
         tinygltf::Value::Object x;
         x["min_intensity"] = tinygltf::Value(l.minIntensity);
         x["explicit_radius"] = tinygltf::Value(l.explicitRadius > 0.0);
+        // KHR_lights_punctual asks for inner < outer: a hard-edged spot's inner
+        // angle is written one double inside (read back within 1e-14 of it).
+        if (l.isSpot() && gl.spot.innerConeAngle >= gl.spot.outerConeAngle)
+            gl.spot.innerConeAngle = std::nextafter(gl.spot.outerConeAngle, 0.0);
         tinygltf::Value::Object extras;
         extras["lightcull"] = tinygltf::Value(x);
         gl.extras = tinygltf::Value(extras);
