@@ -5,6 +5,7 @@
 // per-tile heat sums to the run's metrics. Plus the overlays.vtm files as
 // text (the VTK read-back is tests/ui/test_overlay_export.cpp).
 #include "culling/core/errors.hpp"
+#include "culling/diagnostics/explain.hpp"
 #include "culling/diagnostics/export.hpp"
 #include "culling/diagnostics/overlays.hpp"
 #include "culling/scene/scene_io.hpp"
@@ -447,6 +448,31 @@ TEST(Overlays, TileLightRowsAddUpToTheGroundTruth) {
             }
         }
         EXPECT_GT(falsePositives, 0u);
+    }
+
+    // `all`: the one list's pixels are the whole image, whichever tile is
+    // asked, and each row agrees with Explain's count for that light.
+    {
+        CulledScene all = runBuiltin("atrium", Algorithm::All);
+        const Projection proj(all.scene.camera);
+        const std::uint32_t tiles = all.out.result.grid.tileCount();
+        const auto rows = tileLightRows(all.out, proj, tiles / 2);
+        ASSERT_EQ(rows.size(), all.out.result.listCount[0]);
+        std::uint64_t exact = 0;
+        std::size_t needed = 0;
+        for (const TileLightRow& row : rows) {
+            exact += row.pixelsNeeding;
+            needed += row.verdict == Verdict::Needed;
+            EXPECT_EQ(row.verdict == Verdict::Needed, row.pixelsNeeding > 0);
+            if (row.light % 16 == 0) {
+                EXPECT_EQ(explainLight(all.out, proj, 0, row.light).pixelsNeeding, row.pixelsNeeding) << row.light;
+            }
+        }
+        EXPECT_EQ(exact, all.out.truth.listExactWork[0]);
+        EXPECT_GT(needed, 0u);
+        const auto corner = tileLightRows(all.out, proj, 0);
+        ASSERT_EQ(corner.size(), rows.size());
+        for (std::size_t i = 0; i < rows.size(); ++i) EXPECT_EQ(corner[i].pixelsNeeding, rows[i].pixelsNeeding);
     }
 
     // Remove a needed light from one list: it becomes Missing with its pixels.

@@ -8,6 +8,7 @@
 
 #include "culling/core/errors.hpp"
 #include "culling/core/file_io.hpp"
+#include "truth/light_grid.hpp"
 
 #include <algorithm>
 #include <array>
@@ -269,6 +270,37 @@ std::vector<TileLightRow> tileLightRows(const RunOutput& run, const Projection& 
         if (std::uint32_t(cell) >= count) return rows;
         first += std::uint32_t(cell);
         count = 1;
+    }
+    if (r.algorithm == Algorithm::All) {
+        // `all`'s one list serves every pixel of the image: a light is needed
+        // when some pixel of the image needs it (as Explain judges it), not
+        // only a pixel of the tile clicked.
+        std::vector<glm::dvec3> points;
+        const double inf = std::numeric_limits<double>::infinity();
+        glm::dvec3 lo(inf), hi(-inf);
+        for (std::uint32_t y = 0; y < depth.height; ++y)
+            for (std::uint32_t x = 0; x < depth.width; ++x) {
+                if (!depth.hasGeometry(x, y)) continue;
+                const glm::dvec3 p = proj.viewPositionFromDepth(x, y, depth.at(x, y));
+                if (!std::isfinite(p.x + p.y + p.z)) continue;
+                points.push_back(p);
+                lo = glm::min(lo, p), hi = glm::max(hi, p);
+            }
+        std::vector<std::uint32_t> neededCount(run.lights.size(), 0);
+        if (!points.empty()) {
+            const detail::LightGrid lightGrid(run.lights, lo, hi);
+            for (const glm::dvec3& p : points) lightGrid.forEachContaining(p, [&](std::uint32_t i) { ++neededCount[i]; });
+        }
+        std::vector<char> listed(run.lights.size(), 0);
+        for (std::uint32_t k = 0; k < r.listCount[first]; ++k) {
+            const std::uint32_t light = r.lightIndices[r.listOffset[first] + k];
+            if (light >= run.lights.size()) continue;
+            listed[light] = 1;
+            rows.push_back({first, light, neededCount[light], neededCount[light] ? Verdict::Needed : Verdict::FalsePositive});
+        }
+        for (std::uint32_t i = 0; i < neededCount.size(); ++i)
+            if (neededCount[i] && !listed[i]) rows.push_back({first, i, neededCount[i], Verdict::Missing});
+        return rows;
     }
     const auto rect = r.grid.tileRect(tile % r.grid.tilesX, tile / r.grid.tilesX);
     const bool cellFilter = cell >= 0 && r.algorithm == Algorithm::TwoPointFiveD && tileHasGeometry(r, tile);

@@ -88,7 +88,8 @@ std::vector<std::uint32_t> tilesHoldingLight(const CullResult& r, std::uint32_t 
 // pixelsNeedingLights) and a verdict, followed by every light some pixel of
 // the list needs that the list lacks (Missing: a false negative). For 2.5d a
 // cell >= 0 restricts the pixels to those whose depth lies in that cell.
-// Pixels count only where they hold geometry.
+// `all`'s one list serves the whole image: its pixels are the image's, whatever
+// the tile. Pixels count only where they hold geometry.
 enum class Verdict { Needed, FalsePositive, Missing };
 const char* toString(Verdict v); // "needed", "false positive", "MISSING"
 struct TileLightRow {
