@@ -276,6 +276,9 @@ void CameraView::renderNow() {
 void CameraView::resizeEvent(QResizeEvent* e) {
     QVTKOpenGLNativeWidget::resizeEvent(e);
     updateViewport();
+    // Qt repaints a resized widget from VTK's last frame, drawn for the old
+    // size: draw one for the new size (with a new picture of the meshes).
+    scheduleRender();
 }
 
 void CameraView::updateViewport() {

@@ -114,6 +114,32 @@ class CameraPictureTest : public QObject {
         QCOMPARE(view_->meshPictureCaptures(), after);
     }
 
+    // What a user sees after the view changes size (View > Tabbed views, a
+    // dock dragged) with nothing else happening: the frame drawn for the new
+    // size, not the old frame (the picture squashed, the legend where it was,
+    // and clicks landing on other tiles than the ones drawn under them).
+    void aResizeAloneRedrawsForTheNewSize() {
+        frame();
+        view_->resize(1000, 300);
+        QTest::qWait(300); // the event loop only: no renderNow
+        const QImage shot = view_->grabFramebuffer().convertToFormat(QImage::Format_RGB32);
+        QCOMPARE(shot.width(), view_->width() * int(view_->devicePixelRatio()));
+        const double* vp = view_->sceneRenderer()->GetViewport();
+        const int x0 = int(vp[0] * shot.width() + 0.5), x1 = int(vp[2] * shot.width() + 0.5);
+        // The window background (0.12, 0.12, 0.14) lies left and right of the
+        // letterboxed image; the image's own background is darker.
+        const QRgb window = shot.pixel(2, shot.height() / 2);
+        int first = -1, last = -1;
+        const int y = shot.height() / 2;
+        for (int x = 0; x < x1 + 40 && x < shot.width(); ++x)
+            if (shot.pixel(x, y) != window) {
+                if (first < 0) first = x;
+                last = x;
+            }
+        QVERIFY2(std::abs(first - x0) <= 2 && std::abs(last + 1 - x1) <= 2,
+                 qPrintable(QString("drawn over columns %1..%2, the viewport is %3..%4").arg(first).arg(last + 1).arg(x0).arg(x1)));
+    }
+
     // The image keeps the camera's aspect, fitted beside the legend band,
     // whatever size the view had while it was hidden (a dock re-laid out
     // while another tab showed, a window resized twice).
