@@ -93,7 +93,7 @@ private slots:
         w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(far)));
         QVERIFY(panel->explanation());
         QCOMPARE(panel->explanation()->listed, false);
-        QVERIFY2(verdict->text().contains("rejected by"), qPrintable(verdict->text()));
+        QVERIFY2(verdict->text().contains("the first test to reject it:"), qPrintable(verdict->text()));
         QVERIFY(panel->textView()->toPlainText().contains("FAIL"));
         // For a person to look at (docs/STUDIO.md): the window with the panel.
         w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(light)));

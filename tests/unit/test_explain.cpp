@@ -121,6 +121,13 @@ TEST(Explain, TheDecidingPlaneIsTheOneOfLeastMargin) {
                 least = std::min(least, signedDistance(chunk->planes[std::size_t(k)], e.sphereCenter) + rr);
             EXPECT_DOUBLE_EQ(e.decisiveMargin, least);
             EXPECT_EQ(e.decisiveMargin < 0, planeFailed) << e.text();
+            // One answer to "which test rejected it": the verdict names the
+            // first failing step; the plane line says it ranks the planes.
+            const auto firstFail = std::find_if(e.steps.begin(), e.steps.end(), [](const ExplainStep& st) { return !st.passed; });
+            if (firstFail != e.steps.end() && !e.listed) {
+                EXPECT_NE(e.verdict.find("the first test to reject it: '" + firstFail->test + "'"), std::string::npos) << e.text();
+            }
+            EXPECT_EQ(e.text().find("rejected by"), std::string::npos) << e.text();
             rejectedByPlane += planeFailed;
             kept += !planeFailed;
         }

@@ -283,10 +283,10 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
     } else if (e.pixelsNeeding > 0) {
         e.verdict = "MISSING: not listed, but " + std::to_string(e.pixelsNeeding) + " of the list's pixels need it" +
                     (failed.empty() ? std::string(" (the reference's tests keep it: this pass dropped it)")
-                                    : " (rejected by '" + failed + "')");
+                                    : " (the first test to reject it: '" + failed + "')");
     } else {
         e.verdict = "not listed, rightly: no pixel of the list needs it" +
-                    (failed.empty() ? std::string() : " (rejected by '" + failed + "')");
+                    (failed.empty() ? std::string() : " (the first test to reject it: '" + failed + "')");
     }
     return e;
 }
@@ -301,7 +301,8 @@ std::string Explanation::text(const std::string& lightName) const {
     if (chunkDepthMax > 0) out += "  tested chunk: view depth " + num(chunkDepthMin) + ".." + num(chunkDepthMax) + "\n";
     for (const ExplainStep& s : steps) out += std::string("  ") + (s.passed ? "pass  " : "FAIL  ") + s.test + ": " + s.numbers + "\n";
     if (decisivePlane >= 0)
-        out += std::string("  ") + (decisiveMargin < 0 ? "rejected by the " : "closest to rejecting it: the ") +
+        out += std::string("  ") +
+               (decisiveMargin < 0 ? "of the six planes, farthest outside: the " : "of the six planes, closest to rejecting it: the ") +
                chunkPlaneName(decisivePlane) + " (signed distance + r = " + num(decisiveMargin) + ")\n";
     out += "  tests: " + std::string(testsPass ? "keep it" : "reject it") + "; the list " +
            (listed ? "holds it" : "does not hold it") + "\n";
