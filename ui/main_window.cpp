@@ -663,9 +663,11 @@ void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::Run
 }
 
 void MainWindow::onRunFailed(quint64 generation, const QString& message) {
+    failedGeneration_ = std::max(failedGeneration_, generation);
     doc_->noteRunFailed(generation);
     log(tr("run %1 failed: %2").arg(generation).arg(message), true);
     statusBar()->showMessage(tr("culling failed: %1").arg(message), 10000);
+    updateStatus();
     emit runFailed(generation, message);
 }
 
@@ -691,6 +693,18 @@ void MainWindow::updateStatus() {
     statusTimes_->setStyleSheet(doc_->runIsStale() ? "color: white; background: #b9770e; padding: 0 4px" : "");
     statusTimes_->setToolTip(doc_->runIsStale() ? tr("The scene changed since this run: F5 runs it again.") : QString());
     if (doc_->runIsStale()) statusTimes_->setText(tr("stale: %1").arg(statusTimes_->text()));
+    // A failed run (a custom shader that does not compile, settings the
+    // device refuses) leaves the last good run on screen: say whose it is.
+    if (failedGeneration_ > doc_->runGeneration()) {
+        const QString what = run->custom ? tr("custom shader") : QString(lc::toString(run->result.algorithm));
+        statusTimes_->setStyleSheet("color: white; background: #b9770e; padding: 0 4px");
+        statusTimes_->setText(tr("run %1 failed, showing run %2 (%3): %4")
+                                  .arg(failedGeneration_)
+                                  .arg(doc_->runGeneration())
+                                  .arg(what, statusTimes_->text()));
+        statusTimes_->setToolTip(tr("The last run failed (the message log says why): the view, the tile inspector "
+                                    "and these figures are an earlier run's."));
+    }
     if (!run->truthComputed) {
         // Live edit: ground truth is still being computed (or was superseded).
         const auto& counts = run->result.listCount;

@@ -194,6 +194,9 @@ private:
     QLabel* statusLists_;
     StatusProgress* statusProgress_ = nullptr; // loads, shading and reports, with Cancel
     QString lastBackendName_, lastDeviceName_;
+    // The newest run that failed (0: none): while it is newer than the run
+    // shown, the status bar says the figures are an older run's.
+    quint64 failedGeneration_ = 0;
     ExplainPanel* explain_ = nullptr;
     std::shared_ptr<const lc::CustomShaderOptions> customShader_;
     QFileSystemWatcher* shaderWatcher_ = nullptr;

@@ -7,6 +7,8 @@
 
 #include "studio_test_support.hpp"
 
+#include <QLabel>
+
 #include "document.hpp"
 #include "main_window.hpp"
 #include "tile_inspector.hpp"
@@ -138,6 +140,14 @@ private slots:
         QVERIFY2(why.contains("mine.comp:") && why.contains("compile error"), qPrintable(why));
         QVERIFY(w_->messageLog()->toPlainText().contains("compile error"));
         QCOMPARE(lc::serializeScene(doc()->scene()), sceneBefore);
+        // The flawed shader's run stays on screen: the status bar says it is
+        // not the run of the shader now chosen.
+        auto* times = w_->findChild<QLabel*>("statusTimes");
+        QVERIFY(times);
+        QVERIFY2(times->text().startsWith(QString("run %1 failed, showing run %2 (custom shader)")
+                                              .arg(doc()->runGeneration() + 1)
+                                              .arg(doc()->runGeneration())),
+                 qPrintable(times->text()));
 
         // Back to the built-in algorithm.
         before = doc()->runGeneration();
@@ -145,6 +155,7 @@ private slots:
         QVERIFY(w_->customShaderPath().isEmpty());
         QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
         QVERIFY(!doc()->runOutput()->custom);
+        QVERIFY2(!times->text().contains("failed"), qPrintable(times->text()));
     }
 
     void badFirstLineIsRefusedAndShown() {
