@@ -11,6 +11,7 @@
 #include "property_panel.hpp"
 #include "scene_tree.hpp"
 #include "tile_inspector.hpp"
+#include "undo_keys.hpp"
 #include "report_dock.hpp"
 
 #include "culling/core/errors.hpp"
@@ -487,6 +488,9 @@ void MainWindow::buildToolbar() {
         bar->addWidget(w);
     }
     for (auto& [name, w] : paramWidgets_) w->setObjectName(QString::fromStdString("param_" + name));
+    // Ctrl+Z in a culling field undoes the scene's last edit (tile, width and
+    // height are camera edits), as in the properties panel.
+    (new UndoKeysToWindow(bar))->watch(bar);
 
     bar->addAction(action("actionCustomShader"));
     bar->addSeparator();

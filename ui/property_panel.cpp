@@ -1,5 +1,7 @@
 #include "property_panel.hpp"
 
+#include "undo_keys.hpp"
+
 #include "document.hpp"
 
 #include <QCheckBox>
@@ -49,18 +51,6 @@ double edited(const QDoubleSpinBox* s, double original) {
     return std::abs(s->value() - shown) <= 0.5 * std::pow(10.0, -s->decimals()) ? original : s->value();
 }
 } // namespace
-
-bool PropertyPanel::eventFilter(QObject* watched, QEvent* event) {
-    if (event->type() == QEvent::ShortcutOverride) {
-        auto* key = static_cast<QKeyEvent*>(event);
-        if (key->matches(QKeySequence::Undo) || key->matches(QKeySequence::Redo) ||
-            QKeySequence(key->modifiers() | key->key()) == QKeySequence(tr("Ctrl+Shift+Z"))) {
-            event->ignore(); // not the field's: the window's Undo and Redo actions take it
-            return true;
-        }
-    }
-    return QWidget::eventFilter(watched, event);
-}
 
 QDoubleSpinBox* PropertyPanel::makeSpin(double lo, double hi, int decimals, const char* objectName) {
     auto* s = new QDoubleSpinBox;
@@ -203,8 +193,7 @@ PropertyPanel::PropertyPanel(Document* doc, QWidget* parent) : QWidget(parent), 
     connect(doc_, &Document::lightsChanged, this, &PropertyPanel::refresh);
     connect(doc_, &Document::cameraChanged, this, &PropertyPanel::refresh);
     connect(doc_, &Document::sceneReset, this, &PropertyPanel::refresh);
-    for (QWidget* field : findChildren<QAbstractSpinBox*>()) field->installEventFilter(this);
-    for (QWidget* field : findChildren<QLineEdit*>()) field->installEventFilter(this);
+    (new UndoKeysToWindow(this))->watch(this);
     refresh();
 }
 

@@ -34,11 +34,6 @@ signals:
     // (the fields show the previous values again); `why` names the field.
     void editRefused(const QString& why);
 
-protected:
-    // Ctrl+Z and Ctrl+Shift+Z in a field go to the scene's undo stack, not
-    // the field's own text undo (focus stays in a field after Enter).
-    bool eventFilter(QObject* watched, QEvent* event) override;
-
 private:
     void refresh();
     void commitLight();

@@ -35,6 +35,7 @@
 #include <QSettings>
 #include <QProcessEnvironment>
 #include <QSet>
+#include <QSpinBox>
 #include <QStatusBar>
 #include <QTabBar>
 #include <QImage>
@@ -656,6 +657,22 @@ private slots:
         QCOMPARE(doc()->scene().lights[0].intensity, before);
         QTest::keyClick(intensity, Qt::Key_Z, Qt::ControlModifier | Qt::ShiftModifier);
         QCOMPARE(doc()->scene().lights[0].intensity, 7.5);
+
+        // The culling toolbar's tile size is a camera edit: Ctrl+Z there too.
+        auto* tile = w_->findChild<QSpinBox*>("param_tile");
+        QVERIFY(tile);
+        const std::uint32_t tileBefore = doc()->scene().camera.tileSize;
+        tile->setFocus();
+        QTRY_VERIFY(tile->hasFocus());
+        tile->selectAll();
+        QTest::keyClicks(tile, "64");
+        QTest::keyClick(tile, Qt::Key_Return);
+        QCOMPARE(doc()->scene().camera.tileSize, 64u);
+        QTest::keyClick(tile, Qt::Key_Z, Qt::ControlModifier);
+        QCOMPARE(doc()->scene().camera.tileSize, tileBefore);
+        QCOMPARE(tile->value(), int(tileBefore));
+        QTest::keyClick(tile, Qt::Key_Z, Qt::ControlModifier | Qt::ShiftModifier);
+        QCOMPARE(doc()->scene().camera.tileSize, 64u);
     }
 
     // The keys docs/STUDIO.md lists reach their actions on any platform
