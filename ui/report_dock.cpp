@@ -107,6 +107,21 @@ ReportDock::ReportDock(Document* doc, QWidget* parent) : QWidget(parent), doc_(d
     connect(runButton_, &QPushButton::clicked, this, [this] { start(); });
     connect(cancelButton_, &QPushButton::clicked, this, &ReportDock::cancel);
     connect(yBox_, qOverload<int>(&QComboBox::currentIndexChanged), this, [this] { rebuildChart(); });
+    // A report describes the scene it swept: another scene (New, Open, a
+    // built-in) drops it, and a sweep still running is cancelled and its
+    // result never shown, so no click loads one scene's point into another.
+    connect(doc_, &Document::sceneReset, this, [this] {
+        if (running_) {
+            cancel_.cancelled = true;
+            ++sweepsDropped_;
+        }
+        if (!report_ && !running_) return;
+        report_.reset();
+        rebuildChart();
+        progress_->setRange(0, 1);
+        progress_->setValue(0);
+        status_->setText(tr("Another scene was opened: run the report for it."));
+    });
     rebuildChart();
 }
 
@@ -134,15 +149,20 @@ bool ReportDock::start() {
     emit started();
     const lc::Scene scene = doc_->scene();
     const lc::ReportOptions options = options_;
-    thread_ = std::thread([this, scene, options] {
+    const int dropped = sweepsDropped_;
+    thread_ = std::thread([this, scene, options, dropped] {
         std::shared_ptr<lc::Report> rep;
         QString error;
         bool cancelled = false;
         try {
-            auto progress = [this](std::size_t done, std::size_t total, const std::string& label) {
+            auto progress = [this, dropped](std::size_t done, std::size_t total, const std::string& label) {
                 const QString text = QString::fromStdString(label);
                 QMetaObject::invokeMethod(
-                    this, [this, done, total, text] { onProgress(int(done), int(total), text); }, Qt::QueuedConnection);
+                    this,
+                    [this, done, total, text, dropped] {
+                        if (dropped == sweepsDropped_) onProgress(int(done), int(total), text);
+                    },
+                    Qt::QueuedConnection);
             };
             rep = std::make_shared<lc::Report>(lc::runReport(scene, options, progress, &cancel_));
         } catch (const lc::Cancelled&) {
@@ -151,7 +171,13 @@ bool ReportDock::start() {
             error = QString::fromStdString(e.what());
         }
         QMetaObject::invokeMethod(
-            this, [this, rep, error, cancelled] { onDone(rep, error, cancelled); }, Qt::QueuedConnection);
+            this,
+            [this, rep, error, cancelled, dropped] {
+                // Of a scene no longer open: finish the sweep, show nothing of it.
+                const bool sceneGone = dropped != sweepsDropped_;
+                onDone(sceneGone ? nullptr : rep, error, cancelled || sceneGone, sceneGone);
+            },
+            Qt::QueuedConnection);
     });
     return true;
 }
@@ -169,7 +195,7 @@ void ReportDock::onProgress(int done, int total, const QString& label) {
     emit progressed(done, total, label);
 }
 
-void ReportDock::onDone(std::shared_ptr<lc::Report> report, const QString& error, bool cancelled) {
+void ReportDock::onDone(std::shared_ptr<lc::Report> report, const QString& error, bool cancelled, bool sceneGone) {
     if (thread_.joinable()) thread_.join();
     running_ = false;
     runButton_->setEnabled(true);
@@ -182,7 +208,8 @@ void ReportDock::onDone(std::shared_ptr<lc::Report> report, const QString& error
         rebuildChart();
     } else {
         progress_->setValue(0);
-        status_->setText(cancelled ? tr("Cancelled; the previous report is kept.") : tr("Failed: %1").arg(error));
+        if (!sceneGone) // else the message of the scene's reset stays
+            status_->setText(cancelled ? tr("Cancelled; the previous report is kept.") : tr("Failed: %1").arg(error));
     }
     emit finished(report_ != nullptr && !cancelled && error.isEmpty());
 }
@@ -284,7 +311,7 @@ void ReportDock::loadRow(std::size_t row) {
     if (doc_->scene().camera.tileSize != cfg.tileSize) {
         lc::Camera cam = doc_->scene().camera;
         cam.tileSize = cfg.tileSize;
-        doc_->setCamera(cam, tr("Load report configuration"));
+        doc_->setCamera(cam, tr("Set tile size (from the report)"));
     }
     status_->setText(tr("Loaded %1 (%2)").arg(QString::fromStdString(cfg.label()), QString::fromStdString(cfg.backend)));
     emit configurationLoaded(int(row));

@@ -68,7 +68,8 @@ signals:
 
 private:
     void onProgress(int done, int total, const QString& label);
-    void onDone(std::shared_ptr<lc::Report> report, const QString& error, bool cancelled);
+    // sceneGone: the sweep was of a scene another one replaced (nothing shown).
+    void onDone(std::shared_ptr<lc::Report> report, const QString& error, bool cancelled, bool sceneGone);
     void rebuildChart();
     void onChartClick(vtkObject*, unsigned long, void* callData);
     double yOf(const lc::ReportRow& r) const;
@@ -94,6 +95,9 @@ private:
     std::thread thread_;
     lc::CancelToken cancel_;
     bool running_ = false;
+    // Sweeps cancelled because another scene was opened: a sweep that
+    // finishes with a count other than the one it started under is dropped.
+    int sweepsDropped_ = 0;
 };
 
 } // namespace lcui

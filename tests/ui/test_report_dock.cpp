@@ -168,6 +168,33 @@ private slots:
             QCOMPARE(doc()->scene().camera.tileSize, 16u);
         }
     }
+
+    // A report belongs to the scene it swept: opening another drops it (no
+    // click can load its points into the new scene), and a sweep running
+    // then shows nothing when it ends.
+    void anotherSceneDropsTheReport() {
+        chooseCpu("minmax");
+        dock_->options().tileSizes = {16};
+        QVERIFY(runToEnd());
+        QVERIFY(dock_->report());
+        doc()->undoStack()->setClean(); // no prompt to save
+        QVERIFY(w_->openBuiltin("forest"));
+        QVERIFY(!dock_->report());
+        QVERIFY(!dock_->chartPositionOf(0).has_value());
+        auto* status = dock_->findChild<QLabel*>("reportStatus");
+        QVERIFY2(status->text().contains("Another scene"), qPrintable(status->text()));
+
+        QVERIFY(w_->setParamFromUi("width", "96"));
+        QVERIFY(w_->setParamFromUi("height", "64"));
+        QSignalSpy done(dock_, &ReportDock::finished);
+        QVERIFY(dock_->start());
+        doc()->undoStack()->setClean();
+        QVERIFY(w_->openBuiltin("atrium"));
+        QVERIFY(done.wait(kTimeoutMs));
+        QCOMPARE(done.first().at(0).toBool(), false);
+        QVERIFY(!dock_->report());
+        QVERIFY2(status->text().contains("Another scene"), qPrintable(status->text()));
+    }
 };
 
 LC_STUDIO_TEST_MAIN(ReportDockTest)
