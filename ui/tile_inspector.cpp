@@ -55,8 +55,12 @@ QVariant TileLightsModel::data(const QModelIndex& index, int role) const {
         const auto& p = lights[r.light].position;
         return QString("%1, %2, %3").arg(p.x, 0, 'g', 4).arg(p.y, 0, 'g', 4).arg(p.z, 0, 'g', 4);
     }
-    case ColRadius:
-        return run_ && r.light < run_->lights.size() ? QVariant(run_->lights.radii[r.light]) : QVariant();
+    case ColRadius: {
+        if (!run_ || r.light >= run_->lights.size()) return {};
+        const double radius = run_->lights.radii[r.light];
+        // Shown to 4 digits; sorted by the number (the proxy sorts EditRole).
+        return role == Qt::EditRole ? QVariant(radius) : QVariant(QString::number(radius, 'g', 4));
+    }
     case ColPixels: return int(r.pixelsNeeding);
     case ColVerdict: return QString(lc::toString(r.verdict));
     }
@@ -70,7 +74,7 @@ TileInspector::TileInspector(Document* doc, QWidget* parent) : QWidget(parent), 
     proxy_->setObjectName("tileLightsProxy");
     proxy_->setSourceModel(model_);
     proxy_->setFilterKeyColumn(TileLightsModel::ColVerdict);
-    proxy_->setSortRole(Qt::DisplayRole);
+    proxy_->setSortRole(Qt::EditRole);
     verdictFilter_ = new QComboBox;
     verdictFilter_->setObjectName("tileVerdictFilter");
     verdictFilter_->addItem(tr("All rows"), QString());
@@ -145,6 +149,8 @@ void TileInspector::refresh() {
     const lc::Projection proj(cam);
     const int cell = doc_->selectedCell();
     model_->setRows(lc::tileLightRows(*run, proj, std::uint32_t(tile), cell), run);
+    // With one list per tile the list column only repeats the tile's index.
+    table_->setColumnHidden(TileLightsModel::ColList, run->result.listsPerTile <= 1);
     // Columns as wide as what they hold: light, name, verdict and pixels fit
     // the dock's first-start width.
     table_->resizeColumnsToContents();

@@ -302,6 +302,15 @@ private slots:
         for (int r = 1; r < ti->proxy()->rowCount(); ++r)
             QVERIFY(ti->proxy()->index(r - 1, TileLightsModel::ColPixels).data().toInt() >=
                     ti->proxy()->index(r, TileLightsModel::ColPixels).data().toInt());
+        // By radius: by the number, not its text (10 after 9), shown to 4 digits.
+        ti->proxy()->sort(TileLightsModel::ColRadius, Qt::AscendingOrder);
+        for (int r = 1; r < ti->proxy()->rowCount(); ++r)
+            QVERIFY(ti->proxy()->index(r - 1, TileLightsModel::ColRadius).data(Qt::EditRole).toDouble() <=
+                    ti->proxy()->index(r, TileLightsModel::ColRadius).data(Qt::EditRole).toDouble());
+        QVERIFY(ti->proxy()->index(0, TileLightsModel::ColRadius).data().toString().size() <= 6);
+        // One list per tile: no list column repeating the tile's index.
+        QCOMPARE(run->result.listsPerTile, 1u);
+        QVERIFY(ti->findChild<QTableView*>()->isColumnHidden(TileLightsModel::ColList));
 
         // The scene tree: filter by name, then order by radius.
         auto* filter = w_->findChild<QLineEdit*>("sceneFilter");
