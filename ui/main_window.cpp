@@ -652,11 +652,13 @@ void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::Run
             : tr(" (%1 of %2 triangles)")
                   .arg(qulonglong(out->result.depthTrianglesDrawn))
                   .arg(qulonglong(out->result.depthTriangles));
-    if (out->truthComputed) log(tr("run %1: %2, %3 lights, depth %4 ms%8, cull %5 ms, false negatives %6, efficiency %7")
+    const QString depthTime = out->depthReused ? tr("reused (a light edit keeps the last pre-pass)")
+                                               : tr("%1 ms").arg(out->result.timings.depthMs, 0, 'f', 2);
+    if (out->truthComputed) log(tr("run %1: %2, %3 lights, depth %4%8, cull %5 ms, false negatives %6, efficiency %7")
             .arg(generation)
             .arg(out->custom ? QStringLiteral("custom") : QString(lc::toString(out->result.algorithm)))
             .arg(out->lights.size())
-            .arg(out->result.timings.depthMs, 0, 'f', 2)
+            .arg(depthTime)
             .arg(out->result.timings.cullMs, 0, 'f', 2)
             .arg(m.falseNegatives)
             .arg(m.efficiency, 0, 'f', 4)

@@ -729,6 +729,13 @@ private slots:
         for (QLabel* l : w_->statusBar()->findChildren<QLabel*>())
             saysReused = saysReused || l->text().startsWith("depth reused");
         QVERIFY(saysReused);
+        // The log says so too (not "depth 0.00 ms"), once the truth is in, and
+        // the run knows whose depth it culled against (summary.json's depth_source).
+        QTRY_VERIFY(doc()->runOutput()->truthComputed);
+        const QString log = w_->messageLog()->toPlainText();
+        const QString last = log.section('\n', -1);
+        QVERIFY2(last.contains("depth reused (a light edit keeps the last pre-pass)"), qPrintable(last));
+        QCOMPARE(doc()->runOutput()->depthFrom, std::string("the previous run's pre-pass (a light edit)"));
 
         lc::Camera c = doc()->scene().camera;
         c.position += glm::dvec3(0.0, 0.5, 0.0);
