@@ -183,12 +183,20 @@ struct SceneFlags {
         if (!backendName.empty()) return lc::makeBackend(backendName, device);
         // Default: Vulkan where this build has it and a device opens, else the CPU reference.
         const auto avail = lc::availableBackends();
+        // A device the user named (--device, LIGHTCULL_DEVICE) is wanted, not
+        // a default: when it does not open the run fails rather than timing
+        // the CPU under the GPU's name.
+        const char* env = std::getenv("LIGHTCULL_DEVICE");
+        const bool named = !device.empty() || (env && *env);
         if (std::find(avail.begin(), avail.end(), "vulkan") != avail.end()) {
             try {
                 return lc::makeBackend("vulkan", device);
             } catch (const lc::Error& e) {
+                if (named) throw;
                 std::cerr << "lightcull: note: no Vulkan device (" << oneLine(e.what()) << "), using the cpu backend\n";
             }
+        } else if (named) {
+            throw lc::SettingsError("device", "this build has no Vulkan backend");
         }
         return lc::makeBackend("cpu");
     }

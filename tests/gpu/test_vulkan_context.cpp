@@ -3,6 +3,8 @@
 // and typed errors naming the failed call, its result and the source line.
 #include "gpu_test_env.hpp"
 
+#include "../unit/cli_support.hpp"
+
 #include "culling/core/errors.hpp"
 #include "vk/vk_context.hpp"
 
@@ -83,6 +85,24 @@ TEST_F(GpuTest, DeviceChoiceByIndexNameAndEnvironment) {
     EXPECT_EQ(makeBackend("vulkan", "0")->name(), "vulkan");
     const auto avail = availableBackends();
     EXPECT_NE(std::find(avail.begin(), avail.end(), "vulkan"), avail.end());
+}
+
+// The CLI's default backend falls back to the CPU when no Vulkan device
+// opens, but a device the user named is wanted: naming one that is not there
+// fails, rather than timing the CPU under the name asked for.
+TEST_F(GpuTest, ANamedDeviceThatIsNotThereIsAnErrorNotTheCpu) {
+    lc_test::ScratchDir d;
+    const lc_test::CliResult r = lc_test::runCli({"run", "--builtin", "atrium", "--width", "64", "--height", "64",
+                                                  "--device", "no-such-gpu-xyz", "--out", (d.path / "o").string()},
+                                                 d.path);
+    EXPECT_EQ(r.code, 1) << r.out << r.err;
+    EXPECT_NE(r.err.find("no Vulkan device matches 'no-such-gpu-xyz'"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    const lc_test::CliResult ok = lc_test::runCli(
+        {"run", "--builtin", "atrium", "--width", "64", "--height", "64", "--device", "0", "--out", (d.path / "p").string()},
+        d.path);
+    EXPECT_EQ(ok.code, 0) << ok.err;
+    EXPECT_NE(ok.out.find("backend vulkan"), std::string::npos) << ok.out;
 }
 
 } // namespace
