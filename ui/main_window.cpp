@@ -854,7 +854,10 @@ bool MainWindow::save() {
     return saveAs(doc_->filePath());
 }
 
-bool MainWindow::saveAs(const QString& path) {
+bool MainWindow::saveAs(const QString& given) {
+    // Scene files are told apart by extension (the CLI refuses others): a
+    // name typed without one is scene JSON, and gets .json.
+    const QString path = QFileInfo(given).suffix().isEmpty() ? given + ".json" : given;
     try {
         lc::saveSceneAny(doc_->scene(), path.toStdString()); // .gltf/.glb as glTF, else scene JSON
     } catch (const std::exception& e) {

@@ -510,6 +510,7 @@ int main(int argc, char** argv) {
         if (report.chosen()) return report.run();
 
         if (app.got_subcommand("convert")) {
+            lcli::SceneSource::checkSceneExtension("OUT", convertOut); // before reading IN
             const lc::Scene scene = convertIn.load();
             lc::saveSceneAny(scene, convertOut);
             std::cout << "wrote " << convertOut << ": " << scene.triangleCount() << " triangles, " << scene.lights.size()

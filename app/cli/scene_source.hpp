@@ -8,8 +8,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cctype>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -22,6 +24,7 @@ struct SceneSource {
     // Adds --scene and --builtin (or, with `positional`, the first positional
     // argument IN), --camera and --min-intensity.
     void addTo(CLI::App* cmd, bool positional = false) {
+        positional_ = positional;
         CLI::Option* optScene =
             cmd->add_option(positional ? "in" : "--scene", sceneFile,
                             "Scene to load: scene JSON, glTF 2.0 (.gltf) or binary glTF (.glb)")
@@ -50,6 +53,7 @@ struct SceneSource {
     // Loads it; glTF warnings go to stderr, one line each.
     lc::Scene load() const {
         if (sceneFile.empty()) return lc::makeBuiltinScene(builtin);
+        checkSceneExtension(positional_ ? "IN" : "--scene", sceneFile);
         // A scene JSON holds its camera and each light's I_min: a glTF
         // option given with one would be ignored without a word.
         if (!lc::isGltfPath(sceneFile))
@@ -68,7 +72,21 @@ struct SceneSource {
         return s;
     }
 
+    // Scene files are told apart by extension (docs/CLI.md): .json, .gltf or
+    // .glb. A mesh given as a scene, or any other name, is a clear error
+    // instead of a JSON parse error or a scene JSON written under .obj.
+    static void checkSceneExtension(const std::string& what, const std::string& path) {
+        std::string ext = std::filesystem::path(path).extension().string();
+        for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+        if (ext == ".json" || ext == ".gltf" || ext == ".glb") return;
+        if (what != "OUT" && (ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl"))
+            throw lc::SettingsError(what, path + " is a mesh, not a scene: name it in a scene JSON's meshes "
+                                                 "(docs/FORMATS.md) or import it in the studio");
+        throw lc::SettingsError(what, path + ": a scene is .json (scene JSON), .gltf or .glb (glTF 2.0)");
+    }
+
 private:
+    bool positional_ = false;
     CLI::Option* optCamera_ = nullptr;
     CLI::Option* optMinIntensity_ = nullptr;
 };

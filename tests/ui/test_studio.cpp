@@ -442,6 +442,14 @@ private slots:
         QCOMPARE(asked, 3);
         QCOMPARE(sceneText(doc()), edited);
         QCOMPARE(doc()->filePath(), path);
+
+        // A name typed without an extension is saved as scene JSON under .json
+        // (what the CLI and Open recognise).
+        w_->prompts.savePath = [&](QWidget*, const QString&, const QString&) { return tmp_.path() + "/bare"; };
+        w_->action("actionSaveAs")->trigger();
+        QVERIFY(QFile::exists(tmp_.path() + "/bare.json"));
+        QVERIFY(!QFile::exists(tmp_.path() + "/bare"));
+        QCOMPARE(doc()->filePath(), tmp_.path() + "/bare.json");
     }
 
     void failedImportLeavesSceneIntact() {

@@ -673,4 +673,17 @@ TEST(GltfCli, RunAndConvertTakeGltf) {
     r = lc_test::runCli({"run", "--scene", (s.path / "atrium.glb").string(), "--camera", "nope", "--out", (s.path / "x").string()}, s.path);
     EXPECT_NE(r.code, 0);
     EXPECT_NE(r.err.find("no camera 'nope'"), std::string::npos) << r.err;
+    // Scene files are told apart by extension: another one is refused, not
+    // written as scene JSON under its name, and a mesh is not read as a scene.
+    for (const char* out : {"atrium.obj", "atrium.txt", "atrium"}) {
+        r = lc_test::runCli({"convert", (s.path / "atrium.glb").string(), (s.path / out).string()}, s.path);
+        EXPECT_EQ(r.code, 2) << out;
+        EXPECT_NE(r.err.find("OUT: "), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("a scene is .json (scene JSON), .gltf or .glb"), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(s.path / out)) << out;
+    }
+    std::ofstream(s.path / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    r = lc_test::runCli({"run", "--scene", (s.path / "tri.obj").string(), "--out", (s.path / "y").string()}, s.path);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("tri.obj is a mesh, not a scene"), std::string::npos) << r.err;
 }
