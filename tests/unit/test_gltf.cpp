@@ -462,6 +462,21 @@ TEST(Gltf, CamerasAreChosenAndConverted) {
         EXPECT_NE(std::string(err.what()).find("'missing'"), std::string::npos) << err.what();
         EXPECT_NE(std::string(err.what()).find("0 'wide'"), std::string::npos) << err.what();
     }
+
+    // A name two cameras answer to (here the endless camera's node is named
+    // like the wide camera) is refused, not settled by node order.
+    b.doc["nodes"][std::size_t(endless)]["name"] = "wide";
+    writeBytes(p, b.gltfText());
+    o.camera = "wide";
+    try {
+        lc::loadGltfScene(p.string(), o);
+        ADD_FAILURE() << "no error for an ambiguous camera name";
+    } catch (const lc::SettingsError& err) {
+        EXPECT_NE(std::string(err.what()).find("'wide' names more than one camera"), std::string::npos) << err.what();
+        EXPECT_NE(std::string(err.what()).find("give the camera's index"), std::string::npos) << err.what();
+    }
+    o.camera = "0";
+    EXPECT_EQ(lc::loadGltfScene(p.string(), o).camera.projection, lc::ProjectionKind::Perspective);
 }
 
 TEST(Gltf, WithoutACameraTheSceneIsFramed) {

@@ -678,14 +678,23 @@ Camera readCamera(const std::string& path, const tinygltf::Model& model, const s
     if (!options.camera.empty()) {
         const std::string& want = options.camera;
         const bool numeric = want.find_first_not_of("0123456789") == std::string::npos && want.size() < 10;
+        // By name, every placement that answers to it: more than one is a
+        // question only the user can settle (by index), not the first.
+        std::string matches;
+        int matched = 0;
         for (const auto* p : cams) {
             const int c = model.nodes[std::size_t(p->node)].camera;
             if (numeric ? c == std::stoi(want)
                         : (model.cameras[std::size_t(c)].name == want || model.nodes[std::size_t(p->node)].name == want)) {
-                chosen = p;
-                break;
+                if (!chosen) chosen = p;
+                if (numeric) break;
+                matches += std::string(matched++ ? ", " : "") + idx("cameras", std::size_t(c)) + " on " +
+                           idx("nodes", std::size_t(p->node));
             }
         }
+        if (matched > 1)
+            throw SettingsError("camera", "'" + want + "' names more than one camera in " + path + " (" + matches +
+                                              "): give the camera's index");
         if (!chosen) {
             std::string have;
             for (const auto* p : cams) {
