@@ -528,23 +528,33 @@ int main(int argc, char** argv) {
             char tail = 0;
             if (std::sscanf(explainTile.c_str(), "%u,%u%c", &tx, &ty, &tail) != 2)
                 return fail(2, "--tile: expected X,Y, got '" + explainTile + "'");
+            // Digits are an index (as tiles.csv names lights), anything else a
+            // name; a light named with digits is reached by its index.
             std::uint32_t light = 0;
-            bool byName = false;
-            for (std::size_t i = 0; i < scene.lights.size(); ++i)
-                if (scene.lights[i].name == explainLightText) {
-                    // Two lights of one name (glTF allows it): the index decides.
-                    if (byName)
-                        return fail(2, "--light: lights " + std::to_string(light) + " and " + std::to_string(i) +
-                                           " are both named '" + explainLightText + "': give the index");
-                    light = std::uint32_t(i);
-                    byName = true;
-                }
-            if (!byName) {
-                char* end = nullptr;
-                const unsigned long v = std::strtoul(explainLightText.c_str(), &end, 10);
-                if (explainLightText.empty() || *end != '\0')
-                    return fail(2, "--light: no light named '" + explainLightText + "' and not an index");
+            const bool digits = !explainLightText.empty() && explainLightText.size() < 10 &&
+                                explainLightText.find_first_not_of("0123456789") == std::string::npos;
+            if (digits) {
+                const unsigned long v = std::stoul(explainLightText);
+                if (v >= scene.lights.size())
+                    return fail(2, "--light: " + explainLightText + " is not a light index (the scene has " +
+                                       std::to_string(scene.lights.size()) + " lights)");
                 light = std::uint32_t(v);
+                for (std::size_t i = 0; i < scene.lights.size(); ++i)
+                    if (scene.lights[i].name == explainLightText && i != light)
+                        std::cerr << "lightcull: note: --light " << explainLightText << " is light " << light
+                                  << "; light " << i << " is named '" << explainLightText << "'\n";
+            } else {
+                bool byName = false;
+                for (std::size_t i = 0; i < scene.lights.size(); ++i)
+                    if (scene.lights[i].name == explainLightText) {
+                        // Two lights of one name (glTF allows it): the index decides.
+                        if (byName)
+                            return fail(2, "--light: lights " + std::to_string(light) + " and " + std::to_string(i) +
+                                               " are both named '" + explainLightText + "': give the index");
+                        light = std::uint32_t(i);
+                        byName = true;
+                    }
+                if (!byName) return fail(2, "--light: no light named '" + explainLightText + "' and not an index");
             }
             std::unique_ptr<lc::CullBackend> backend = explainFlags.openBackend();
             lc::RunOptions options;

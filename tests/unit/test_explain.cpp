@@ -230,4 +230,23 @@ TEST(Explain, CliPrintsTheSameExplanation) {
                                            d.path);
     EXPECT_EQ(ambiguous.code, 2);
     EXPECT_NE(ambiguous.err.find("lights 7 and 9 are both named"), std::string::npos) << ambiguous.err;
+
+    // Digits are an index even where a light is named with them (tiles.csv
+    // names lights by index); a negative or too large one is said plainly.
+    Scene numeric = s;
+    numeric.lights[0].name = "7";
+    lc::saveSceneFile(numeric, (d.path / "numeric.json").string());
+    const auto byIndex = lc_test::runCli({"explain", "--scene", (d.path / "numeric.json").string(), "--backend", "cpu",
+                                          "--tile", "4,2", "--light", "7"},
+                                         d.path);
+    EXPECT_EQ(byIndex.code, 0) << byIndex.err;
+    EXPECT_NE(byIndex.out.find("light 7 '" + s.lights[light].name + "'"), std::string::npos) << byIndex.out;
+    EXPECT_NE(byIndex.err.find("light 0 is named '7'"), std::string::npos) << byIndex.err;
+    for (const char* wrong : {"-1", "4294967295"}) {
+        const auto r2 = lc_test::runCli({"explain", "--scene", (d.path / "s.json").string(), "--backend", "cpu",
+                                         "--tile", "4,2", "--light", wrong},
+                                        d.path);
+        EXPECT_EQ(r2.code, 2) << wrong;
+        EXPECT_EQ(r2.err.find("4294967295 is outside"), std::string::npos) << r2.err;
+    }
 }
