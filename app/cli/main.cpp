@@ -264,12 +264,58 @@ Stats stats(std::vector<double> v) {
 
 nlohmann::json statsJson(const Stats& s) { return {{"median", s.median}, {"min", s.min}, {"max", s.max}}; }
 
+// One sweep value applied to a configuration; `generate` false only checks a
+// light count (generating a million lights to check it would be a run).
+void applySweepValue(const SceneFlags& flags, lc::Scene& scene, lc::CullSettings& settings, const std::string& key,
+                     const std::string& value, bool generate) {
+    if (key == "lights") {
+        long long n = 0;
+        std::size_t used = 0;
+        try {
+            n = std::stoll(value, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used != value.size()) throw lc::SettingsError("sweep", "lights: not an integer: '" + value + "'");
+        if (n < 0 || n > 1000000) throw lc::SettingsError("sweep", "lights: must be in 0..1000000, got " + value);
+        if (generate) flags.replaceLights(scene, n);
+    } else if (key == "resolution") {
+        const auto x = value.find('x');
+        if (x == std::string::npos) throw lc::SettingsError("sweep", "resolution: expected WxH, got '" + value + "'");
+        lc::setParam(settings, scene.camera, "width", value.substr(0, x));
+        lc::setParam(settings, scene.camera, "height", value.substr(x + 1));
+    } else {
+        lc::setParam(settings, scene.camera, key, value);
+    }
+}
+
 int runBench(const SceneFlags& flags, const BenchOptions& opt) {
     const std::vector<Sweep> sweeps = parseSweeps(opt.sweeps);
     const lc::Scene base = flags.loadScene();
     lc::CullSettings baseSettings;
     lc::Scene baseWithParams = base;
     flags.applyParams(baseSettings, baseWithParams.camera);
+    // Every sweep value and the JSON's folder are checked before the first
+    // run: a long sweep must not end in an error its first second could tell.
+    for (const Sweep& sw : sweeps)
+        for (const std::string& value : sw.values) {
+            lc::Scene scene = baseWithParams;
+            lc::CullSettings settings = baseSettings;
+            try {
+                applySweepValue(flags, scene, settings, sw.key, value, false);
+                if (const std::string bad = settings.validate(); !bad.empty()) throw lc::SettingsError("settings", bad);
+            } catch (const lc::SettingsError& e) {
+                if (e.field() == "sweep") throw;
+                throw lc::SettingsError("sweep", sw.key + "=" + value + ": " + e.what());
+            }
+        }
+    if (!opt.jsonFile.empty()) {
+        namespace fs = std::filesystem;
+        const fs::path parent = fs::path(opt.jsonFile).parent_path();
+        std::error_code ec;
+        if (!parent.empty() && !fs::is_directory(parent, ec))
+            throw lc::SettingsError("json", "folder " + parent.string() + " of " + opt.jsonFile + " does not exist");
+    }
     std::unique_ptr<lc::CullBackend> backend = flags.openBackend();
 
     std::cout << "bench " << base.name << ": backend " << backend->name() << ", device " << backend->deviceName()
@@ -286,23 +332,7 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
         for (std::size_t k = 0; k < sweeps.size(); ++k) {
             const std::string& key = sweeps[k].key;
             const std::string& value = sweeps[k].values[index[k]];
-            if (key == "lights") {
-                long long n = 0;
-                try {
-                    n = std::stoll(value);
-                } catch (const std::exception&) {
-                    throw lc::SettingsError("sweep", "lights: not an integer: '" + value + "'");
-                }
-                flags.replaceLights(scene, n);
-            } else if (key == "resolution") {
-                const auto x = value.find('x');
-                if (x == std::string::npos)
-                    throw lc::SettingsError("sweep", "resolution: expected WxH, got '" + value + "'");
-                lc::setParam(settings, scene.camera, "width", value.substr(0, x));
-                lc::setParam(settings, scene.camera, "height", value.substr(x + 1));
-            } else {
-                lc::setParam(settings, scene.camera, key, value);
-            }
+            applySweepValue(flags, scene, settings, key, value, true);
             params[key] = value;
             label += (label.empty() ? "" : " ") + key + "=" + value;
         }

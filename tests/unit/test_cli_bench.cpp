@@ -67,13 +67,17 @@ TEST(CliBench, BadSweepsFailWithOneLine) {
     for (const std::vector<std::string>& bad :
          {std::vector<std::string>{"--sweep", "nonsense=1,2"}, {"--sweep", "cells"}, {"--sweep", "cells=4,,8"},
           {"--sweep", "cells=4,99"}, {"--sweep", "resolution=640"}, {"--sweep", "lights=a"},
-          {"--sweep", "cells=4", "--sweep", "cells=8"}, {"--repeat", "0"}}) {
+          {"--sweep", "cells=4", "--sweep", "cells=8"}, {"--repeat", "0"},
+          // Found before the first run: nothing measured, nothing on stdout.
+          {"--sweep", "resolution=64x36,0x5"}, {"--sweep", "tile=8,300"}, {"--sweep", "lights=5,2000000"},
+          {"--sweep", "tile=8,16", "--json", "/nonexistent-folder/x.json"}}) {
         std::vector<std::string> args = {"bench", "--builtin", "wall", "--backend", "cpu", "--width", "64",
                                          "--height", "36", "--repeat", "1", "--warmup", "0"};
         args.insert(args.end(), bad.begin(), bad.end());
         const CliResult r = runCli(args, s.path);
-        EXPECT_NE(r.code, 0) << bad[1];
+        EXPECT_EQ(r.code, 2) << bad[1] << ": " << r.err;
         EXPECT_EQ(lineCount(r.err), 1u) << r.err;
         EXPECT_NE(r.err.find("error"), std::string::npos) << r.err;
+        EXPECT_TRUE(r.out.empty()) << bad[1] << ": " << r.out;
     }
 }
