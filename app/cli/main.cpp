@@ -84,11 +84,13 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
     std::cout << "scene " << scene.name << ": " << r.grid.width << "x" << r.grid.height << ", tile "
               << r.grid.tileSize << " (" << r.grid.tilesX << "x" << r.grid.tilesY << " tiles), "
               << run.lights.size() << " lights\n"
-              << "algorithm " << (run.custom ? "custom" : lc::toString(settings.algorithm)) << ", test "
-              << lc::toString(settings.test)
-              << (settings.algorithm == lc::Algorithm::ZBin ? ", bins " + std::to_string(settings.bins)
-                                                            : ", cells " + std::to_string(settings.cells) + ", slicing " +
-                                                                  lc::toString(settings.slicing))
+              << "algorithm "
+              << (run.custom ? std::string("custom")
+                             : std::string(lc::toString(settings.algorithm)) + ", test " + lc::toString(settings.test) +
+                                   (settings.algorithm == lc::Algorithm::ZBin
+                                        ? ", bins " + std::to_string(settings.bins)
+                                        : ", cells " + std::to_string(settings.cells) + ", slicing " +
+                                              lc::toString(settings.slicing)))
               << ", backend " << r.backend << " (" << r.device << ")\n"
               << "false negatives " << m.falseNegatives << ", efficiency " << fmt("%.4f", m.efficiency)
               << " (exact work " << m.exactWork << " / shading work " << m.shadingWork << ")\n"
@@ -172,6 +174,15 @@ struct SceneFlags {
         lc::LightGenSettings gen = lc::defaultLightGen(scene, std::uint32_t(count), seed);
         gen.spotFraction = spotFraction; // generateLights refuses values outside [0, 1]
         scene.lights = lc::generateLights(gen);
+    }
+
+    // The first culling parameter given on the command line that is not the
+    // camera's (tile, width, height): with lists from a shader or a dump it
+    // would have no effect. Empty when none.
+    std::string givenCullingFlag() const {
+        for (const auto& [name, opt] : paramOptions)
+            if (opt->count() && name != "tile" && name != "width" && name != "height") return opt->get_name();
+        return {};
     }
 
     void applyParams(lc::CullSettings& settings, lc::Camera& camera) const {
@@ -607,6 +618,9 @@ int main(int argc, char** argv) {
             if (!checkFlags.hasScene()) return fail(2, "check: give --scene FILE or --builtin NAME (the scene the lists were culled for)");
             lc::Scene scene = checkFlags.loadScene();
             lc::CullSettings settings;
+            if (const std::string f = checkFlags.givenCullingFlag(); !f.empty())
+                return fail(2, f + ": has no effect on check: the dump's lists are judged as they are (--rule says "
+                                   "whose pixels read each list)");
             checkFlags.applyParams(settings, scene.camera);
             const lc::Projection proj(scene.camera);
             lc::DepthImage depth;
@@ -641,6 +655,10 @@ int main(int argc, char** argv) {
         }
 
         if (!runFlags.hasScene()) return fail(2, "run: give --scene FILE or --builtin NAME");
+        if (!runCustom.shader.empty())
+            if (const std::string f = runFlags.givenCullingFlag(); !f.empty())
+                return fail(2, f + ": has no effect with --shader: the shader culls (--layout and --lists say how "
+                                   "its lists read)");
         {
             // Fail before the (possibly long) run when the output cannot be written.
             namespace fs = std::filesystem;

@@ -602,6 +602,9 @@ TEST_F(GpuTest, CliRunShaderAndCheckWriteTheDiagnostics) {
     EXPECT_EQ(j["algorithm"], "custom");
     EXPECT_EQ(j["custom"]["layout"], "bitmask"); // the flag beat the first line's fixed:256
     EXPECT_EQ(j["custom"]["lists"], "tile");
+    // No built-in setting made these lists: none is reported as if it had.
+    for (const char* k : {"test", "cells", "slicing", "skip_empty", "spot_test", "bins"})
+        EXPECT_TRUE(j[k].is_null()) << k;
     EXPECT_TRUE(j["custom"]["validation_messages"].empty());
     const auto fn = j["metrics"]["false_negatives"].get<std::uint64_t>();
     std::uint64_t located = 0;
@@ -643,4 +646,17 @@ TEST_F(GpuTest, CliRunShaderAndCheckWriteTheDiagnostics) {
     EXPECT_EQ(c["depth_triangles"]["scene"], 11880);
     EXPECT_NE(r.out.find("pre-pass on vulkan ("), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("--no-image-error"), std::string::npos) << r.out; // not a flag of check
+
+    // Culling flags that would change nothing are refused, not recorded.
+    r = lc_test::runCli({"check", "--builtin", "atrium", "--width", "330", "--height", "190", "--lights", "150", "--lists",
+                         (d.path / "all.csv").string(), "--algorithm", "clustered", "--out", (d.path / "e2").string()},
+                        d.path);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--algorithm: has no effect on check"), std::string::npos) << r.err;
+    r = lc_test::runCli({"run", "--builtin", "atrium", "--width", "64", "--height", "64", "--shader",
+                         kExamples + "tiled_fixed.comp", "--cells", "4", "--out", (d.path / "e3").string()},
+                        d.path);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--cells: has no effect with --shader"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(d.path / "e2") || fs::exists(d.path / "e3"));
 }

@@ -153,6 +153,10 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     j["skip_empty"] = settings.skipEmpty;
     j["spot_test"] = toString(settings.spotTest);
     j["bins"] = settings.bins;
+    // Lists from a custom shader or an engine's dump were made by none of
+    // the built-in settings: they are not reported as if they were.
+    if (run.custom)
+        for (const char* k : {"test", "cells", "slicing", "skip_empty", "spot_test", "bins"}) j[k] = nullptr;
     j["lights"] = run.lights.size();
     std::size_t spots = 0;
     for (std::size_t i = 0; i < run.lights.size(); ++i) spots += run.lights.isSpot(i);
