@@ -109,6 +109,22 @@ TEST_F(GpuTest, GlslTiledExampleMatchesMinMax) {
     EXPECT_EQ(rep.builtinAlgorithm, "minmax");
 }
 
+// Saved by an editor with a UTF-8 byte order mark: the first line's settings
+// still apply and glslang does not see the mark.
+TEST_F(GpuTest, AByteOrderMarkIsNotPartOfTheShader) {
+    const Scene s = atrium(64, 64);
+    const fs::path dir = fs::temp_directory_path() / ("lc_bom_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    std::ifstream in(kExamples + "tiled_fixed.comp", std::ios::binary);
+    std::ofstream(dir / "bom.comp", std::ios::binary) << "\xEF\xBB\xBF" << in.rdbuf();
+    std::ofstream(dir / "lightcull.glsl") << std::ifstream(std::string(LC_SOURCE_DIR) + "/shaders/custom/lightcull.glsl").rdbuf();
+    CustomCullReport rep;
+    const RunOutput out = runShader(s, optionsFor((dir / "bom.comp").string()), rep);
+    EXPECT_EQ(rep.layout, "fixed:256");
+    EXPECT_EQ(out.truth.metrics.falseNegatives, 0u);
+    fs::remove_all(dir);
+}
+
 TEST_F(GpuTest, HlslTiledExampleMatchesMinMax) {
     const Scene s = atrium();
     CustomCullReport rep;

@@ -272,7 +272,9 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
     } else {
         const bool hlsl = ext == ".hlsl";
         if (!hlsl) entry = "main";
-        spirv = compileSource(o.path, detail::readWholeFile(o.path), hlsl, o.entry,
+        std::string text = detail::readWholeFile(o.path);
+        if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3); // glslang takes a byte order mark for a token
+        spirv = compileSource(o.path, text, hlsl, o.entry,
                               definesFor(o, grid, skeleton.listsPerTile, lightCount, compactEntries));
     }
 
