@@ -271,6 +271,19 @@ std::vector<TileLightRow> tileLightRows(const RunOutput& run, const Projection& 
         first += std::uint32_t(cell);
         count = 1;
     }
+    // List l's rows from per-light counts of its pixels that need each light:
+    // its lights first (needed or false positive), then the missing ones.
+    auto appendRows = [&](std::uint32_t l, const std::vector<std::uint32_t>& neededCount) {
+        std::vector<char> listed(run.lights.size(), 0);
+        for (std::uint32_t k = 0; k < r.listCount[l]; ++k) {
+            const std::uint32_t light = r.lightIndices[r.listOffset[l] + k];
+            if (light >= run.lights.size()) continue;
+            listed[light] = 1;
+            rows.push_back({l, light, neededCount[light], neededCount[light] ? Verdict::Needed : Verdict::FalsePositive});
+        }
+        for (std::uint32_t i = 0; i < neededCount.size(); ++i)
+            if (neededCount[i] && !listed[i]) rows.push_back({l, i, neededCount[i], Verdict::Missing});
+    };
     if (r.algorithm == Algorithm::All) {
         // `all`'s one list serves every pixel of the image: a light is needed
         // when some pixel of the image needs it (as Explain judges it), not
@@ -291,15 +304,7 @@ std::vector<TileLightRow> tileLightRows(const RunOutput& run, const Projection& 
             const detail::LightGrid lightGrid(run.lights, lo, hi);
             for (const glm::dvec3& p : points) lightGrid.forEachContaining(p, [&](std::uint32_t i) { ++neededCount[i]; });
         }
-        std::vector<char> listed(run.lights.size(), 0);
-        for (std::uint32_t k = 0; k < r.listCount[first]; ++k) {
-            const std::uint32_t light = r.lightIndices[r.listOffset[first] + k];
-            if (light >= run.lights.size()) continue;
-            listed[light] = 1;
-            rows.push_back({first, light, neededCount[light], neededCount[light] ? Verdict::Needed : Verdict::FalsePositive});
-        }
-        for (std::uint32_t i = 0; i < neededCount.size(); ++i)
-            if (neededCount[i] && !listed[i]) rows.push_back({first, i, neededCount[i], Verdict::Missing});
+        appendRows(first, neededCount);
         return rows;
     }
     const auto rect = r.grid.tileRect(tile % r.grid.tilesX, tile / r.grid.tilesX);
@@ -319,18 +324,9 @@ std::vector<TileLightRow> tileLightRows(const RunOutput& run, const Projection& 
                     continue;
                 d = depth.at(x, y);
             }
-        const auto needed = pixelsNeedingLights(masked, proj, run.lights, r.grid, tile);
         std::vector<std::uint32_t> neededCount(run.lights.size(), 0);
-        for (const auto& [light, n] : needed) neededCount[light] = n;
-        std::vector<char> listed(run.lights.size(), 0);
-        for (std::uint32_t k = 0; k < r.listCount[l]; ++k) {
-            const std::uint32_t light = r.lightIndices[r.listOffset[l] + k];
-            if (light >= run.lights.size()) continue;
-            listed[light] = 1;
-            rows.push_back({l, light, neededCount[light], neededCount[light] ? Verdict::Needed : Verdict::FalsePositive});
-        }
-        for (const auto& [light, n] : needed)
-            if (!listed[light]) rows.push_back({l, light, n, Verdict::Missing});
+        for (const auto& [light, n] : pixelsNeedingLights(masked, proj, run.lights, r.grid, tile)) neededCount[light] = n;
+        appendRows(l, neededCount);
     }
     return rows;
 }
