@@ -34,14 +34,6 @@
 
 namespace lcui {
 
-namespace {
-
-// Okabe-Ito, one per algorithm in table order (as pareto.png).
-const unsigned char kAlgorithmRgb[6][3] = {{0, 0, 0},    {230, 159, 0},  {86, 180, 233},
-                                           {0, 158, 115}, {204, 121, 167}, {0, 114, 178}};
-
-} // namespace
-
 ReportDock::ReportDock(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
     auto* layout = new QVBoxLayout(this);
     auto* row = new QHBoxLayout;
@@ -269,7 +261,9 @@ void ReportDock::rebuildChart() {
             if (members.empty()) continue;
             const std::string name = algorithms[a] + " (" + backend + ")";
             vtkPlot* plot = addSeries(vtkChart::POINTS, name, members);
-            plot->SetColor(kAlgorithmRgb[a][0], kAlgorithmRgb[a][1], kAlgorithmRgb[a][2], 255);
+            const glm::dvec3 rgb = lc::algorithmColour(lc::algorithmFromString(algorithms[a])) * 255.0;
+            plot->SetColor(static_cast<unsigned char>(rgb.r + 0.5), static_cast<unsigned char>(rgb.g + 0.5),
+                           static_cast<unsigned char>(rgb.b + 0.5), 255);
             if (auto* pts = vtkPlotPoints::SafeDownCast(plot)) {
                 pts->SetMarkerStyle(b == 0 ? vtkPlotPoints::SQUARE : vtkPlotPoints::CIRCLE);
                 pts->SetMarkerSize(7);

@@ -255,3 +255,16 @@ TEST(Report, WritesCsvMarkdownAndPngAtomically) {
     for (const auto& e : fs::directory_iterator(tmp.path))
         EXPECT_EQ(e.path().filename().string().rfind(".rep", 0), std::string::npos) << "staging left behind";
 }
+
+// pareto.png and the studio's chart tell algorithms apart by colour alone:
+// no two share one (clustered, fptl and zbin did).
+TEST(Report, EveryAlgorithmHasItsOwnColour) {
+    const auto names = lc::cullParam("algorithm").choices;
+    ASSERT_EQ(names.size(), 8u);
+    for (std::size_t i = 0; i < names.size(); ++i)
+        for (std::size_t j = i + 1; j < names.size(); ++j) {
+            const glm::dvec3 a = lc::algorithmColour(lc::algorithmFromString(names[i]));
+            const glm::dvec3 b = lc::algorithmColour(lc::algorithmFromString(names[j]));
+            EXPECT_GT(glm::length(a - b), 0.15) << names[i] << " and " << names[j];
+        }
+}

@@ -485,13 +485,6 @@ struct Plot {
     }
 };
 
-// Okabe-Ito colours, one per algorithm in table order.
-glm::dvec3 algorithmColour(Algorithm a) {
-    static const glm::dvec3 k[] = {{0.0, 0.0, 0.0},   {0.90, 0.62, 0.0}, {0.34, 0.71, 0.91},
-                                   {0.0, 0.62, 0.45}, {0.80, 0.47, 0.65}, {0.0, 0.45, 0.70}};
-    return k[std::min<std::size_t>(std::size_t(a), 5)];
-}
-
 std::string tickText(double v) {
     if (v == 0) return "0";
     const double a = std::abs(v);
@@ -654,6 +647,15 @@ void writeReport(const Report& rep, const std::string& dir) {
                           writeFileSynced((tmp / "report.md").string(), reportMarkdown(rep));
                           writePng(paretoImage(rep), (tmp / "pareto.png").string());
                       });
+}
+
+glm::dvec3 algorithmColour(Algorithm a) {
+    // Okabe-Ito's colours, then its vermillion and a grey: eight algorithms,
+    // eight colours, none of them the Pareto front's red.
+    static const glm::dvec3 k[] = {{0.0, 0.0, 0.0},    {0.90, 0.62, 0.0},  {0.34, 0.71, 0.91}, {0.0, 0.62, 0.45},
+                                   {0.80, 0.47, 0.65}, {0.0, 0.45, 0.70},  {0.84, 0.37, 0.0},  {0.55, 0.55, 0.55}};
+    static_assert(sizeof k / sizeof k[0] == std::size_t(Algorithm::ZBin) + 1, "a colour per algorithm");
+    return k[std::min<std::size_t>(std::size_t(a), std::size(k) - 1)];
 }
 
 } // namespace lc

@@ -114,6 +114,9 @@ void markPareto(std::vector<ReportRow>& rows);
 std::string reportCsv(const Report& report);      // docs/FORMATS.md, "report.csv"
 std::string reportMarkdown(const Report& report); // table and a reading of it
 RgbImage paretoImage(const Report& report);       // time vs efficiency | time vs image error
+// The colour of an algorithm's points (RGB in [0, 1]), one per algorithm, in
+// pareto.png and the studio's Report chart alike.
+glm::dvec3 algorithmColour(Algorithm a);
 
 // Writes report.csv, report.md and pareto.png into `dir` atomically (staged
 // in a sibling folder, renamed at the end; an existing `dir` is replaced only
