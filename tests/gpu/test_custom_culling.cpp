@@ -603,6 +603,35 @@ TEST_F(GpuTest, ReportPutsCustomShadersBesideTheBuiltinRows) {
     EXPECT_LE(good->efficiencyVsOptimal, 1.0);
     const std::string csv = reportCsv(rep);
     EXPECT_NE(csv.find(",custom:tiled_fixed.comp,"), std::string::npos);
+    // The reading names the shaders as themselves, never as the built-in
+    // algorithm whose default settings their rows carry, and names the row
+    // with false negatives.
+    const std::string md = reportMarkdown(rep);
+    const auto best = md.find("- Best total per algorithm on vulkan:");
+    ASSERT_NE(best, std::string::npos) << md;
+    const std::string bestLine = md.substr(best, md.find('\n', best) - best);
+    EXPECT_NE(bestLine.find("`custom:tiled_fixed.comp bitmask tile`"), std::string::npos) << bestLine;
+    double best25d = 1e300;
+    for (const ReportRow& r : rep.rows)
+        if (r.config.customLabel.empty() && r.config.settings.algorithm == Algorithm::TwoPointFiveD)
+            best25d = std::min(best25d, r.totalMs);
+    char want[64];
+    std::snprintf(want, sizeof want, "2.5d %.3f ms", best25d); // the built-in rows' best, not a shader's
+    EXPECT_NE(bestLine.find(want), std::string::npos) << want << " in " << bestLine;
+    EXPECT_NE(md.find("have false negatives** (lights missing where they matter): `custom:flawed_tile_edges.comp"),
+              std::string::npos) << md;
+
+    // Swept on the CPU only, the shaders still ran on a Vulkan device: the
+    // header says which.
+    o.backends = {"cpu", "cpu"}; // and a backend named twice is swept once
+    o.shaders.pop_back();
+    const Report cpuRep = runReport(s, o);
+    std::size_t cpuRows = 0;
+    for (const ReportRow& r : cpuRep.rows) cpuRows += r.config.backend == "cpu";
+    EXPECT_EQ(cpuRows, reportConfigs(o, "cpu", false).size());
+    const std::string cpuMd = reportMarkdown(cpuRep);
+    EXPECT_NE(cpuMd.find("- backend `vulkan`: " + good->device + " (the custom shaders)"), std::string::npos) << cpuMd;
+    EXPECT_NE(cpuMd.find("Best total per algorithm on vulkan: `custom:tiled_fixed.comp"), std::string::npos) << cpuMd;
 }
 
 TEST_F(GpuTest, CliRunShaderAndCheckWriteTheDiagnostics) {

@@ -201,7 +201,11 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
     sceneIn.validate();
     if (options.repeat < 1 || options.repeat > 1000) throw SettingsError("repeat", "must be in 1..1000");
     if (options.warmup < 0 || options.warmup > 1000) throw SettingsError("warmup", "must be in 0..1000");
-    std::vector<std::string> backends = options.backends.empty() ? availableBackends() : options.backends;
+    std::vector<std::string> backends;
+    // A backend named twice is swept once (twice would double every row and
+    // split the Pareto front between the copies).
+    for (const std::string& b : options.backends.empty() ? availableBackends() : options.backends)
+        if (std::find(backends.begin(), backends.end(), b) == backends.end()) backends.push_back(b);
 
     Report rep;
     rep.sceneName = sceneIn.name;
@@ -305,6 +309,15 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
         ++done;
         if (progress) progress(done, total, "custom " + file);
     }
+    // Custom shaders run on a Vulkan device of their own: where no vulkan
+    // backend was swept, the header still says which device and clock.
+    const auto shaderRow = std::find_if(rep.rows.begin(), rep.rows.end(),
+                                        [](const ReportRow& r) { return !r.config.customLabel.empty(); });
+    if (shaderRow != rep.rows.end() &&
+        std::none_of(rep.backendDevices.begin(), rep.backendDevices.end(), [](const auto& d) { return d.first == "vulkan"; })) {
+        rep.backendDevices.emplace_back("vulkan", shaderRow->device + " (the custom shaders)");
+        rep.backendTiming.emplace_back("vulkan", "cpu-wall-clock around the shader's dispatch (submit and wait)");
+    }
     markPareto(rep.rows);
     return rep;
 }
@@ -369,11 +382,16 @@ std::string reportMarkdown(const Report& rep) {
         md += "No configuration ran.\n";
     } else {
         std::uint64_t fnRows = 0;
-        for (const ReportRow& r : rep.rows) fnRows += r.falseNegatives > 0;
+        std::string fnNames;
+        for (const ReportRow& r : rep.rows)
+            if (r.falseNegatives > 0 && fnRows++ < 5)
+                fnNames += std::string(fnNames.empty() ? "" : ", ") + "`" + r.config.label() + "` (" + r.config.backend +
+                           ", " + std::to_string(r.falseNegatives) + ")";
         md += fnRows == 0 ? "- Every configuration has zero false negatives.\n"
                           : "- **" + std::to_string(fnRows) +
-                                " configurations have false negatives** (lights missing where they matter); they "
-                                "are left off the Pareto fronts.\n";
+                                " configurations have false negatives** (lights missing where they matter): " +
+                                fnNames + (fnRows > 5 ? " and " + std::to_string(fnRows - 5) + " more" : "") +
+                                "; they are left off the Pareto fronts.\n";
         for (const auto& [backend, device] : rep.backendDevices) {
             std::vector<const ReportRow*> rows;
             for (const ReportRow& r : rep.rows)
@@ -422,12 +440,23 @@ std::string reportMarkdown(const Report& rep) {
             for (const std::string& a : cullParam("algorithm").choices) {
                 const ReportRow* best = nullptr;
                 for (const ReportRow* r : rows)
-                    if (toString(r->config.settings.algorithm) == a && (!best || r->totalMs < best->totalMs)) best = r;
+                    if (r->config.customLabel.empty() && toString(r->config.settings.algorithm) == a &&
+                        (!best || r->totalMs < best->totalMs))
+                        best = r;
                 if (!best) continue;
                 md += (first ? " " : "; ") + a + " " + fmt("%.3f", best->totalMs) + " ms (efficiency " +
                       fmt("%.3f", best->efficiency) + ")";
                 first = false;
             }
+            // A custom shader is its own row, never one of the built-in algorithms.
+            for (const ReportRow* r : rows)
+                if (!r->config.customLabel.empty()) {
+                    md += (first ? " " : "; ") + std::string("`") + r->config.customLabel + "` " +
+                          fmt("%.3f", r->totalMs) + " ms (efficiency " + fmt("%.3f", r->efficiency) +
+                          (r->falseNegatives ? ", false negatives " + std::to_string(r->falseNegatives) : std::string()) +
+                          ")";
+                    first = false;
+                }
             md += ".\n";
         }
     }
