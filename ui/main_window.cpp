@@ -11,7 +11,7 @@
 #include "property_panel.hpp"
 #include "scene_tree.hpp"
 #include "tile_inspector.hpp"
-#include "undo_keys.hpp"
+#include "field_events.hpp"
 #include "report_dock.hpp"
 
 #include "culling/core/errors.hpp"

@@ -1,6 +1,6 @@
 #include "property_panel.hpp"
 
-#include "undo_keys.hpp"
+#include "field_events.hpp"
 
 #include "document.hpp"
 
@@ -194,6 +194,7 @@ PropertyPanel::PropertyPanel(Document* doc, QWidget* parent) : QWidget(parent), 
     connect(doc_, &Document::cameraChanged, this, &PropertyPanel::refresh);
     connect(doc_, &Document::sceneReset, this, &PropertyPanel::refresh);
     (new UndoKeysToWindow(this))->watch(this);
+    (new WheelOnlyWhenFocused(this))->watch(this);
     refresh();
 }
 

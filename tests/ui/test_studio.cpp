@@ -43,6 +43,7 @@
 #include <QRegularExpression>
 #include <QTimer>
 #include <QUndoStack>
+#include <QWheelEvent>
 
 #include <nlohmann/json.hpp>
 #include <vtkAlgorithm.h>
@@ -681,6 +682,36 @@ private slots:
         QCOMPARE(tile->value(), int(tileBefore));
         QTest::keyClick(tile, Qt::Key_Z, Qt::ControlModifier | Qt::ShiftModifier);
         QCOMPARE(doc()->scene().camera.tileSize, 64u);
+    }
+
+    // The wheel over the properties scrolls them; it edits a field only once
+    // the user has put the focus there (wheeling past Min intensity set it to
+    // 1e-6 and the radius to 2 km).
+    void theWheelScrollsThePropertiesUntilAFieldHasFocus() {
+        openSmall();
+        doc()->setSelectedLights({0});
+        auto* panel = w_->findChild<PropertyPanel*>();
+        auto* minIntensity = panel->findChild<QDoubleSpinBox*>("lightMinIntensity");
+        QVERIFY(minIntensity);
+        const std::string before = sceneText(doc());
+        const int steps = doc()->undoStack()->count();
+        auto wheel = [&](QWidget* target) {
+            const QPoint at = target->rect().center();
+            QWheelEvent e(at, target->mapToGlobal(at), QPoint(), QPoint(0, -120), Qt::NoButton, Qt::NoModifier,
+                          Qt::NoScrollPhase, false);
+            QApplication::sendEvent(target, &e);
+        };
+        minIntensity->clearFocus();
+        for (int i = 0; i < 5; ++i) wheel(minIntensity);
+        QCOMPARE(sceneText(doc()), before);
+        QCOMPARE(doc()->undoStack()->count(), steps);
+        // Focused, the wheel is the field's again.
+        QApplication::setActiveWindow(w_.get());
+        minIntensity->setFocus();
+        QTRY_VERIFY(minIntensity->hasFocus());
+        const double value = minIntensity->value();
+        wheel(minIntensity);
+        QVERIFY(minIntensity->value() != value);
     }
 
     // The keys docs/STUDIO.md lists reach their actions on any platform

@@ -1,6 +1,7 @@
-#include "undo_keys.hpp"
+#include "field_events.hpp"
 
 #include <QAbstractSpinBox>
+#include <QComboBox>
 #include <QKeyEvent>
 #include <QKeySequence>
 #include <QLineEdit>
@@ -19,6 +20,28 @@ bool UndoKeysToWindow::eventFilter(QObject* watched, QEvent* event) {
         if (key->matches(QKeySequence::Undo) || key->matches(QKeySequence::Redo) ||
             QKeySequence(int(key->modifiers()) | key->key()) == QKeySequence(QStringLiteral("Ctrl+Shift+Z"))) {
             event->ignore(); // not the field's: the window's Undo and Redo actions take it
+            return true;
+        }
+    }
+    return QObject::eventFilter(watched, event);
+}
+
+void WheelOnlyWhenFocused::watch(QWidget* panel) {
+    for (QWidget* w : panel->findChildren<QAbstractSpinBox*>()) {
+        w->setFocusPolicy(Qt::StrongFocus); // not focused by the wheel
+        w->installEventFilter(this);
+    }
+    for (QWidget* w : panel->findChildren<QComboBox*>()) {
+        w->setFocusPolicy(Qt::StrongFocus);
+        w->installEventFilter(this);
+    }
+}
+
+bool WheelOnlyWhenFocused::eventFilter(QObject* watched, QEvent* event) {
+    if (event->type() == QEvent::Wheel) {
+        auto* w = qobject_cast<QWidget*>(watched);
+        if (w && !w->hasFocus()) {
+            event->ignore(); // unaccepted, it goes on to the parents: the scroll area scrolls
             return true;
         }
     }
