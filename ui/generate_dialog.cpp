@@ -70,13 +70,9 @@ GenerateLightsDialog::GenerateLightsDialog(const lc::LightGenSettings& g, QWidge
     spotAngleMax_->setObjectName("genSpotAngleMax");
     form->addRow(tr("Spot outer angle min (deg)"), spotAngleMin_);
     form->addRow(tr("Spot outer angle max (deg)"), spotAngleMax_);
-    // An inverted range would be refused by the generator; keep it ordered.
-    connect(spotAngleMin_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, [this](double v) {
-        if (spotAngleMax_->value() < v) spotAngleMax_->setValue(v);
-    });
-    connect(spotAngleMax_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, [this](double v) {
-        if (spotAngleMin_->value() > v) spotAngleMin_->setValue(v);
-    });
+    // An inverted angle range is refused at OK like the intensity's (below),
+    // not put in order while the user types: a max typed digit by digit
+    // ("6" of "60") dragged the min down with it.
     // Settings the generator refuses keep the dialog open with the reason,
     // every value as typed.
     error_ = new QLabel;

@@ -105,9 +105,29 @@ private slots:
         auto* angleMax = dlg.findChild<QDoubleSpinBox*>("genSpotAngleMax");
         QVERIFY(fraction && angleMin && angleMax);
         QCOMPARE(fraction->value(), 0.0); // the default stays all point lights
-        angleMax->setValue(20);
-        angleMin->setValue(35); // above the maximum: the maximum follows
-        QCOMPARE(angleMax->value(), 35.0);
+        // Typed as a person types, digit by digit: neither field moves the other.
+        dlg.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&dlg));
+        QApplication::setActiveWindow(&dlg);
+        auto type = [](QDoubleSpinBox* box, const char* text) {
+            box->setFocus();
+            box->selectAll();
+            QTest::keyClicks(box, text);
+            QTest::keyClick(box, Qt::Key_Tab);
+        };
+        type(angleMin, "20");
+        type(angleMax, "60");
+        QCOMPARE(angleMin->value(), 20.0);
+        QCOMPARE(angleMax->value(), 60.0);
+        // Upside down, the range is refused at OK with the reason, as typed.
+        type(angleMin, "35");
+        type(angleMax, "20");
+        fraction->setValue(1.0);
+        QTest::mouseClick(dlg.findChild<QDialogButtonBox*>()->button(QDialogButtonBox::Ok), Qt::LeftButton);
+        QVERIFY(dlg.isVisible());
+        QVERIFY2(dlg.findChild<QLabel*>("genError")->text().contains("spot_angle"),
+                 qPrintable(dlg.findChild<QLabel*>("genError")->text()));
+        QCOMPARE(angleMin->value(), 35.0);
         angleMin->setValue(10);
         angleMax->setValue(20);
         fraction->setValue(1.0);
