@@ -599,14 +599,19 @@ void writeOverlaysVtm(const Scene& scene, const RunOutput& run, const std::strin
                 entries += r.listCount[l];
                 longest = std::max(longest, r.listCount[l]);
             }
+            // A tile without geometry (drawn for naive) shades nothing:
+            // W_t = E_t = 0, no false positive, efficiency 1 (the heat map's
+            // NaN there means "not tinted", which a threshold in ParaView
+            // would trip on).
+            const bool empty = !tileHasGeometry(r, t) && r.algorithm != Algorithm::All;
             for (int f = 0; f < 6; ++f) {
                 aTile.values.push_back(t);
                 aTx.values.push_back(t % r.grid.tilesX);
                 aTy.values.push_back(t / r.grid.tilesX);
                 aCount.values.push_back(double(entries));
                 aMax.values.push_back(longest);
-                aFp.values.push_back(fp[t]);
-                aEff.values.push_back(eff[t]);
+                aFp.values.push_back(empty ? 0.0 : fp[t]);
+                aEff.values.push_back(empty ? 1.0 : eff[t]);
             }
         }
     }
