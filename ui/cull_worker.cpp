@@ -276,7 +276,7 @@ void CullWorker::drain() {
                 out = std::make_shared<lc::RunOutput>(
                     lc::runPipeline(*runScene, req.settings, *backend_, options, cancel.get()));
             }
-            if (out->depthReused) out->depthFrom = "the previous run's pre-pass (a light edit)";
+            if (out->depthReused) out->depthFrom = "the previous run's pre-pass (camera and meshes unchanged)";
             if (!out->depthReused) {
                 depth_ = std::make_shared<const lc::DepthImage>(out->depth);
                 depthCamera_ = req.scene->camera;

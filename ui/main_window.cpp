@@ -652,18 +652,22 @@ void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::Run
             : tr(" (%1 of %2 triangles)")
                   .arg(qulonglong(out->result.depthTrianglesDrawn))
                   .arg(qulonglong(out->result.depthTriangles));
-    const QString depthTime = out->depthReused ? tr("reused (a light edit keeps the last pre-pass)")
+    // The worker keeps the last depth image while the camera and meshes stay.
+    const QString depthTime = out->depthReused ? tr("reused (camera and meshes unchanged)")
                                                : tr("%1 ms").arg(out->result.timings.depthMs, 0, 'f', 2);
-    if (out->truthComputed) log(tr("run %1: %2, %3 lights, depth %4%8, cull %5 ms, false negatives %6, efficiency %7")
-            .arg(generation)
-            .arg(out->custom ? QStringLiteral("custom") : QString(lc::toString(out->result.algorithm)))
-            .arg(out->lights.size())
-            .arg(depthTime)
-            .arg(out->result.timings.cullMs, 0, 'f', 2)
-            .arg(m.falseNegatives)
-            .arg(m.efficiency, 0, 'f', 4)
-            .arg(depthTriangles),
-        m.falseNegatives > 0);
+    if (out->truthComputed) {
+        const QString line = tr("run %1: %2, %3 lights, depth %4%8, cull %5 ms, false negatives %6, efficiency %7")
+                                 .arg(generation)
+                                 .arg(out->custom ? QStringLiteral("custom") : QString(lc::toString(out->result.algorithm)))
+                                 .arg(out->lights.size())
+                                 .arg(depthTime)
+                                 .arg(out->result.timings.cullMs, 0, 'f', 2)
+                                 .arg(m.falseNegatives)
+                                 .arg(m.efficiency, 0, 'f', 4)
+                                 .arg(depthTriangles);
+        if (m.falseNegatives > 0) warn(line); // a finding about the culling, not a failure of the run
+        else log(line);
+    }
     statusBar()->showMessage(tr("culling done (run %1)").arg(generation), 4000);
     emit runFinished(generation);
 }
@@ -798,7 +802,7 @@ bool MainWindow::openSceneFile(const QString& path) {
                 return lc::loadSceneAny(p, o, &gltfReport, &c, pr);
             });
         doc_->resetScene(std::move(s), path);
-        for (const std::string& w : gltfReport.warnings) log(QString::fromStdString(w), true);
+        for (const std::string& w : gltfReport.warnings) warn(QString::fromStdString(w));
         if (lc::isGltfPath(p))
             log(tr("%1: %2 triangles, %3 lights, camera: %4; loaded in %5 ms")
                     .arg(path)
@@ -833,7 +837,7 @@ bool MainWindow::importMeshFile(const QString& path) {
         const std::size_t tris = m.triangleCount();
         doc_->importMesh(std::move(m));
         log(tr("imported %1: %2 triangles").arg(path).arg(tris));
-        if (!report.warning.empty()) log(QString::fromStdString(report.warning), true);
+        if (!report.warning.empty()) warn(QString::fromStdString(report.warning));
     } catch (const lc::Cancelled&) {
         log(tr("import of %1 cancelled").arg(path));
         return false;
@@ -983,6 +987,10 @@ QImage MainWindow::grabWindow() {
 void MainWindow::log(const QString& message, bool error) {
     const QString line = QDateTime::currentDateTime().toString("hh:mm:ss ") + (error ? "ERROR " : "") + message;
     log_->appendPlainText(line);
+}
+
+void MainWindow::warn(const QString& message) {
+    log_->appendPlainText(QDateTime::currentDateTime().toString("hh:mm:ss ") + "WARNING " + message);
 }
 
 void MainWindow::updateTitle() {

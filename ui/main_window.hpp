@@ -137,6 +137,9 @@ public:
     // Whole-window image with both views' GL content.
     QImage grabWindow();
     void log(const QString& message, bool error = false);
+    // A line marked WARNING: the action went through, with something to know
+    // (faces dropped on import, a glTF light skipped, false negatives).
+    void warn(const QString& message);
 
 signals:
     void runFinished(quint64 generation);

@@ -453,6 +453,21 @@ private slots:
         QCOMPARE(doc()->filePath(), tmp_.path() + "/bare.json");
     }
 
+    // An import that drops degenerate faces went through: the log warns, it
+    // does not say ERROR (a user scanning for errors thought it failed).
+    void droppedFacesAreAWarningNotAnError() {
+        openSmall();
+        const QString path = tmp_.path() + "/degenerate.obj";
+        QFile f(path);
+        QVERIFY(f.open(QIODevice::WriteOnly));
+        f.write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 1 2\n");
+        f.close();
+        QVERIFY(w_->importMeshFile(path));
+        const QString log = w_->messageLog()->toPlainText();
+        QVERIFY2(log.contains(QRegularExpression("WARNING .*degenerate.obj: dropped 1 degenerate")), qPrintable(log));
+        QVERIFY2(!log.contains("ERROR"), qPrintable(log));
+    }
+
     void failedImportLeavesSceneIntact() {
         openSmall();
         const std::string before = sceneText(doc());
@@ -773,8 +788,8 @@ private slots:
         QTRY_VERIFY(doc()->runOutput()->truthComputed);
         const QString log = w_->messageLog()->toPlainText();
         const QString last = log.section('\n', -1);
-        QVERIFY2(last.contains("depth reused (a light edit keeps the last pre-pass)"), qPrintable(last));
-        QCOMPARE(doc()->runOutput()->depthFrom, std::string("the previous run's pre-pass (a light edit)"));
+        QVERIFY2(last.contains("depth reused (camera and meshes unchanged)"), qPrintable(last));
+        QCOMPARE(doc()->runOutput()->depthFrom, std::string("the previous run's pre-pass (camera and meshes unchanged)"));
 
         lc::Camera c = doc()->scene().camera;
         c.position += glm::dvec3(0.0, 0.5, 0.0);
