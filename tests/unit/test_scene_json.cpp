@@ -129,6 +129,12 @@ TEST(SceneJson, BaseSceneParsesAsWritten) {
     EXPECT_NEAR(p.x, 1, 1e-12);
     EXPECT_NEAR(p.y, 2, 1e-12);
     EXPECT_NEAR(p.z, 1, 1e-12);
+    // Whole numbers written as floats (Python's json.dump writes 640.0) read
+    // as the whole numbers they are.
+    std::string floats = kBase;
+    floats.replace(floats.find("\"version\": 1"), 12, "\"version\": 1.0");
+    floats.replace(floats.find("\"width\": 320"), 12, "\"width\": 320.0");
+    EXPECT_EQ(parseScene(floats, "/nowhere/floats.json").camera.width, 320u);
 }
 
 TEST(SceneJson, RoundTripIsLossless) {
@@ -209,6 +215,7 @@ TEST(SceneJson, EveryErrorNamesFileFieldAndLine) {
         {11, R"(    "far": "inf",)", "camera.far", 11, "reversed_z"},
         {11, R"(    "far": "infinite",)", "camera.far", 11, "inf"},
         {12, R"(    "width": -3,)", "camera.width", 12, "[0, 4294967295]"},
+        {12, R"(    "width": 640.5,)", "camera.width", 12, "whole number, not 640.5"},
         {12, R"(    "width": 0,)", "camera.width", 12, "[1, 16384]"},
         {14, R"(    "tile_size": 300)", "camera.tile_size", 14, "256"},
         {19, R"(      "positions": [0, 0, 0, 1, 0, 0, 0, 1],)", "meshes[0].positions", 19, "3n"},

@@ -261,7 +261,14 @@ public:
         return v.get<std::string>();
     }
     std::uint32_t uint(const json& v, const std::string& path) const {
-        if (!v.is_number_integer()) fail(path, "must be a whole number");
+        // 640.0 is a whole number too (Python's json writes floats so).
+        if (v.is_number_float()) {
+            const double d = v.get<double>();
+            if (!(std::floor(d) == d)) fail(path, "must be a whole number, not " + v.dump());
+            if (!(d >= 0 && d <= 4294967295.0)) fail(path, "must be in [0, 4294967295]");
+            return std::uint32_t(d);
+        }
+        if (!v.is_number_integer()) fail(path, std::string("must be a whole number, not ") + typeName(v));
         if (v.is_number_unsigned() ? v.get<std::uint64_t>() > 0xFFFFFFFFull : v.get<std::int64_t>() < 0)
             fail(path, "must be in [0, 4294967295]");
         return v.get<std::uint32_t>();
@@ -466,11 +473,10 @@ Scene parseSceneImpl(const std::string& text, const std::string& file, const Can
     r.checkKeys(root, "", {"format", "version", "name", "camera", "meshes", "lights"});
     if (r.string(r.require(root, "", "format"), "format") != "lightcull-scene")
         r.fail("format", "must be \"lightcull-scene\"");
-    const json& ver = r.require(root, "", "version");
-    if (!ver.is_number_integer()) r.fail("version", "must be a whole number");
-    if (ver.get<std::int64_t>() != kSceneFormatVersion)
+    const std::uint32_t ver = r.uint(r.require(root, "", "version"), "version");
+    if (ver != std::uint32_t(kSceneFormatVersion))
         r.fail("version", "this build reads version " + std::to_string(kSceneFormatVersion) + ", not " +
-                              std::to_string(ver.get<std::int64_t>()));
+                              std::to_string(ver));
 
     Scene s;
     s.name = fs::path(file).stem().string();
