@@ -28,6 +28,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <functional>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -48,6 +49,17 @@ std::string oneLine(std::string s) {
         if (c == '\n' || c == '\r') c = ' ';
     while (!s.empty() && s.back() == ' ') s.pop_back();
     return s;
+}
+
+// What `check` (a file_io check of an output path) says is wrong, or empty:
+// a bad output path is a bad command line (exit 2), found before the work.
+std::string outputProblem(const std::function<void()>& check) {
+    try {
+        check();
+    } catch (const lc::Error& e) {
+        return e.what();
+    }
+    return {};
 }
 
 int fail(int code, const std::string& message) {
@@ -321,11 +333,8 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
             }
         }
     if (!opt.jsonFile.empty()) {
-        namespace fs = std::filesystem;
-        const fs::path parent = fs::path(opt.jsonFile).parent_path();
-        std::error_code ec;
-        if (!parent.empty() && !fs::is_directory(parent, ec))
-            throw lc::SettingsError("json", "folder " + parent.string() + " of " + opt.jsonFile + " does not exist");
+        if (const std::string why = outputProblem([&] { lc::checkFileTarget(opt.jsonFile); }); !why.empty())
+            throw lc::SettingsError("json", why);
     }
     std::unique_ptr<lc::CullBackend> backend = flags.openBackend();
 
@@ -552,6 +561,8 @@ int main(int argc, char** argv) {
 
         if (app.got_subcommand("convert")) {
             lcli::SceneSource::checkSceneExtension("OUT", convertOut); // before reading IN
+            if (const std::string why = outputProblem([&] { lc::checkFileTarget(convertOut); }); !why.empty())
+                return fail(2, "OUT: " + why);
             const lc::Scene scene = convertIn.load();
             lc::saveSceneAny(scene, convertOut);
             std::cout << "wrote " << convertOut << ": " << scene.triangleCount() << " triangles, " << scene.lights.size()
@@ -618,6 +629,8 @@ int main(int argc, char** argv) {
             if (!checkFlags.hasScene()) return fail(2, "check: give --scene FILE or --builtin NAME (the scene the lists were culled for)");
             lc::Scene scene = checkFlags.loadScene();
             lc::CullSettings settings;
+            if (const std::string why = outputProblem([&] { lc::checkDiagnosticsFolder(checkOut); }); !why.empty())
+                return fail(2, "--out: " + why);
             if (const std::string f = checkFlags.givenCullingFlag(); !f.empty())
                 return fail(2, f + ": has no effect on check: the dump's lists are judged as they are (--rule says "
                                    "whose pixels read each list)");
@@ -659,17 +672,9 @@ int main(int argc, char** argv) {
             if (const std::string f = runFlags.givenCullingFlag(); !f.empty())
                 return fail(2, f + ": has no effect with --shader: the shader culls (--layout and --lists say how "
                                    "its lists read)");
-        {
-            // Fail before the (possibly long) run when the output cannot be written.
-            namespace fs = std::filesystem;
-            fs::path target = fs::path(outDir).lexically_normal();
-            if (!target.has_filename()) target = target.parent_path();
-            fs::path parent = target.parent_path();
-            if (parent.empty()) parent = ".";
-            std::error_code ec;
-            if (!fs::is_directory(parent, ec))
-                return fail(2, "--out: parent folder " + parent.string() + " of " + outDir + " does not exist");
-        }
+        // Fail before the (possibly long) run when the output cannot be written.
+        if (const std::string why = outputProblem([&] { lc::checkDiagnosticsFolder(outDir); }); !why.empty())
+            return fail(2, "--out: " + why);
 
         lc::Scene scene = runFlags.loadScene();
         lc::CullSettings settings;

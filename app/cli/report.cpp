@@ -78,15 +78,11 @@ void ReportCommand::add(CLI::App& app) {
 
 int ReportCommand::run() {
     if (!source_.given()) return usage("report: give --scene FILE or --builtin NAME");
-    {
-        namespace fs = std::filesystem;
-        fs::path target = fs::path(outDir_).lexically_normal();
-        if (!target.has_filename()) target = target.parent_path();
-        fs::path parent = target.parent_path();
-        if (parent.empty()) parent = ".";
-        std::error_code ec;
-        if (!fs::is_directory(parent, ec))
-            return usage("--out: parent folder " + parent.string() + " of " + outDir_ + " does not exist");
+    // Before the sweep: a folder the report may not replace is a bad --out.
+    try {
+        lc::checkReportFolder(outDir_);
+    } catch (const lc::Error& e) {
+        return usage(std::string("--out: ") + e.what());
     }
 
     lc::Scene scene = source_.load();

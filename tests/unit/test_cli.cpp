@@ -162,6 +162,41 @@ TEST(Cli, BadCommandLinesFailWithOneLineNamingTheProblem) {
     expectCleanFailure({}, "subcommand");
 }
 
+// An output the command could not write is a bad command line, said before
+// any work (a large run took minutes to end in 'refusing to replace'), with
+// nothing on stdout and no temporary names in the message.
+TEST(Cli, OutputsThatCannotBeWrittenAreRefusedFirst) {
+    ScratchDir s;
+    fs::create_directory(s.path / "mine");
+    std::ofstream(s.path / "mine" / "notes.txt") << "keep";
+    std::ofstream(s.path / "afile") << "x";
+    fs::create_directory(s.path / "adir");
+    struct Case {
+        std::vector<std::string> args;
+        std::string expected;
+    };
+    const std::vector<Case> cases = {
+        {{"run", "--builtin", "wall", "--out", (s.path / "mine").string()}, "--out: refusing to replace"},
+        {{"run", "--builtin", "wall", "--out", (s.path / "afile").string()}, "--out: cannot export diagnostics into"},
+        {{"report", "--builtin", "wall", "--backend", "cpu", "--out", (s.path / "mine").string()},
+         "--out: refusing to replace"},
+        {{"bench", "--builtin", "wall", "--backend", "cpu", "--repeat", "1", "--warmup", "0", "--json",
+          (s.path / "adir").string()},
+         "--json: cannot write " + (s.path / "adir").string() + ": it is a folder"},
+        {{"convert", std::string(LC_SOURCE_DIR) + "/resources/scenes/stele_courtyard.json",
+          (s.path / "nodir" / "x.glb").string()},
+         "OUT: cannot write"},
+    };
+    for (const Case& c : cases) {
+        const CliResult r = runCli(c.args, s.path);
+        EXPECT_EQ(r.code, 2) << c.args[0] << ": " << r.err;
+        EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find(".tmp"), std::string::npos) << r.err;
+        EXPECT_TRUE(r.out.empty()) << r.out;
+    }
+    EXPECT_EQ(lc_test::slurp(s.path / "mine" / "notes.txt"), "keep");
+}
+
 TEST(Cli, BadSceneFileFailsNamingTheFileAndNothingIsWritten) {
     ScratchDir s;
     {

@@ -9,6 +9,9 @@
 #include <nlohmann/json.hpp>
 #include <png.h>
 
+#include <signal.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -251,6 +254,25 @@ TEST(Export, DiagnosticsFolderIsWrittenAndReplacedAtomically) {
     exportDiagnostics(r2.scene, r2.settings, r2.out, out.string() + "/");
     EXPECT_EQ(tmp.entries(), std::vector<std::string>{"diag"});
     EXPECT_EQ(readText(out / "summary.json"), summaryJson(r2.scene, r2.settings, r2.out));
+
+    // A writer interrupted mid-export (Ctrl+C: no handler runs) leaves its
+    // temporary folders: the next export beside them removes those of
+    // writers that are gone, and leaves a live writer's alone.
+    pid_t gone = 4194000;
+    while (gone > 300 && ::kill(gone, 0) == 0) --gone;
+    const fs::path abandoned = tmp.path / (".diag.tmp-" + std::to_string(gone) + "-AbCdEf");
+    const fs::path abandonedOld = tmp.path / (".diag.old-" + std::to_string(gone) + "-XyZ123");
+    const fs::path live = tmp.path / (".diag.tmp-" + std::to_string(::getppid()) + "-LiVe00");
+    for (const fs::path& p : {abandoned, abandonedOld, live}) {
+        fs::create_directory(p);
+        std::ofstream(p / "summary.json") << "{}";
+    }
+    exportDiagnostics(r.scene, r.settings, r.out, out.string());
+    EXPECT_FALSE(fs::exists(abandoned));
+    EXPECT_FALSE(fs::exists(abandonedOld));
+    EXPECT_TRUE(fs::exists(live));
+    fs::remove_all(live);
+    EXPECT_EQ(tmp.entries(), std::vector<std::string>{"diag"});
 }
 
 TEST(Export, FailureLeavesNothingBehind) {

@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <signal.h>
 #include <sys/stat.h>
 
 #include <cerrno>
@@ -59,6 +60,7 @@ void writeFileSynced(const std::string& path, const std::string& text) {
 
 void writeFileAtomic(const std::string& path, const std::string& text) {
     namespace fs = std::filesystem;
+    checkFileTarget(path);
     const fs::path target(path);
     const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
     const std::string tmp = (dir / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()))).string();
@@ -88,8 +90,21 @@ void syncFolder(const std::string& path) {
     if (rc != 0) throw Error("cannot sync " + path + ": " + std::strerror(err));
 }
 
-void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outputs, const std::string& action,
-                       const std::string& outputKind, const std::function<void(const std::string& tmp)>& fill) {
+void checkFileTarget(const std::string& path) {
+    namespace fs = std::filesystem;
+    const fs::path target(path);
+    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    std::error_code ec;
+    if (path.empty() || !target.has_filename()) throw Error("cannot write '" + path + "': give a file name");
+    if (!fs::is_directory(dir, ec))
+        throw Error("cannot write " + path + ": folder " + dir.string() + " does not exist");
+    if (fs::is_directory(target, ec)) throw Error("cannot write " + path + ": it is a folder");
+}
+
+namespace {
+
+// The folder's name and its parent, checked as writeFolderAtomic needs them.
+std::pair<std::filesystem::path, std::filesystem::path> folderTarget(const std::string& dir, const std::string& action) {
     namespace fs = std::filesystem;
     fs::path target = fs::path(dir).lexically_normal();
     if (!target.has_filename()) target = target.parent_path();
@@ -98,12 +113,39 @@ void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outp
         throw Error("cannot " + action + " into '" + dir + "': give a folder name");
     fs::path parent = target.parent_path();
     if (parent.empty()) parent = ".";
+    return {target, parent};
+}
+
+// Temporary folders beside `target` that an interrupted writer (its process
+// gone) left: ".NAME.tmp-PID-XXXXXX" and ".NAME.old-PID-XXXXXX".
+void removeAbandonedTemporaries(const std::filesystem::path& parent, const std::string& name) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(parent, ec)) {
+        const std::string f = e.path().filename().string();
+        for (const char* kind : {".tmp-", ".old-"}) {
+            const std::string head = "." + name + kind;
+            if (f.rfind(head, 0) != 0) continue;
+            const std::string rest = f.substr(head.size());
+            const auto dash = rest.find('-');
+            if (dash == std::string::npos || dash == 0 || rest.find_first_not_of("0123456789") != dash) continue;
+            const long pid = std::strtol(rest.substr(0, dash).c_str(), nullptr, 10);
+            if (pid > 0 && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH) fs::remove_all(e.path(), ec);
+        }
+    }
+}
+
+} // namespace
+
+void checkFolderTarget(const std::string& dir, const std::set<std::string>& outputs, const std::string& action,
+                       const std::string& outputKind) {
+    namespace fs = std::filesystem;
+    const auto [target, parent] = folderTarget(dir, action);
     std::error_code ec;
     if (!fs::is_directory(parent, ec))
         throw Error("cannot " + action + " into " + target.string() + ": parent folder " + parent.string() +
                     " does not exist");
-    const bool exists = fs::exists(fs::symlink_status(target, ec));
-    if (exists) {
+    if (fs::exists(fs::symlink_status(target, ec))) {
         if (!fs::is_directory(fs::symlink_status(target, ec)))
             throw Error("cannot " + action + " into " + target.string() + ": it exists and is not a folder");
         for (const auto& e : fs::directory_iterator(target, ec))
@@ -112,8 +154,22 @@ void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outp
                             ", which is not a " + outputKind);
         if (ec) throw Error("cannot read " + target.string() + ": " + ec.message());
     }
+}
 
-    std::string tmpl = (parent / ("." + name + ".tmp-XXXXXX")).string();
+void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outputs, const std::string& action,
+                       const std::string& outputKind, const std::function<void(const std::string& tmp)>& fill) {
+    namespace fs = std::filesystem;
+    checkFolderTarget(dir, outputs, action, outputKind);
+    const auto [target, parent] = folderTarget(dir, action);
+    const std::string name = target.filename().string();
+    std::error_code ec;
+    const bool exists = fs::exists(fs::symlink_status(target, ec));
+    removeAbandonedTemporaries(parent, name);
+
+    // The writer's pid in the name: a later writer removes what an
+    // interrupted one (Ctrl+C in the middle of a large export) left.
+    const std::string pid = std::to_string(::getpid());
+    std::string tmpl = (parent / ("." + name + ".tmp-" + pid + "-XXXXXX")).string();
     if (!::mkdtemp(tmpl.data()))
         throw Error("cannot create a temporary folder beside " + target.string() + ": " + std::strerror(errno));
     const fs::path tmp = tmpl;
@@ -124,7 +180,7 @@ void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outp
         fill(tmp.string());
         syncFolder(tmp.string());
         if (exists) {
-            std::string asideTmpl = (parent / ("." + name + ".old-XXXXXX")).string();
+            std::string asideTmpl = (parent / ("." + name + ".old-" + pid + "-XXXXXX")).string();
             if (!::mkdtemp(asideTmpl.data()))
                 throw Error("cannot create a temporary folder beside " + target.string() + ": " + std::strerror(errno));
             aside = asideTmpl;

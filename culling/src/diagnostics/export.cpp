@@ -420,18 +420,30 @@ void writeShadedImages(const RunOutput& run, const std::string& dir) {
     writePng(p.difference, (base / "shaded_diff.png").string());
 }
 
+namespace {
+// What an export folder may hold: an older export is replaced, anything else
+// is refused (writeFolderAtomic).
+const std::set<std::string>& diagnosticsOutputs() {
+    static const std::set<std::string> k = {"summary.json", "tiles.csv", "heatmap.png",
+                                            "overlays.vtm", "overlays", kExportViewImages[0],
+                                            kExportViewImages[1],
+                                            // writeShadedImages
+                                            "shaded_culled.png", "shaded_all.png", "shaded_diff.png"};
+    return k;
+}
+} // namespace
+
+void checkDiagnosticsFolder(const std::string& dir) {
+    checkFolderTarget(dir, diagnosticsOutputs(), "export diagnostics", "diagnostics output");
+}
+
 void exportDiagnostics(const Scene& scene, const CullSettings& settings, const RunOutput& run,
                        const std::string& dir, const std::vector<NamedImage>& viewImages) {
     for (const NamedImage& v : viewImages)
         if (std::find(std::begin(kExportViewImages), std::end(kExportViewImages), v.fileName) ==
             std::end(kExportViewImages))
             throw Error("cannot export diagnostics image '" + v.fileName + "': not a view image name");
-    static const std::set<std::string> kOutputs = {"summary.json", "tiles.csv", "heatmap.png",
-                                                   "overlays.vtm", "overlays", kExportViewImages[0],
-                                                   kExportViewImages[1],
-                                                   // writeShadedImages
-                                                   "shaded_culled.png", "shaded_all.png", "shaded_diff.png"};
-    writeFolderAtomic(dir, kOutputs, "export diagnostics", "diagnostics output", [&](const std::string& out) {
+    writeFolderAtomic(dir, diagnosticsOutputs(), "export diagnostics", "diagnostics output", [&](const std::string& out) {
         const fs::path tmp = out;
         writeFileSynced((tmp / "summary.json").string(), summaryJson(scene, settings, run));
         writeFileSynced((tmp / "tiles.csv").string(), tilesCsv(run));

@@ -668,6 +668,10 @@ RgbImage paretoImage(const Report& rep) {
 // ---- the folder ------------------------------------------------------------------
 
 
+void checkReportFolder(const std::string& dir) {
+    checkFolderTarget(dir, {"report.csv", "report.md", "pareto.png"}, "write the report", "report output");
+}
+
 void writeReport(const Report& rep, const std::string& dir) {
     writeFolderAtomic(dir, {"report.csv", "report.md", "pareto.png"}, "write the report", "report output",
                       [&](const std::string& out) {

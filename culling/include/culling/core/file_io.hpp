@@ -17,6 +17,11 @@ void writeFileSynced(const std::string& path, const std::string& text);
 // removed and `path` is untouched. Throws Error naming the file.
 void writeFileAtomic(const std::string& path, const std::string& text);
 
+// What writeFileAtomic needs of `path` before it writes: a file name in a
+// folder that exists, not a folder. Throws Error naming them (callers check
+// it before long work).
+void checkFileTarget(const std::string& path);
+
 // fsyncs a folder (its entries' names). Throws Error naming it.
 void syncFolder(const std::string& path);
 
@@ -28,5 +33,10 @@ void syncFolder(const std::string& path);
 // DIR: ..." and "... which is not a <outputKind>".
 void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outputs, const std::string& action,
                        const std::string& outputKind, const std::function<void(const std::string& tmp)>& fill);
+// writeFolderAtomic's checks of `dir` alone (with its messages), for callers
+// to run before long work. Temporary folders an interrupted writer left
+// beside `dir` are removed by the next writeFolderAtomic there.
+void checkFolderTarget(const std::string& dir, const std::set<std::string>& outputs, const std::string& action,
+                       const std::string& outputKind);
 
 } // namespace lc

@@ -122,5 +122,7 @@ glm::dvec3 algorithmColour(Algorithm a);
 // in a sibling folder, renamed at the end; an existing `dir` is replaced only
 // when it holds nothing but report outputs). Throws Error naming the path.
 void writeReport(const Report& report, const std::string& dir);
+// writeReport's checks of `dir` alone (throws Error), before the sweep.
+void checkReportFolder(const std::string& dir);
 
 } // namespace lc
