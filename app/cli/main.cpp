@@ -93,6 +93,10 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
                   const std::string& out, const std::string& noImageErrorWhy = "--no-image-error") {
     const lc::CullResult& r = run.result;
     const lc::Metrics& m = run.truth.metrics;
+    // Nothing to judge reads like a perfect culler: say so.
+    if (run.truthComputed && m.geometryPixels == 0)
+        std::cerr << "lightcull: warning: the camera sees no geometry (0 geometry pixels): there is nothing to "
+                     "cull for, and every metric is trivially perfect; check the camera\n";
     std::cout << "scene " << scene.name << ": " << r.grid.width << "x" << r.grid.height << ", tile "
               << r.grid.tileSize << " (" << r.grid.tilesX << "x" << r.grid.tilesY << " tiles), "
               << run.lights.size() << " lights\n"

@@ -162,6 +162,30 @@ TEST(Cli, BadCommandLinesFailWithOneLineNamingTheProblem) {
     expectCleanFailure({}, "subcommand");
 }
 
+// A view with no geometry scores as a perfect culler: the CLI says so. A
+// scene JSON without a camera frames its meshes (as a glTF does) instead of
+// looking at the origin from a fixed place.
+TEST(Cli, AnEmptyViewIsSaidAndAMissingCameraFramesTheMeshes) {
+    ScratchDir s;
+    const std::string mesh = R"("meshes": [{"positions": [40, 0, 40, 44, 0, 40, 40, 4, 40], "indices": [0, 1, 2]}],
+        "lights": [{"name": "a", "position": [41, 1, 39], "radius": 3}])";
+    std::ofstream(s.path / "away.json") << R"({"format": "lightcull-scene", "version": 1,
+        "camera": {"position": [0, 0, 0], "target": [0, 0, 5], "width": 64, "height": 64}, )" << mesh << "}";
+    std::ofstream(s.path / "nocam.json") << R"({"format": "lightcull-scene", "version": 1, )" << mesh << "}";
+    CliResult r = runCli({"run", "--scene", (s.path / "away.json").string(), "--backend", "cpu", "--out",
+                          (s.path / "o1").string()},
+                         s.path);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: the camera sees no geometry"), std::string::npos) << r.err;
+    r = runCli({"run", "--scene", (s.path / "nocam.json").string(), "--backend", "cpu", "--width", "64", "--height",
+                "64", "--out", (s.path / "o2").string()},
+               s.path);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+    const auto j = nlohmann::json::parse(lc_test::slurp(s.path / "o2" / "summary.json"));
+    EXPECT_GT(j["metrics"]["geometry_pixels"].get<std::uint64_t>(), 200u);
+}
+
 // An output the command could not write is a bad command line, said before
 // any work (a large run took minutes to end in 'refusing to replace'), with
 // nothing on stdout and no temporary names in the message.
