@@ -237,6 +237,26 @@ TEST(Export, HeatmapPngIsReadableWithImageSizeAndLegend) {
     EXPECT_GT(right[1], 200);
     EXPECT_LT(right[2], 80);
     EXPECT_THROW(writePng(img, (tmp.path / "missing" / "h.png").string()), Error);
+
+    // The tick above the bar marks the mean in the tint's unit, lights per
+    // geometry pixel, not the mean over clustered's mostly empty froxel lists.
+    const PipelineRun c = runBuiltin("atrium", Algorithm::Clustered, 320, 180);
+    const RgbImage ci = heatmapImage(c.out);
+    const Metrics& m = c.out.truth.metrics;
+    const CullResult& res = c.out.result;
+    const auto [lo, hi] = std::minmax_element(res.listCount.begin(), res.listCount.end());
+    const double perPixel = double(m.shadingWork) / double(m.geometryPixels);
+    const double perList = double(res.entries()) / double(res.listCount.size());
+    ASSERT_GT(perPixel, 2 * perList); // the two differ here
+    const int bx0 = 4, bx1 = 320 - 4;
+    const auto tickAt = [&](double v) { return bx0 + int(std::lround((v - *lo) / double(*hi - *lo) * (bx1 - bx0 - 1))); };
+    int tick = -1;
+    const std::uint32_t tickY = 180 + 2;
+    for (int x = 0; x < 320; ++x) {
+        const std::uint8_t* p = &ci.rgb[(std::size_t(tickY) * 320 + std::size_t(x)) * 3];
+        if (p[0] == 255 && p[1] == 255 && p[2] == 255) tick = x;
+    }
+    EXPECT_LE(std::abs(tick - tickAt(perPixel)), 2) << tick << " vs " << tickAt(perPixel);
 }
 
 TEST(Export, DiagnosticsFolderIsWrittenAndReplacedAtomically) {

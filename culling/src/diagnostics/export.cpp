@@ -291,7 +291,15 @@ RgbImage heatmapImage(const RunOutput& run) {
     std::uint32_t minList = std::numeric_limits<std::uint32_t>::max(), maxList = 0;
     for (std::uint32_t c : r.listCount) minList = std::min(minList, c), maxList = std::max(maxList, c);
     if (r.listCount.empty()) minList = 0;
-    const double mean = r.listCount.empty() ? 0.0 : double(r.entries()) / double(r.listCount.size());
+    // The legend's mean in the tint's unit: the list length a geometry pixel
+    // loops over, on average (shading work / geometry pixels). The mean over
+    // lists would count clustered's many empty froxels and read 20x lower
+    // than the colours around it. Without ground truth, the mean over lists.
+    const Metrics& gm = run.truth.metrics;
+    const bool perPixel = run.truthComputed && gm.geometryPixels > 0;
+    const double mean = perPixel ? double(gm.shadingWork) / double(gm.geometryPixels)
+                        : r.listCount.empty() ? 0.0
+                                              : double(r.entries()) / double(r.listCount.size());
     auto colourOf = [&](double count) {
         return viridis(maxList > minList ? (count - minList) / double(maxList - minList) : 0.0);
     };
@@ -364,7 +372,7 @@ RgbImage heatmapImage(const RunOutput& run) {
     const int ty = y0 + m + 10 * scale + 3 * scale;
     const std::string left = "MIN " + std::to_string(minList);
     const std::string right = "MAX " + std::to_string(maxList);
-    const std::string centre = "MEAN " + fixed2(mean) + " LIGHTS/LIST";
+    const std::string centre = "MEAN " + fixed2(mean) + (perPixel ? " LIGHTS/PIXEL" : " LIGHTS/LIST");
     cv.text(bx0, ty, left, scale, glm::dvec3(1.0));
     cv.text(bx1 - cv.textWidth(right, scale), ty, right, scale, glm::dvec3(1.0));
     const int cw = cv.textWidth(centre, scale);
