@@ -106,6 +106,10 @@ TileInspector::TileInspector(Document* doc, QWidget* parent) : QWidget(parent), 
     connect(doc_, &Document::tileSelectionChanged, this, &TileInspector::refresh);
     connect(doc_, &Document::runOutputChanged, this, &TileInspector::refresh);
     connect(doc_, &Document::runWentStale, this, &TileInspector::refresh);
+    // The highlighted row follows the current light wherever it was chosen
+    // (scene tree, 3D view, this table): a row left highlighted beside
+    // Explain's text about another light misleads.
+    connect(doc_, &Document::selectionChanged, this, &TileInspector::showCurrentLight);
     connect(table_, &QTableView::doubleClicked, this, [this](const QModelIndex& shown) {
         const QModelIndex i = proxy_->mapToSource(shown);
         if (!i.isValid() || i.row() >= int(model_->rows().size())) return;
@@ -115,6 +119,24 @@ TileInspector::TileInspector(Document* doc, QWidget* parent) : QWidget(parent), 
         doc_->setSelectedLights({int(row.light)});
     });
     refresh();
+}
+
+void TileInspector::showCurrentLight() {
+    const int light = doc_->currentLight();
+    const int list = doc_->explainedList();
+    QItemSelectionModel* sel = table_->selectionModel();
+    QModelIndex first;
+    QItemSelection rows;
+    for (int r = 0; r < proxy_->rowCount(); ++r) {
+        const QModelIndex src = proxy_->mapToSource(proxy_->index(r, 0));
+        const lc::TileLightRow& row = model_->rows()[std::size_t(src.row())];
+        // The explained list's row where the tile has several (halfz, clustered).
+        if (int(row.light) != light || (list >= 0 && int(row.list) != list)) continue;
+        rows.select(proxy_->index(r, 0), proxy_->index(r, proxy_->columnCount() - 1));
+        if (!first.isValid()) first = proxy_->index(r, 0);
+    }
+    sel->select(rows, QItemSelectionModel::ClearAndSelect);
+    if (first.isValid()) table_->scrollTo(first);
 }
 
 std::vector<int> TileInspector::listedLights() const {
@@ -166,6 +188,7 @@ void TileInspector::refresh() {
                           .arg(fp)
                           .arg(missing));
     summary_->setStyleSheet(missing ? "color: rgb(230,60,60); font-weight: bold" : "");
+    showCurrentLight();
 }
 
 } // namespace lcui

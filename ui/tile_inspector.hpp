@@ -59,6 +59,9 @@ public:
 
 private:
     void refresh();
+    // Selects the current light's row(s) (of the explained list, if one is
+    // picked), or none.
+    void showCurrentLight();
     Document* doc_;
     TileLightsModel* model_;
     QSortFilterProxyModel* proxy_;

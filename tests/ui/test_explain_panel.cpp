@@ -33,6 +33,9 @@
 #include <QFileInfo>
 #include <QPlainTextEdit>
 #include <QTableView>
+#include <QItemSelectionModel>
+
+#include <set>
 #include <QUndoStack>
 
 using namespace lcui;
@@ -57,6 +60,46 @@ private slots:
     void cleanup() {
         doc()->undoStack()->setClean();
         w_.reset();
+    }
+
+    // The inspector's highlighted row follows the current light, wherever it
+    // is chosen: a double-clicked row gives way to a light picked in the
+    // scene tree (or the 3D view).
+    void theHighlightedRowFollowsTheCurrentLight() {
+        auto run = doc()->runOutput();
+        std::uint32_t tile = 0;
+        for (std::uint32_t t = 0; t < run->result.grid.tileCount(); ++t)
+            if (run->result.listCount[t] > run->result.listCount[tile]) tile = t;
+        doc()->setSelectedTile(int(tile));
+        TileInspector* ti = w_->tileInspector();
+        QVERIFY(ti->proxy()->rowCount() >= 2);
+        auto selectedLights = [&] {
+            std::set<int> lights;
+            for (const QModelIndex& i : ti->table()->selectionModel()->selectedRows())
+                lights.insert(ti->proxy()->index(i.row(), TileLightsModel::ColLight).data().toInt());
+            return lights;
+        };
+        const int a = ti->proxy()->index(0, TileLightsModel::ColLight).data().toInt();
+        const int b = ti->proxy()->index(1, TileLightsModel::ColLight).data().toInt();
+        const QRect rowA = ti->table()->visualRect(ti->proxy()->index(0, TileLightsModel::ColName));
+        QTest::mouseClick(ti->table()->viewport(), Qt::LeftButton, {}, rowA.center());
+        QTest::mouseDClick(ti->table()->viewport(), Qt::LeftButton, {}, rowA.center());
+        QCOMPARE(doc()->currentLight(), a);
+        QCOMPARE(selectedLights(), std::set<int>{a});
+        w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(b)); // as a click in the tree
+        QCOMPARE(doc()->currentLight(), b);
+        QCOMPARE(selectedLights(), std::set<int>{b});
+        // A light the tile's lists do not hold: no row stays highlighted.
+        int other = -1;
+        for (int i = 0; i < int(doc()->scene().lights.size()) && other < 0; ++i) {
+            bool listed = false;
+            for (int r = 0; r < ti->model()->rowCount(); ++r)
+                listed = listed || int(ti->model()->rows()[std::size_t(r)].light) == i;
+            if (!listed) other = i;
+        }
+        QVERIFY(other >= 0);
+        doc()->setSelectedLights({other});
+        QVERIFY(selectedLights().empty());
     }
 
     void explainsTheSelectedLightInTheSelectedTile() {
