@@ -76,12 +76,18 @@ void ExplainPanel::refresh() {
         error = QString::fromStdString(ex.what());
     }
     if (!e) {
+        const auto run = doc_->runOutput();
+        const bool selected = doc_->selectedTile() >= 0 && doc_->currentLight() >= 0;
         verdict_->setText(!error.isEmpty()       ? error
                           : doc_->runIsStale() ? tr("The scene changed since the last run: run culling again (F5) "
                                                     "to explain it.")
-                                               : tr("Select a tile (click the camera view) and a light (the scene tree or "
-                                                "a row of the tile inspector) to see why the light is, or is not, in "
-                                                "that tile's list."));
+                          // A Live edit's lists come before their ground truth.
+                          : selected && run && !run->truthComputed
+                              ? tr("Waiting for the ground truth of run %1 (a Live edit shows its lists first)...")
+                                    .arg(doc_->runGeneration())
+                              : tr("Select a tile (click the camera view) and a light (the scene tree or "
+                                   "a row of the tile inspector) to see why the light is, or is not, in "
+                                   "that tile's list."));
         verdict_->setStyleSheet({});
         text_->clear();
         return;

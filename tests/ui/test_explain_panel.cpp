@@ -102,6 +102,24 @@ private slots:
         QVERIFY(selectedLights().empty());
     }
 
+    // While a Live edit's lists wait for their ground truth, the panel says
+    // so; it does not ask for a tile and a light already selected.
+    void aRunWithoutTruthYetIsWaitedFor() {
+        doc()->setSelectedTile(0);
+        doc()->setSelectedLights({0});
+        ExplainPanel* panel = w_->explainPanel();
+        auto* verdict = panel->findChild<QLabel*>("explainVerdict");
+        QVERIFY(panel->explanation());
+        auto listsOnly = std::make_shared<lc::RunOutput>(*doc()->runOutput());
+        listsOnly->truthComputed = false;
+        listsOnly->truth = {};
+        QVERIFY(doc()->setRunOutput(listsOnly, doc()->runGeneration() + 1));
+        QVERIFY(!panel->explanation());
+        QVERIFY2(verdict->text().startsWith("Waiting for the ground truth"), qPrintable(verdict->text()));
+        doc()->setSelectedTile(-1);
+        QVERIFY2(verdict->text().startsWith("Select a tile"), qPrintable(verdict->text()));
+    }
+
     void explainsTheSelectedLightInTheSelectedTile() {
         ExplainPanel* panel = w_->explainPanel();
         QVERIFY(panel);
