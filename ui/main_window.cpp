@@ -374,7 +374,7 @@ void MainWindow::buildActions() {
     live->setCheckable(true);
     live->setToolTip(tr("Re-run culling after every edit"));
     connect(live, &QAction::toggled, this, [this](bool on) {
-        if (on) runCulling();
+        if (on && !restoringSettings_) runCulling();
     });
 }
 
@@ -1096,7 +1096,11 @@ void MainWindow::restoreSettings() {
     const QString backend = st.value("backend").toString();
     if (!backend.isEmpty() && backendCombo_->findText(backend) >= 0) backendCombo_->setCurrentText(backend);
     deviceEdit_->setText(st.value("device").toString());
+    // Live comes back on without a run: the window holds no scene yet, and
+    // the scene opened next runs once (a run here logged 'run 1: 0 lights').
+    restoringSettings_ = true;
     action("actionLive")->setChecked(st.value("live", false).toBool());
+    restoringSettings_ = false;
 }
 
 void MainWindow::saveSettings() {

@@ -200,6 +200,7 @@ private:
     // The newest run that failed (0: none): while it is newer than the run
     // shown, the status bar says the figures are an older run's.
     quint64 failedGeneration_ = 0;
+    bool restoringSettings_ = false; // restoreSettings() is setting the widgets
     ExplainPanel* explain_ = nullptr;
     std::shared_ptr<const lc::CustomShaderOptions> customShader_;
     QFileSystemWatcher* shaderWatcher_ = nullptr;

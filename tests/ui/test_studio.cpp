@@ -914,6 +914,16 @@ private slots:
         w_->action("actionTabbedViews")->setChecked(false);
         QVERIFY(w_->setParamFromUi("algorithm", "2.5d"));
         QVERIFY(w_->setParamFromUi("cells", "32"));
+        // Live comes back on, without a run of the window's empty scene
+        // before any scene opens (the log began 'run 1: ..., 0 lights').
+        w_->setLive(true);
+        QVERIFY(w_->close());
+        w_ = std::make_unique<MainWindow>();
+        QVERIFY(w_->isLive());
+        QTest::qWait(50);
+        QCOMPARE(w_->cullService()->lastGeneration(), quint64(0));
+        QVERIFY(!w_->messageLog()->toPlainText().contains("run 1"));
+        w_->setLive(false);
         w_->close(); // leave default settings for the next tests
     }
 
