@@ -66,13 +66,17 @@ SpotHandles::SpotHandles(Document* doc, vtkRenderer* renderer, vtkRenderWindowIn
         rep->GetProperty()->SetLineWidth(3);
         rep->GetSelectedProperty()->SetLineWidth(3);
         rep->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
+        // Unlit: lit, the violet read pale pink and the lime pale yellow
+        // beside the yellow selection (STUDIO.md names them by colour).
+        rep->GetProperty()->LightingOff();
+        rep->GetSelectedProperty()->LightingOff();
         rep->ActiveRepresentationOff();
         w->SetInteractor(interactor);
         w->SetRepresentation(rep);
         w->EnabledOff();
     };
-    setUp(dirWidget_, dirRep_, 0.6, 0.4, 1.0);    // violet: on the axis
-    setUp(angleWidget_, angleRep_, 0.7, 1.0, 0.2); // lime: on the rim
+    setUp(dirWidget_, dirRep_, 0.45, 0.1, 0.9);   // violet: on the axis
+    setUp(angleWidget_, angleRep_, 0.3, 0.85, 0.0); // lime: on the rim
     dirWidget_->AddObserver(vtkCommand::StartInteractionEvent, this, &SpotHandles::onDirStart);
     dirWidget_->AddObserver(vtkCommand::InteractionEvent, this, &SpotHandles::onDirMove);
     dirWidget_->AddObserver(vtkCommand::EndInteractionEvent, this, &SpotHandles::onDirEnd);
