@@ -8,6 +8,7 @@
 #include <QFontDatabase>
 #include <QLabel>
 #include <QPlainTextEdit>
+#include <QTextOption>
 #include <QVBoxLayout>
 
 namespace lcui {
@@ -21,7 +22,10 @@ ExplainPanel::ExplainPanel(Document* doc, QWidget* parent) : QWidget(parent), do
     text_ = new QPlainTextEdit;
     text_->setObjectName("explainText");
     text_->setReadOnly(true);
-    text_->setLineWrapMode(QPlainTextEdit::NoWrap);
+    // Wrapped at the dock's width: each test's numbers (signed distance
+    // against -r) sit at the end of its line, past a 330 px dock's edge.
+    text_->setLineWrapMode(QPlainTextEdit::WidgetWidth);
+    text_->setWordWrapMode(QTextOption::WrapAtWordBoundaryOrAnywhere);
     text_->setFont(QFontDatabase::systemFont(QFontDatabase::FixedFont));
     layout->addWidget(verdict_);
     layout->addWidget(text_, 1);

@@ -32,6 +32,7 @@
 #include <QSortFilterProxyModel>
 #include <QFileInfo>
 #include <QPlainTextEdit>
+#include <QScrollBar>
 #include <QTableView>
 #include <QItemSelectionModel>
 
@@ -156,6 +157,9 @@ private slots:
         QCOMPARE(panel->explanation()->listed, false);
         QVERIFY2(verdict->text().contains("the first test to reject it:"), qPrintable(verdict->text()));
         QVERIFY(panel->textView()->toPlainText().contains("FAIL"));
+        // Read at the default layout without scrolling sideways: the numbers
+        // at the ends of the lines wrap into the dock.
+        QTRY_COMPARE(panel->textView()->horizontalScrollBar()->maximum(), 0);
         // For a person to look at (docs/STUDIO.md): the window with the panel.
         w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(light)));
         QDir().mkpath(LC_RENDER_OUT_DIR);
