@@ -103,19 +103,6 @@ void checkFileTarget(const std::string& path) {
 
 namespace {
 
-// The folder's name and its parent, checked as writeFolderAtomic needs them.
-std::pair<std::filesystem::path, std::filesystem::path> folderTarget(const std::string& dir, const std::string& action) {
-    namespace fs = std::filesystem;
-    fs::path target = fs::path(dir).lexically_normal();
-    if (!target.has_filename()) target = target.parent_path();
-    const std::string name = target.filename().string();
-    if (dir.empty() || name.empty() || name == "." || name == "..")
-        throw Error("cannot " + action + " into '" + dir + "': give a folder name");
-    fs::path parent = target.parent_path();
-    if (parent.empty()) parent = ".";
-    return {target, parent};
-}
-
 // Temporary folders beside `target` that an interrupted writer (its process
 // gone) left: ".NAME.tmp-PID-XXXXXX" and ".NAME.old-PID-XXXXXX".
 void removeAbandonedTemporaries(const std::filesystem::path& parent, const std::string& name) {
@@ -135,12 +122,19 @@ void removeAbandonedTemporaries(const std::filesystem::path& parent, const std::
     }
 }
 
-} // namespace
-
-void checkFolderTarget(const std::string& dir, const std::set<std::string>& outputs, const std::string& action,
-                       const std::string& outputKind) {
+// checkFolderTarget's checks; returns the folder and its parent.
+std::pair<std::filesystem::path, std::filesystem::path> checkedFolderTarget(const std::string& dir,
+                                                                           const std::set<std::string>& outputs,
+                                                                           const std::string& action,
+                                                                           const std::string& outputKind) {
     namespace fs = std::filesystem;
-    const auto [target, parent] = folderTarget(dir, action);
+    fs::path target = fs::path(dir).lexically_normal();
+    if (!target.has_filename()) target = target.parent_path();
+    const std::string name = target.filename().string();
+    if (dir.empty() || name.empty() || name == "." || name == "..")
+        throw Error("cannot " + action + " into '" + dir + "': give a folder name");
+    fs::path parent = target.parent_path();
+    if (parent.empty()) parent = ".";
     std::error_code ec;
     if (!fs::is_directory(parent, ec))
         throw Error("cannot " + action + " into " + target.string() + ": parent folder " + parent.string() +
@@ -154,13 +148,20 @@ void checkFolderTarget(const std::string& dir, const std::set<std::string>& outp
                             ", which is not a " + outputKind);
         if (ec) throw Error("cannot read " + target.string() + ": " + ec.message());
     }
+    return {target, parent};
+}
+
+} // namespace
+
+void checkFolderTarget(const std::string& dir, const std::set<std::string>& outputs, const std::string& action,
+                       const std::string& outputKind) {
+    checkedFolderTarget(dir, outputs, action, outputKind);
 }
 
 void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outputs, const std::string& action,
                        const std::string& outputKind, const std::function<void(const std::string& tmp)>& fill) {
     namespace fs = std::filesystem;
-    checkFolderTarget(dir, outputs, action, outputKind);
-    const auto [target, parent] = folderTarget(dir, action);
+    const auto [target, parent] = checkedFolderTarget(dir, outputs, action, outputKind);
     const std::string name = target.filename().string();
     std::error_code ec;
     const bool exists = fs::exists(fs::symlink_status(target, ec));

@@ -668,12 +668,17 @@ RgbImage paretoImage(const Report& rep) {
 // ---- the folder ------------------------------------------------------------------
 
 
+namespace {
+// What a report folder holds: an older report is replaced, anything else refused.
+const std::set<std::string> kReportOutputs = {"report.csv", "report.md", "pareto.png"};
+} // namespace
+
 void checkReportFolder(const std::string& dir) {
-    checkFolderTarget(dir, {"report.csv", "report.md", "pareto.png"}, "write the report", "report output");
+    checkFolderTarget(dir, kReportOutputs, "write the report", "report output");
 }
 
 void writeReport(const Report& rep, const std::string& dir) {
-    writeFolderAtomic(dir, {"report.csv", "report.md", "pareto.png"}, "write the report", "report output",
+    writeFolderAtomic(dir, kReportOutputs, "write the report", "report output",
                       [&](const std::string& out) {
                           const fs::path tmp = out;
                           writeFileSynced((tmp / "report.csv").string(), reportCsv(rep));

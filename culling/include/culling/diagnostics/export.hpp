@@ -53,12 +53,11 @@ inline constexpr const char* kExportViewImages[] = {"camera_view.png", "inspecto
 // all files go to a temporary sibling folder that is renamed onto `dir` at the
 // end; on any failure nothing is left behind and an existing `dir` is
 // untouched until the rename. Throws Error naming the path.
+void exportDiagnostics(const Scene& scene, const CullSettings& settings, const RunOutput& run,
+                       const std::string& dir, const std::vector<NamedImage>& viewImages = {});
 // Whether exportDiagnostics could write into `dir` (its parent exists; it is
 // absent, empty or an earlier export): throws Error saying why not. For
 // callers to check before the run.
 void checkDiagnosticsFolder(const std::string& dir);
-
-void exportDiagnostics(const Scene& scene, const CullSettings& settings, const RunOutput& run,
-                       const std::string& dir, const std::vector<NamedImage>& viewImages = {});
 
 } // namespace lc
