@@ -259,8 +259,7 @@ CustomShaderOptions shaderOptionsFromFile(const std::string& path, const std::st
         if (!in) throw InputError(path, "", 0, "cannot open shader for reading");
         std::string first;
         std::getline(in, first);
-        if (first.rfind("\xEF\xBB\xBF", 0) == 0) first.erase(0, 3); // an editor's UTF-8 byte order mark
-        applyShaderHeader(first, path, o, !layout.empty(), !lists.empty(), !entry.empty());
+        applyShaderHeader(detail::withoutByteOrderMark(first), path, o, !layout.empty(), !lists.empty(), !entry.empty());
     }
     return o;
 }

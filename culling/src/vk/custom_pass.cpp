@@ -185,7 +185,7 @@ void checkInterface(const std::string& path, const std::vector<std::uint32_t>& w
     constexpr std::uint32_t kGLCompute = 5, kDecBinding = 33, kDecDescriptorSet = 34, kPushConstant = 9;
     std::vector<std::string> computeEntries;
     std::map<std::uint32_t, std::uint32_t> bindingOf, setOf;
-    std::vector<std::uint32_t> pushConstants;
+    bool pushConstants = false;
     for (std::size_t i = 5; i < words.size();) {
         const std::uint32_t count = words[i] >> 16, op = words[i] & 0xFFFFu;
         if (count == 0 || count > words.size() - i)
@@ -205,7 +205,7 @@ void checkInterface(const std::string& path, const std::vector<std::uint32_t>& w
         } else if (op == kOpDecorate && count >= 4 && w[2] == kDecDescriptorSet) {
             setOf[w[1]] = w[3];
         } else if (op == kOpVariable && count >= 4 && w[3] == kPushConstant) {
-            pushConstants.push_back(w[2]);
+            pushConstants = true;
         }
         i += count;
     }
@@ -215,7 +215,7 @@ void checkInterface(const std::string& path, const std::vector<std::uint32_t>& w
         throw InputError(path, "", 0, "no compute entry point '" + entry + "' (the module has " +
                                           (have.empty() ? std::string("none") : have) + "; --entry)");
     }
-    if (!pushConstants.empty())
+    if (pushConstants)
         throw InputError(path, "", 0, "declares push constants: the contract has none (the parameters are binding 0)");
     static const char* const kBindings = "0 parameters, 1 depth texture, 2 depth buffer, 3 lights, 4 lists";
     for (const auto& [id, binding] : bindingOf) {
@@ -272,9 +272,7 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
     } else {
         const bool hlsl = ext == ".hlsl";
         if (!hlsl) entry = "main";
-        std::string text = detail::readWholeFile(o.path);
-        if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3); // glslang takes a byte order mark for a token
-        spirv = compileSource(o.path, text, hlsl, o.entry,
+        spirv = compileSource(o.path, detail::withoutByteOrderMark(detail::readWholeFile(o.path)), hlsl, o.entry,
                               definesFor(o, grid, skeleton.listsPerTile, lightCount, compactEntries));
     }
 
