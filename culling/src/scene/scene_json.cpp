@@ -496,17 +496,11 @@ Scene parseSceneImpl(const std::string& text, const std::string& file, const Can
             if (progress) progress(0.1 + 0.9 * double(i + 1) / double(x->size()));
         }
     }
-    if (!r.find(root, "camera") && !s.meshes.empty()) {
+    if (!r.find(root, "camera") && s.triangleCount() > 0) {
         // No camera: one that frames the meshes, as a glTF without a camera
         // gets (the fixed default looked at the origin from 5 m, inside or
         // away from most scenes: an empty view that scored as perfect).
-        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-        for (const Mesh& m : s.meshes)
-            for (std::size_t v = 0; v < m.vertexCount(); ++v) {
-                const glm::dvec3 p(m.transform * glm::dvec4(glm::dvec3(m.vertex(v)), 1.0));
-                lo = glm::min(lo, p);
-                hi = glm::max(hi, p);
-            }
+        const auto [lo, hi] = s.bounds();
         if (std::isfinite(lo.x + lo.y + lo.z + hi.x + hi.y + hi.z)) s.camera = frameBounds(lo, hi, s.camera);
     }
     if (progress) progress(1.0);
