@@ -695,21 +695,15 @@ int main(int argc, char** argv) {
             engineDepth = lc::loadDepthFile(runCustom.depthFile, lc::Projection(scene.camera));
             options.reuseDepth = &engineDepth;
         }
-        if (!runCustom.shader.empty()) {
-            lc::CustomCullReport report;
-            lc::RunOutput result =
-                lc::runCustomPipeline(scene, runCustom.shaderOptions(runFlags.device), *backend, options, report,
-                                      options.reuseDepth);
-            if (options.reuseDepth) result.depthFrom = "depth file " + runCustom.depthFile;
-            lc::exportDiagnostics(scene, settings, result, outDir);
-            printSummary(scene, settings, result, outDir);
-            lcli::printCustomReport(result, scene, lc::Projection(scene.camera));
-            return 0;
-        }
-        lc::RunOutput result = lc::runPipeline(scene, settings, *backend, options);
+        const bool custom = !runCustom.shader.empty();
+        lc::CustomCullReport report;
+        lc::RunOutput result = custom ? lc::runCustomPipeline(scene, runCustom.shaderOptions(runFlags.device), *backend,
+                                                              options, report, options.reuseDepth)
+                                      : lc::runPipeline(scene, settings, *backend, options);
         if (options.reuseDepth) result.depthFrom = "depth file " + runCustom.depthFile;
         lc::exportDiagnostics(scene, settings, result, outDir);
         printSummary(scene, settings, result, outDir);
+        if (custom) lcli::printCustomReport(result, scene, lc::Projection(scene.camera));
         return 0;
     } catch (const lc::SettingsError& e) {
         // A bad value on the command line (docs/CLI.md: exit 2), named by the
