@@ -984,13 +984,12 @@ QImage MainWindow::grabWindow() {
     return grab().toImage();
 }
 
-void MainWindow::log(const QString& message, bool error) {
-    const QString line = QDateTime::currentDateTime().toString("hh:mm:ss ") + (error ? "ERROR " : "") + message;
-    log_->appendPlainText(line);
-}
+void MainWindow::log(const QString& message, bool error) { logLine(error ? "ERROR " : "", message); }
 
-void MainWindow::warn(const QString& message) {
-    log_->appendPlainText(QDateTime::currentDateTime().toString("hh:mm:ss ") + "WARNING " + message);
+void MainWindow::warn(const QString& message) { logLine("WARNING ", message); }
+
+void MainWindow::logLine(const QString& level, const QString& message) {
+    log_->appendPlainText(QDateTime::currentDateTime().toString("hh:mm:ss ") + level + message);
 }
 
 void MainWindow::updateTitle() {

@@ -151,6 +151,8 @@ protected:
     void dropEvent(QDropEvent* e) override;
 
 private:
+    // The time, `level` ("ERROR ", "WARNING " or none) and the message.
+    void logLine(const QString& level, const QString& message);
     void reloadCustomShader(); // the watched file changed
     void buildActions();
     void buildMenus();

@@ -6,7 +6,6 @@
 
 #include <QCheckBox>
 #include <QAbstractSpinBox>
-#include <QKeyEvent>
 #include <QColorDialog>
 #include <QComboBox>
 #include <QDoubleSpinBox>

@@ -66,15 +66,14 @@ SpotHandles::SpotHandles(Document* doc, vtkRenderer* renderer, vtkRenderWindowIn
         rep->GetProperty()->SetLineWidth(3);
         rep->GetSelectedProperty()->SetLineWidth(3);
         rep->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
-        // Unlit: lit, the violet read pale pink and the lime pale yellow
-        // beside the yellow selection (STUDIO.md names them by colour).
-        rep->GetProperty()->LightingOff();
-        rep->GetSelectedProperty()->LightingOff();
         rep->ActiveRepresentationOff();
         w->SetInteractor(interactor);
         w->SetRepresentation(rep);
         w->EnabledOff();
     };
+    // The handles draw brighter than their colour (0.6, 0.4, 1.0 read pale
+    // pink, 0.7, 1.0, 0.2 pale yellow beside the yellow selection): deep
+    // ones, so that they read as STUDIO.md names them.
     setUp(dirWidget_, dirRep_, 0.45, 0.1, 0.9);   // violet: on the axis
     setUp(angleWidget_, angleRep_, 0.3, 0.85, 0.0); // lime: on the rim
     dirWidget_->AddObserver(vtkCommand::StartInteractionEvent, this, &SpotHandles::onDirStart);
