@@ -45,6 +45,14 @@ class ExplainPanelTest : public QObject {
     Q_OBJECT
     std::unique_ptr<MainWindow> w_;
     Document* doc() const { return w_->document(); }
+    // The tile whose list is longest in the shown run (the first of them).
+    std::uint32_t busiestTile() const {
+        const lc::CullResult& r = doc()->runOutput()->result;
+        std::uint32_t tile = 0;
+        for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t)
+            if (r.listCount[t] > r.listCount[tile]) tile = t;
+        return tile;
+    }
 
     bool waitTruth(quint64 generation) { return lctest::waitRun(*w_, generation, true); }
 
@@ -68,9 +76,7 @@ private slots:
     // scene tree (or the 3D view).
     void theHighlightedRowFollowsTheCurrentLight() {
         auto run = doc()->runOutput();
-        std::uint32_t tile = 0;
-        for (std::uint32_t t = 0; t < run->result.grid.tileCount(); ++t)
-            if (run->result.listCount[t] > run->result.listCount[tile]) tile = t;
+        const std::uint32_t tile = busiestTile();
         doc()->setSelectedTile(int(tile));
         TileInspector* ti = w_->tileInspector();
         QVERIFY(ti->proxy()->rowCount() >= 2);
@@ -128,9 +134,7 @@ private slots:
         auto run = doc()->runOutput();
         // The busiest tile and a light listed there, chosen as a user would:
         // the tile in the camera view, the light in the scene tree.
-        std::uint32_t tile = 0;
-        for (std::uint32_t t = 0; t < run->result.grid.tileCount(); ++t)
-            if (run->result.listCount[t] > run->result.listCount[tile]) tile = t;
+        const std::uint32_t tile = busiestTile();
         const std::uint32_t light = run->result.lightIndices[run->result.listOffset[tile]];
         doc()->setSelectedTile(int(tile));
         w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(light)));
@@ -337,9 +341,7 @@ private slots:
     // verdict filter and column sort, the scene tree's filter and orders.
     void tooltipsFiltersAndSorting() {
         auto run = doc()->runOutput();
-        std::uint32_t tile = 0;
-        for (std::uint32_t t = 0; t < run->result.grid.tileCount(); ++t)
-            if (run->result.listCount[t] > run->result.listCount[tile]) tile = t;
+        const std::uint32_t tile = busiestTile();
         CameraView* cv = w_->cameraView();
         const QString tip = cv->tileTooltip(int(tile));
         const std::uint32_t tx = tile % run->result.grid.tilesX, ty = tile / run->result.grid.tilesX;
@@ -412,9 +414,7 @@ private slots:
     // until the next run; a run of the edited scene brings them back.
     void anEditLeavesTheRunStaleUntilTheNextRun() {
         auto run = doc()->runOutput();
-        std::uint32_t tile = 0;
-        for (std::uint32_t t = 0; t < run->result.grid.tileCount(); ++t)
-            if (run->result.listCount[t] > run->result.listCount[tile]) tile = t;
+        const std::uint32_t tile = busiestTile();
         doc()->setSelectedTile(int(tile));
         TileInspector* ti = w_->tileInspector();
         QVERIFY(ti->model()->rows().size() >= 2);
