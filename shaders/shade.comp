@@ -40,8 +40,9 @@ layout(push_constant) uniform Chunk { uvec4 C; };
 
 // One light's term at one pixel, the CPU reference's float operations in its
 // order (shade.cpp).
-vec3 lightTerm(vec3 p, vec3 n, vec3 lightPos, vec3 power, vec4 s) {
-    precise vec3 d = lightPos - p;
+// lightPos.w: 1 / range^2 of a light with a shading range, else 0 (no window).
+vec3 lightTerm(vec3 p, vec3 n, vec4 lightPos, vec3 power, vec4 s) {
+    precise vec3 d = lightPos.xyz - p;
     precise float d2 = (d.x * d.x + d.y * d.y) + d.z * d.z;
     // A light exactly at the pixel has no direction: clamp the length.
     precise float len = sqrt(max(d2, 1e-30));
@@ -50,6 +51,10 @@ vec3 lightTerm(vec3 p, vec3 n, vec3 lightPos, vec3 power, vec4 s) {
     // Spot cone (shade.cpp): inside when -(axis.d) >= len cos a.
     precise float axial = 0.0 - ((s.x * d.x + s.y * d.y) + s.z * d.z);
     if (!(axial >= len * s.w)) f = 0.0;
+    // KHR_lights_punctual's range window: max(0, 1 - (d^2/r^2)^2)^2.
+    precise float t = d2 * lightPos.w;
+    precise float w = max(1.0 - t * t, 0.0);
+    f = f * (w * w);
     precise vec3 term = power * f;
     return term;
 }
@@ -89,7 +94,7 @@ vec3 shadeList(uint l, vec3 p, vec3 n, vec3 sum) {
     uvec2 r = listRange(l);
     for (uint k = r.x; k < r.y; ++k) {
         uint li = lightIndices[k];
-        acc += lightTerm(p, n, LIGHT(li, position.xyz), LIGHT(li, power.xyz), LIGHT(li, spot));
+        acc += lightTerm(p, n, LIGHT(li, position), LIGHT(li, power.xyz), LIGHT(li, spot));
     }
     return acc;
 }
@@ -121,7 +126,8 @@ void main() {
         uvec2 r = ALL_LIGHTS != 0u ? uvec2(0u, C.y) : listRange(l[0]);
         for (uint k = r.x; k < r.y; ++k) {
             uint li = ALL_LIGHTS != 0u ? C.x + k : lightIndices[k];
-            vec3 lp = LIGHT(li, position.xyz), pw = LIGHT(li, power.xyz);
+            vec4 lp = LIGHT(li, position);
+            vec3 pw = LIGHT(li, power.xyz);
             vec4 s = LIGHT(li, spot);
             for (uint j = 0u; j < PX; ++j) acc[j] += lightTerm(p[j], n[j], lp, pw, s);
         }

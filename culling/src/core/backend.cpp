@@ -22,6 +22,10 @@ ViewLights makeViewLights(const Scene& scene) {
         out.centers.push_back(glm::dvec3(viewFromWorld * glm::dvec4(l.position, 1.0)));
         out.radii.push_back(l.radius());
         out.power.push_back(l.color * l.intensity);
+        if (l.explicitRadius > 0.0) {
+            if (out.shadingRanges.empty()) out.shadingRanges.assign(scene.lights.size(), 0.0);
+            out.shadingRanges[i] = l.explicitRadius;
+        }
         if (l.isSpot()) {
             if (out.spotAngles.empty()) {
                 out.spotAxes.assign(scene.lights.size(), glm::dvec3(0.0, 0.0, -1.0));

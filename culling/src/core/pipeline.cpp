@@ -132,10 +132,12 @@ LightsDiff diffShadingLights(const ViewLights& before, const ViewLights& after) 
 ViewLights lightsOf(const ViewLights& l, const std::vector<std::size_t>& which) {
     ViewLights s;
     const bool spots = !l.spotAngles.empty();
+    const bool ranges = !l.shadingRanges.empty();
     for (std::size_t i : which) {
         s.centers.push_back(l.centers[i]);
         s.radii.push_back(l.radii[i]);
         s.power.push_back(l.power[i]);
+        if (ranges) s.shadingRanges.push_back(l.shadingRanges[i]);
         if (spots) {
             s.spotAxes.push_back(l.spotAxes[i]);
             s.spotAngles.push_back(l.spotAngles[i]);
@@ -145,7 +147,8 @@ ViewLights lightsOf(const ViewLights& l, const std::vector<std::size_t>& which) 
 }
 
 bool sameLights(const ViewLights& a, const ViewLights& b) {
-    return a.centers == b.centers && a.power == b.power && a.spotAxes == b.spotAxes && a.spotAngles == b.spotAngles;
+    return a.centers == b.centers && a.power == b.power && a.spotAxes == b.spotAxes && a.spotAngles == b.spotAngles &&
+           a.shadingRanges == b.shadingRanges;
 }
 
 } // namespace

@@ -64,16 +64,18 @@ template <class Fn> void forEachRowBand(std::uint32_t height, std::uint32_t band
 
 // Light data for the shading kernel, float SoA. A spot light's cone is its
 // axis (ax, ay, az) and cos(outer angle); a point light has axis 0 and cos -2,
-// so that the one cone test below always passes for it.
+// so that the one cone test below always passes for it. invRange2 is
+// 1 / range^2 for a light with a shading range, 0 (no window) otherwise.
 struct LightSoA {
-    std::vector<float> x, y, z, r, g, b, ax, ay, az, cosA;
+    std::vector<float> x, y, z, r, g, b, ax, ay, az, cosA, invRange2;
     explicit LightSoA(const ViewLights& l) {
         const std::size_t n = l.size();
         x.resize(n), y.resize(n), z.resize(n), r.resize(n), g.resize(n), b.resize(n);
-        ax.assign(n, 0.0f), ay.assign(n, 0.0f), az.assign(n, 0.0f), cosA.assign(n, -2.0f);
+        ax.assign(n, 0.0f), ay.assign(n, 0.0f), az.assign(n, 0.0f), cosA.assign(n, -2.0f), invRange2.assign(n, 0.0f);
         for (std::size_t i = 0; i < n; ++i) {
             x[i] = float(l.centers[i].x), y[i] = float(l.centers[i].y), z[i] = float(l.centers[i].z);
             r[i] = float(l.power[i].x), g[i] = float(l.power[i].y), b[i] = float(l.power[i].z);
+            invRange2[i] = shadingInvRange2(l.shadingRange(i));
             if (l.isSpot(i)) {
                 ax[i] = float(l.spotAxes[i].x), ay[i] = float(l.spotAxes[i].y), az[i] = float(l.spotAxes[i].z);
                 cosA[i] = float(std::cos(l.spotAngles[i]));
@@ -97,7 +99,12 @@ struct PixelGroup {
 // loop runs over pixels and vectorises; light data are loop invariants.
 //   contribution = power * max(0, n.l) / max(d^2, 1e-4),  l = (c - P) / |c - P|
 // times, for a spot light, 1 inside its cone and 0 outside (a hard cone, no
-// penumbra): inside when (P - c).axis >= |P - c| cos(outer angle).
+// penumbra): inside when (P - c).axis >= |P - c| cos(outer angle), and, for a
+// light with a shading range r, times KHR_lights_punctual's window
+//   w = max(0, 1 - (d^2/r^2)^2)^2,
+// which is 1 at the light and falls to 0 at d = r (with no range the factor
+// is computed with 1/r^2 = 0 and is exactly 1, so such lights shade bitwise as
+// without it).
 // x86-64 always has SSE2: the pixel loop runs 4 pixels per instruction with
 // explicit intrinsics (GCC will not vectorise std::sqrt without
 // -fno-math-errno). SSE's add/mul/div/sqrt are IEEE-exact like the scalar
@@ -118,12 +125,14 @@ void shadeGroup(PixelGroup& g, std::size_t begin, std::size_t end, const LightSo
         const float lx = L.x[i], ly = L.y[i], lz = L.z[i];
         const float cr = L.r[i], cg = L.g[i], cb = L.b[i];
         const float sx = L.ax[i], sy = L.ay[i], sz = L.az[i], cosA = L.cosA[i];
+        const float invR2 = L.invRange2[i];
         std::size_t p = begin;
 #if defined(__SSE2__)
         const __m128 vlx = _mm_set1_ps(lx), vly = _mm_set1_ps(ly), vlz = _mm_set1_ps(lz);
         const __m128 vcr = _mm_set1_ps(cr), vcg = _mm_set1_ps(cg), vcb = _mm_set1_ps(cb);
         const __m128 tiny = _mm_set1_ps(1e-30f), floor2 = _mm_set1_ps(1e-4f), zero = _mm_setzero_ps();
         const __m128 vsx = _mm_set1_ps(sx), vsy = _mm_set1_ps(sy), vsz = _mm_set1_ps(sz), vcos = _mm_set1_ps(cosA);
+        const __m128 vinvR2 = _mm_set1_ps(invR2), one = _mm_set1_ps(1.0f);
         for (; p + 4 <= end; p += 4) {
             const __m128 dx = _mm_sub_ps(vlx, _mm_loadu_ps(px + p));
             const __m128 dy = _mm_sub_ps(vly, _mm_loadu_ps(py + p));
@@ -138,7 +147,10 @@ void shadeGroup(PixelGroup& g, std::size_t begin, std::size_t end, const LightSo
             const __m128 axial = _mm_sub_ps(zero, _mm_add_ps(_mm_add_ps(_mm_mul_ps(vsx, dx), _mm_mul_ps(vsy, dy)),
                                                              _mm_mul_ps(vsz, dz)));
             const __m128 inCone = _mm_cmpge_ps(axial, _mm_mul_ps(len, vcos));
-            const __m128 f = _mm_and_ps(inCone, _mm_div_ps(_mm_max_ps(ndl, zero), _mm_max_ps(d2, floor2)));
+            const __m128 t = _mm_mul_ps(d2, vinvR2);
+            const __m128 w = _mm_max_ps(_mm_sub_ps(one, _mm_mul_ps(t, t)), zero);
+            const __m128 f = _mm_mul_ps(_mm_and_ps(inCone, _mm_div_ps(_mm_max_ps(ndl, zero), _mm_max_ps(d2, floor2))),
+                                        _mm_mul_ps(w, w));
             _mm_storeu_ps(ar + p, _mm_add_ps(_mm_loadu_ps(ar + p), _mm_mul_ps(vcr, f)));
             _mm_storeu_ps(ag + p, _mm_add_ps(_mm_loadu_ps(ag + p), _mm_mul_ps(vcg, f)));
             _mm_storeu_ps(ab + p, _mm_add_ps(_mm_loadu_ps(ab + p), _mm_mul_ps(vcb, f)));
@@ -151,7 +163,11 @@ void shadeGroup(PixelGroup& g, std::size_t begin, std::size_t end, const LightSo
             const float len = std::sqrt(d2 > 1e-30f ? d2 : 1e-30f);
             const float ndl = ((nx[p] * dx + ny[p] * dy) + nz[p] * dz) / len;
             const float axial = 0.0f - ((sx * dx + sy * dy) + sz * dz);
-            const float f = axial >= len * cosA ? (ndl > 0.0f ? ndl : 0.0f) / (d2 > 1e-4f ? d2 : 1e-4f) : 0.0f;
+            const float t = d2 * invR2;
+            const float w0 = 1.0f - t * t;
+            const float w = w0 > 0.0f ? w0 : 0.0f;
+            const float f =
+                (axial >= len * cosA ? (ndl > 0.0f ? ndl : 0.0f) / (d2 > 1e-4f ? d2 : 1e-4f) : 0.0f) * (w * w);
             ar[p] += cr * f;
             ag[p] += cg * f;
             ab[p] += cb * f;

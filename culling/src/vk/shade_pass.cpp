@@ -132,7 +132,7 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     std::memcpy(listBuf.mapped, in.list.data(), pixels * 4);
     GpuShadeLight* L = lightBuf.as<GpuShadeLight>();
     for (std::size_t i = 0; i < lightCount; ++i) {
-        L[i].position = glm::vec4(glm::vec3(lights.centers[i]), 0.0f);
+        L[i].position = glm::vec4(glm::vec3(lights.centers[i]), shadingInvRange2(lights.shadingRange(i)));
         L[i].power = glm::vec4(glm::vec3(lights.power[i]), 0.0f);
         L[i].spot = lights.isSpot(i) ? glm::vec4(glm::vec3(lights.spotAxes[i]), float(std::cos(lights.spotAngles[i])))
                                      : glm::vec4(0.0f, 0.0f, 0.0f, -2.0f);

@@ -26,8 +26,15 @@ struct ViewLights {
     // spotAngles[i] == 0 marks light i as a point light.
     std::vector<glm::dvec3> spotAxes; // view space, unit length
     std::vector<double> spotAngles;   // outer half-angle in radians, (0, pi/2]
+    // Lights with an explicit range (a glTF `range`, a scene JSON `radius`):
+    // one entry per light, the range (> 0) where the light's shading falls to
+    // zero, 0 for a light whose radius is its inverse-square cut-off; empty
+    // when no light has a range. Shading only: culling uses `radii`.
+    std::vector<double> shadingRanges;
     std::size_t size() const { return radii.size(); }
     bool isSpot(std::size_t i) const { return i < spotAngles.size() && spotAngles[i] > 0.0; }
+    // Light i's shading range, 0 when its light has none (shadingRanges).
+    double shadingRange(std::size_t i) const { return i < shadingRanges.size() ? shadingRanges[i] : 0.0; }
     // Light i's cone. Precondition: isSpot(i).
     SpotCone spotCone(std::size_t i) const {
         return makeSpotCone(centers[i], spotAxes[i], radii[i], spotAngles[i]);

@@ -7,6 +7,11 @@
 // Per pixel p with view position P and shading normal n (both view space):
 //   rgb(p) = sum_i power_i * max(0, n . l_i) / max(|c_i - P|^2, 1e-4),
 //   l_i = (c_i - P) / |c_i - P|,
+// times, for a light with a shading range r (ViewLights::shadingRanges: a glTF
+// `range`, a scene JSON `radius`), KHR_lights_punctual's window
+//   max(0, 1 - (|c_i - P|^2 / r^2)^2)^2,
+// so that such a light adds nothing beyond its range; a spot light adds only
+// inside its cone (a hard cone);
 // accumulated in list order (ascending light index) in float. The normal comes
 // from the depth buffer: per axis the shorter of the forward and backward
 // differences of the neighbours' view positions, facing the camera; without a
@@ -14,6 +19,7 @@
 
 #include "culling/core/backend.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -25,6 +31,12 @@ namespace lc {
 // Vulkan pass so both shade bitwise the same inputs: per pixel (row-major) the
 // view position, the shading normal and the list the pixel loops over
 // (kNoList for background pixels). Positions and normals are float.
+// 1 / range^2 as the shading passes take it (float); 0 for no range. Held
+// below float's largest value so that a pixel at the light gets 0 * it = 0.
+inline float shadingInvRange2(double range) {
+    return range > 0.0 ? float(std::min(1.0 / (range * range), 3.0e38)) : 0.0f;
+}
+
 struct ShadeInputs {
     static constexpr std::uint32_t kNoList = 0xffffffffu;
     std::uint32_t width = 0, height = 0;

@@ -24,7 +24,7 @@ struct GpuShadeParams {
 
 // One light (binding 3): view-space centre, colour * intensity and cone.
 struct GpuShadeLight {
-    vec4 position; // xyz view space, w unused
+    vec4 position; // xyz view space, w: 1 / range^2 (shadingInvRange2), 0 without a range
     vec4 power;    // rgb linear, w unused
     vec4 spot;     // xyz: a spot light's unit axis (view space), w: cos(outer angle);
                    // a point light: (0, 0, 0, -2), which every pixel passes
