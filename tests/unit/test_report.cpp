@@ -268,3 +268,70 @@ TEST(Report, EveryAlgorithmHasItsOwnColour) {
             EXPECT_GT(glm::length(a - b), 0.15) << names[i] << " and " << names[j];
         }
 }
+
+// A configuration that misses lights is never "the fastest" or "the most
+// efficient": the reading ranks only rows without false negatives and lists
+// the others apart (a flawed shader was named the fastest on Sponza).
+TEST(Report, ReadingRanksOnlyConfigurationsWithoutFalseNegatives) {
+    Report rep;
+    rep.sceneName = "hand";
+    rep.backendDevices = {{"cpu", "reference"}};
+    rep.backendTiming = {{"cpu", "wall clock"}};
+    auto row = [](const char* custom, double ms, double eff, std::uint64_t fn) {
+        ReportRow r;
+        r.config.backend = "cpu";
+        r.config.customLabel = custom;
+        r.cullMs = ms / 2, r.shadeMs = ms / 2, r.totalMs = ms, r.efficiency = eff, r.falseNegatives = fn;
+        return r;
+    };
+    rep.rows = {row("custom:flawed.comp", 0.5, 1.2, 7), row("custom:good.comp", 2.0, 0.8, 0),
+                row("custom:slow.comp", 3.0, 0.6, 0)};
+    markPareto(rep.rows);
+    const std::string md = reportMarkdown(rep);
+    const std::size_t fastest = md.find("the fastest configuration without false negatives is `custom:good.comp`");
+    EXPECT_NE(fastest, std::string::npos) << md;
+    EXPECT_NE(md.find("The most efficient is `custom:good.comp`"), std::string::npos) << md;
+    EXPECT_NE(md.find("`custom:flawed.comp` (cpu, 7); they are left off the Pareto fronts and are not ranked below"),
+              std::string::npos)
+        << md;
+    // The flawed row appears in the reading only in that list (and in the table).
+    const std::string reading = md.substr(0, md.find("## Table"));
+    EXPECT_EQ(reading.find("custom:flawed.comp"), reading.rfind("custom:flawed.comp")) << reading;
+
+    for (ReportRow& r : rep.rows) r.falseNegatives = 3;
+    const std::string none = reportMarkdown(rep);
+    EXPECT_NE(none.find("no configuration is free of false negatives: none is ranked"), std::string::npos) << none;
+    EXPECT_EQ(none.find("the fastest configuration"), std::string::npos) << none;
+}
+
+// pareto.png's axes: ticks at round values whose labels say exactly where they
+// sit (ticks read 0, 441, 881, "1E+03", "2E+03", with "1E+03" at 1,322).
+TEST(Report, AxisTicksAreRoundAndLabelledWithTheirValue) {
+    const AxisTicks a = axisTicks(0, 1762, false);
+    EXPECT_LE(a.lo, 0.0);
+    EXPECT_GE(a.hi, 1762.0);
+    ASSERT_GE(a.ticks.size(), 3u);
+    EXPECT_EQ(a.ticks.front(), a.lo);
+    EXPECT_EQ(a.ticks.back(), a.hi);
+    const double step = a.ticks[1] - a.ticks[0];
+    EXPECT_EQ(step, 500.0);
+    for (std::size_t i = 0; i < a.ticks.size(); ++i) {
+        EXPECT_DOUBLE_EQ(a.ticks[i], a.lo + step * double(i));
+        // The label is the value: parsing it back gives the tick.
+        EXPECT_DOUBLE_EQ(std::stod(tickText(a.ticks[i])), a.ticks[i]) << tickText(a.ticks[i]);
+    }
+    EXPECT_EQ(tickText(1500), "1500");
+    EXPECT_EQ(tickText(0.25), "0.25");
+
+    const AxisTicks f = axisTicks(0.13, 0.97, false);
+    for (double v : f.ticks) EXPECT_EQ(tickText(v).size() <= 3u, true) << tickText(v); // 0, 0.2, ..., 1
+    EXPECT_NE(std::find(f.ticks.begin(), f.ticks.end(), 0.6), f.ticks.end());
+
+    // Log axis: 1, 2, 5 per decade over the decades that hold the data.
+    const AxisTicks l = axisTicks(0.37, 42, true);
+    EXPECT_EQ(l.lo, 0.1);
+    EXPECT_EQ(l.hi, 100.0);
+    const std::vector<double> want{0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100};
+    ASSERT_EQ(l.ticks.size(), want.size());
+    for (std::size_t i = 0; i < want.size(); ++i) EXPECT_DOUBLE_EQ(l.ticks[i], want[i]);
+}

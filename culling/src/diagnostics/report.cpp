@@ -391,12 +391,17 @@ std::string reportMarkdown(const Report& rep) {
                           : "- **" + std::to_string(fnRows) +
                                 " configurations have false negatives** (lights missing where they matter): " +
                                 fnNames + (fnRows > 5 ? " and " + std::to_string(fnRows - 5) + " more" : "") +
-                                "; they are left off the Pareto fronts.\n";
+                                "; they are left off the Pareto fronts and are not ranked below.\n";
         for (const auto& [backend, device] : rep.backendDevices) {
+            // Only configurations without false negatives are ranked: one that
+            // misses lights is wrong, however fast or tight it looks.
             std::vector<const ReportRow*> rows;
             for (const ReportRow& r : rep.rows)
-                if (r.config.backend == backend) rows.push_back(&r);
-            if (rows.empty()) continue;
+                if (r.config.backend == backend && r.falseNegatives == 0) rows.push_back(&r);
+            if (rows.empty()) {
+                md += "- On " + backend + ", no configuration is free of false negatives: none is ranked.\n";
+                continue;
+            }
             const ReportRow* fastest = *std::min_element(rows.begin(), rows.end(), [](auto* a, auto* b) {
                 return a->totalMs < b->totalMs;
             });
@@ -406,7 +411,7 @@ std::string reportMarkdown(const Report& rep) {
             const ReportRow* slowest = *std::max_element(rows.begin(), rows.end(), [](auto* a, auto* b) {
                 return a->totalMs < b->totalMs;
             });
-            md += "- On " + backend + ", the fastest configuration is " + describe(*fastest) + "; the slowest takes " +
+            md += "- On " + backend + ", the fastest configuration without false negatives is " + describe(*fastest) + "; the slowest takes " +
                   fmt("%.1f", fastest->totalMs > 0 ? slowest->totalMs / fastest->totalMs : 0.0) +
                   "x as long. The most efficient is " + describe(*tightest) + ", at " +
                   fmt("%.1f", 100.0 * tightest->efficiencyVsOptimal) +
@@ -452,9 +457,7 @@ std::string reportMarkdown(const Report& rep) {
             for (const ReportRow* r : rows)
                 if (!r->config.customLabel.empty()) {
                     md += (first ? " " : "; ") + std::string("`") + r->config.customLabel + "` " +
-                          fmt("%.3f", r->totalMs) + " ms (efficiency " + fmt("%.3f", r->efficiency) +
-                          (r->falseNegatives ? ", false negatives " + std::to_string(r->falseNegatives) : std::string()) +
-                          ")";
+                          fmt("%.3f", r->totalMs) + " ms (efficiency " + fmt("%.3f", r->efficiency) + ")";
                     first = false;
                 }
             md += ".\n";
@@ -514,15 +517,6 @@ struct Plot {
     }
 };
 
-std::string tickText(double v) {
-    if (v == 0) return "0";
-    const double a = std::abs(v);
-    if (a >= 1000 || a < 0.001) return fmt("%.0e", v);
-    if (a >= 10) return fmt("%.0f", v);
-    if (a >= 1) return fmt("%.1f", v);
-    return fmt("%.3g", v);
-}
-
 // One scatter panel: x = total ms (log scale when it spans more than 10x),
 // y = `yOf`; the Pareto front of each backend joined by a line.
 void drawPanel(Plot& p, int x0, int y0, int w, int h, const Report& rep, const std::string& title,
@@ -539,41 +533,25 @@ void drawPanel(Plot& p, int x0, int y0, int w, int h, const Report& rep, const s
     if (!(xmin <= xmax)) xmin = 0.1, xmax = 1;
     if (!(ymax > ymin)) ymax = ymin + 1;
     const bool logX = xmax > 10 * xmin;
-    double lx0 = logX ? std::log10(xmin) : 0.0, lx1 = logX ? std::log10(xmax) : xmax * 1.05;
-    if (logX) {
-        lx0 = std::floor(lx0 * 2) / 2, lx1 = std::ceil(lx1 * 2) / 2;
-    } else if (lx1 <= lx0) {
-        lx1 = lx0 + 1;
-    }
-    ymax *= 1.05;
+    const AxisTicks xa = axisTicks(logX ? xmin : 0.0, xmax, logX), ya = axisTicks(ymin, ymax, false);
+    const double lx0 = logX ? std::log10(xa.lo) : xa.lo, lx1 = logX ? std::log10(xa.hi) : xa.hi;
     auto px = [&](double ms) {
         const double t = logX ? (std::log10(ms) - lx0) / (lx1 - lx0) : (ms - lx0) / (lx1 - lx0);
         return left + int(std::lround(t * (right - left)));
     };
-    auto py = [&](double v) { return bottom - int(std::lround((v - ymin) / (ymax - ymin) * (bottom - top))); };
-    // Grid and ticks.
-    for (int i = 0; i <= 4; ++i) {
-        const double v = ymin + (ymax - ymin) * i / 4.0;
+    auto py = [&](double v) { return bottom - int(std::lround((v - ya.lo) / (ya.hi - ya.lo) * (bottom - top))); };
+    // Grid and ticks, each at its own value.
+    for (double v : ya.ticks) {
         const int y = py(v);
         p.line(left, y, right, y, grid);
         const std::string t = tickText(v);
         p.text(left - 6 - Plot::textWidth(t, 1), y - 3, t, 1, ink);
     }
-    if (logX) {
-        for (double e = lx0; e <= lx1 + 1e-9; e += 0.5) {
-            const int x = px(std::pow(10.0, e));
-            p.line(x, top, x, bottom, grid);
-            const std::string t = tickText(std::pow(10.0, e));
-            p.text(x - Plot::textWidth(t, 1) / 2, bottom + 6, t, 1, ink);
-        }
-    } else {
-        for (int i = 0; i <= 4; ++i) {
-            const double v = lx0 + (lx1 - lx0) * i / 4.0;
-            const int x = px(v);
-            p.line(x, top, x, bottom, grid);
-            const std::string t = tickText(v);
-            p.text(x - Plot::textWidth(t, 1) / 2, bottom + 6, t, 1, ink);
-        }
+    for (double v : xa.ticks) {
+        const int x = px(v);
+        p.line(x, top, x, bottom, grid);
+        const std::string t = tickText(v);
+        p.text(x - Plot::textWidth(t, 1) / 2, bottom + 6, t, 1, ink);
     }
     p.line(left, top, left, bottom, ink);
     p.line(left, bottom, right, bottom, ink);
@@ -622,6 +600,44 @@ void drawPanel(Plot& p, int x0, int y0, int w, int h, const Report& rep, const s
 }
 
 } // namespace
+
+std::string tickText(double v) {
+    if (v == 0) return "0";
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
+AxisTicks axisTicks(double lo, double hi, bool log, int target) {
+    AxisTicks a;
+    if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi)) hi = lo + 1;
+    if (log && lo > 0) {
+        const int d0 = int(std::floor(std::log10(lo) + 1e-9)), d1 = int(std::ceil(std::log10(hi) - 1e-9));
+        a.lo = std::pow(10.0, d0), a.hi = std::pow(10.0, std::max(d1, d0 + 1));
+        const bool onlyDecades = d1 - d0 > 3;
+        for (int d = d0; d <= std::max(d1, d0 + 1); ++d)
+            for (double m : {1.0, 2.0, 5.0}) {
+                if (onlyDecades && m != 1.0) continue;
+                const double v = m * std::pow(10.0, d);
+                if (v <= a.hi * (1 + 1e-9)) a.ticks.push_back(v);
+            }
+        return a;
+    }
+    const double raw = (hi - lo) / std::max(target, 1);
+    const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+    // The round step nearest the raw one (in ratio).
+    double step = mag;
+    for (double m : {2.0, 5.0, 10.0})
+        if (std::abs(std::log(m * mag / raw)) < std::abs(std::log(step / raw))) step = m * mag;
+    const long k0 = long(std::floor(lo / step + 1e-9)), k1 = long(std::ceil(hi / step - 1e-9));
+    a.lo = double(k0) * step, a.hi = double(std::max(k1, k0 + 1)) * step;
+    for (long k = k0; k <= std::max(k1, k0 + 1); ++k) {
+        // Rounded to the step's decimals, so that 3 * 0.1 is 0.3.
+        const double scale = std::pow(10.0, std::max(0.0, -std::floor(std::log10(step))));
+        a.ticks.push_back(std::round(double(k) * step * scale) / scale);
+    }
+    return a;
+}
 
 RgbImage paretoImage(const Report& rep) {
     const int panelW = 560, panelH = 420, legendH = 60;

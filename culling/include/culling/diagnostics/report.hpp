@@ -114,6 +114,18 @@ void markPareto(std::vector<ReportRow>& rows);
 std::string reportCsv(const Report& report);      // docs/FORMATS.md, "report.csv"
 std::string reportMarkdown(const Report& report); // table and a reading of it
 RgbImage paretoImage(const Report& report);       // time vs efficiency | time vs image error
+
+// An axis of pareto.png: ticks at round values (1, 2 or 5 times a power of
+// ten, about `target` of them) and the range they span, which holds [lo, hi].
+// On a log axis (lo > 0) the ticks are 1, 2 and 5 per decade, or 1 alone
+// when the axis spans more than three decades.
+struct AxisTicks {
+    double lo = 0, hi = 1;
+    std::vector<double> ticks;
+};
+AxisTicks axisTicks(double lo, double hi, bool log, int target = 4);
+// A tick's label: the value itself, as few digits as it needs ("1500", "0.25", "2e+06").
+std::string tickText(double v);
 // The colour of an algorithm's points (RGB in [0, 1]), one per algorithm, in
 // pareto.png and the studio's Report chart alike.
 glm::dvec3 algorithmColour(Algorithm a);
