@@ -467,7 +467,9 @@ void CameraView::updateOverlay() {
         lut_->SetHueRange(0.667, 0.0);
         const double top = std::max(1.0, maxHeat);
         lut_->SetTableRange(0, top);
-        legend_->SetTitle(mode == lc::HeatMode::ListLength ? "lights\nper tile" : "false\npositives");
+        legend_->SetTitle(mode == lc::HeatMode::ListLength       ? "lights\nper tile"
+                          : mode == lc::HeatMode::FalsePositives ? "false\npositives"
+                                                                 : "false\nnegatives");
         legend_->SetLabelFormat("%.0f");
         // Counts: below 5 a label per whole number (five evenly spaced labels
         // over 0..2 would read 0, 0, 1, 2, 2).

@@ -2,8 +2,11 @@
 
 #include "commands.hpp"
 
+#include "culling/core/file_io.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 namespace lcui {
 
@@ -34,6 +37,14 @@ void Document::resetScene(lc::Scene scene, const QString& path) {
 
 void Document::markSaved(const QString& path) {
     filePath_ = path;
+    // The scene now is that file: an export records it, unedited.
+    scene_.origin = {};
+    scene_.origin.file = std::filesystem::absolute(path.toStdString()).lexically_normal().string();
+    try {
+        scene_.origin.contentHash = lc::fileHashFnv1a64(path.toStdString());
+    } catch (const std::exception&) {
+        // Saved but unreadable now: the record keeps the path alone.
+    }
     undo_.setClean();
     emit filePathChanged(path);
     emit dirtyChanged(false);

@@ -731,12 +731,18 @@ void MainWindow::updateStatus() {
                                   .arg(mx));
         return;
     }
-    statusFn_->setText(tr("FN %1").arg(m.falseNegatives));
+    statusFn_->setText(m.falseNegatives > 0 ? tr("MISSES LIGHTS: FN %1").arg(m.falseNegatives)
+                                            : tr("FN %1").arg(m.falseNegatives));
     statusFn_->setStyleSheet(m.falseNegatives > 0 ? "color: white; background: #c0392b; padding: 0 4px"
                                                   : "color: #2e7d32");
-    statusEfficiency_->setText(tr("efficiency %1 (%2% of this grid's optimum)")
-                                   .arg(m.efficiency, 0, 'f', 4)
-                                   .arg(100.0 * m.efficiencyVsOptimal, 0, 'f', 1));
+    // With misses efficiency is no score: lists that drop needed lights look
+    // tighter than any correct list can be.
+    if (m.falseNegatives > 0)
+        statusEfficiency_->setText(tr("efficiency %1: not a score with false negatives").arg(m.efficiency, 0, 'f', 4));
+    else
+        statusEfficiency_->setText(tr("efficiency %1 (%2% of this grid's optimum)")
+                                       .arg(m.efficiency, 0, 'f', 4)
+                                       .arg(100.0 * m.efficiencyVsOptimal, 0, 'f', 1));
     statusEfficiency_->setToolTip(tr("Exact work / shading work. The optimum is the shading work of lists holding "
                                      "exactly the lights their pixels need together (optimal work %1): no culling "
                                      "with these tiles, cells or froxels can do better.")
@@ -849,10 +855,30 @@ bool MainWindow::importMeshFile(const QString& path) {
     return true;
 }
 
+namespace {
+// Whether `path` is the glTF file another tool wrote that the scene came from
+// (SceneOrigin::foreignGltf): never overwritten.
+bool isForeignSource(const lc::Scene& scene, const QString& path) {
+    const lc::SceneOrigin& o = scene.origin;
+    if (!o.foreignGltf || o.file.empty()) return false;
+    const QFileInfo a(path), b(QString::fromStdString(o.file));
+    return a.exists() && b.exists() && a.canonicalFilePath() == b.canonicalFilePath();
+}
+
+const char* kForeignGltfLoss =
+    QT_TRANSLATE_NOOP("lcui::MainWindow", "%1 was written by another tool. LightCull writes glTF with geometry, lights "
+                                          "and cameras only, so saving over it would lose its materials, textures, "
+                                          "animations and anything else it holds: save the scene under a new name.");
+} // namespace
+
 bool MainWindow::save() {
-    if (doc_->filePath().isEmpty()) {
-        const QString p = prompts.savePath(this, tr("Save scene"),
-                                           tr("Scene JSON (*.json);;Binary glTF (*.glb);;glTF 2.0 (*.gltf)"));
+    const bool foreign = isForeignSource(doc_->scene(), doc_->filePath());
+    if (doc_->filePath().isEmpty() || foreign) {
+        if (foreign) log(tr(kForeignGltfLoss).arg(QFileInfo(doc_->filePath()).fileName()));
+        const QString p = prompts.savePath(
+            this, foreign ? tr("Save scene as a new file (%1 stays as it is)").arg(QFileInfo(doc_->filePath()).fileName())
+                          : tr("Save scene"),
+            tr("Scene JSON (*.json);;Binary glTF (*.glb);;glTF 2.0 (*.gltf)"));
         return !p.isEmpty() && saveAs(p);
     }
     return saveAs(doc_->filePath());
@@ -862,6 +888,12 @@ bool MainWindow::saveAs(const QString& given) {
     // Scene files are told apart by extension (the CLI refuses others): a
     // name typed without one is scene JSON, and gets .json.
     const QString path = QFileInfo(given).suffix().isEmpty() ? given + ".json" : given;
+    if (isForeignSource(doc_->scene(), path)) {
+        const QString why = tr(kForeignGltfLoss).arg(QFileInfo(path).fileName());
+        log(tr("not saved: %1").arg(why), true);
+        prompts.showError(this, tr("Save scene"), why);
+        return false;
+    }
     try {
         lc::saveSceneAny(doc_->scene(), path.toStdString()); // .gltf/.glb as glTF, else scene JSON
     } catch (const std::exception& e) {

@@ -82,7 +82,8 @@ void MainWindow::buildOverlayMenus(QMenu* file, QMenu* view) {
     auto* group = new QActionGroup(this);
     const std::pair<QString, lc::HeatMode> modes[] = {{tr("List length"), lc::HeatMode::ListLength},
                                                       {tr("False positives"), lc::HeatMode::FalsePositives},
-                                                      {tr("Efficiency"), lc::HeatMode::Efficiency}};
+                                                      {tr("Efficiency"), lc::HeatMode::Efficiency},
+                                                      {tr("False negatives (misses)"), lc::HeatMode::FalseNegatives}};
     for (const auto& [text, mode] : modes) {
         QAction* a = heat->addAction(text);
         a->setObjectName(QString("actionHeat_%1").arg(lc::toString(mode)));
@@ -126,7 +127,11 @@ bool MainWindow::exportDiagnostics(const QString& dir) {
         views.push_back({"camera_view.png", toRgb(cameraView_->grabFramebuffer())});
         views.push_back({"inspector_view.png", toRgb(inspectorView_->grabFramebuffer())});
         // The settings the run used (the toolbar may have changed since).
-        lc::exportDiagnostics(doc_->scene(), run->result.settings, *run, dir.toStdString(), views);
+        // Unsaved edits: the export records them and writes the edited scene
+        // beside summary.json, so that the figures can be reproduced.
+        lc::Scene scene = doc_->scene();
+        scene.origin.edited = doc_->isDirty();
+        lc::exportDiagnostics(scene, run->result.settings, *run, dir.toStdString(), views);
     } catch (const std::exception& e) {
         const QString msg = QString::fromStdString(e.what());
         log(tr("export diagnostics: %1").arg(msg), true);

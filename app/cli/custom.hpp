@@ -81,15 +81,25 @@ inline void printCustomReport(const lc::RunOutput& run, const lc::Scene& scene, 
     for (const std::string& w : c.warnings) std::cout << "  warning: " << w << "\n";
     for (std::size_t i = 0; i < c.validationMessages.size() && i < 5; ++i)
         std::cout << "  validation: " << c.validationMessages[i].substr(0, 300) << "\n";
+    // The culling test's misses first: a full list is a limit, and its many
+    // misses must not hide the shader's real flaw.
     const auto missed = lc::locateFalseNegatives(run, proj);
-    for (std::size_t i = 0; i < missed.size() && i < 10; ++i) {
-        const auto& m = missed[i];
-        std::cout << "  MISSING light " << m.light
-                  << (m.light < scene.lights.size() ? " '" + scene.lights[m.light].name + "'" : std::string())
-                  << " in tile " << m.tile % run.result.grid.tilesX << "," << m.tile / run.result.grid.tilesX
-                  << " (list " << m.list << "): " << m.pixels << " pixels need it\n";
+    for (lc::MissCause cause : {lc::MissCause::CullingTest, lc::MissCause::ListFull, lc::MissCause::InvalidIndex}) {
+        std::size_t shown = 0, total = 0;
+        for (const auto& m : missed) {
+            if (m.cause != cause) continue;
+            if (total++ >= 10) continue;
+            ++shown;
+            std::cout << "  MISSING light " << m.light
+                      << (m.light < scene.lights.size() ? " '" + scene.lights[m.light].name + "'" : std::string())
+                      << " in tile " << m.tile % run.result.grid.tilesX << "," << m.tile / run.result.grid.tilesX
+                      << " (list " << m.list << "): " << m.pixels << " pixels need it; cause: " << lc::toString(cause)
+                      << "\n";
+        }
+        if (total > shown)
+            std::cout << "  ... " << total - shown << " more missed by " << lc::toString(cause)
+                      << " (summary.json custom.missed)\n";
     }
-    if (missed.size() > 10) std::cout << "  ... " << missed.size() - 10 << " more (summary.json custom.missed)\n";
 }
 
 } // namespace lcli

@@ -89,6 +89,38 @@ std::string fmt(const char* f, double v) {
 
 std::string ms(double v) { return v < 0 ? std::string("n/a") : fmt("%.2f ms", v); }
 
+// The command line as a shell would take it back (summary.json records it).
+std::string commandLine(int argc, char** argv) {
+    std::string out;
+    for (int i = 0; i < argc; ++i) {
+        const std::string a = i == 0 ? std::string("lightcull") : std::string(argv[i]);
+        const bool plain = !a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                                             "0123456789-_./:=,+@%") == std::string::npos;
+        std::string q = a;
+        if (!plain) {
+            q = "'";
+            for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+            q += "'";
+        }
+        out += (i ? " " : "") + q;
+    }
+    return out;
+}
+
+// docs/CLI.md, "Errors and exit codes": exit 3 when the judged culling misses
+// lights, overflows a list or writes an index past the light count, so that a
+// CI job fails on a miss without reading summary.json.
+constexpr int kExitMisses = 3;
+int verdictExit(const lc::RunOutput& run) {
+    const std::uint64_t fn = run.truthComputed ? run.truth.metrics.falseNegatives : 0;
+    const std::uint64_t overflow = run.custom ? run.custom->overflowLists : 0;
+    const std::uint64_t invalid = run.custom ? run.custom->invalidIndices : 0;
+    if (fn == 0 && overflow == 0 && invalid == 0) return 0;
+    std::cerr << "lightcull: the culling fails: " << fn << " false negatives, " << overflow << " overflowed lists, "
+              << invalid << " invalid indices (exit " << kExitMisses << ")\n";
+    return kExitMisses;
+}
+
 void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, const lc::RunOutput& run,
                   const std::string& out, const std::string& noImageErrorWhy = "--no-image-error") {
     const lc::CullResult& r = run.result;
@@ -108,11 +140,21 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
                                         : ", cells " + std::to_string(settings.cells) + ", slicing " +
                                               lc::toString(settings.slicing)))
               << ", backend " << r.backend << " (" << r.device << ")\n"
-              << "false negatives " << m.falseNegatives << ", efficiency " << fmt("%.4f", m.efficiency)
-              << " (exact work " << m.exactWork << " / shading work " << m.shadingWork << ")\n"
-              << "optimum of this grid: " << fmt("%.1f", 100.0 * m.efficiencyVsOptimal)
-              << "% (optimal work " << m.optimalWork << " / shading work " << m.shadingWork << ")\n"
-              << "lists " << r.listCountTotal() << ", entries " << r.entries() << ", mean list "
+;
+    // With misses, efficiency is no score: it counts only what the lists hold,
+    // and lists that drop needed lights can look tighter than the optimum.
+    if (m.falseNegatives > 0)
+        std::cout << "FALSE NEGATIVES " << m.falseNegatives
+                  << ": the culling misses lights that pixels need (efficiency below is not a score)\n"
+                  << "efficiency " << fmt("%.4f", m.efficiency) << ", " << fmt("%.1f", 100.0 * m.efficiencyVsOptimal)
+                  << "% of this grid's optimum: meaningless with false negatives (exact work " << m.exactWork
+                  << " / shading work " << m.shadingWork << ")\n";
+    else
+        std::cout << "false negatives 0, efficiency " << fmt("%.4f", m.efficiency) << " (exact work " << m.exactWork
+                  << " / shading work " << m.shadingWork << ")\n"
+                  << "optimum of this grid: " << fmt("%.1f", 100.0 * m.efficiencyVsOptimal) << "% (optimal work "
+                  << m.optimalWork << " / shading work " << m.shadingWork << ")\n";
+    std::cout << "lists " << r.listCountTotal() << ", entries " << r.entries() << ", mean list "
               << fmt("%.2f", m.meanList) << ", max list " << m.maxList << ", " << m.resultBytes
               << " bytes\n";
     if (m.imageErrorComputed)
@@ -128,7 +170,7 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
     }
     std::cout << ", cull " << ms(r.timings.cullMs)
               << ", shade " << ms(r.timings.shadeMs) << ", ground truth " << ms(r.timings.groundTruthMs) << " (" << r.timingMethod << ")\n"
-              << "wrote " << out << "/summary.json, tiles.csv, heatmap.png"
+              << "wrote " << out << "/summary.json, tiles.csv, heatmap.png, heatmap_misses.png"
               << (run.shadedAll.empty() ? "" : ", shaded_culled.png, shaded_all.png, shaded_diff.png") << "\n";
 }
 
@@ -632,6 +674,7 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("check")) {
             if (!checkFlags.hasScene()) return fail(2, "check: give --scene FILE or --builtin NAME (the scene the lists were culled for)");
             lc::Scene scene = checkFlags.loadScene();
+            scene.origin.command = commandLine(argc, argv);
             lc::CullSettings settings;
             if (const std::string why = outputProblem([&] { lc::checkDiagnosticsFolder(checkOut); }); !why.empty())
                 return fail(2, "--out: " + why);
@@ -668,7 +711,7 @@ int main(int argc, char** argv) {
             lc::exportDiagnostics(scene, settings, result, checkOut);
             printSummary(scene, settings, result, checkOut, "lists from a dump are not shaded");
             lcli::printCustomReport(result, scene, proj);
-            return 0;
+            return verdictExit(result);
         }
 
         if (!runFlags.hasScene()) return fail(2, "run: give --scene FILE or --builtin NAME");
@@ -681,6 +724,7 @@ int main(int argc, char** argv) {
             return fail(2, "--out: " + why);
 
         lc::Scene scene = runFlags.loadScene();
+        scene.origin.command = commandLine(argc, argv);
         lc::CullSettings settings;
         runFlags.applyParams(settings, scene.camera);
         std::unique_ptr<lc::CullBackend> backend = runFlags.openBackend();
@@ -704,7 +748,7 @@ int main(int argc, char** argv) {
         lc::exportDiagnostics(scene, settings, result, outDir);
         printSummary(scene, settings, result, outDir);
         if (custom) lcli::printCustomReport(result, scene, lc::Projection(scene.camera));
-        return 0;
+        return verdictExit(result);
     } catch (const lc::SettingsError& e) {
         // A bad value on the command line (docs/CLI.md: exit 2), named by the
         // flag that gave it where the parameter is one.

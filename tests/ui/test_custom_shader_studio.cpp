@@ -114,6 +114,13 @@ private slots:
         QCOMPARE(QString::fromStdString(run->custom->layout), QString("bitmask"));
         QVERIFY(run->truth.metrics.falseNegatives > 0);
         QVERIFY(w_->messageLog()->toPlainText().contains("mine.comp changed: culling again"));
+        // The status bar leads with the misses and does not present the
+        // efficiency of lists that drop lights as a score.
+        const QString fnText = w_->findChild<QLabel*>("statusFalseNegatives")->text();
+        QVERIFY2(fnText.startsWith("MISSES LIGHTS: FN "), qPrintable(fnText));
+        const QString effText = w_->findChild<QLabel*>("statusEfficiency")->text();
+        QVERIFY2(effText.contains("not a score with false negatives") && !effText.contains("optimum"),
+                 qPrintable(effText));
         // The tile of the first located miss shows it as MISSING, in red.
         const auto missed = lc::locateFalseNegatives(*run, lc::Projection(doc()->scene().camera));
         QVERIFY(!missed.empty());

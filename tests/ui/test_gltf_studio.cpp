@@ -9,6 +9,7 @@
 #include "document.hpp"
 #include "main_window.hpp"
 
+#include "culling/core/file_io.hpp"
 #include "culling/scene/gltf_io.hpp"
 #include "culling/core/pipeline.hpp"
 #include "culling/scene/scene_io.hpp"
@@ -154,6 +155,74 @@ private slots:
             QVERIFY(std::abs(back.lights[i].radius() - doc()->scene().lights[i].radius()) < 1e-9);
         QCOMPARE(doc()->filePath(), p);
         QVERIFY(doc()->undoStack()->isClean());
+    }
+
+    // A .glb another tool wrote holds what this tool's writer drops
+    // (materials, textures, animations): Save never overwrites it, it asks for
+    // a new file and says why; Save As onto it is refused. An export of the
+    // edited scene records the file and the edit, and writes the edited scene.
+    void saveNeverOverwritesAForeignGltfAndExportRecordsTheEdit() {
+        const QString src = tmp_.path() + "/sponza.gltf";
+        {
+            auto j = nlohmann::json::parse(lc::serializeGltf(smallAtrium(), false));
+            j["asset"]["generator"] = "Khronos glTF Blender I/O";
+            std::ofstream(src.toStdString()) << j.dump();
+        }
+        const auto bytes = [](const QString& path) {
+            std::ifstream in(path.toStdString(), std::ios::binary);
+            return std::string(std::istreambuf_iterator<char>(in), {});
+        };
+        const std::string original = bytes(src);
+        w_->runOnOpen = true;
+        QVERIFY(w_->openSceneFile(src));
+        QVERIFY(waitRun());
+        doc()->deleteLights({0}); // an unsaved edit
+        QVERIFY(doc()->isDirty());
+
+        // Export: the record says which file, which version, edited, and the
+        // edited scene is there to reproduce the figures.
+        QVERIFY(lctest::waitRun(*w_, w_->runCulling(), true));
+        const QString dir = tmp_.path() + "/export";
+        QVERIFY(w_->exportDiagnostics(dir));
+        const auto summary = nlohmann::json::parse(bytes(dir + "/summary.json"));
+        const auto& source = summary["scene_source"];
+        QCOMPARE(QString::fromStdString(source["file"].get<std::string>()), QFileInfo(src).absoluteFilePath());
+        QCOMPARE(source["content_hash_fnv1a64"].get<std::string>(), lc::fileHashFnv1a64(src.toStdString()));
+        QVERIFY(source["edited"].get<bool>());
+        QCOMPARE(source["gltf_min_intensity"].get<double>(), w_->gltfOptions.minIntensity);
+        QVERIFY(source["gltf_camera"].get<std::string>().find("culling camera") != std::string::npos);
+        const lc::Scene edited = lc::loadSceneFile((dir + "/scene.json").toStdString());
+        QCOMPARE(edited.lights.size(), std::size_t(47));
+        QCOMPARE(edited.triangleCount(), doc()->scene().triangleCount());
+
+        QString caption;
+        const QString fresh = tmp_.path() + "/sponza-lit.glb";
+        w_->prompts.savePath = [&](QWidget*, const QString& c, const QString&) {
+            caption = c;
+            return fresh;
+        };
+        w_->action("actionSave")->trigger();
+        QVERIFY2(caption.contains("sponza.gltf stays as it is"), qPrintable(caption));
+        QVERIFY(w_->messageLog()->toPlainText().contains("would lose its materials, textures, animations"));
+        QCOMPARE(bytes(src), original);
+        QCOMPARE(doc()->filePath(), fresh);
+        QCOMPARE(lc::loadGltfScene(fresh.toStdString()).lights.size(), std::size_t(47));
+        // Now the document is our own file: Save writes it without asking.
+        caption.clear();
+        doc()->deleteLights({0});
+        w_->action("actionSave")->trigger();
+        QVERIFY(caption.isEmpty());
+        QCOMPARE(lc::loadGltfScene(fresh.toStdString()).lights.size(), std::size_t(46));
+
+        // Save As onto the foreign file, from a scene opened from it: refused.
+        QVERIFY(w_->openSceneFile(src));
+        QString shown;
+        w_->prompts.showError = [&](QWidget*, const QString&, const QString& m) { shown = m; };
+        doc()->deleteLights({0});
+        QVERIFY(!w_->saveAs(src));
+        QVERIFY2(shown.contains("sponza.gltf was written by another tool"), qPrintable(shown));
+        QCOMPARE(bytes(src), original);
+        QVERIFY(doc()->isDirty());
     }
 
     void lightCutoffSettingSetsTheRadiusOfLightsWithoutRange() {

@@ -3,6 +3,8 @@
 // and on failure.
 #include "culling/core/errors.hpp"
 #include "culling/diagnostics/export.hpp"
+#include "culling/diagnostics/overlays.hpp"
+#include "culling/truth/ground_truth.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
@@ -156,8 +158,17 @@ TEST(Export, SummaryJsonHasEveryKeyConsistentWithTheRun) {
     EXPECT_EQ(m["max_list"], *std::max_element(res.listCount.begin(), res.listCount.end()));
     EXPECT_EQ(m["result_bytes"], res.bytes());
     EXPECT_EQ(m["geometry_pixels"], r.out.depth.geometryPixelCount());
-    EXPECT_TRUE(m["image_rmse"].is_number());
-    EXPECT_GE(m["image_max_error"].get<double>(), m["image_rmse"].get<double>());
+    // The run's own figures, not figures recomputed from the same JSON: an
+    // image error that ignored a light's range passed "is a number" checks.
+    const Metrics& run = r.out.truth.metrics;
+    ASSERT_TRUE(run.imageErrorComputed);
+    EXPECT_EQ(m["image_rmse"].get<double>(), run.imageRmse);
+    EXPECT_EQ(m["image_max_error"].get<double>(), run.imageMaxError);
+    EXPECT_EQ(W, run.shadingWork);
+    EXPECT_EQ(E, run.exactWork);
+    EXPECT_EQ(m["false_negatives"].get<std::uint64_t>(), run.falseNegatives);
+    EXPECT_EQ(m["optimal_work"].get<std::uint64_t>(), run.optimalWork);
+    EXPECT_GT(run.imageRmse, 0.0); // inverse-square lights: the cut-off's error
 
     const PipelineRun noImg = runBuiltin("wall", Algorithm::MinMax, 48, 32, false);
     const auto j2 = nlohmann::json::parse(summaryJson(noImg.scene, noImg.settings, noImg.out));
@@ -327,4 +338,64 @@ TEST(Export, FailureLeavesNothingBehind) {
     EXPECT_THROW(exportDiagnostics(r.scene, r.settings, broken, out.string()), Error);
     EXPECT_EQ(readText(out / "summary.json"), before);
     EXPECT_EQ(tmp.entries(), (std::vector<std::string>{"diag", "file", "mine"}));
+}
+
+// heatmap_misses.png and the FalseNegatives heat mode: a tile is red exactly
+// where its pixels miss lights, and the figure per tile is the ground truth's
+// own (sum of listFalseNegatives over the tile's lists).
+TEST(Export, MissHeatmapIsRedExactlyWhereTilesMissLights) {
+    PipelineRun r = runBuiltin("atrium", Algorithm::HalfZ, 96, 64, false);
+    const Projection proj(r.scene.camera);
+    // Drop every light from the lists of the left half of the tiles.
+    CullResult& res = r.out.result;
+    const TileGrid& g = res.grid;
+    CullResult cut = res;
+    cut.lightIndices.clear();
+    for (std::size_t l = 0; l < res.listCount.size(); ++l) {
+        const std::uint32_t tile = std::uint32_t(l / res.listsPerTile);
+        cut.listOffset[l] = std::uint32_t(cut.lightIndices.size());
+        const bool drop = tile % g.tilesX < g.tilesX / 2;
+        cut.listCount[l] = drop ? 0 : res.listCount[l];
+        if (!drop)
+            cut.lightIndices.insert(cut.lightIndices.end(), res.lightIndices.begin() + res.listOffset[l],
+                                    res.lightIndices.begin() + res.listOffset[l] + res.listCount[l]);
+    }
+    res = cut;
+    GroundTruthOptions to;
+    to.imageError = false;
+    r.out.truth = computeGroundTruth(r.out.depth, proj, r.out.lights, res, to);
+    ASSERT_GT(r.out.truth.metrics.falseNegatives, 0u);
+    const std::vector<double> fn = tileHeat(r.out, HeatMode::FalseNegatives);
+    std::uint64_t sum = 0;
+    std::size_t missing = 0;
+    for (std::uint32_t t = 0; t < g.tileCount(); ++t) {
+        std::uint64_t want = 0;
+        for (std::uint32_t k = 0; k < res.listsPerTile; ++k) want += r.out.truth.listFalseNegatives[t * res.listsPerTile + k];
+        if (std::isnan(fn[t])) {
+            EXPECT_EQ(want, 0u);
+            continue;
+        }
+        EXPECT_EQ(fn[t], double(want)) << "tile " << t;
+        if (t % g.tilesX >= g.tilesX / 2) EXPECT_EQ(fn[t], 0.0) << "tile " << t << " kept its lists";
+        sum += std::uint64_t(fn[t]);
+        missing += fn[t] > 0;
+    }
+    EXPECT_EQ(sum, r.out.truth.metrics.falseNegatives);
+    ASSERT_GT(missing, 0u);
+
+    TempDir tmp;
+    const fs::path out = tmp.path / "miss";
+    exportDiagnostics(r.scene, r.settings, r.out, out.string());
+    const Png png = readPng(out / "heatmap_misses.png");
+    ASSERT_EQ(png.width, 96u);
+    ASSERT_GT(png.height, 64u); // the legend band below
+    // The centre pixel of every tile: red (r well above g and b) iff it misses.
+    for (std::uint32_t t = 0; t < g.tileCount(); ++t) {
+        const auto rect = g.tileRect(t % g.tilesX, t / g.tilesX);
+        const std::uint32_t x = (rect.x0 + rect.x1) / 2, y = (rect.y0 + rect.y1) / 2;
+        const std::uint8_t* p = &png.rgb[(std::size_t(y) * png.width + x) * 3];
+        const bool red = p[0] > p[1] + 40 && p[0] > p[2] + 40;
+        EXPECT_EQ(red, !std::isnan(fn[t]) && fn[t] > 0) << "tile " << t << " rgb " << int(p[0]) << "," << int(p[1])
+                                                      << "," << int(p[2]);
+    }
 }

@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -204,6 +205,21 @@ void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outp
     }
     if (!aside.empty()) fs::remove_all(aside, ec);
     syncFolder(parent.string());
+}
+
+std::string fileHashFnv1a64(const std::string& path) {
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) throw Error("cannot read " + path + ": " + std::strerror(errno));
+    std::uint64_t h = 0xcbf29ce484222325ull;
+    unsigned char buf[1 << 16];
+    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;)
+        for (std::size_t i = 0; i < n; ++i) h = (h ^ buf[i]) * 0x100000001b3ull;
+    const bool bad = std::ferror(f);
+    std::fclose(f);
+    if (bad) throw Error("cannot read " + path);
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    return hex;
 }
 
 } // namespace lc

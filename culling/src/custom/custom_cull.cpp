@@ -68,6 +68,7 @@ void assignLists(std::vector<std::vector<std::uint32_t>>& lists, std::uint32_t l
         auto& v = lists[l];
         const auto bad = std::remove_if(v.begin(), v.end(), [&](std::uint32_t i) { return i >= lightCount; });
         report.invalidIndices += std::uint64_t(v.end() - bad);
+        if (bad != v.end()) report.invalidIndexListIds.push_back(std::uint32_t(l));
         v.erase(bad, v.end());
         std::sort(v.begin(), v.end());
         const auto dup = std::unique(v.begin(), v.end());
@@ -221,16 +222,68 @@ std::uint64_t layoutWords(const LayoutSpec& layout, std::uint64_t lists, std::ui
     return 0;
 }
 
+namespace {
+
+// Where a line holds the settings tag as a comment ("// lightcull: ...", or
+// " * lightcull: ..." inside a block comment): the text after the tag, else
+// npos.
+std::size_t settingsTagEnd(const std::string& line) {
+    const std::string tag = "lightcull:";
+    std::size_t i = line.find_first_not_of(" \t");
+    if (i == std::string::npos) return std::string::npos;
+    if (line.compare(i, 2, "//") == 0 || line.compare(i, 2, "/*") == 0) i += 2;
+    else if (line[i] == '*') i += 1;
+    else return std::string::npos;
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '*' || line[i] == '/')) ++i;
+    return line.compare(i, tag.size(), tag) == 0 ? i + tag.size() : std::string::npos;
+}
+
+} // namespace
+
 void applyShaderHeader(const std::string& text, const std::string& path, CustomShaderOptions& o, bool layoutGiven,
                        bool listsGiven, bool entryGiven) {
-    const std::string first = text.substr(0, text.find('\n'));
-    const std::string tag = "lightcull:";
-    const auto at = first.find(tag);
-    if (first.rfind("//", 0) != 0 || at == std::string::npos) return;
-    std::istringstream words(first.substr(at + tag.size()));
+    // The settings line sits in the file's leading block: comments (a
+    // licence header is normal in ported code), blank lines and preprocessor
+    // lines (#version, #extension) before the first line of code.
+    std::istringstream lines(text);
+    std::string line, settings;
+    int number = 0, settingsLine = 0, firstCode = 0;
+    bool inBlock = false;
+    while (std::getline(lines, line)) {
+        ++number;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        const std::size_t tagEnd = settingsTagEnd(line);
+        const std::size_t first = line.find_first_not_of(" \t");
+        const bool code = !inBlock && first != std::string::npos && line.compare(first, 2, "//") != 0 &&
+                          line.compare(first, 2, "/*") != 0 && line[first] != '#';
+        if (tagEnd != std::string::npos) {
+            if (firstCode)
+                throw InputError(path, "", number,
+                                 "lightcull settings: this line must be in the comment block at the top of the file, "
+                                 "before the first line of code (line " + std::to_string(firstCode) + ")");
+            if (settingsLine)
+                throw InputError(path, "", number,
+                                 "lightcull settings: a second settings line (the first is line " +
+                                     std::to_string(settingsLine) + "): keep one");
+            settings = line.substr(tagEnd);
+            if (const auto close = settings.find("*/"); close != std::string::npos) settings.resize(close);
+            settingsLine = number;
+        } else if (code && !firstCode) {
+            firstCode = number;
+        }
+        // Block comments: track whether the next line starts inside one.
+        for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+            if (!inBlock && line.compare(i, 2, "//") == 0) break;
+            if (!inBlock && line.compare(i, 2, "/*") == 0) inBlock = true, ++i;
+            else if (inBlock && line.compare(i, 2, "*/") == 0) inBlock = false, ++i;
+        }
+    }
+    if (!settingsLine) return;
+    std::istringstream words(settings);
     std::string flag, value;
     while (words >> flag) {
-        if (!(words >> value)) throw InputError(path, "", 1, "lightcull settings: " + flag + " needs a value");
+        if (!(words >> value))
+            throw InputError(path, "", settingsLine, "lightcull settings: " + flag + " needs a value");
         try {
             if (flag == "--layout") {
                 if (!layoutGiven) o.layout = parseLayout(value);
@@ -239,10 +292,11 @@ void applyShaderHeader(const std::string& text, const std::string& path, CustomS
             } else if (flag == "--entry") {
                 if (!entryGiven) o.entry = value;
             } else {
-                throw InputError(path, "", 1, "lightcull settings: unknown flag '" + flag + "' (--layout, --lists, --entry)");
+                throw InputError(path, "", settingsLine,
+                                 "lightcull settings: unknown flag '" + flag + "' (--layout, --lists, --entry)");
             }
         } catch (const SettingsError& e) {
-            throw InputError(path, "", 1, std::string("lightcull settings: ") + e.what());
+            throw InputError(path, "", settingsLine, std::string("lightcull settings: ") + e.what());
         }
     }
 }
@@ -257,9 +311,10 @@ CustomShaderOptions shaderOptionsFromFile(const std::string& path, const std::st
     if (fs::path(path).extension() != ".spv") {
         std::ifstream in(path, std::ios::binary);
         if (!in) throw InputError(path, "", 0, "cannot open shader for reading");
-        std::string first;
-        std::getline(in, first);
-        applyShaderHeader(detail::withoutByteOrderMark(first), path, o, !layout.empty(), !lists.empty(), !entry.empty());
+        std::ostringstream text;
+        text << in.rdbuf();
+        applyShaderHeader(detail::withoutByteOrderMark(text.str()), path, o, !layout.empty(), !lists.empty(),
+                          !entry.empty());
     }
     return o;
 }
@@ -279,6 +334,7 @@ void decodeLists(const std::vector<std::uint32_t>& words, const LayoutSpec& layo
             const std::uint64_t count = words[base];
             if (count > n) {
                 ++report.overflowLists;
+                report.overflowedListIds.push_back(std::uint32_t(l));
                 report.overflowEntries += count - n;
             }
             for (std::uint64_t i = 0; i < std::min(count, n); ++i) perList[l].push_back(words[base + 1 + i]);
@@ -297,6 +353,7 @@ void decodeLists(const std::vector<std::uint32_t>& words, const LayoutSpec& layo
             const std::uint64_t kept = offset >= cap ? 0 : std::min(count, cap - offset);
             if (kept < count) {
                 ++report.overflowLists;
+                report.overflowedListIds.push_back(std::uint32_t(l));
                 report.overflowEntries += count - kept;
             }
             for (std::uint64_t i = 0; i < kept; ++i) perList[l].push_back(words[start + offset + i]);
@@ -305,8 +362,34 @@ void decodeLists(const std::vector<std::uint32_t>& words, const LayoutSpec& layo
     assignLists(perList, lightCount, result, report);
 }
 
+const char* toString(MissCause c) {
+    switch (c) {
+    case MissCause::CullingTest: return "culling test";
+    case MissCause::ListFull: return "list full";
+    case MissCause::InvalidIndex: return "invalid index";
+    }
+    return "?";
+}
+
+const char* jsonName(MissCause c) {
+    switch (c) {
+    case MissCause::CullingTest: return "culling_test";
+    case MissCause::ListFull: return "list_full";
+    case MissCause::InvalidIndex: return "invalid_index";
+    }
+    return "?";
+}
+
 std::vector<MissedLight> locateFalseNegatives(const RunOutput& run, const Projection& proj) {
     std::vector<MissedLight> out;
+    auto causeOf = [&](std::uint32_t list) {
+        if (!run.custom) return MissCause::CullingTest;
+        const auto& full = run.custom->overflowedListIds;
+        const auto& bad = run.custom->invalidIndexListIds;
+        if (std::binary_search(full.begin(), full.end(), list)) return MissCause::ListFull;
+        if (std::binary_search(bad.begin(), bad.end(), list)) return MissCause::InvalidIndex;
+        return MissCause::CullingTest;
+    };
     const CullResult& r = run.result;
     if (!run.truthComputed || run.truth.metrics.falseNegatives == 0) return out;
     const std::uint32_t per = r.algorithm == Algorithm::All ? 0 : std::max(r.listsPerTile, 1u);
@@ -327,9 +410,11 @@ std::vector<MissedLight> locateFalseNegatives(const RunOutput& run, const Projec
                 for (std::uint32_t i = 0; i < run.lights.size(); ++i)
                     if (detail::lightNeeds(run.lights, i, p) && !std::binary_search(first, last, i)) ++missed[{list, i}];
             }
-        for (const auto& [key, pixels] : missed) out.push_back({t, key.first, key.second, pixels});
+        for (const auto& [key, pixels] : missed) out.push_back({t, key.first, key.second, pixels, causeOf(key.first)});
     }
-    std::stable_sort(out.begin(), out.end(), [](const MissedLight& a, const MissedLight& b) { return a.pixels > b.pixels; });
+    std::stable_sort(out.begin(), out.end(), [](const MissedLight& a, const MissedLight& b) {
+        return a.cause != b.cause ? a.cause < b.cause : a.pixels > b.pixels;
+    });
     return out;
 }
 
@@ -362,6 +447,8 @@ RunOutput runCustomPipeline(const Scene& scene, const CustomShaderOptions& optio
         out.depthReused = true;
     } else {
         out.depth = depthBackend.renderDepth(scene, proj);
+        // The rasteriser that drew the depth, not the lists' source ("custom").
+        out.depthFrom = "pre-pass on " + depthBackend.name() + " (" + depthBackend.deviceName() + ")";
     }
     out.result = runCustomShader(options, out.depth, proj, grid, out.lights, report);
     out.result.timings.depthMs = depthOverride ? 0.0 : depthBackend.lastDepthMs();

@@ -9,6 +9,7 @@
 #include "culling/diagnostics/overlays.hpp"
 
 #include "culling/core/errors.hpp"
+#include "culling/scene/scene_io.hpp"
 #include "culling/truth/shade.hpp"
 #include "diagnostics/font5x7.hpp"
 
@@ -138,6 +139,22 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     const Metrics& m = run.truth.metrics;
     nlohmann::ordered_json j;
     j["scene"] = scene.name;
+    // What reproduces this run: the file and its version, the glTF choices
+    // that shaped the scene, the command, and whether it was edited since
+    // (then the edited scene is beside this file as scene.json).
+    const SceneOrigin& o = scene.origin;
+    nlohmann::ordered_json src;
+    src["file"] = o.file.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(o.file);
+    src["content_hash_fnv1a64"] =
+        o.contentHash.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(o.contentHash);
+    src["builtin"] = o.builtin.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(o.builtin);
+    src["gltf_camera"] = o.gltfCamera.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(o.gltfCamera);
+    src["gltf_min_intensity"] =
+        o.gltfMinIntensity > 0 ? nlohmann::ordered_json(o.gltfMinIntensity) : nlohmann::ordered_json(nullptr);
+    src["command"] = o.command.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(o.command);
+    src["edited"] = o.edited;
+    src["edited_scene"] = o.edited ? nlohmann::ordered_json("scene.json") : nlohmann::ordered_json(nullptr);
+    j["scene_source"] = std::move(src);
     j["algorithm"] = run.custom ? std::string("custom") : std::string(toString(settings.algorithm));
     j["test"] = toString(settings.test);
     j["backend"] = r.backend;
@@ -214,6 +231,10 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
         const Projection proj(scene.camera);
         nlohmann::ordered_json missed = nlohmann::ordered_json::array();
         const std::vector<MissedLight> located = locateFalseNegatives(run, proj);
+        nlohmann::ordered_json byCause;
+        for (MissCause c : {MissCause::CullingTest, MissCause::ListFull, MissCause::InvalidIndex})
+            byCause[jsonName(c)] = std::count_if(located.begin(), located.end(),
+                                                 [&](const MissedLight& m) { return m.cause == c; });
         for (std::size_t i = 0; i < located.size() && i < 1000; ++i) {
             const MissedLight& ml = located[i];
             nlohmann::ordered_json e;
@@ -222,10 +243,12 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
             e["light"] = ml.light;
             e["light_name"] = ml.light < scene.lights.size() ? scene.lights[ml.light].name : std::string();
             e["pixels"] = ml.pixels;
+            e["cause"] = jsonName(ml.cause);
             missed.push_back(std::move(e));
         }
         cj["missed"] = std::move(missed);
         cj["missed_pairs"] = located.size();
+        cj["missed_pairs_by_cause"] = std::move(byCause);
         j["custom"] = std::move(cj);
     }
     return j.dump(2) + "\n";
@@ -274,6 +297,33 @@ std::string tilesCsv(const RunOutput& run) {
     }
     return out;
 }
+
+namespace {
+// Per pixel a grey from depth, near bright, histogram-equalised: 1 - (the
+// fraction of geometry pixels nearer than it), mapped to [0.3, 1]; background
+// 0.12. Window depth is monotonic in view depth for every projection kind, so
+// this needs no linearisation, and perspective depth (bunched near 1) still
+// shows detail.
+std::vector<double> depthGrey(const DepthImage& depth) {
+    const bool reversed = depth.clearDepth == 0.0f; // reversed-Z: larger is nearer
+    std::vector<float> sorted;
+    sorted.reserve(depth.depth.size());
+    for (float d : depth.depth)
+        if (d != depth.clearDepth) sorted.push_back(reversed ? -d : d);
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<double> grey(std::size_t(depth.width) * depth.height, 0.12);
+    for (std::uint32_t y = 0; y < depth.height; ++y)
+        for (std::uint32_t x = 0; x < depth.width; ++x) {
+            if (!depth.hasGeometry(x, y)) continue;
+            const float key = reversed ? -depth.at(x, y) : depth.at(x, y);
+            const double rank = double(std::lower_bound(sorted.begin(), sorted.end(), key) - sorted.begin());
+            const double farness = sorted.size() > 1 ? rank / double(sorted.size() - 1) : 0.0;
+            grey[std::size_t(y) * depth.width + x] = 0.3 + 0.7 * (1.0 - farness);
+        }
+    return grey;
+}
+
+} // namespace
 
 RgbImage heatmapImage(const RunOutput& run) {
     const DepthImage& depth = run.depth;
@@ -328,29 +378,12 @@ RgbImage heatmapImage(const RunOutput& run) {
         tileValue[t] = px ? double(work) / px : longest;
     }
 
-    // Grey from depth, near bright, histogram-equalised: a pixel's grey is
-    // 1 - (fraction of geometry pixels nearer than it). Window depth is
-    // monotonic in view depth for every projection kind, so this needs no
-    // linearisation, and perspective depth (bunched near 1) still shows detail.
-    const bool reversed = depth.clearDepth == 0.0f; // reversed-Z: larger is nearer
-    std::vector<float> sorted;
-    sorted.reserve(depth.depth.size());
-    for (float d : depth.depth)
-        if (d != depth.clearDepth) sorted.push_back(reversed ? -d : d);
-    std::sort(sorted.begin(), sorted.end());
+    const std::vector<double> grey = depthGrey(depth);
     const std::uint32_t ts = std::max(r.grid.tileSize, 1u);
     for (std::uint32_t y = 0; y < H; ++y)
         for (std::uint32_t x = 0; x < W; ++x) {
             const std::size_t t = tiles ? r.grid.tileOfPixel(x, y) : 0;
-            double shade = 0.12; // background: dim
-            if (depth.hasGeometry(x, y)) {
-                const float key = reversed ? -depth.at(x, y) : depth.at(x, y);
-                const double rank =
-                    double(std::lower_bound(sorted.begin(), sorted.end(), key) - sorted.begin());
-                const double farness = sorted.size() > 1 ? rank / double(sorted.size() - 1) : 0.0;
-                shade = 0.3 + 0.7 * (1.0 - farness);
-            }
-            glm::dvec3 c = colourOf(t < tileValue.size() ? tileValue[t] : 0.0) * shade;
+            glm::dvec3 c = colourOf(t < tileValue.size() ? tileValue[t] : 0.0) * grey[std::size_t(y) * W + x];
             if (x % ts == 0 || y % ts == 0) c = c * 0.8 + glm::dvec3(0.2); // faint tile grid
             cv.set(int(x), int(y), c);
         }
@@ -381,6 +414,51 @@ RgbImage heatmapImage(const RunOutput& run) {
     if (cx > bx0 + cv.textWidth(left, scale) + 2 * scale &&
         cx + cw < bx1 - cv.textWidth(right, scale) - 2 * scale)
         cv.text(cx, ty, centre, scale, glm::dvec3(1.0));
+    return img;
+}
+
+RgbImage missHeatmapImage(const RunOutput& run) {
+    const DepthImage& depth = run.depth;
+    const CullResult& r = run.result;
+    const std::uint32_t W = depth.width, H = depth.height;
+    const int scale = std::max(1, int(W) / 480);
+    const int legendH = scale * 16;
+    RgbImage img;
+    img.width = W;
+    img.height = H + std::uint32_t(legendH);
+    img.rgb.assign(std::size_t(img.width) * img.height * 3, 0);
+    Canvas cv{img};
+    const std::vector<double> fn = tileHeat(run, HeatMode::FalseNegatives);
+    double most = 0;
+    std::size_t tilesMissing = 0;
+    for (double v : fn)
+        if (v > 0) most = std::max(most, v), ++tilesMissing;
+    // Grey depth; a tile with misses red, brighter with more (log scale, so
+    // that a tile missing one light at a few pixels still stands out).
+    const std::vector<double> grey = depthGrey(depth);
+    const std::uint32_t ts = std::max(r.grid.tileSize, 1u);
+    for (std::uint32_t y = 0; y < H; ++y)
+        for (std::uint32_t x = 0; x < W; ++x) {
+            const std::size_t t = r.grid.tileCount() ? r.grid.tileOfPixel(x, y) : 0;
+            const double v = t < fn.size() && fn[t] > 0 ? fn[t] : 0.0;
+            const double g = grey[std::size_t(y) * W + x];
+            glm::dvec3 c(g * 0.6);
+            if (v > 0) {
+                const double k = most > 1 ? 0.45 + 0.55 * std::log(v) / std::log(most) : 1.0;
+                c = glm::dvec3(0.35 + 0.65 * k, 0.08, 0.08) * (0.55 + 0.45 * g);
+            }
+            if (x % ts == 0 || y % ts == 0) c = c * 0.8 + glm::dvec3(0.2); // faint tile grid
+            cv.set(int(x), int(y), c);
+        }
+    const int y0 = int(H), m = 4 * scale;
+    cv.fill(0, y0, int(W), y0 + legendH, glm::dvec3(0.1));
+    const std::string text =
+        !run.truthComputed ? "NO GROUND TRUTH: MISSES NOT COUNTED"
+        : tilesMissing == 0
+            ? "NO FALSE NEGATIVES"
+            : "FALSE NEGATIVES " + std::to_string(run.truth.metrics.falseNegatives) + " IN " +
+                  std::to_string(tilesMissing) + " TILES, MOST " + std::to_string(std::uint64_t(most)) + " IN ONE";
+    cv.text(m, y0 + m, text, scale, tilesMissing ? glm::dvec3(1.0, 0.45, 0.45) : glm::dvec3(1.0));
     return img;
 }
 
@@ -432,11 +510,13 @@ namespace {
 // What an export folder may hold: an older export is replaced, anything else
 // is refused (writeFolderAtomic).
 const std::set<std::string>& diagnosticsOutputs() {
-    static const std::set<std::string> k = {"summary.json", "tiles.csv", "heatmap.png",
+    static const std::set<std::string> k = {"summary.json", "tiles.csv", "heatmap.png", "heatmap_misses.png",
                                             "overlays.vtm", "overlays", kExportViewImages[0],
                                             kExportViewImages[1],
                                             // writeShadedImages
-                                            "shaded_culled.png", "shaded_all.png", "shaded_diff.png"};
+                                            "shaded_culled.png", "shaded_all.png", "shaded_diff.png",
+                                            // the edited scene (SceneOrigin::edited)
+                                            "scene.json"};
     return k;
 }
 } // namespace
@@ -454,8 +534,11 @@ void exportDiagnostics(const Scene& scene, const CullSettings& settings, const R
     writeFolderAtomic(dir, diagnosticsOutputs(), "export diagnostics", "diagnostics output", [&](const std::string& out) {
         const fs::path tmp = out;
         writeFileSynced((tmp / "summary.json").string(), summaryJson(scene, settings, run));
+        // Mesh paths relative to `dir`, where it will live (a sibling of tmp).
+        if (scene.origin.edited) writeFileSynced((tmp / "scene.json").string(), serializeScene(scene, dir));
         writeFileSynced((tmp / "tiles.csv").string(), tilesCsv(run));
         writePng(heatmapImage(run), (tmp / "heatmap.png").string());
+        writePng(missHeatmapImage(run), (tmp / "heatmap_misses.png").string());
         if (!run.shadedAll.empty()) writeShadedImages(run, tmp.string());
         writeOverlaysVtm(scene, run, tmp.string());
         for (const NamedImage& v : viewImages) writePng(v.image, (tmp / v.fileName).string());

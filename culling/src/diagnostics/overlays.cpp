@@ -336,6 +336,7 @@ const char* toString(HeatMode m) {
     case HeatMode::ListLength: return "list-length";
     case HeatMode::FalsePositives: return "false-positives";
     case HeatMode::Efficiency: return "efficiency";
+    case HeatMode::FalseNegatives: return "false-negatives";
     }
     return "?";
 }
@@ -353,6 +354,17 @@ std::vector<double> tileHeat(const RunOutput& run, HeatMode mode) {
             for (std::uint32_t l = first; l < first + count && l < r.listCount.size(); ++l)
                 m = std::max(m, r.listCount[l]);
             heat[t] = m;
+            continue;
+        }
+        if (mode == HeatMode::FalseNegatives) {
+            if (r.algorithm == Algorithm::All) {
+                heat[t] = 0; // one list of every light misses none
+                continue;
+            }
+            if (gt.listFalseNegatives.size() < std::size_t(first) + count) continue; // no ground truth
+            std::uint64_t fn = 0;
+            for (std::uint32_t l = first; l < first + count; ++l) fn += gt.listFalseNegatives[l];
+            heat[t] = double(fn);
             continue;
         }
         if (r.algorithm == Algorithm::All) continue;
@@ -581,6 +593,7 @@ void writeOverlaysVtm(const Scene& scene, const RunOutput& run, const std::strin
     {
         const auto fp = tileHeat(run, HeatMode::FalsePositives);
         const auto eff = tileHeat(run, HeatMode::Efficiency);
+        const auto fn = tileHeat(run, HeatMode::FalseNegatives);
         auto& aTile = tileFr.cellArray("tile", "Int64");
         auto& aTx = tileFr.cellArray("tile_x", "Int64");
         auto& aTy = tileFr.cellArray("tile_y", "Int64");
@@ -588,6 +601,7 @@ void writeOverlaysVtm(const Scene& scene, const RunOutput& run, const std::strin
         auto& aMax = tileFr.cellArray("max_list", "Int64");
         auto& aFp = tileFr.cellArray("false_positives", "Float64");
         auto& aEff = tileFr.cellArray("efficiency", "Float64");
+        auto& aFn = tileFr.cellArray("false_negatives", "Float64");
         for (std::uint32_t t = 0; t < tiles; ++t) {
             const auto chunk = tileFrustum(r, proj, run.lights, t);
             if (!chunk) continue;
@@ -612,6 +626,7 @@ void writeOverlaysVtm(const Scene& scene, const RunOutput& run, const std::strin
                 aMax.values.push_back(longest);
                 aFp.values.push_back(empty ? 0.0 : fp[t]);
                 aEff.values.push_back(empty ? 1.0 : eff[t]);
+                aFn.values.push_back(empty ? 0.0 : fn[t]);
             }
         }
     }

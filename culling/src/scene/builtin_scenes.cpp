@@ -330,7 +330,11 @@ const std::vector<BuiltinInfo>& builtinScenes() {
 
 Scene makeBuiltinScene(const std::string& name) {
     for (const auto& e : entries())
-        if (e.info.name == name) return e.make();
+        if (e.info.name == name) {
+            Scene s = e.make();
+            s.origin.builtin = name;
+            return s;
+        }
     std::string list;
     for (const auto& e : entries()) list += (list.empty() ? "" : ", ") + e.info.name;
     throw SettingsError("builtin", "unknown built-in scene '" + name + "' (valid: " + list + ")");

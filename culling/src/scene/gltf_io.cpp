@@ -19,6 +19,10 @@
 
 namespace lc {
 
+// asset.generator of the glTF files this tool writes.
+constexpr const char* kGltfGenerator = "LightCull Studio";
+
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -929,6 +933,7 @@ Mesh loadGltfMesh(const std::string& path, GltfReadReport* report, const CancelT
     GltfReadReport local;
     GltfReadReport& rep = report ? *report : local;
     const tinygltf::Model model = parseModel(path, rep);
+    rep.generator = model.asset.generator;
     GltfReader r(path, model, rep, cancel);
     Loaded l = readGeometry(path, model, r, rep, cancel, progress);
     if (l.mesh.indices.empty()) throw InputError(path, "", 0, "no triangles in the scene");
@@ -964,7 +969,7 @@ std::string serializeGltf(const Scene& scene, bool binary) {
     scene.validate();
     tinygltf::Model m;
     m.asset.version = "2.0";
-    m.asset.generator = "LightCull Studio";
+    m.asset.generator = kGltfGenerator;
     m.buffers.emplace_back();
     tinygltf::Scene gs;
     gs.name = scene.name;
@@ -1099,8 +1104,19 @@ void saveGltfScene(const Scene& scene, const std::string& path) {
 
 Scene loadSceneAny(const std::string& path, const GltfReadOptions& options, GltfReadReport* report,
                    const CancelToken* cancel, const Progress& progress) {
-    if (isGltfPath(path)) return loadGltfScene(path, options, report, cancel, progress);
-    return loadSceneFile(path, cancel, progress);
+    GltfReadReport local;
+    GltfReadReport& rep = report ? *report : local;
+    Scene s = isGltfPath(path) ? loadGltfScene(path, options, &rep, cancel, progress)
+                               : loadSceneFile(path, cancel, progress);
+    s.origin = {};
+    s.origin.file = std::filesystem::absolute(path).lexically_normal().string();
+    s.origin.contentHash = fileHashFnv1a64(path);
+    if (isGltfPath(path)) {
+        s.origin.gltfCamera = rep.camera;
+        s.origin.gltfMinIntensity = options.minIntensity;
+        s.origin.foreignGltf = rep.generator != kGltfGenerator;
+    }
+    return s;
 }
 
 void saveSceneAny(const Scene& scene, const std::string& path) {

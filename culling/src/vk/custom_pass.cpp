@@ -458,7 +458,9 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
         // the next run open a fresh device.
         (void)st.release();
         throw DeviceError(o.path + ": the culling shader did not finish within " + std::to_string(int(o.timeoutMs)) +
-                          " ms (an endless loop?); that device was abandoned and the next run opens a fresh one");
+                          " ms, the time limit for one dispatch (a slow shader on this device, or one that never "
+                          "ends): raise it with --timeout-ms; that device was abandoned and the next run opens a "
+                          "fresh one");
     }
     report.passMs = wallMs;
 

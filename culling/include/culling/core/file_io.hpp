@@ -22,6 +22,11 @@ void writeFileAtomic(const std::string& path, const std::string& text);
 // it before long work).
 void checkFileTarget(const std::string& path);
 
+// The FNV-1a 64-bit hash of a file's bytes as 16 hex digits, to record which
+// version of a file a result came from (not a cryptographic hash). Throws
+// Error naming the file when it cannot be read.
+std::string fileHashFnv1a64(const std::string& path);
+
 // fsyncs a folder (its entries' names). Throws Error naming it.
 void syncFolder(const std::string& path);
 

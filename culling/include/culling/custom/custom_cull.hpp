@@ -58,9 +58,11 @@ struct CustomShaderOptions {
     std::string device;            // Vulkan device, as for the built-in backend
 };
 
-// The settings a shader states in its first line, `// lightcull: --layout
-// fixed:64 --lists tile` (`--entry NAME` too); flags given by the caller
-// override them. Throws SettingsError naming the file for a bad first line.
+// The settings a shader states in a comment of its leading block (comments,
+// blank and # lines before the first line of code; a licence header may come
+// first): `// lightcull: --layout fixed:64 --lists tile` (`--entry NAME` too);
+// flags given by the caller override them. Throws InputError naming the file
+// and line for bad settings, a second settings line, or one after code.
 void applyShaderHeader(const std::string& shaderText, const std::string& path, CustomShaderOptions& options,
                        bool layoutGiven, bool listsGiven, bool entryGiven);
 
@@ -79,6 +81,9 @@ struct CustomCullReport {
     std::uint64_t overflowEntries = 0;   // entries that did not fit (fixed: count - N summed; compact: past N)
     std::uint64_t invalidIndices = 0;    // indices >= the light count (reported, never followed)
     std::uint64_t duplicateIndices = 0;  // the same light twice in one list (kept once)
+    // Which lists (CullResult numbering, ascending) overflowed, and which held
+    // an invalid index: a miss in such a list is labelled with that cause.
+    std::vector<std::uint32_t> overflowedListIds, invalidIndexListIds;
     std::vector<std::string> validationMessages; // the validation layer's, during this shader's run
     double passMs = -1;                  // CPU wall time around submit and wait of the dispatch
     std::string device;
@@ -91,12 +96,23 @@ struct CustomCullReport {
     std::vector<std::string> warnings;
 };
 
+// Why a list lacks a light its pixels need. A list that overflowed its
+// layout's capacity, or that held an index past the light count, is labelled
+// by that (the tool cannot tell whether the culling's test would have listed
+// the light had there been room); any other miss is the culling's own test.
+enum class MissCause { CullingTest, ListFull, InvalidIndex };
+const char* toString(MissCause c); // "culling test", "list full", "invalid index"
+const char* jsonName(MissCause c); // "culling_test", "list_full", "invalid_index"
+
 // One false negative, located: in `tile`, `pixels` geometry pixels need
 // `light` but their list (`list`) does not hold it.
 struct MissedLight {
     std::uint32_t tile = 0, list = 0, light = 0, pixels = 0;
+    MissCause cause = MissCause::CullingTest;
 };
-// Every (list, light) pair behind run.truth's false negatives, most pixels first.
+// Every (list, light) pair behind run.truth's false negatives: the culling
+// test's misses first (they are the culling's flaws; a full list is a limit),
+// then list full, then invalid index; within a cause, most pixels first.
 std::vector<MissedLight> locateFalseNegatives(const RunOutput& run, const Projection& proj);
 
 // Decodes raw output words (as `layout` lays them out) into `result`'s lists

@@ -19,6 +19,10 @@ struct RgbImage {
     std::vector<std::uint8_t> rgb;
 };
 RgbImage heatmapImage(const RunOutput& run);
+// heatmap_misses.png: the depth image in grey with every tile that misses
+// lights in red, brighter with more false negatives (tileHeat's
+// FalseNegatives, log scale), and a legend line with the counts.
+RgbImage missHeatmapImage(const RunOutput& run);
 void writePng(const RgbImage& img, const std::string& path);
 
 // shaded_culled.png, shaded_all.png (one exposure: the all-lights image's

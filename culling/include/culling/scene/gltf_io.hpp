@@ -36,6 +36,7 @@ struct GltfReadReport {
     std::vector<std::string> warnings;       // one line each: what was skipped and why
     std::size_t degenerateTrianglesDropped = 0;
     std::string camera;                      // "cameras[2] 'Main' on nodes[7]", or how it was framed
+    std::string generator;                   // the file's asset.generator ("LightCull Studio" for ours)
 };
 
 // True for names ending in .gltf or .glb (any case).

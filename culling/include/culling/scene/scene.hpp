@@ -110,11 +110,28 @@ struct Camera {
     std::string validate() const;
 };
 
+// Where a scene came from, for the record an export keeps (summary.json's
+// scene_source): not part of the scene, never saved with it.
+struct SceneOrigin {
+    std::string file;        // absolute path of the scene file read; empty for a built-in or a new scene
+    std::string contentHash; // fileHashFnv1a64 of that file (a .gltf's own text, not its .bin files)
+    std::string builtin;     // the built-in scene's name
+    std::string gltfCamera;  // glTF: which camera was used, or how the scene was framed
+    double gltfMinIntensity = 0; // glTF: the I_min that set the radii of lights without `range`
+    std::string command;     // the CLI command line that made the run, when it came from the CLI
+    bool edited = false;     // changed since it was read (the studio's unsaved edits)
+    // A glTF another tool wrote: this tool's writer keeps geometry, lights and
+    // cameras only, so saving over it would lose its materials, textures and
+    // animations (the studio saves such a scene under a new name).
+    bool foreignGltf = false;
+};
+
 struct Scene {
     std::string name;
     std::vector<Mesh> meshes;
     std::vector<PointLight> lights;
     Camera camera;
+    SceneOrigin origin;
 
     std::size_t triangleCount() const;
     // Throws LightError for the first bad light, SettingsError for a bad
