@@ -1,4 +1,5 @@
 #include "main_window.hpp"
+#include "miss_navigator.hpp"
 
 #include "camera_view.hpp"
 #include "cull_worker.hpp"
@@ -69,6 +70,11 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     setObjectName("LightCullStudio");
     doc_ = new Document(this);
     service_ = new CullService(this);
+    misses_ = new MissNavigator(doc_, this);
+    connect(misses_, &MissNavigator::message, this, [this](const QString& text) {
+        log(text);
+        statusBar()->showMessage(text, 10000);
+    });
 
     prompts.askUnsaved = [](QWidget* parent, const QString& text) {
         return QMessageBox::question(parent, tr("Unsaved changes"), text,
@@ -231,6 +237,10 @@ void MainWindow::buildDocks() {
     explain_ = new ExplainPanel(doc_);
     explain_->setObjectName("explainPanel");
     auto* explainDock = dock(tr("Explain"), "explainDock", explain_, Qt::RightDockWidgetArea);
+    connect(misses_, &MissNavigator::missSelected, this, [explainDock] {
+        explainDock->show();
+        explainDock->raise();
+    });
     splitDockWidget(tileDock, explainDock, Qt::Vertical);
     dock(tr("Message log"), "logDock", log_, Qt::BottomDockWidgetArea);
     auto* logDock = findChild<QDockWidget*>("logDock");
@@ -426,6 +436,9 @@ void MainWindow::buildMenus() {
     QMenu* cull = menuBar()->addMenu(tr("&Culling"));
     cull->addAction(action("actionRun"));
     cull->addAction(action("actionLive"));
+    cull->addSeparator();
+    cull->addAction(misses_->nextAction());
+    cull->addAction(misses_->previousAction());
     cull->addSeparator();
     cull->addAction(action("actionCustomShader"));
     cull->addAction(action("actionBuiltinAlgorithm"));

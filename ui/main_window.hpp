@@ -37,6 +37,8 @@ class QFileSystemWatcher;
 
 namespace lcui {
 
+class MissNavigator;
+
 class CameraView;
 class CullService;
 class ExplainPanel;
@@ -73,6 +75,7 @@ public:
     PropertyPanel* propertyPanel() const { return properties_; }
     TileInspector* tileInspector() const { return tileInspector_; }
     ExplainPanel* explainPanel() const { return explain_; }
+    MissNavigator* missNavigator() const { return misses_; }
     QPlainTextEdit* messageLog() const { return log_; }
     QAction* action(const QString& objectName) const; // e.g. "actionRun"
     Prompts prompts;
@@ -176,6 +179,7 @@ private:
 
     Document* doc_;
     CullService* service_;
+    MissNavigator* misses_;
     CameraView* cameraView_;
     InspectorView* inspectorView_;
     QSplitter* viewSplitter_;

@@ -7,6 +7,8 @@
 // a dump or CSV are judged the same way.
 #include "gpu_test_env.hpp"
 
+#include "culling/diagnostics/explain.hpp"
+
 #include "../unit/cli_support.hpp"
 
 #include "culling/custom/custom_cull.hpp"
@@ -256,6 +258,10 @@ TEST_F(GpuTest, OverflowingFixedListsAreReportedNotHidden) {
         EXPECT_EQ(m.cause, MissCause::ListFull) << "list " << m.list;
         EXPECT_TRUE(std::binary_search(rep.overflowedListIds.begin(), rep.overflowedListIds.end(), m.list));
     }
+    // Explain says so for such a light, not "the tests keep it".
+    const Explanation e = explainLight(out, Projection(s.camera), missed[0].list, missed[0].light);
+    EXPECT_EQ(e.verdict.rfind("MISSING", 0), 0u) << e.verdict;
+    EXPECT_NE(e.verdict.find("dropped: list full, layout fixed:2"), std::string::npos) << e.verdict;
 }
 
 TEST_F(GpuTest, InvalidAndDuplicateIndicesAreReportedNeverFollowed) {

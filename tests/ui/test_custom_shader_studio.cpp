@@ -7,9 +7,11 @@
 
 #include "studio_test_support.hpp"
 
+#include <QDockWidget>
 #include <QLabel>
 
 #include "document.hpp"
+#include "explain_panel.hpp"
 #include "main_window.hpp"
 #include "tile_inspector.hpp"
 
@@ -136,6 +138,32 @@ private slots:
             }
         }
         QVERIFY2(shown, "the missed light is not listed as MISSING in the tile inspector");
+
+        // Culling > Next miss (F8) walks the misses: tile, light and list
+        // selected, Explain shown on it with MISSING; Previous goes back.
+        auto* explainDock = w_->findChild<QDockWidget*>("explainDock");
+        explainDock->hide();
+        doc()->setSelectedTile(-1);
+        w_->action("actionNextMiss")->trigger(); // F8 (test_studio checks the binding)
+        QCOMPARE(doc()->selectedTile(), int(missed[0].tile));
+        QCOMPARE(doc()->currentLight(), int(missed[0].light));
+        QCOMPARE(doc()->explainedList(), int(missed[0].list));
+        QVERIFY(explainDock->isVisible());
+        QVERIFY(w_->explainPanel()->explanation());
+        QCOMPARE(w_->explainPanel()->explanation()->light, missed[0].light);
+        QVERIFY2(QString::fromStdString(w_->explainPanel()->explanation()->verdict).startsWith("MISSING"),
+                 w_->explainPanel()->explanation()->verdict.c_str());
+        QVERIFY(w_->messageLog()->toPlainText().contains(
+            QString("miss 1 of %1: light %2").arg(missed.size()).arg(missed[0].light)));
+        QVERIFY(w_->messageLog()->toPlainText().contains("cause: culling test"));
+        QVERIFY(missed.size() > 2); // the drift misses lights in several tiles: a walk to test
+        w_->action("actionNextMiss")->trigger();
+        QCOMPARE(doc()->selectedTile(), int(missed[1].tile));
+        QCOMPARE(doc()->currentLight(), int(missed[1].light));
+        w_->action("actionPreviousMiss")->trigger();
+        QCOMPARE(doc()->selectedTile(), int(missed[0].tile));
+        w_->action("actionPreviousMiss")->trigger(); // wraps to the last
+        QCOMPARE(doc()->selectedTile(), int(missed.back().tile));
 
         // A syntax error: the run fails with file and line, the scene stays.
         const std::string sceneBefore = lc::serializeScene(doc()->scene());

@@ -736,7 +736,8 @@ private slots:
             {"actionNew", "Ctrl+N"},      {"actionOpen", "Ctrl+O"},         {"actionImport", "Ctrl+I"},
             {"actionSave", "Ctrl+S"},     {"actionSaveAs", "Ctrl+Shift+S"}, {"actionExportDiagnostics", "Ctrl+E"},
             {"actionQuit", "Ctrl+Q"},     {"actionUndo", "Ctrl+Z"},         {"actionRedo", "Ctrl+Shift+Z"},
-            {"actionDuplicate", "Ctrl+D"}, {"actionGenerate", "Ctrl+G"},   {"actionRun", "F5"}};
+            {"actionDuplicate", "Ctrl+D"}, {"actionGenerate", "Ctrl+G"},   {"actionRun", "F5"},
+            {"actionNextMiss", "F8"},     {"actionPreviousMiss", "Shift+F8"}};
         for (const auto& [name, key] : keys) {
             QAction* a = w_->action(name);
             QVERIFY2(a, name);

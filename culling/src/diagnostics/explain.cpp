@@ -5,6 +5,7 @@
 
 #include "culling/core/errors.hpp"
 #include "culling/cpu/fine_prune.hpp"
+#include "culling/custom/custom_cull.hpp"
 #include "culling/math/spot_tests.hpp"
 #include "culling/math/tile_math.hpp"
 #include "truth/light_grid.hpp"
@@ -281,9 +282,24 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
                                                            "chunk, not the pixels' surfaces)"
                                                          : "");
     } else if (e.pixelsNeeding > 0) {
+        // A custom culling's list that overflowed or held an invalid index:
+        // that, not the test, is the likely cause (MissCause).
+        const CustomCullReport* c = run.custom.get();
+        const auto among = [&](const std::vector<std::uint32_t>& ids) {
+            return std::binary_search(ids.begin(), ids.end(), list);
+        };
+        std::string cause;
+        if (c && among(c->overflowedListIds))
+            cause = " (dropped: list full, layout " + c->layout + "; the shader wrote more entries than fit)";
+        else if (c && among(c->invalidIndexListIds))
+            cause = " (the list held an index past the light count: an invalid index, perhaps where this light's "
+                    "belonged)";
+        else if (failed.empty())
+            cause = " (the reference's tests keep it: this pass dropped it)";
+        else
+            cause = " (the first test to reject it: '" + failed + "')";
         e.verdict = "MISSING: not listed, but " + std::to_string(e.pixelsNeeding) + " of the list's pixels need it" +
-                    (failed.empty() ? std::string(" (the reference's tests keep it: this pass dropped it)")
-                                    : " (the first test to reject it: '" + failed + "')");
+                    cause;
     } else {
         e.verdict = "not listed, rightly: no pixel of the list needs it" +
                     (failed.empty() ? std::string() : " (the first test to reject it: '" + failed + "')");
