@@ -4,6 +4,7 @@
 #include "cli_support.hpp"
 
 #include "culling/core/params.hpp"
+#include "culling/core/pipeline.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
@@ -69,6 +70,30 @@ TEST(Cli, RunFromASceneFileWritesTheDiagnostics) {
     EXPECT_EQ(j["lights"], 50);
     EXPECT_EQ(j["backend"], "cpu");
     EXPECT_EQ(j["metrics"]["lists"], 10 * 6 * 2);
+    // The metrics are the run's own: the same scene, lights and settings run
+    // here give the same figures (CPU backend: deterministic; the summary's
+    // doubles read back exactly).
+    {
+        lc::Scene same = lc::loadSceneFile((s.path / "scene.json").string());
+        same.lights = lc::generateLights(lc::defaultLightGen(same, 50, 9));
+        lc::CullSettings cs;
+        lc::setParam(cs, same.camera, "width", "80");
+        lc::setParam(cs, same.camera, "height", "48");
+        lc::setParam(cs, same.camera, "tile", "8");
+        lc::setParam(cs, same.camera, "algorithm", "halfz");
+        auto cpu = lc::makeBackend("cpu");
+        const lc::Metrics m = lc::runPipeline(same, cs, *cpu).truth.metrics;
+        ASSERT_TRUE(m.imageErrorComputed);
+        const auto& jm = j["metrics"];
+        EXPECT_EQ(jm["false_negatives"].get<std::uint64_t>(), m.falseNegatives);
+        EXPECT_EQ(jm["shading_work"].get<std::uint64_t>(), m.shadingWork);
+        EXPECT_EQ(jm["exact_work"].get<std::uint64_t>(), m.exactWork);
+        EXPECT_EQ(jm["optimal_work"].get<std::uint64_t>(), m.optimalWork);
+        EXPECT_EQ(jm["efficiency"].get<double>(), m.efficiency);
+        EXPECT_EQ(jm["image_rmse"].get<double>(), m.imageRmse);
+        EXPECT_EQ(jm["image_max_error"].get<double>(), m.imageMaxError);
+        EXPECT_GT(m.exactWork, 0u); // the lights reach the wall: the comparison is not of zeros
+    }
     EXPECT_TRUE(fs::is_regular_file(out / "tiles.csv"));
     EXPECT_TRUE(fs::is_regular_file(out / "heatmap.png"));
     // The folder gets the permissions mkdir would give it (not mkdtemp's 0700).

@@ -3,8 +3,15 @@
 // leave no output folder.
 #include "cli_support.hpp"
 
+#include "culling/core/params.hpp"
+#include "culling/core/pipeline.hpp"
+#include "culling/scene/scene_io.hpp"
+
 #include <gtest/gtest.h>
 #include <png.h>
+
+#include <algorithm>
+#include <cstdlib>
 
 using namespace lc_test;
 namespace fs = std::filesystem;
@@ -27,6 +34,28 @@ TEST(CliReport, WritesCsvMarkdownAndPareto) {
                             "image_rmse", "image_max_error"})
         EXPECT_NE(header.find(col), std::string::npos) << col;
     const auto commas = [](const std::string& s) { return std::count(s.begin(), s.end(), ','); };
+    // Split at every comma: the cpu rows hold no quoted field (their comma
+    // count is the header's, checked below).
+    const auto fields = [](const std::string& s) {
+        std::vector<std::string> out(1);
+        for (char c : s) {
+            if (c == ',') out.emplace_back();
+            else out.back().push_back(c);
+        }
+        return out;
+    };
+    const std::vector<std::string> cols = fields(header);
+    const auto col = [&](const std::string& name) {
+        const auto it = std::find(cols.begin(), cols.end(), name);
+        EXPECT_NE(it, cols.end()) << name;
+        return std::size_t(it - cols.begin());
+    };
+    // The scene the command ran: sky, 64x36, 8 generated lights (seed 1).
+    lc::Scene scene = lc::makeBuiltinScene("sky");
+    scene.camera.width = 64;
+    scene.camera.height = 36;
+    scene.lights = lc::generateLights(lc::defaultLightGen(scene, 8, 1));
+    auto cpu = lc::makeBackend("cpu");
     std::istringstream lines(csv);
     std::string line;
     std::getline(lines, line);
@@ -34,6 +63,30 @@ TEST(CliReport, WritesCsvMarkdownAndPareto) {
         EXPECT_EQ(commas(line), commas(header)) << line;
         EXPECT_EQ(line.rfind("cpu,", 0), 0u) << line;
         EXPECT_NE(line.find(",2.5d,"), std::string::npos) << line;
+        // The row's figures are its configuration's own run, made here again
+        // from the parameter columns (the CPU backend is deterministic and
+        // the CSV's doubles round-trip): not merely numbers in range.
+        const std::vector<std::string> f = fields(line);
+        ASSERT_EQ(f.size(), cols.size()) << line;
+        lc::Scene s = scene;
+        lc::CullSettings cs;
+        for (const lc::ParamSpec& p : lc::cullParams()) {
+            if (p.name == "width" || p.name == "height") continue;
+            std::string c = p.name;
+            std::replace(c.begin(), c.end(), '-', '_');
+            if (const std::string& v = f[col(c)]; !v.empty()) lc::setParam(cs, s.camera, p.name, v);
+        }
+        const lc::Metrics m = lc::runPipeline(s, cs, *cpu).truth.metrics;
+        ASSERT_TRUE(m.imageErrorComputed);
+        const auto num = [&](const char* name) { return std::strtod(f[col(name)].c_str(), nullptr); };
+        EXPECT_EQ(num("image_rmse"), m.imageRmse) << line;
+        EXPECT_EQ(num("image_max_error"), m.imageMaxError) << line;
+        EXPECT_EQ(num("efficiency"), m.efficiency) << line;
+        EXPECT_EQ(num("mean_list"), m.meanList) << line;
+        EXPECT_EQ(f[col("false_negatives")], std::to_string(m.falseNegatives)) << line;
+        EXPECT_EQ(f[col("max_list")], std::to_string(m.maxList)) << line;
+        EXPECT_EQ(f[col("result_bytes")], std::to_string(m.resultBytes)) << line;
+        EXPECT_EQ(f[col("optimal_work")], std::to_string(m.optimalWork)) << line;
     }
     EXPECT_NE(slurp(out / "report.md").find("| backend | configuration |"), std::string::npos);
     png_image img{};

@@ -168,6 +168,12 @@ TEST(Export, SummaryJsonHasEveryKeyConsistentWithTheRun) {
     EXPECT_EQ(E, run.exactWork);
     EXPECT_EQ(m["false_negatives"].get<std::uint64_t>(), run.falseNegatives);
     EXPECT_EQ(m["optimal_work"].get<std::uint64_t>(), run.optimalWork);
+    EXPECT_EQ(m["efficiency"].get<double>(), run.efficiency);
+    EXPECT_EQ(m["efficiency_vs_optimal"].get<double>(), run.efficiencyVsOptimal);
+    EXPECT_EQ(m["mean_list"].get<double>(), run.meanList);
+    EXPECT_EQ(m["max_list"].get<std::uint64_t>(), run.maxList);
+    EXPECT_EQ(m["result_bytes"].get<std::uint64_t>(), run.resultBytes);
+    EXPECT_EQ(m["geometry_pixels"].get<std::uint64_t>(), run.geometryPixels);
     EXPECT_GT(run.imageRmse, 0.0); // inverse-square lights: the cut-off's error
 
     const PipelineRun noImg = runBuiltin("wall", Algorithm::MinMax, 48, 32, false);
@@ -365,6 +371,13 @@ TEST(Export, MissHeatmapIsRedExactlyWhereTilesMissLights) {
     to.imageError = false;
     r.out.truth = computeGroundTruth(r.out.depth, proj, r.out.lights, res, to);
     ASSERT_GT(r.out.truth.metrics.falseNegatives, 0u);
+    // The summary reports the misses this run has, not a 0 from elsewhere.
+    {
+        const auto sm = nlohmann::json::parse(summaryJson(r.scene, r.settings, r.out))["metrics"];
+        EXPECT_EQ(sm["false_negatives"].get<std::uint64_t>(), r.out.truth.metrics.falseNegatives);
+        EXPECT_EQ(sm["shading_work"].get<std::uint64_t>(), r.out.truth.metrics.shadingWork);
+        EXPECT_EQ(sm["exact_work"].get<std::uint64_t>(), r.out.truth.metrics.exactWork);
+    }
     const std::vector<double> fn = tileHeat(r.out, HeatMode::FalseNegatives);
     std::uint64_t sum = 0;
     std::size_t missing = 0;

@@ -3,6 +3,7 @@
 // timings, metrics, progress, cancel), the Pareto flags against their
 // definition, and the written folder (csv shape, atomic refusal).
 #include "culling/core/errors.hpp"
+#include "culling/core/pipeline.hpp"
 #include "culling/diagnostics/report.hpp"
 #include "culling/scene/scene_io.hpp"
 
@@ -45,6 +46,30 @@ std::vector<std::string> splitCsvLine(const std::string& line) {
     }
     out.push_back(cur);
     return out;
+}
+
+// A report row against a run of its own configuration, made apart from the
+// report (runPipeline on the CPU backend, image error on). The CPU backend is
+// deterministic and the report judges a row as runPipeline does (the same
+// ground truth, the backend's shading pass, compareShadedImages): equal.
+void expectRowIsTheRunsOwn(const Scene& scene, const ReportRow& row) {
+    ASSERT_EQ(row.config.backend, "cpu");
+    Scene s = scene;
+    s.camera.tileSize = row.config.tileSize;
+    auto backend = makeBackend("cpu");
+    const RunOutput run = runPipeline(s, row.config.settings, *backend, RunOptions{});
+    const Metrics& m = run.truth.metrics;
+    ASSERT_TRUE(m.imageErrorComputed);
+    const std::string what = row.config.label();
+    EXPECT_EQ(row.falseNegatives, m.falseNegatives) << what;
+    EXPECT_EQ(row.efficiency, m.efficiency) << what;
+    EXPECT_EQ(row.optimalWork, m.optimalWork) << what;
+    EXPECT_EQ(row.efficiencyVsOptimal, m.efficiencyVsOptimal) << what;
+    EXPECT_EQ(row.meanList, m.meanList) << what;
+    EXPECT_EQ(row.maxList, m.maxList) << what;
+    EXPECT_EQ(row.resultBytes, m.resultBytes) << what;
+    EXPECT_EQ(row.imageRmse, m.imageRmse) << what;
+    EXPECT_EQ(row.imageMaxError, m.imageMaxError) << what;
 }
 
 struct TempDir {
@@ -132,7 +157,8 @@ TEST(Report, RunsOnATinySceneWithProgressAndParetoFlags) {
     o.repeat = 1;
     o.warmup = 0;
     std::vector<std::size_t> seen;
-    const Report rep = runReport(tinyScene(), o, [&](std::size_t done, std::size_t total, const std::string&) {
+    const Scene scene = tinyScene();
+    const Report rep = runReport(scene, o, [&](std::size_t done, std::size_t total, const std::string&) {
         EXPECT_EQ(total, 9u);
         seen.push_back(done);
     });
@@ -148,7 +174,8 @@ TEST(Report, RunsOnATinySceneWithProgressAndParetoFlags) {
         EXPECT_GT(r.efficiency, 0.0);
         EXPECT_LE(r.efficiency, 1.0);
         EXPECT_GT(r.resultBytes, 0u);
-        EXPECT_GE(r.imageRmse, 0.0);
+        // The row's figures are its configuration's own, not merely numbers.
+        expectRowIsTheRunsOwn(scene, r);
         onFront += r.paretoEfficiency;
         // The flag is exactly "no row dominates it".
         bool dominated = false;
@@ -168,9 +195,10 @@ TEST(Report, RunsOnATinySceneWithProgressAndParetoFlags) {
     // `all` shades every light: its image error is exactly 0.
     ReportOptions all = o;
     all.fixed = {{"algorithm", "all"}};
-    const Report allRep = runReport(tinyScene(), all);
+    const Report allRep = runReport(scene, all);
     ASSERT_EQ(allRep.rows.size(), 1u);
     EXPECT_EQ(allRep.rows[0].imageRmse, 0.0);
+    expectRowIsTheRunsOwn(scene, allRep.rows[0]);
     EXPECT_EQ(allRep.rows[0].efficiency, allRep.rows[0].efficiency); // not NaN
 }
 
@@ -227,10 +255,29 @@ TEST(Report, WritesCsvMarkdownAndPngAtomically) {
     EXPECT_EQ(cols.front(), "backend");
     EXPECT_NE(std::find(cols.begin(), cols.end(), "image_rmse"), cols.end());
     EXPECT_NE(std::find(cols.begin(), cols.end(), "skip_empty"), cols.end());
+    const auto col = [&](const char* name) {
+        const auto it = std::find(cols.begin(), cols.end(), name);
+        EXPECT_NE(it, cols.end()) << name;
+        return std::size_t(it - cols.begin());
+    };
     std::size_t rows = 0;
     while (std::getline(csv, line)) {
+        const std::vector<std::string> f = splitCsvLine(line);
+        ASSERT_EQ(f.size(), cols.size()) << line;
+        ASSERT_LT(rows, rep.rows.size());
+        // Each row's figures as the report holds them (doubles round-trip).
+        const ReportRow& r = rep.rows[rows];
+        const auto num = [&](const char* name) { return std::strtod(f[col(name)].c_str(), nullptr); };
+        EXPECT_EQ(num("image_rmse"), r.imageRmse) << line;
+        EXPECT_EQ(num("image_max_error"), r.imageMaxError) << line;
+        EXPECT_EQ(num("efficiency"), r.efficiency) << line;
+        EXPECT_EQ(num("efficiency_vs_optimal"), r.efficiencyVsOptimal) << line;
+        EXPECT_EQ(num("mean_list"), r.meanList) << line;
+        EXPECT_EQ(f[col("false_negatives")], std::to_string(r.falseNegatives)) << line;
+        EXPECT_EQ(f[col("max_list")], std::to_string(r.maxList)) << line;
+        EXPECT_EQ(f[col("result_bytes")], std::to_string(r.resultBytes)) << line;
+        EXPECT_EQ(f[col("optimal_work")], std::to_string(r.optimalWork)) << line;
         ++rows;
-        EXPECT_EQ(splitCsvLine(line).size(), cols.size()) << line;
     }
     EXPECT_EQ(rows, rep.rows.size());
     EXPECT_EQ(rows, 6u);
