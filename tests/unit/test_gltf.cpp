@@ -298,7 +298,48 @@ TEST(Gltf, GeometryFeatures) {
         bool warned = false;
         for (const auto& w : rep.warnings) warned |= w.find("'mixed'") != std::string::npos && w.find("lines") != std::string::npos;
         EXPECT_TRUE(warned);
-        // Strip triangle 1 keeps the glTF winding (1, 0, 2 of the quad -> v1, v0... as spec: odd triangles swap).
+        // Every triangle, in order, with its winding: the same corners in the
+        // same cyclic order as the specification gives them (glTF 2.0,
+        // 3.7.2.1: strip triangle i is {v_i, v_i+(1+i%2), v_i+(2-i%2)}, so odd
+        // ones swap two corners; fan triangle i is {v_i+1, v_i+2, v_0}). A
+        // reader that winds the second strip or fan triangle the other way
+        // draws it facing away.
+        {
+            using V = glm::dvec3;
+            struct Tri {
+                V a, b, c;
+            };
+            const V q0(0, 0, 0), q1(1, 0, 0), q2(0, 1, 0), q3(1, 1, 0); // the strip's quad
+            const V f0(0, 0, 0), f1(1, 0, 0), f2(1, 1, 0), f3(0, 1, 0); // the fan's
+            const std::vector<Tri> meshA = {
+                {q0, q1, q2}, {q1, q3, q2},                           // strip: i = 0, 1
+                {f1, f2, f0}, {f2, f3, f0},                           // fan: i = 0, 1
+                {V(0, 0, 0), V(1, 0, 0), V(0, 0, 1)}, {V(0, 0, 0), V(0, 0, 1), V(0, 1, 0)}}; // soup
+            const std::vector<Tri> meshB = {{V(0, 0, 0), V(1, 0, 0), V(0, -1, 0)},  // quantised
+                                            {V(0, 0, 0), V(2, 0, 0), V(0, 2, 0)}}; // sparse
+            // The instances: x' = 10 + 2x; 10 + 2 R(x) with R 90 degrees about
+            // +Y, (x, y, z) -> (z, y, -x); meshB at +5 in y.
+            const auto first = [](V v) { return V(10, 0, 0) + 2.0 * v; };
+            const auto second = [](V v) { return V(10, 0, 0) + 2.0 * V(v.z, v.y, -v.x); };
+            const auto packedAt = [](V v) { return v + V(0, 5, 0); };
+            std::vector<Tri> want;
+            for (const Tri& t : meshA) want.push_back({first(t.a), first(t.b), first(t.c)});
+            for (const Tri& t : meshA) want.push_back({second(t.a), second(t.b), second(t.c)});
+            for (const Tri& t : meshB) want.push_back({packedAt(t.a), packedAt(t.b), packedAt(t.c)});
+            ASSERT_EQ(m.triangleCount(), want.size());
+            const auto near = [](V x, V y) { return glm::length(x - y) < 1e-4; }; // quantised: 1/32767
+            for (std::size_t t = 0; t < want.size(); ++t) {
+                const V got[3] = {worldVertex(m, std::uint32_t(3 * t)), worldVertex(m, std::uint32_t(3 * t + 1)),
+                                  worldVertex(m, std::uint32_t(3 * t + 2))};
+                const V w[3] = {want[t].a, want[t].b, want[t].c};
+                bool same = false; // equal up to a cyclic rotation: the same triangle, wound the same way
+                for (int r = 0; r < 3 && !same; ++r)
+                    same = near(got[0], w[r]) && near(got[1], w[(r + 1) % 3]) && near(got[2], w[(r + 2) % 3]);
+                EXPECT_TRUE(same) << "triangle " << t << ": (" << got[0].x << "," << got[0].y << "," << got[0].z
+                                  << ") (" << got[1].x << "," << got[1].y << "," << got[1].z << ") (" << got[2].x
+                                  << "," << got[2].y << "," << got[2].z << ")";
+            }
+        }
         // First instance: x' = 10 + 2x.
         EXPECT_LT(glm::length(worldVertex(m, 0) - glm::dvec3(10, 0, 0)), 1e-6);
         EXPECT_LT(glm::length(worldVertex(m, 1) - glm::dvec3(12, 0, 0)), 1e-6);

@@ -355,14 +355,38 @@ TEST(Lambert, FlatWallMatchesHandComputedValue) {
 
 TEST(Lambert, LightBehindTheSurfaceAndTooCloseAreHandled) {
     FourByFour f;
-    ViewLights lights;
-    addLight(lights, {0.0, 0.0, -9.0}, 10.0, {1, 1, 1});   // behind the wall: n.l < 0
-    addLight(lights, {-0.5, 1.5, -5.0}, 1.0, {1, 1, 1});   // at pixel (1,0): d^2 ~ 0
-    const std::vector<float> rgb = shadeLambertCpu(f.depth, f.proj, lights, nullptr);
-    for (float v : rgb) {
-        EXPECT_TRUE(std::isfinite(v));
-        EXPECT_GE(v, 0.0f);
-    }
+    // Behind the wall (z = -5, facing the camera): n.l < 0 at every pixel, so
+    // it adds exactly nothing, not a negative or a clamped-away NaN.
+    ViewLights behind;
+    addLight(behind, {0.0, 0.0, -9.0}, 10.0, {1, 1, 1});
+    for (float v : shadeLambertCpu(f.depth, f.proj, behind, nullptr)) EXPECT_EQ(v, 0.0f);
+
+    // 1 mm in front of pixel (1,0)'s centre (-0.5, 1.5, -5): d^2 = 1e-6 is
+    // under the 1e-4 floor, so that pixel gets power x n.l / 1e-4 (n.l ~ 1),
+    // not 1e6 or inf; every other pixel the plain inverse-square Lambert term.
+    ViewLights close;
+    const glm::dvec3 c(-0.5, 1.5, -4.999);
+    addLight(close, c, 1.0, {1, 1, 1});
+    const std::vector<float> rgb = shadeLambertCpu(f.depth, f.proj, close, nullptr);
+    ASSERT_EQ(rgb.size(), 4u * 4u * 3u);
+    for (std::uint32_t y = 0; y < 4; ++y)
+        for (std::uint32_t x = 0; x < 4; ++x) {
+            const glm::dvec3 p(double(x) - 1.5, 1.5 - double(y), -5.0); // ortho pixel centres, the wall
+            const glm::dvec3 d = c - p;
+            const double d2 = glm::dot(d, d);
+            const double expect = (d.z / std::sqrt(d2)) / std::max(d2, 1e-4); // n = (0, 0, 1)
+            // The stored depth is a float: P.z is off by up to ~1e-6, which
+            // moves n.l by that much at pixels 1 m away (1e-3 of their 1e-3).
+            const double tol = x == 1 && y == 0 ? 1e-4 * expect : 2e-3 * expect + 1e-9;
+            for (int ch = 0; ch < 3; ++ch)
+                EXPECT_NEAR(rgb[(y * 4 + x) * 3 + ch], expect, tol) << "pixel " << x << "," << y;
+        }
+    EXPECT_GT(rgb[(0 * 4 + 1) * 3], 0.99e4f); // the floor, reached
+
+    // Both together: the light behind adds nothing, bitwise.
+    ViewLights both = behind;
+    addLight(both, c, 1.0, {1, 1, 1});
+    EXPECT_EQ(shadeLambertCpu(f.depth, f.proj, both, nullptr), rgb);
 }
 
 TEST(Lambert, SilhouettePixelTakesTheNormalOfItsOwnSurface) {
