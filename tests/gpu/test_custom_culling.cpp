@@ -462,27 +462,50 @@ TEST_F(GpuTest, EngineListDumpsAreJudgedLikeShaders) {
             << wrongRep.warnings[0];
     }
 
-    // CSV with one light dropped from the busiest list: exactly that miss.
+    // CSV with one light dropped from the busiest list, as a broken engine
+    // would: exactly that miss. The light dropped is one some pixel of the
+    // tile needs (asserted, not hoped for: a dropped false positive would
+    // miss nothing and the miss checks would never run); dropping a false
+    // positive instead misses nothing.
     std::size_t busiest = 0;
     for (std::size_t l = 0; l < ref.listCount.size(); ++l)
         if (ref.listCount[l] > ref.listCount[busiest]) busiest = l;
-    std::uint32_t dropped = 0;
-    {
-        std::ofstream csv(dir / "lists.csv");
+    ASSERT_EQ(ref.listsPerTile, 1u); // minmax: list == tile
+    const auto needingInBusiest =
+        pixelsNeedingLights(depth, proj, out.lights, out.result.grid, std::uint32_t(busiest));
+    ASSERT_FALSE(needingInBusiest.empty()) << "the busiest tile needs no light: nothing to drop";
+    const std::uint32_t dropped = needingInBusiest[0].first;
+    const std::uint64_t needing = needingInBusiest[0].second;
+    ASSERT_GT(needing, 0u);
+    std::uint32_t droppedFalsePositive = 0;
+    bool haveFalsePositive = false;
+    for (std::uint32_t k = 0; k < ref.listCount[busiest] && !haveFalsePositive; ++k) {
+        const std::uint32_t light = ref.lightIndices[ref.listOffset[busiest] + k];
+        if (std::none_of(needingInBusiest.begin(), needingInBusiest.end(),
+                         [&](const auto& n) { return n.first == light; }))
+            droppedFalsePositive = light, haveFalsePositive = true;
+    }
+    ASSERT_TRUE(haveFalsePositive) << "minmax lists a false positive in the busiest atrium tile";
+    const auto writeCsvWithout = [&](const fs::path& file, std::uint32_t drop) {
+        std::ofstream csv(file);
         csv << "list,lights\n";
+        bool droppedOne = false;
         for (std::size_t l = 0; l < ref.listCount.size(); ++l) {
             csv << l;
             for (std::uint32_t k = 0; k < ref.listCount[l]; ++k) {
                 const std::uint32_t light = ref.lightIndices[ref.listOffset[l] + k];
-                if (l == busiest && k == 0) {
-                    dropped = light;
+                if (l == busiest && light == drop) {
+                    droppedOne = true;
                     continue;
                 }
                 csv << "," << light;
             }
             csv << "\n";
         }
-    }
+        ASSERT_TRUE(droppedOne) << "light " << drop << " is not in list " << busiest;
+    };
+    writeCsvWithout(dir / "lists.csv", dropped);
+    writeCsvWithout(dir / "lists_fp.csv", droppedFalsePositive);
     // Judged on the engine's own depth, written as raw float32.
     std::ofstream(dir / "depth.f32", std::ios::binary)
         .write(reinterpret_cast<const char*>(depth.depth.data()), std::streamsize(depth.depth.size() * 4));
@@ -491,19 +514,19 @@ TEST_F(GpuTest, EngineListDumpsAreJudgedLikeShaders) {
     CustomCullReport csvRep;
     const RunOutput csvOut = checkListDump(s, (dir / "lists.csv").string(), parseLayout("fixed:32"), parseListSpec("tile"),
                                            engineDepth, ro, csvRep);
+    EXPECT_EQ(csvOut.truth.metrics.falseNegatives, needing);
     const auto missed = locateFalseNegatives(csvOut, proj);
-    const std::uint64_t needing = [&] {
-        for (const auto& [light, count] : pixelsNeedingLights(depth, proj, csvOut.lights, csvOut.result.grid, std::uint32_t(busiest)))
-            if (light == dropped) return std::uint64_t(count);
-        return std::uint64_t(0);
-    }();
-    if (needing == 0) {
-        EXPECT_TRUE(missed.empty()); // a false positive was dropped: nothing missed
-    } else {
-        ASSERT_EQ(missed.size(), 1u);
-        EXPECT_EQ(missed[0].tile, busiest);
-        EXPECT_EQ(missed[0].light, dropped);
-        EXPECT_EQ(missed[0].pixels, needing);
+    ASSERT_EQ(missed.size(), 1u);
+    EXPECT_EQ(missed[0].tile, busiest);
+    EXPECT_EQ(missed[0].light, dropped);
+    EXPECT_EQ(missed[0].pixels, needing);
+    {
+        CustomCullReport fpRep;
+        const RunOutput fpOut = checkListDump(s, (dir / "lists_fp.csv").string(), parseLayout("fixed:32"),
+                                              parseListSpec("tile"), engineDepth, ro, fpRep);
+        EXPECT_EQ(fpOut.truth.metrics.falseNegatives, 0u);
+        EXPECT_TRUE(locateFalseNegatives(fpOut, proj).empty()); // a false positive was dropped: nothing missed
+        EXPECT_EQ(fpOut.result.entries(), ref.entries() - 1);
     }
     // Bad dumps: one line naming the file and the line.
     std::ofstream(dir / "bad.csv") << "0,1,2\n99999,3\n";

@@ -99,7 +99,7 @@ TEST(Explain, TheDecidingPlaneIsTheOneOfLeastMargin) {
     const Scene s = smallAtrium();
     const Projection proj(s.camera);
     const RunOutput run = cpuRun(s, minmax());
-    std::uint32_t rejectedByPlane = 0, kept = 0;
+    std::uint32_t rejectedByPlane = 0, kept = 0, rejectedVerdicts = 0;
     for (std::uint32_t t = 0; t < run.result.grid.tileCount(); t += 7) {
         const auto chunk = tileFrustum(run.result, proj, run.lights, t);
         if (!chunk) continue;
@@ -124,8 +124,11 @@ TEST(Explain, TheDecidingPlaneIsTheOneOfLeastMargin) {
             // One answer to "which test rejected it": the verdict names the
             // first failing step; the plane line says it ranks the planes.
             const auto firstFail = std::find_if(e.steps.begin(), e.steps.end(), [](const ExplainStep& st) { return !st.passed; });
-            if (firstFail != e.steps.end() && !e.listed) {
+            if (!e.listed) {
+                // A rejected light has a failing step, and the verdict names the first.
+                ASSERT_NE(firstFail, e.steps.end()) << e.text();
                 EXPECT_NE(e.verdict.find("the first test to reject it: '" + firstFail->test + "'"), std::string::npos) << e.text();
+                ++rejectedVerdicts;
             }
             EXPECT_EQ(e.text().find("rejected by"), std::string::npos) << e.text();
             rejectedByPlane += planeFailed;
@@ -134,14 +137,17 @@ TEST(Explain, TheDecidingPlaneIsTheOneOfLeastMargin) {
     }
     EXPECT_GT(rejectedByPlane, 0u);
     EXPECT_GT(kept, 0u);
+    EXPECT_GT(rejectedVerdicts, 0u); // the verdict check above ran
 }
 
 TEST(Explain, GroundTruthCountsMatchTheTileInspector) {
     const Scene s = smallAtrium();
     const Projection proj(s.camera);
     const RunOutput run = cpuRun(s, minmax());
+    std::size_t neededChecked = 0;
     for (std::uint32_t t = 0; t < run.result.grid.tileCount(); t += 3) {
         const auto needing = pixelsNeedingLights(run.depth, proj, run.lights, run.result.grid, t);
+        neededChecked += needing.size();
         for (const auto& [light, count] : needing) {
             const Explanation e = explainLight(run, proj, listOf(run.result, t, -1), light);
             EXPECT_EQ(e.pixelsNeeding, count) << "tile " << t << " light " << light;
@@ -149,6 +155,7 @@ TEST(Explain, GroundTruthCountsMatchTheTileInspector) {
             EXPECT_NE(e.verdict.find("needed"), std::string::npos) << e.verdict;
         }
     }
+    ASSERT_GT(neededChecked, 0u); // some tile needs some light: the loop above checked something
     // A false positive names the nearest pixel and its distance.
     bool sawFalsePositive = false;
     for (std::uint32_t l = 0; l < run.result.listCount.size() && !sawFalsePositive; ++l)
