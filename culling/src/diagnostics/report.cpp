@@ -53,9 +53,18 @@ std::string roundTrip(double v) {
 
 bool sweptByTable(const ParamSpec& p) { return p.name != "width" && p.name != "height"; }
 
+std::vector<std::string> splitCommas(const std::string& s) {
+    std::vector<std::string> out;
+    std::size_t start = 0;
+    for (std::size_t comma; (comma = s.find(',', start)) != std::string::npos; start = comma + 1)
+        out.push_back(s.substr(start, comma - start));
+    out.push_back(s.substr(start));
+    return out;
+}
+
 // Values of one parameter in the sweep.
 std::vector<std::string> sweepValues(const ParamSpec& p, const ReportOptions& o) {
-    if (auto it = o.fixed.find(p.name); it != o.fixed.end()) return {it->second};
+    if (auto it = o.fixed.find(p.name); it != o.fixed.end()) return splitCommas(it->second);
     auto asText = [](const std::vector<std::uint32_t>& v) {
         std::vector<std::string> s;
         for (auto x : v) s.push_back(std::to_string(x));
@@ -100,9 +109,11 @@ std::vector<ReportConfig> reportConfigs(const ReportOptions& options, const std:
     for (const auto& [name, value] : options.fixed) {
         const ParamSpec& p = cullParam(name); // throws for unknown names
         if (!sweptByTable(p)) throw SettingsError(name, "is part of the camera, not swept by the report");
-        CullSettings s;
-        Camera c;
-        setParam(s, c, name, value); // throws for bad values
+        for (const std::string& v : splitCommas(value)) {
+            CullSettings s;
+            Camera c;
+            setParam(s, c, name, v); // throws for bad (and empty) values
+        }
     }
     std::vector<const ParamSpec*> specs;
     for (const ParamSpec& p : cullParams())
@@ -237,6 +248,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
     }
 
     total += options.shaders.size();
+    rep.queued = total;
     const ViewLights lights = makeViewLights(sceneIn);
     const Projection proj(sceneIn.camera);
     std::size_t done = 0;
@@ -245,69 +257,78 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
     std::shared_ptr<const DepthImage> shaderDepth;
     std::shared_ptr<const std::vector<float>> shaderAll;
     CullBackend* shaderShade = nullptr;
-    for (auto& [backend, cfgs] : work) {
-        if (cancelled(cancel)) throw Cancelled();
-        rep.backendDevices.emplace_back(backend->name(), backend->deviceName());
-        rep.backendTiming.emplace_back(backend->name(), backend->timingMethod());
-        // Depth does not depend on any swept parameter: one pre-pass and one
-        // all-lights image per backend.
-        const DepthImage depth = backend->renderDepth(sceneIn, proj);
-        const ShadeInputs allIn = makeShadeInputs(depth, proj, nullptr);
-        const std::vector<float> allImage = backend->shade(allIn, lights, nullptr);
-        if (!shaderDepth || backend->name() == "vulkan") {
-            shaderDepth = std::make_shared<const DepthImage>(depth);
-            shaderAll = std::make_shared<const std::vector<float>>(allImage);
-            shaderShade = backend.get();
-        }
-        for (const ReportConfig& cfg : cfgs) {
+    try {
+        for (auto& [backend, cfgs] : work) {
             if (cancelled(cancel)) throw Cancelled();
-            const TileGrid grid = TileGrid::make(sceneIn.camera.width, sceneIn.camera.height, cfg.tileSize);
+            rep.backendDevices.emplace_back(backend->name(), backend->deviceName());
+            rep.backendTiming.emplace_back(backend->name(), backend->timingMethod());
+            // Depth does not depend on any swept parameter: one pre-pass and one
+            // all-lights image per backend.
+            const DepthImage depth = backend->renderDepth(sceneIn, proj);
+            const ShadeInputs allIn = makeShadeInputs(depth, proj, nullptr);
+            const std::vector<float> allImage = backend->shade(allIn, lights, nullptr);
+            if (!shaderDepth || backend->name() == "vulkan") {
+                shaderDepth = std::make_shared<const DepthImage>(depth);
+                shaderAll = std::make_shared<const std::vector<float>>(allImage);
+                shaderShade = backend.get();
+            }
+            for (const ReportConfig& cfg : cfgs) {
+                if (cancelled(cancel)) throw Cancelled();
+                const TileGrid grid =
+                    TileGrid::make(sceneIn.camera.width, sceneIn.camera.height, cfg.tileSize);
+                ReportRow row;
+                row.config = cfg;
+                row.device = backend->deviceName();
+                std::vector<double> cullMs;
+                CullResult result;
+                for (int r = 0; r < options.warmup + options.repeat; ++r) {
+                    result = backend->cull(depth, proj, grid, lights, cfg.settings);
+                    if (r >= options.warmup) cullMs.push_back(result.timings.cullMs);
+                }
+                if (const std::string bad = result.validate(lights.size()); !bad.empty())
+                    throw Error("backend '" + backend->name() + "' produced an inconsistent result for " +
+                                cfg.label() + ": " + bad);
+                judgeRow(row, cullMs, result, depth, proj, lights, *backend, allImage, options, cancel);
+                rep.rows.push_back(std::move(row));
+                ++done;
+                if (progress) progress(done, total, cfg.backend + " " + cfg.label());
+            }
+        }
+        for (const CustomShaderOptions& so : options.shaders) {
+            if (cancelled(cancel)) throw Cancelled();
+            if (!shaderDepth) throw Error("custom shaders need a backend for the depth pre-pass");
+            const TileGrid grid =
+                TileGrid::make(sceneIn.camera.width, sceneIn.camera.height, sceneIn.camera.tileSize);
             ReportRow row;
-            row.config = cfg;
-            row.device = backend->deviceName();
+            row.config.backend = "vulkan"; // it runs on a Vulkan device: judged beside the vulkan rows
+            row.config.tileSize = grid.tileSize;
+            const std::string file = std::filesystem::path(so.path).filename().string();
+            row.config.params["algorithm"] = "custom:" + file;
+            row.config.params["tile"] = std::to_string(grid.tileSize);
+            row.config.customLabel = "custom:" + file + " " + toString(so.layout) + " " + toString(so.lists);
             std::vector<double> cullMs;
             CullResult result;
+            CustomCullReport crep;
             for (int r = 0; r < options.warmup + options.repeat; ++r) {
-                result = backend->cull(depth, proj, grid, lights, cfg.settings);
-                if (r >= options.warmup) cullMs.push_back(result.timings.cullMs);
+                crep = CustomCullReport{};
+                result = runCustomShader(so, *shaderDepth, proj, grid, lights, crep);
+                if (r >= options.warmup) cullMs.push_back(crep.passMs);
             }
-            if (const std::string bad = result.validate(lights.size()); !bad.empty())
-                throw Error("backend '" + backend->name() + "' produced an inconsistent result for " + cfg.label() +
-                            ": " + bad);
-            judgeRow(row, cullMs, result, depth, proj, lights, *backend, allImage, options, cancel);
+            row.device = crep.device;
+            judgeRow(row, cullMs, result, *shaderDepth, proj, lights, *shaderShade, *shaderAll, options,
+                     cancel);
+            if (crep.overflowLists || crep.invalidIndices || !crep.validationMessages.empty())
+                rep.notes.push_back(row.config.customLabel + ": " + std::to_string(crep.overflowLists) +
+                                    " overflowed lists, " + std::to_string(crep.invalidIndices) +
+                                    " invalid indices, " + std::to_string(crep.validationMessages.size()) +
+                                    " validation messages");
             rep.rows.push_back(std::move(row));
             ++done;
-            if (progress) progress(done, total, cfg.backend + " " + cfg.label());
+            if (progress) progress(done, total, "custom " + file);
         }
-    }
-    for (const CustomShaderOptions& so : options.shaders) {
-        if (cancelled(cancel)) throw Cancelled();
-        if (!shaderDepth) throw Error("custom shaders need a backend for the depth pre-pass");
-        const TileGrid grid = TileGrid::make(sceneIn.camera.width, sceneIn.camera.height, sceneIn.camera.tileSize);
-        ReportRow row;
-        row.config.backend = "vulkan"; // it runs on a Vulkan device: judged beside the vulkan rows
-        row.config.tileSize = grid.tileSize;
-        const std::string file = std::filesystem::path(so.path).filename().string();
-        row.config.params["algorithm"] = "custom:" + file;
-        row.config.params["tile"] = std::to_string(grid.tileSize);
-        row.config.customLabel = "custom:" + file + " " + toString(so.layout) + " " + toString(so.lists);
-        std::vector<double> cullMs;
-        CullResult result;
-        CustomCullReport crep;
-        for (int r = 0; r < options.warmup + options.repeat; ++r) {
-            crep = CustomCullReport{};
-            result = runCustomShader(so, *shaderDepth, proj, grid, lights, crep);
-            if (r >= options.warmup) cullMs.push_back(crep.passMs);
-        }
-        row.device = crep.device;
-        judgeRow(row, cullMs, result, *shaderDepth, proj, lights, *shaderShade, *shaderAll, options, cancel);
-        if (crep.overflowLists || crep.invalidIndices || !crep.validationMessages.empty())
-            rep.notes.push_back(row.config.customLabel + ": " + std::to_string(crep.overflowLists) + " overflowed lists, " +
-                                std::to_string(crep.invalidIndices) + " invalid indices, " +
-                                std::to_string(crep.validationMessages.size()) + " validation messages");
-        rep.rows.push_back(std::move(row));
-        ++done;
-        if (progress) progress(done, total, "custom " + file);
+    } catch (const Cancelled&) {
+        if (!options.partialOnCancel) throw;
+        rep.cancelled = true; // the rows finished so far are the report
     }
     // Custom shaders run on a Vulkan device of their own: where no vulkan
     // backend was swept, the header still says which device and clock.
@@ -373,6 +394,9 @@ std::string reportMarkdown(const Report& rep) {
           " lights, " + std::to_string(rep.rows.size()) + " configurations; times are medians of " +
           std::to_string(rep.repeat) + " runs after " + std::to_string(rep.warmup) + " untimed. Total = culling pass + shading pass (the depth pre-pass, the "
           "same for every configuration, is not included).\n\n";
+    if (rep.cancelled)
+        md += "**Partial: cancelled after " + std::to_string(rep.rows.size()) + " of " + std::to_string(rep.queued) +
+              " configurations.**\n\n";
     for (std::size_t i = 0; i < rep.backendDevices.size(); ++i)
         md += "- backend `" + rep.backendDevices[i].first + "`: " + rep.backendDevices[i].second + "; timing: " +
               rep.backendTiming[i].second + "\n";

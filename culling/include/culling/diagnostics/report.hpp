@@ -64,7 +64,9 @@ struct ReportOptions {
     std::string device;                // Vulkan device (see makeBackend)
     std::vector<std::uint32_t> tileSizes{8, 16, 32};
     std::vector<std::uint32_t> cellCounts{1, 2, 4, 8, 16, 32};
-    // Parameters held at one value instead of swept (name -> value as text).
+    // Parameters held at one value instead of swept (name -> value as text),
+    // or swept over a subset of their values: a comma-separated list
+    // ("minmax,halfz"; for tile and cells it replaces tileSizes/cellCounts).
     std::map<std::string, std::string> fixed;
     int repeat = 3; // timed runs of cull and of shade per configuration
     int warmup = 1; // untimed runs before them (first-use pipeline compiles)
@@ -72,6 +74,9 @@ struct ReportOptions {
     // scene camera's tile size, beside the vulkan rows: on the vulkan
     // backend's depth when it ran, else the first backend's.
     std::vector<CustomShaderOptions> shaders;
+    // A cancel returns the rows finished so far (Report::cancelled set)
+    // instead of throwing Cancelled: the studio shows what a long sweep made.
+    bool partialOnCancel = false;
 };
 
 struct Report {
@@ -84,6 +89,10 @@ struct Report {
     std::vector<std::pair<std::string, std::string>> backendDevices, backendTiming;
     std::vector<std::string> notes;      // e.g. a backend that could not open
     std::vector<ReportRow> rows;
+    // Configurations the sweep queued (backends that opened, custom shaders):
+    // rows.size() unless the sweep was cancelled.
+    std::size_t queued = 0;
+    bool cancelled = false; // a partial report (ReportOptions::partialOnCancel)
 };
 
 // Whether parameter `name` changes what `algorithm` computes (with `cells`:
@@ -103,8 +112,9 @@ using ReportProgress = std::function<void(std::size_t, std::size_t, const std::s
 
 // Runs the sweep. Per backend: one depth pre-pass and one all-lights shading,
 // then per configuration `repeat` culls and shades and the ground truth.
-// Throws Cancelled when `cancel` fires, Error for bad input; a backend that
-// cannot be opened is skipped with a note unless it is the only one asked for.
+// Throws Cancelled when `cancel` fires (unless options.partialOnCancel), Error
+// for bad input; a backend that cannot be opened is skipped with a note unless
+// it is the only one asked for.
 Report runReport(const Scene& scene, const ReportOptions& options, const ReportProgress& progress = {},
                  const CancelToken* cancel = nullptr);
 
