@@ -258,6 +258,15 @@ void MainWindow::buildDocks() {
                                      tr("report %1/%2 %3").arg(done).arg(total).arg(label));
     });
     connect(report, &ReportDock::finished, this, [this] { statusProgress_->end("report"); });
+    // A point loaded from the chart is culled at once, on its backend and
+    // with the built-in algorithm, so the views show its result.
+    connect(report, &ReportDock::cullRequested, this, [this](const QString& backend) {
+        if (backendCombo_->findText(backend) >= 0) backendCombo_->setCurrentText(backend);
+        if (customShader_)
+            setCustomShader({}); // runs culling
+        else
+            runCulling();
+    });
     reportScroll->setWidgetResizable(true);
     reportScroll->setFrameShape(QFrame::NoFrame);
     auto* reportDock = dock(tr("Report"), "reportDock", reportScroll, Qt::BottomDockWidgetArea);

@@ -4,13 +4,20 @@
 
 #include "culling/core/backend.hpp"
 #include "culling/core/errors.hpp"
+#include "culling/core/pipeline.hpp"
 
 #include <QComboBox>
+#include <QEvent>
 #include <QHBoxLayout>
 #include <QLabel>
+#include <QLocale>
+#include <QMenu>
+#include <QMessageBox>
+#include <QMouseEvent>
 #include <QProgressBar>
 #include <QPushButton>
 #include <QSpinBox>
+#include <QToolButton>
 #include <QVBoxLayout>
 #include <QVTKOpenGLNativeWidget.h>
 
@@ -26,26 +33,68 @@
 #include <vtkPlotPoints.h>
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
+#include <vtkStringArray.h>
 #include <vtkTable.h>
 #include <vtkTextProperty.h>
+#include <vtkTooltipItem.h>
 
 #include <algorithm>
 #include <cmath>
 
 namespace lcui {
 
+namespace {
+
+// "4 h 34 min", "12 min", "40 s".
+QString duration(double seconds) {
+    if (seconds < 1) return ReportDock::tr("under a second");
+    if (seconds < 90) return ReportDock::tr("%1 s").arg(qRound(seconds));
+    const int minutes = qRound(seconds / 60);
+    if (minutes < 90) return ReportDock::tr("%1 min").arg(minutes);
+    return ReportDock::tr("%1 h %2 min").arg(minutes / 60).arg(minutes % 60);
+}
+QString aboutTime(double seconds) {
+    return seconds < 1 ? duration(seconds) : ReportDock::tr("about %1").arg(duration(seconds));
+}
+
+QString count(std::size_t n) { return QLocale(QLocale::English).toString(qulonglong(n)); }
+
+QString join(const std::vector<std::string>& values) {
+    std::string s;
+    for (const std::string& v : values) s += (s.empty() ? "" : ",") + v;
+    return QString::fromStdString(s);
+}
+
+// A held parameter's menu stays open while values are toggled.
+class StayOpen : public QObject {
+public:
+    using QObject::QObject;
+    bool eventFilter(QObject* o, QEvent* e) override {
+        auto* menu = qobject_cast<QMenu*>(o);
+        if (menu && e->type() == QEvent::MouseButtonRelease) {
+            QAction* a = menu->actionAt(static_cast<QMouseEvent*>(e)->pos());
+            if (a && a->isCheckable() && a->isEnabled()) {
+                a->trigger();
+                return true;
+            }
+        }
+        return QObject::eventFilter(o, e);
+    }
+};
+
+} // namespace
+
 ReportDock::ReportDock(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
+    confirm = [](QWidget* parent, const QString& title, const QString& text) {
+        return QMessageBox::question(parent, title, text, QMessageBox::Yes | QMessageBox::No, QMessageBox::No) ==
+               QMessageBox::Yes;
+    };
     auto* layout = new QVBoxLayout(this);
     auto* row = new QHBoxLayout;
     backendBox_ = new QComboBox;
     backendBox_->setObjectName("reportBackend");
     backendBox_->addItem(tr("every backend"), QString());
     for (const std::string& b : lc::availableBackends()) backendBox_->addItem(QString::fromStdString(b), QString::fromStdString(b));
-    algorithmBox_ = new QComboBox;
-    algorithmBox_->setObjectName("reportAlgorithm");
-    algorithmBox_->addItem(tr("every algorithm"), QString());
-    for (const std::string& a : lc::cullParam("algorithm").choices)
-        algorithmBox_->addItem(QString::fromStdString(a), QString::fromStdString(a));
     repeatBox_ = new QSpinBox;
     repeatBox_->setObjectName("reportRepeat");
     repeatBox_->setRange(1, 50);
@@ -61,19 +110,51 @@ ReportDock::ReportDock(Document* doc, QWidget* parent) : QWidget(parent), doc_(d
     cancelButton_->setObjectName("reportCancel");
     cancelButton_->setEnabled(false);
     row->addWidget(backendBox_);
-    row->addWidget(algorithmBox_);
     row->addWidget(repeatBox_);
     row->addWidget(runButton_);
     row->addWidget(cancelButton_);
     row->addWidget(yBox_);
     row->addStretch(1);
     layout->addLayout(row);
+
+    // One menu per swept parameter, from the parameter table: every value
+    // the sweep would take, checked; unchecking holds the parameter at the
+    // rest (ReportOptions::fixed, as the CLI's flags do). Int parameters
+    // other than tile and cells keep their default in the sweep: no menu.
+    auto* paramRow = new QHBoxLayout;
+    paramRow->addWidget(new QLabel(tr("Sweep:")));
+    auto asText = [](const std::vector<std::uint32_t>& v) {
+        std::vector<std::string> s;
+        for (auto x : v) s.push_back(std::to_string(x));
+        return s;
+    };
+    for (const lc::ParamSpec& p : lc::cullParams()) {
+        if (p.name == "tile")
+            addParamControl(p, {"4", "8", "12", "16", "20", "24", "32", "48", "64"}, asText(options_.tileSizes));
+        else if (p.name == "cells")
+            addParamControl(p, {"1", "2", "4", "8", "16", "32"}, asText(options_.cellCounts));
+        else if (p.type == lc::ParamType::Choice)
+            addParamControl(p, p.choices, p.choices);
+        else if (p.type == lc::ParamType::Bool)
+            addParamControl(p, {"false", "true"}, {"false", "true"});
+    }
+    for (const auto& c : params_) paramRow->addWidget(c->button);
+    paramRow->addStretch(1);
+    layout->addLayout(paramRow);
+
+    queue_ = new QLabel;
+    queue_->setObjectName("reportQueue");
+    queue_->setWordWrap(true);
+    layout->addWidget(queue_);
     progress_ = new QProgressBar;
     progress_->setObjectName("reportProgress");
     progress_->setRange(0, 1);
     progress_->setValue(0);
-    status_ = new QLabel(tr("Sweeps every culling configuration of the scene; click a point to load it."));
+    // Counts, not a percentage: one configuration of thousands is 0%.
+    progress_->setFormat(tr("%v of %m"));
+    status_ = new QLabel(tr("Sweeps the culling configurations chosen above; click a point to load and run it."));
     status_->setObjectName("reportStatus");
+    status_->setWordWrap(true);
     auto* row2 = new QHBoxLayout;
     row2->addWidget(progress_, 1);
     row2->addWidget(status_, 2);
@@ -99,12 +180,20 @@ ReportDock::ReportDock(Document* doc, QWidget* parent) : QWidget(parent), doc_(d
     connect(runButton_, &QPushButton::clicked, this, [this] { start(); });
     connect(cancelButton_, &QPushButton::clicked, this, &ReportDock::cancel);
     connect(yBox_, qOverload<int>(&QComboBox::currentIndexChanged), this, [this] { rebuildChart(); });
+    connect(backendBox_, qOverload<int>(&QComboBox::currentIndexChanged), this, &ReportDock::updateQueueLabel);
+    connect(repeatBox_, qOverload<int>(&QSpinBox::valueChanged), this, &ReportDock::updateQueueLabel);
+    // What changes the count (spot lights) or the pace (size, lights, meshes).
+    connect(doc_, &Document::sceneEdited, this, &ReportDock::updateQueueLabel);
+    connect(doc_, &Document::cameraChanged, this, &ReportDock::updateQueueLabel);
+    connect(doc_, &Document::runOutputChanged, this, &ReportDock::onRunOutput);
     // A report describes the scene it swept: another scene (New, Open, a
     // built-in) drops it, and a sweep still running is cancelled and its
     // result never shown, so no click loads one scene's point into another.
     connect(doc_, &Document::sceneReset, this, [this] {
+        loadedRow_ = -1;
+        updateQueueLabel();
         if (running_) {
-            cancel_.cancelled = true;
+            stopSweep();
             ++sweepsDropped_;
         }
         if (!report_ && !running_) return;
@@ -114,40 +203,214 @@ ReportDock::ReportDock(Document* doc, QWidget* parent) : QWidget(parent), doc_(d
         progress_->setValue(0);
         status_->setText(tr("Another scene was opened: run the report for it."));
     });
+    updateQueueLabel();
     rebuildChart();
 }
 
 ReportDock::~ReportDock() {
-    cancel_.cancelled = true;
+    stopSweep();
     if (thread_.joinable()) thread_.join();
+}
+
+void ReportDock::addParamControl(const lc::ParamSpec& p, const std::vector<std::string>& values,
+                                 const std::vector<std::string>& checked) {
+    auto c = std::make_unique<ParamControl>();
+    c->name = p.name;
+    c->values = values;
+    c->button = new QToolButton;
+    c->button->setObjectName(QString::fromStdString("reportParam_" + p.name));
+    c->button->setPopupMode(QToolButton::InstantPopup);
+    c->menu = new QMenu(c->button);
+    c->menu->installEventFilter(new StayOpen(c->menu));
+    QAction* every = c->menu->addAction(tr("Every value"));
+    every->setObjectName("every");
+    c->menu->addSeparator();
+    for (const std::string& v : values) {
+        QAction* a = c->menu->addAction(QString::fromStdString(v));
+        a->setCheckable(true);
+        a->setData(QString::fromStdString(v));
+        a->setChecked(std::find(checked.begin(), checked.end(), v) != checked.end());
+    }
+    c->button->setMenu(c->menu);
+    ParamControl* raw = c.get();
+    connect(c->menu, &QMenu::triggered, this, [this, raw](QAction* a) { paramToggled(*raw, a); });
+    params_.push_back(std::move(c));
+    paramToggled(*raw, nullptr);
+}
+
+void ReportDock::paramToggled(ParamControl& c, QAction* changed) {
+    std::vector<QAction*> values;
+    for (QAction* a : c.menu->actions())
+        if (a->isCheckable()) values.push_back(a);
+    if (changed && !changed->isCheckable()) // Every value
+        for (QAction* a : values) a->setChecked(true);
+    // A parameter holds at least one value: the last one stays checked.
+    if (std::none_of(values.begin(), values.end(), [](QAction* a) { return a->isChecked(); }) && changed)
+        changed->setChecked(true);
+    QStringList on;
+    for (QAction* a : values)
+        if (a->isChecked()) on << a->data().toString();
+    const QString label = QString::fromStdString(lc::cullParam(c.name).label);
+    QString text;
+    if (c.name == "tile" || c.name == "cells" || (on.size() <= 2 && on.size() < int(values.size())))
+        text = on.join(",");
+    else if (on.size() == int(values.size()))
+        text = tr("every (%1)").arg(on.size());
+    else
+        text = tr("%1 of %2").arg(on.size()).arg(values.size());
+    c.button->setText(tr("%1: %2").arg(label, text));
+    c.button->setToolTip(tr("%1 swept over: %2").arg(label, on.join(", ")));
+    if (queue_) updateQueueLabel();
+}
+
+lc::ReportOptions ReportDock::optionsFromControls() const {
+    lc::ReportOptions o = options_;
+    o.backends.clear();
+    if (const QString b = backendBox_->currentData().toString(); !b.isEmpty()) o.backends = {b.toStdString()};
+    o.repeat = repeatBox_->value();
+    for (const auto& c : params_) {
+        std::vector<std::string> on;
+        for (QAction* a : c->menu->actions())
+            if (a->isCheckable() && a->isChecked()) on.push_back(a->data().toString().toStdString());
+        if (c->name == "tile" || c->name == "cells") {
+            std::vector<std::uint32_t>& list = c->name == "tile" ? o.tileSizes : o.cellCounts;
+            list.clear();
+            for (const std::string& v : on) list.push_back(std::uint32_t(std::stoul(v)));
+            o.fixed.erase(c->name);
+        } else if (on.size() == c->values.size()) {
+            o.fixed.erase(c->name); // swept over all its values
+        } else {
+            o.fixed[c->name] = join(on).toStdString();
+        }
+    }
+    return o;
+}
+
+std::vector<std::string> ReportDock::sweptBackends() const {
+    if (const QString b = backendBox_->currentData().toString(); !b.isEmpty()) return {b.toStdString()};
+    return lc::availableBackends();
+}
+
+std::map<std::string, std::size_t> ReportDock::queuedPerBackend() const {
+    const lc::ReportOptions o = optionsFromControls();
+    const auto& lights = doc_->scene().lights;
+    const bool spots = std::any_of(lights.begin(), lights.end(), [](const lc::PointLight& l) { return l.isSpot(); });
+    std::map<std::string, std::size_t> n;
+    for (const std::string& b : sweptBackends()) n[b] = lc::reportConfigs(o, b, spots).size();
+    return n;
+}
+
+std::size_t ReportDock::queuedConfigurations() const {
+    std::size_t total = 0;
+    for (const auto& [b, k] : queuedPerBackend()) total += k;
+    return total;
+}
+
+std::optional<double> ReportDock::estimatedSeconds() const {
+    if (pace_.empty() || paceKey_ != paceKey()) return std::nullopt;
+    double seconds = 0;
+    for (const auto& [b, k] : queuedPerBackend()) {
+        auto it = pace_.find(b);
+        if (it == pace_.end()) return std::nullopt;
+        seconds += double(k) * it->second;
+    }
+    return seconds;
+}
+
+QString ReportDock::paceKey() const {
+    const lc::Scene& s = doc_->scene();
+    return QString("%1|%2x%3|%4 lights|geometry %5|repeat %6 warmup %7")
+        .arg(QString::fromStdString(s.name))
+        .arg(s.camera.width)
+        .arg(s.camera.height)
+        .arg(s.lights.size())
+        .arg(doc_->geometryRevision())
+        .arg(repeatBox_->value())
+        .arg(options_.warmup);
+}
+
+void ReportDock::updateQueueLabel() {
+    std::size_t n = 0;
+    try {
+        n = queuedConfigurations();
+    } catch (const std::exception& e) {
+        queue_->setText(tr("Cannot queue the sweep: %1").arg(QString::fromStdString(e.what())));
+        return;
+    }
+    QString text = n == 1 ? tr("Queues 1 configuration") : tr("Queues %1 configurations").arg(count(n));
+    if (const std::optional<double> s = estimatedSeconds()) {
+        double perConfig = 0;
+        for (const auto& [b, pace] : pace_) perConfig = std::max(perConfig, pace);
+        text += tr(": %1 (an estimate from the last run on this scene, up to %2 s a configuration).")
+                    .arg(aboutTime(*s))
+                    .arg(perConfig, 0, 'g', 2);
+    } else {
+        text += tr("; the time is not known yet: Run times the first configuration and asks before going on "
+                   "when the whole sweep would take over %1.")
+                    .arg(duration(confirmAboveSeconds));
+    }
+    queue_->setText(text);
+}
+
+void ReportDock::releaseGate() {
+    if (!gate_) return;
+    {
+        std::lock_guard lock(gate_->mutex);
+        gate_->open = true;
+    }
+    gate_->cv.notify_all();
+    gate_.reset();
+}
+
+void ReportDock::stopSweep() {
+    cancel_.cancelled = true;
+    releaseGate();
 }
 
 bool ReportDock::start() {
     if (running_) return false;
     if (thread_.joinable()) thread_.join();
-    options_.backends.clear();
-    if (const QString b = backendBox_->currentData().toString(); !b.isEmpty()) options_.backends = {b.toStdString()};
-    if (const QString a = algorithmBox_->currentData().toString(); !a.isEmpty())
-        options_.fixed["algorithm"] = a.toStdString();
-    else
-        options_.fixed.erase("algorithm");
-    options_.repeat = repeatBox_->value();
+    std::size_t queued = 0;
+    try {
+        queued = queuedConfigurations();
+    } catch (const std::exception& e) {
+        status_->setText(tr("Failed: %1").arg(QString::fromStdString(e.what())));
+        return false;
+    }
+    const std::optional<double> estimate = estimatedSeconds();
+    if (estimate && *estimate > confirmAboveSeconds &&
+        !confirm(this, tr("Run report"),
+                 tr("This sweep queues %1 configurations: %2 (an estimate from the last run on this scene). "
+                    "Run it?")
+                     .arg(count(queued), aboutTime(*estimate)))) {
+        status_->setText(tr("Not started: hold some parameters above to queue fewer configurations."));
+        return false;
+    }
+    options_ = optionsFromControls();
     cancel_.cancelled = false;
+    // Without a pace the first configuration is the timing: the worker waits
+    // after it until onProgress has estimated the rest.
+    gate_ = !estimate && queued > 1 ? std::make_shared<Gate>() : nullptr;
     running_ = true;
     runButton_->setEnabled(false);
     cancelButton_->setEnabled(true);
-    progress_->setRange(0, 0); // busy until the first progress report
-    status_->setText(tr("Opening backends..."));
+    progress_->setRange(0, 0); // busy until the first configuration
+    status_->setText(tr("Opening backends, depth pre-pass..."));
+    runPace_.clear();
+    runPaceKey_ = paceKey();
+    activeMs_ = lastProgressMs_ = 0;
+    clock_.start();
     emit started();
     const lc::Scene scene = doc_->scene();
-    const lc::ReportOptions options = options_;
+    lc::ReportOptions options = options_;
+    options.partialOnCancel = true;
     const int dropped = sweepsDropped_;
-    thread_ = std::thread([this, scene, options, dropped] {
+    thread_ = std::thread([this, scene, options, dropped, gate = gate_] {
         std::shared_ptr<lc::Report> rep;
         QString error;
         bool cancelled = false;
         try {
-            auto progress = [this, dropped](std::size_t done, std::size_t total, const std::string& label) {
+            auto progress = [this, dropped, gate](std::size_t done, std::size_t total, const std::string& label) {
                 const QString text = QString::fromStdString(label);
                 QMetaObject::invokeMethod(
                     this,
@@ -155,6 +418,10 @@ bool ReportDock::start() {
                         if (dropped == sweepsDropped_) onProgress(int(done), int(total), text);
                     },
                     Qt::QueuedConnection);
+                if (gate && done == 1) {
+                    std::unique_lock lock(gate->mutex);
+                    gate->cv.wait(lock, [&] { return gate->open; });
+                }
             };
             rep = std::make_shared<lc::Report>(lc::runReport(scene, options, progress, &cancel_));
         } catch (const lc::Cancelled&) {
@@ -176,34 +443,91 @@ bool ReportDock::start() {
 
 void ReportDock::cancel() {
     if (!running_) return;
-    cancel_.cancelled = true;
+    stopSweep();
     status_->setText(tr("Cancelling..."));
 }
 
 void ReportDock::onProgress(int done, int total, const QString& label) {
+    const qint64 now = clock_.elapsed();
+    activeMs_ += now - lastProgressMs_;
+    auto& [ms, n] = runPace_[label.section(' ', 0, 0).toStdString()]; // the label starts with the backend
+    ms += now - lastProgressMs_;
+    ++n;
+    lastProgressMs_ = now;
     progress_->setRange(0, std::max(total, 1));
     progress_->setValue(done);
-    status_->setText(tr("%1/%2 %3").arg(done).arg(total).arg(label));
+    const double left = double(activeMs_) / std::max(done, 1) * (total - done) / 1000.0;
+    status_->setText(done < total ? tr("%1 left (at this run's pace); last: %2").arg(aboutTime(left), label)
+                                  : tr("last: %1").arg(label));
     emit progressed(done, total, label);
+    if (done == 1 && gate_) {
+        // The first configuration timed: the estimate of the whole sweep.
+        const double estimate = double(activeMs_) / 1000.0 * total;
+        if (estimate > confirmAboveSeconds) {
+            const bool go = confirm(
+                this, tr("Run report"),
+                tr("This sweep queues %1 configurations: %2 (an estimate from its first configuration, which took "
+                   "%3 s). Go on? No keeps the one that finished.")
+                    .arg(count(std::size_t(total)), aboutTime(estimate))
+                    .arg(double(activeMs_) / 1000.0, 0, 'g', 2));
+            if (!go) cancel_.cancelled = true;
+            lastProgressMs_ = clock_.elapsed(); // the question's time is not the sweep's
+        }
+        releaseGate();
+    }
 }
 
 void ReportDock::onDone(std::shared_ptr<lc::Report> report, const QString& error, bool cancelled, bool sceneGone) {
     if (thread_.joinable()) thread_.join();
+    gate_.reset();
     running_ = false;
     runButton_->setEnabled(true);
     cancelButton_->setEnabled(false);
     if (progress_->maximum() == 0) progress_->setRange(0, 1);
-    if (report) {
-        report_ = std::move(report);
-        progress_->setValue(progress_->maximum());
-        status_->setText(tr("%1 configurations; click a point to load it.").arg(report_->rows.size()));
-        rebuildChart();
-    } else {
-        progress_->setValue(0);
-        if (!sceneGone) // else the message of the scene's reset stays
-            status_->setText(cancelled ? tr("Cancelled; the previous report is kept.") : tr("Failed: %1").arg(error));
+    // The pace of this sweep estimates the next one of the same scene.
+    if (!sceneGone && !runPace_.empty()) {
+        pace_.clear();
+        for (const auto& [backend, msn] : runPace_) pace_[backend] = double(msn.first) / 1000.0 / msn.second;
+        paceKey_ = runPaceKey_;
     }
-    emit finished(report_ != nullptr && !cancelled && error.isEmpty());
+    const bool partial = report && report->cancelled;
+    if (report && !(partial && report->rows.empty())) {
+        report_ = std::move(report);
+        loadedRow_ = -1;
+        rebuildChart();
+        if (partial) {
+            status_->setText(tr("Partial report: cancelled after %1 of %2 configurations. %3")
+                                 .arg(report_->rows.size())
+                                 .arg(report_->queued)
+                                 .arg(summary()));
+        } else {
+            progress_->setValue(progress_->maximum());
+            status_->setText(tr("%1 configurations in %2. %3")
+                                 .arg(report_->rows.size())
+                                 .arg(duration(clock_.elapsed() / 1000.0))
+                                 .arg(summary()));
+        }
+    } else if (!sceneGone) { // else the message of the scene's reset stays
+        progress_->setValue(0);
+        status_->setText(partial || cancelled ? tr("Cancelled before a configuration finished; the previous report is kept.")
+                                              : tr("Failed: %1").arg(error));
+    }
+    updateQueueLabel();
+    emit finished(report_ != nullptr && !partial && !cancelled && error.isEmpty() && !sceneGone);
+}
+
+QString ReportDock::summary() const {
+    if (!report_) return {};
+    const lc::ReportRow* fastest = nullptr;
+    for (const lc::ReportRow& r : report_->rows)
+        if (r.falseNegatives == 0 && r.totalMs > 0 && (!fastest || r.totalMs < fastest->totalMs)) fastest = &r;
+    QString s = fastest ? tr("Fastest without false negatives: %1 on %2, %3 ms (efficiency %4).")
+                              .arg(QString::fromStdString(fastest->config.label()),
+                                   QString::fromStdString(fastest->config.backend))
+                              .arg(fastest->totalMs, 0, 'f', 3)
+                              .arg(fastest->efficiency, 0, 'f', 3)
+                        : tr("Every configuration misses lights.");
+    return s + tr(" Click a point to load and run it.");
 }
 
 double ReportDock::yOf(const lc::ReportRow& r) const {
@@ -226,6 +550,11 @@ vtkPlot* ReportDock::addSeries(int plotType, const std::string& name, const std:
     vtkPlot* plot = chart_->AddPlot(plotType);
     plot->SetInputData(table, 0, 1);
     plot->SetLabel(name);
+    // Hovering a point names its configuration, not just its numbers.
+    vtkNew<vtkStringArray> labels;
+    for (std::size_t row : rowIndices) labels->InsertNextValue(tooltipOf(row).toStdString());
+    plot->SetIndexedLabels(labels);
+    plot->SetTooltipLabelFormat("%i");
     return plot;
 }
 
@@ -240,9 +569,13 @@ void ReportDock::rebuildChart() {
         chartWidget_->renderWindow()->Render();
         return;
     }
-    chart_->SetTitle(report_->sceneName + ", " + std::to_string(report_->width) + "x" +
-                     std::to_string(report_->height) + ", " + std::to_string(report_->lights) + " lights");
     const auto& rows = report_->rows;
+    std::string title = report_->sceneName + ", " + std::to_string(report_->width) + "x" +
+                        std::to_string(report_->height) + ", " + std::to_string(report_->lights) + " lights";
+    if (report_->cancelled)
+        title += " (partial: cancelled after " + std::to_string(rows.size()) + " of " +
+                 std::to_string(report_->queued) + ")";
+    chart_->SetTitle(title);
     double xmin = 1e300, xmax = 0;
     for (const lc::ReportRow& r : rows)
         if (r.totalMs > 0) xmin = std::min(xmin, r.totalMs), xmax = std::max(xmax, r.totalMs);
@@ -307,9 +640,51 @@ void ReportDock::loadRow(std::size_t row) {
         cam.tileSize = cfg.tileSize;
         doc_->setCamera(cam, tr("Set tile size (from the report)"));
     }
-    status_->setText(tr("Loaded %1 (%2)").arg(QString::fromStdString(cfg.label()), QString::fromStdString(cfg.backend)));
+    loadedRow_ = int(row);
+    status_->setText(tr("Loaded %1 (%2): culling it...").arg(QString::fromStdString(cfg.label()),
+                                                            QString::fromStdString(cfg.backend)));
     emit configurationLoaded(int(row));
+    // Loading alone would leave the previous run on screen as if it were
+    // this configuration's.
+    emit cullRequested(QString::fromStdString(cfg.backend));
 }
+
+void ReportDock::onRunOutput() {
+    if (!report_ || loadedRow_ < 0 || std::size_t(loadedRow_) >= report_->rows.size()) return;
+    const auto run = doc_->runOutput();
+    if (!run) return;
+    // Is the run the loaded configuration's? Every parameter the row names.
+    const lc::ReportRow& r = report_->rows[std::size_t(loadedRow_)];
+    lc::Camera cam;
+    cam.tileSize = run->result.grid.tileSize;
+    for (const auto& [name, value] : r.config.params)
+        if (!value.empty() && lc::getParam(run->result.settings, cam, name) != value) return;
+    status_->setText(tr("Showing %1: the views show its run (false negatives %2, efficiency %3; in the report %4, "
+                        "%5).")
+                         .arg(QString::fromStdString(r.config.label()))
+                         .arg(run->truthComputed ? QString::number(run->truth.metrics.falseNegatives) : tr("not yet"))
+                         .arg(run->truthComputed ? QString::number(run->truth.metrics.efficiency, 'f', 3) : tr("not yet"))
+                         .arg(r.falseNegatives)
+                         .arg(r.efficiency, 0, 'f', 3));
+    if (run->truthComputed) loadedRow_ = -1;
+}
+
+QString ReportDock::tooltipOf(std::size_t row) const {
+    if (!report_ || row >= report_->rows.size()) return {};
+    const lc::ReportRow& r = report_->rows[row];
+    return tr("%1 (%2)\ntotal %3 ms = cull %4 + shade %5\nefficiency %6, false negatives %7, image RMSE %8")
+        .arg(QString::fromStdString(r.config.label()), QString::fromStdString(r.config.backend))
+        .arg(r.totalMs, 0, 'f', 3)
+        .arg(r.cullMs, 0, 'f', 3)
+        .arg(r.shadeMs, 0, 'f', 3)
+        .arg(r.efficiency, 0, 'f', 3)
+        .arg(r.falseNegatives)
+        .arg(r.imageRmse, 0, 'g', 3);
+}
+
+QString ReportDock::chartTooltip() const { return QString::fromStdString(chart_->GetTooltip()->GetText()); }
+bool ReportDock::chartTooltipVisible() const { return chart_->GetTooltip()->GetVisible(); }
+QString ReportDock::chartTitle() const { return QString::fromStdString(chart_->GetTitle()); }
 
 std::optional<QPoint> ReportDock::chartPositionOf(std::size_t row) const {
     if (!report_ || row >= report_->rows.size()) return std::nullopt;
