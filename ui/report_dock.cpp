@@ -330,6 +330,14 @@ QString ReportDock::paceKey() const {
 }
 
 void ReportDock::updateQueueLabel() {
+    // spot-* parameters are swept only for a scene with spot lights.
+    const auto& lights = doc_->scene().lights;
+    const bool spots = std::any_of(lights.begin(), lights.end(), [](const lc::PointLight& l) { return l.isSpot(); });
+    for (const auto& c : params_)
+        if (c->name.rfind("spot-", 0) == 0) {
+            c->button->setEnabled(spots);
+            if (!spots) c->button->setToolTip(tr("The scene has no spot light: not swept."));
+        }
     std::size_t n = 0;
     try {
         n = queuedConfigurations();
