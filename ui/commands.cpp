@@ -35,6 +35,13 @@ SetLightCommand::SetLightCommand(Document* doc, int index, lc::PointLight from, 
     : doc_(doc), index_(index), from_(std::move(from)), to_(std::move(to)) {
     setText(QObject::tr("Edit light %1").arg(QString::fromStdString(to_.name)));
 }
+SetGltfCutoffCommand::SetGltfCutoffCommand(Document* doc, std::vector<int> lights, double from, double to)
+    : doc_(doc), lights_(std::move(lights)), from_(from), to_(to) {
+    setText(QObject::tr("glTF light cut-off %1 lux").arg(to));
+}
+void SetGltfCutoffCommand::undo() { doc_->applyGltfCutoff(lights_, from_); }
+void SetGltfCutoffCommand::redo() { doc_->applyGltfCutoff(lights_, to_); }
+
 void SetLightCommand::undo() { doc_->applyLight(index_, from_); }
 void SetLightCommand::redo() { doc_->applyLight(index_, to_); }
 

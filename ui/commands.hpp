@@ -46,6 +46,20 @@ private:
     double from_, to_;
 };
 
+// File > glTF light cut-off on the open scene: the I_min of the lights that
+// take their radius from the glTF cut-off, and the scene's record of it.
+class SetGltfCutoffCommand : public QUndoCommand {
+public:
+    SetGltfCutoffCommand(Document* doc, std::vector<int> lights, double from, double to);
+    void undo() override;
+    void redo() override;
+
+private:
+    Document* doc_;
+    std::vector<int> lights_;
+    double from_, to_;
+};
+
 class SetLightCommand : public QUndoCommand {
 public:
     SetLightCommand(Document* doc, int index, lc::PointLight from, lc::PointLight to);

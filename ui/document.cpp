@@ -3,6 +3,7 @@
 #include "commands.hpp"
 
 #include "culling/core/file_io.hpp"
+#include "culling/scene/gltf_io.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -186,6 +187,22 @@ bool Document::runIsStale() const {
     for (const auto& p : pending_)
         if (p.second == sceneRevision_) return false;
     return true;
+}
+
+int Document::setGltfCutoff(double lux) {
+    const std::vector<std::size_t> cut = lc::gltfCutoffLights(scene_);
+    if (cut.empty() || !(lux > 0) || lux == scene_.origin.gltfMinIntensity) return 0;
+    std::vector<int> lights(cut.begin(), cut.end());
+    const int n = int(lights.size());
+    undo_.push(new SetGltfCutoffCommand(this, std::move(lights), scene_.origin.gltfMinIntensity, lux));
+    return n;
+}
+
+void Document::applyGltfCutoff(const std::vector<int>& lights, double lux) {
+    for (int i : lights) scene_.lights[std::size_t(i)].minIntensity = lux;
+    scene_.origin.gltfMinIntensity = lux;
+    emit lightsChanged();
+    edited();
 }
 
 void Document::setExplainedList(int list) {

@@ -93,6 +93,10 @@ public:
     void duplicateLights(const std::vector<int>& indices);
     void deleteLights(std::vector<int> indices);
     void setCamera(const lc::Camera& camera, const QString& text = tr("Edit camera"));
+    // A new glTF light cut-off for the open scene: the lights that took their
+    // radius from the cut-off (lc::gltfCutoffLights) get I_min = `lux`, one
+    // undo step. Returns how many; 0 (and no step) when the scene has none.
+    int setGltfCutoff(double lux);
     void importMesh(lc::Mesh mesh);
 
     // --- latest culling run ----------------------------------------------------
@@ -128,6 +132,7 @@ public:
                            bool select);
     void applyRemoveLights(const std::vector<int>& indices); // ascending
     void applyCamera(const lc::Camera& c);
+    void applyGltfCutoff(const std::vector<int>& lights, double lux);
     void applyAddMesh(const lc::Mesh& m);
     void applyRemoveLastMesh();
 

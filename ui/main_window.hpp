@@ -201,6 +201,7 @@ private:
     QLabel* statusFn_;
     QLabel* statusEfficiency_;
     QLabel* statusLists_;
+    QLabel* statusCutoff_;
     StatusProgress* statusProgress_ = nullptr; // loads, shading and reports, with Cancel
     QString lastBackendName_, lastDeviceName_;
     // The newest run that failed (0: none): while it is newer than the run

@@ -16,6 +16,7 @@
 
 #include <QAction>
 #include <QElapsedTimer>
+#include <QLabel>
 #include <QMessageBox>
 #include <QMimeData>
 #include <QPlainTextEdit>
@@ -256,6 +257,58 @@ private slots:
         w_.reset();
         w_ = lctest::makeTestWindow();
         QCOMPARE(w_->gltfOptions.minIntensity, 0.5);
+        w_->setGltfMinIntensity(lc::kGltfDefaultMinIntensity);
+    }
+
+    // File > glTF light cut-off acts on the open scene: the lights without a
+    // range get the new radius at once, as one undo step; lights with a range
+    // keep theirs; the status bar names the cut-off; radii wider than the
+    // scene are warned about.
+    void lightCutoffAppliesToTheOpenSceneAsOneUndoStep() {
+        lc::Scene s = smallAtrium();
+        s.lights.resize(2);
+        for (auto& l : s.lights) {
+            l.kind = lc::LightKind::Point;
+            l.intensity = 80.0;
+            l.color = glm::dvec3(1.0);
+        }
+        s.lights[0].explicitRadius = 0.0;
+        s.lights[1].explicitRadius = 1.5;
+        const QString p = tmp_.path() + "/cutoff.gltf";
+        {
+            auto j = nlohmann::json::parse(lc::serializeGltf(s, false));
+            auto& light = j["extensions"]["KHR_lights_punctual"]["lights"][0];
+            light.erase("range");
+            light.erase("extras");
+            std::ofstream(p.toStdString()) << j.dump();
+        }
+        w_->runOnOpen = false;
+        w_->setGltfMinIntensity(lc::kGltfDefaultMinIntensity);
+        QVERIFY(w_->openSceneFile(p));
+        const double before = doc()->scene().lights[0].radius();
+        QVERIFY(std::abs(before - std::sqrt(80.0 / lc::kGltfDefaultMinIntensity)) < 1e-9);
+        // sqrt(80 / 0.01) = 89 m, wider than the atrium: warned.
+        const auto* cutLabel = w_->findChild<QLabel*>("statusCutoff");
+        QVERIFY(cutLabel);
+        QVERIFY2(cutLabel->text().contains("cut-off 0.01 lux (1 lights)"), qPrintable(cutLabel->text()));
+        QVERIFY(!lc::cutoffCoverageWarning(doc()->scene()).empty());
+        const int steps = doc()->undoStack()->count();
+
+        w_->prompts.askNumber = [](QWidget*, const QString&, const QString&, double, double, double& v) {
+            v = 2.0;
+            return true;
+        };
+        w_->action("actionGltfCutoff")->trigger();
+        QCOMPARE(doc()->undoStack()->count(), steps + 1);
+        QVERIFY(std::abs(doc()->scene().lights[0].radius() - std::sqrt(40.0)) < 1e-12); // sqrt(80 / 2)
+        QCOMPARE(doc()->scene().lights[1].radius(), 1.5);
+        QVERIFY2(cutLabel->text().contains("cut-off 2 lux"), qPrintable(cutLabel->text()));
+        QVERIFY(w_->messageLog()->toPlainText().contains("radii of 1 lights without a range re-derived"));
+        QVERIFY(lc::cutoffCoverageWarning(doc()->scene()).empty());
+
+        doc()->undoStack()->undo();
+        QVERIFY(std::abs(doc()->scene().lights[0].radius() - before) < 1e-12);
+        QVERIFY2(cutLabel->text().contains("cut-off 0.01 lux"), qPrintable(cutLabel->text()));
         w_->setGltfMinIntensity(lc::kGltfDefaultMinIntensity);
     }
 

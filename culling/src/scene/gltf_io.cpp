@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -1115,8 +1116,42 @@ Scene loadSceneAny(const std::string& path, const GltfReadOptions& options, Gltf
         s.origin.gltfCamera = rep.camera;
         s.origin.gltfMinIntensity = options.minIntensity;
         s.origin.foreignGltf = rep.generator != kGltfGenerator;
+        if (std::string w = cutoffCoverageWarning(s); !w.empty()) rep.warnings.push_back(path + ": " + w);
     }
     return s;
+}
+
+std::vector<std::size_t> gltfCutoffLights(const Scene& scene) {
+    std::vector<std::size_t> out;
+    const double lux = scene.origin.gltfMinIntensity;
+    if (!(lux > 0)) return out;
+    for (std::size_t i = 0; i < scene.lights.size(); ++i)
+        if (scene.lights[i].explicitRadius == 0.0 && scene.lights[i].minIntensity == lux) out.push_back(i);
+    return out;
+}
+
+std::string cutoffCoverageWarning(const Scene& scene) {
+    const std::vector<std::size_t> cut = gltfCutoffLights(scene);
+    if (cut.empty() || scene.meshes.empty()) return {};
+    const auto [lo, hi] = scene.bounds();
+    const double across = glm::length(hi - lo);
+    if (!(across > 0)) return {};
+    std::size_t wide = 0;
+    double largest = 0;
+    for (std::size_t i : cut) {
+        if (!scene.lights[i].validate().empty()) continue;
+        const double r = scene.lights[i].radius();
+        largest = std::max(largest, r);
+        wide += r > across;
+    }
+    if (wide == 0) return {};
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "%zu of the %zu lights without a range reach farther than the scene is wide (radius up to %.3g at "
+                  "I_min %g lux; the scene is %.3g across): each lands in every list near it; raise the cut-off "
+                  "(--min-intensity, File > glTF light cut-off) or give the lights a range",
+                  wide, cut.size(), largest, scene.origin.gltfMinIntensity, across);
+    return buf;
 }
 
 void saveSceneAny(const Scene& scene, const std::string& path) {
@@ -1127,7 +1162,13 @@ void saveSceneAny(const Scene& scene, const std::string& path) {
 Camera frameBounds(const glm::dvec3& lo, const glm::dvec3& hi, const Camera& base) {
     Camera c = base;
     const glm::dvec3 centre = (lo + hi) * 0.5;
-    const double radius = std::max(0.5 * glm::length(hi - lo), 1e-3);
+    // The camera's offset from the centre must survive rounding: far from the
+    // origin (a mesh at 1e20) a small radius vanished in centre + offset and
+    // the camera sat on its target, an invalid camera from a reader (found by
+    // fuzz_scene_json and fuzz_gltf). 1e-9 of the centre's largest coordinate
+    // keeps the offset ~1e6 ulps clear; nearer the origin it is below 1e-3.
+    const double reach = std::max({std::abs(centre.x), std::abs(centre.y), std::abs(centre.z)});
+    const double radius = std::max({0.5 * glm::length(hi - lo), 1e-3, 1e-9 * reach});
     // From the front (+Z), a little above, as a person first looks at a model.
     const glm::dvec3 dir = glm::normalize(glm::dvec3(0.0, 0.45, 1.0));
     double distance;

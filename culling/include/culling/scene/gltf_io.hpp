@@ -65,6 +65,15 @@ std::string serializeGltf(const Scene& scene, bool binary);
 void saveGltfScene(const Scene& scene, const std::string& path);
 
 // Any scene file: .gltf/.glb through loadGltfScene, everything else as scene JSON.
+// The lights of a glTF scene that take their radius from the cut-off (no
+// `range`: explicitRadius 0 and I_min the scene was read with,
+// SceneOrigin::gltfMinIntensity), by index. Empty for other scenes.
+std::vector<std::size_t> gltfCutoffLights(const Scene& scene);
+// A warning when cut-off radii reach farther than the scene is wide (such a
+// light lands in every list around it, and the heat map turns uniform): how
+// many, the largest radius, the scene's size and what to do. Empty otherwise.
+std::string cutoffCoverageWarning(const Scene& scene);
+
 Scene loadSceneAny(const std::string& path, const GltfReadOptions& options = {}, GltfReadReport* report = nullptr,
                    const CancelToken* cancel = nullptr, const Progress& progress = {});
 // Saves by extension: .gltf/.glb as glTF, anything else as scene JSON.
