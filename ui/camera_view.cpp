@@ -9,6 +9,8 @@
 #include "culling/diagnostics/overlays.hpp"
 
 #include <QHelpEvent>
+#include <QMouseEvent>
+#include <QWheelEvent>
 #include <QTimer>
 #include <QToolTip>
 #include <vtkActor.h>
@@ -36,28 +38,52 @@
 #include <vtkScalarBarActor.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkTransformPolyDataFilter.h>
 #include <vtkUnsignedCharArray.h>
 #include <QVTKInteractor.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 namespace lcui {
 
 namespace {
-constexpr int kLegendWidthPx = 110; // band to the right of the image for the legend
+constexpr int kLegendWidthPx = 110;  // band to the right of the image for the legend
+constexpr int kLegendHeightPx = 76;  // or under it: a horizontal legend and the caption
 
-// 2D mapper whose points are in the renderer's normalised viewport
-// coordinates: (0,0) bottom-left, (1,1) top-right of the letterboxed image.
-vtkSmartPointer<vtkPolyDataMapper2D> normalizedMapper(vtkPolyData* pd) {
+// 2D mapper whose points are in normalised image coordinates: (0,0)
+// bottom-left, (1,1) top-right of the whole culling image. `zoom` takes them
+// into the renderer's normalised viewport (identity at zoom 1); the renderer
+// scissors what falls outside its viewport.
+vtkSmartPointer<vtkPolyDataMapper2D> normalizedMapper(vtkPolyData* pd, vtkTransform* zoom) {
+    if (!pd->GetPoints()) pd->SetPoints(vtkSmartPointer<vtkPoints>::New()); // see clearOverlay
     auto coord = vtkSmartPointer<vtkCoordinate>::New();
     coord->SetCoordinateSystemToNormalizedViewport();
+    auto xf = vtkSmartPointer<vtkTransformPolyDataFilter>::New();
+    xf->SetInputData(pd);
+    xf->SetTransform(zoom);
     auto m = vtkSmartPointer<vtkPolyDataMapper2D>::New();
-    m->SetInputData(pd);
+    m->SetInputConnection(xf->GetOutputPort());
     m->SetTransformCoordinate(coord);
     return m;
+}
+
+// Empties an overlay's polydata but keeps a (empty) point set: the zoom's
+// transform filter reports an error for polydata without one.
+void clearOverlay(vtkPolyData* pd) {
+    pd->Initialize();
+    pd->SetPoints(vtkSmartPointer<vtkPoints>::New());
+}
+
+// A scalar bar's title for its orientation: two short lines beside the
+// image, one line under it.
+std::string barTitle(const std::string& twoLines, bool horizontal) {
+    std::string t = twoLines;
+    if (horizontal) std::replace(t.begin(), t.end(), '\n', ' ');
+    return t;
 }
 
 // Copies an RGB8 picture (row 0 at the top) into `out` (VTK rows go up).
@@ -138,18 +164,18 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
     lut_->SetAlphaRange(0.55, 0.55);
     lut_->SetNumberOfTableValues(256);
     lut_->Build();
-    auto heatMapper = normalizedMapper(heatData_);
+    auto heatMapper = normalizedMapper(heatData_, overlayTransform_);
     heatMapper->SetScalarModeToUseCellData();
     heatMapper->SetLookupTable(lut_);
     heatMapper->UseLookupTableScalarRangeOn();
     heatActor_->SetMapper(heatMapper);
-    gridActor_->SetMapper(normalizedMapper(gridData_));
+    gridActor_->SetMapper(normalizedMapper(gridData_, overlayTransform_));
     gridActor_->GetProperty()->SetColor(1, 1, 1);
     gridActor_->GetProperty()->SetOpacity(0.3);
-    selActor_->SetMapper(normalizedMapper(selData_));
+    selActor_->SetMapper(normalizedMapper(selData_, overlayTransform_));
     selActor_->GetProperty()->SetColor(1, 1, 0);
     selActor_->GetProperty()->SetLineWidth(3);
-    reverseActor_->SetMapper(normalizedMapper(reverseData_));
+    reverseActor_->SetMapper(normalizedMapper(reverseData_, overlayTransform_));
     reverseActor_->GetProperty()->SetColor(1.0, 0.3, 1.0);
     reverseActor_->GetProperty()->SetLineWidth(2);
     scene_->AddActor2D(heatActor_);
@@ -158,7 +184,8 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
     scene_->AddActor2D(selActor_);
 
     legend_->SetLookupTable(lut_);
-    legend_->SetTitle("lights\nper tile");
+    legendTitle_ = "lights\nper tile";
+    legend_->SetTitle(legendTitle_.c_str());
     legend_->SetNumberOfLabels(5);
     legend_->SetLabelFormat("%.0f");
     legend_->SetMaximumWidthInPixels(kLegendWidthPx - 10);
@@ -221,6 +248,8 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
 
     connect(doc_, &Document::sceneReset, this, [this] {
         picturesRun_.reset();
+        zoom_ = 1.0;
+        centreU_ = centreV_ = 0.5;
         rebuildMeshes();
         updateCamera();
         updateOverlay();
@@ -284,22 +313,136 @@ void CameraView::resizeEvent(QResizeEvent* e) {
 void CameraView::updateViewport() {
     const lc::Camera& cam = doc_->scene().camera;
     const double w = std::max(1, width()), h = std::max(1, height());
-    const double availW = std::max(1.0, w - kLegendWidthPx);
     const double aspect = cam.aspect();
-    double vw = availW, vh = availW / aspect;
-    if (vh > h) {
-        vh = h;
-        vw = h * aspect;
-    }
-    const double x0 = (availW - vw) / 2, y0 = (h - vh) / 2;
+    // The image's letterbox in a w x h area (its largest size at the aspect).
+    auto fit = [aspect](double aw, double ah) {
+        double vw = std::max(1.0, aw), vh = vw / aspect;
+        if (vh > ah) {
+            vh = std::max(1.0, ah);
+            vw = vh * aspect;
+        }
+        return std::pair{vw, vh};
+    };
+    // The legend never eats the image: it goes beside or under the image,
+    // wherever the image then stays larger (a 16:9 image in a tall view
+    // leaves the band under it empty anyway).
+    const auto [rw, rh] = fit(w - kLegendWidthPx, h);
+    const auto [bw, bh] = fit(w, h - kLegendHeightPx);
+    legendPlace_ = bw * bh > rw * rh ? LegendPlace::Below : LegendPlace::Right;
+    const bool below = legendPlace_ == LegendPlace::Below;
+    const double vw = below ? bw : rw, vh = below ? bh : rh;
+    const double x0 = below ? (w - vw) / 2 : (w - kLegendWidthPx - vw) / 2;
+    const double y0 = below ? kLegendHeightPx + (h - kLegendHeightPx - vh) / 2 : (h - vh) / 2;
     scene_->SetViewport(x0 / w, y0 / h, (x0 + vw) / w, (y0 + vh) / h);
     image_->SetViewport(scene_->GetViewport());
     meshes_->SetViewport(scene_->GetViewport());
     for (vtkScalarBarActor* bar : {legend_.Get(), diffLegend_.Get()}) {
-        bar->SetPosition((availW + 6) / w, 0.08);
-        bar->SetWidth((kLegendWidthPx - 10) / w);
-        bar->SetHeight(0.84);
+        if (below) {
+            // Right-aligned under the image; the caption keeps the left.
+            const double lw = std::min(vw * 0.55, 340.0);
+            bar->SetOrientationToHorizontal();
+            bar->SetPosition((x0 + vw - lw) / w, 22 / h);
+            bar->SetWidth(lw / w);
+            bar->SetHeight((kLegendHeightPx - 26) / h);
+            bar->SetMaximumWidthInPixels(int(lw));
+            bar->SetMaximumHeightInPixels(kLegendHeightPx - 26);
+        } else {
+            bar->SetOrientationToVertical();
+            bar->SetPosition((w - kLegendWidthPx + 6) / w, 0.08);
+            bar->SetWidth((kLegendWidthPx - 10) / w);
+            bar->SetHeight(0.84);
+            bar->SetMaximumWidthInPixels(kLegendWidthPx - 10);
+            bar->SetMaximumHeightInPixels(100000);
+        }
     }
+    legend_->SetTitle(barTitle(legendTitle_, below).c_str());
+    diffLegend_->SetTitle(barTitle("abs.\nerror", below).c_str());
+    applyZoom();
+}
+
+QRect CameraView::imageRect() const {
+    const double* vp = scene_->GetViewport();
+    const double w = width(), h = height();
+    return QRect(QPoint(int(std::lround(vp[0] * w)), int(std::lround((1 - vp[3]) * h))),
+                 QPoint(int(std::lround(vp[2] * w)) - 1, int(std::lround((1 - vp[1]) * h)) - 1));
+}
+
+void CameraView::setZoom(double zoom, QPointF centre) {
+    const double before = zoom_;
+    zoom_ = std::isfinite(zoom) ? std::clamp(zoom, 1.0, kMaxZoom) : 1.0;
+    centreU_ = std::isfinite(centre.x()) ? centre.x() : 0.5;
+    centreV_ = std::isfinite(centre.y()) ? centre.y() : 0.5;
+    applyZoom();
+    if (zoom_ != before) emit zoomChanged(zoom_);
+}
+
+void CameraView::zoomAt(const QPoint& pos, double factor) {
+    const QRect r = imageRect();
+    if (r.width() <= 0 || r.height() <= 0 || !(factor > 0)) return;
+    // The viewport point under the cursor, and the image point it shows.
+    const double u = (pos.x() + 0.5 - r.left()) / r.width();
+    const double v = 1.0 - (pos.y() + 0.5 - r.top()) / r.height();
+    const double iu = centreU_ + (u - 0.5) / zoom_, iv = centreV_ + (v - 0.5) / zoom_;
+    const double z = std::clamp(zoom_ * factor, 1.0, kMaxZoom);
+    setZoom(z, QPointF(iu - (u - 0.5) / z, iv - (v - 0.5) / z));
+}
+
+void CameraView::panBy(const QPoint& delta) {
+    const QRect r = imageRect();
+    if (r.width() <= 0 || r.height() <= 0) return;
+    setZoom(zoom_, QPointF(centreU_ - double(delta.x()) / r.width() / zoom_,
+                           centreV_ + double(delta.y()) / r.height() / zoom_));
+}
+
+void CameraView::fitImage() { setZoom(1.0, QPointF(0.5, 0.5)); }
+
+void CameraView::applyZoom() {
+    // The window onto the image stays inside it: at zoom z it is 1/z wide.
+    const double half = 0.5 / zoom_;
+    centreU_ = std::clamp(centreU_, half, 1.0 - half);
+    centreV_ = std::clamp(centreV_, half, 1.0 - half);
+    // Overlay points: image coordinates -> viewport, p' = (p - c) z + 0.5.
+    overlayTransform_->Identity();
+    overlayTransform_->Translate(0.5, 0.5, 0);
+    overlayTransform_->Scale(zoom_, zoom_, 1);
+    overlayTransform_->Translate(-centreU_, -centreV_, 0);
+    // The culling camera's projection, narrowed by z and shifted so that the
+    // image point c sits mid-viewport. VTK's window centre is in units of the
+    // zoomed half-extent: NDC c' = 2c - 1 of the whole image is z (2c - 1).
+    const lc::Camera& c = doc_->scene().camera;
+    vtkCamera* vc = scene_->GetActiveCamera();
+    const double tanHalf = std::tan(c.fovYDeg * M_PI / 360.0) / zoom_;
+    vc->SetViewAngle(std::atan(tanHalf) * 360.0 / M_PI);
+    vc->SetParallelScale(c.orthoHeight / 2 / zoom_);
+    vc->SetWindowCenter(zoom_ * (2 * centreU_ - 1), zoom_ * (2 * centreV_ - 1));
+    frameImageCamera();
+    updateGridVisibility();
+    updateLegendAndCaption();
+    scheduleRender();
+}
+
+void CameraView::frameImageCamera() {
+    if (!picturesRun_) return;
+    // Pixel (i, j) of the picture is centred at (i, j); the whole picture
+    // spans -0.5 .. W - 0.5. Frame the zoomed window of it exactly.
+    const double W = picturesRun_->depth.width, H = picturesRun_->depth.height;
+    const double fx = centreU_ * W - 0.5, fy = centreV_ * H - 0.5;
+    vtkCamera* ic = image_->GetActiveCamera();
+    ic->SetFocalPoint(fx, fy, 0);
+    ic->SetPosition(fx, fy, 10);
+    ic->SetViewUp(0, 1, 0);
+    ic->SetParallelScale(H / 2 / zoom_);
+    ic->SetClippingRange(1, 20);
+}
+
+void CameraView::updateGridVisibility() {
+    // A grid finer than ~6 screen pixels per tile is noise: hide it then.
+    const auto run = doc_->runOutput();
+    if (!run) return;
+    const double* vp = scene_->GetViewport();
+    const double tilePx =
+        run->result.grid.tileSize * zoom_ * (vp[2] - vp[0]) * width() / std::max(1u, run->result.grid.width);
+    gridActor_->SetVisibility(tilePx >= 6.0);
 }
 
 CameraView::MeshPictureKey CameraView::meshPictureKey() const {
@@ -374,8 +517,8 @@ void CameraView::updateCamera() {
     vc->OrthogonalizeViewUp();
     const bool ortho = lc::isOrthographic(c.projection);
     vc->SetParallelProjection(ortho);
-    vc->SetParallelScale(c.orthoHeight / 2); // VTK: half the viewport height
-    vc->SetViewAngle(c.fovYDeg);             // VTK's view angle is vertical
+    // View angle (VTK's is vertical) and parallel scale (half the viewport
+    // height) come from the camera with the zoom: applyZoom, via updateViewport.
     // Near plane = the culling camera's; far = its far plane, pulled in to the
     // scene's extent (an infinite or very far plane would waste depth precision).
     const auto [lo, hi] = doc_->scene().bounds();
@@ -414,8 +557,8 @@ std::vector<int> CameraView::tileHeatValues(const lc::RunOutput& run) {
 void CameraView::updateOverlay() {
     const auto run = doc_->runOutput();
     const lc::Camera& cam = doc_->scene().camera;
-    heatData_->Initialize();
-    gridData_->Initialize();
+    clearOverlay(heatData_);
+    clearOverlay(gridData_);
     if (!run) {
         heatCaption_ = "no culling run yet (F5)";
         updateImage();
@@ -460,21 +603,22 @@ void CameraView::updateOverlay() {
     if (mode == lc::HeatMode::Efficiency) {
         lut_->SetHueRange(0.0, 0.667);
         lut_->SetTableRange(0, 1);
-        legend_->SetTitle("efficiency\nper tile");
+        legendTitle_ = "efficiency\nper tile";
         legend_->SetLabelFormat("%.2f");
         legend_->SetNumberOfLabels(5);
     } else {
         lut_->SetHueRange(0.667, 0.0);
         const double top = std::max(1.0, maxHeat);
         lut_->SetTableRange(0, top);
-        legend_->SetTitle(mode == lc::HeatMode::ListLength       ? "lights\nper tile"
-                          : mode == lc::HeatMode::FalsePositives ? "false\npositives"
-                                                                 : "false\nnegatives");
+        legendTitle_ = mode == lc::HeatMode::ListLength       ? "lights\nper tile"
+                       : mode == lc::HeatMode::FalsePositives ? "false\npositives"
+                                                              : "false\nnegatives";
         legend_->SetLabelFormat("%.0f");
         // Counts: below 5 a label per whole number (five evenly spaced labels
         // over 0..2 would read 0, 0, 1, 2, 2).
         legend_->SetNumberOfLabels(top < 5 ? int(top) + 1 : 5);
     }
+    legend_->SetTitle(barTitle(legendTitle_, legendPlace_ == LegendPlace::Below).c_str());
     lut_->Build();
 
     vtkNew<vtkCellArray> lines;
@@ -488,10 +632,7 @@ void CameraView::updateOverlay() {
     }
     gridData_->SetPoints(pts);
     gridData_->SetLines(lines);
-    // A grid finer than ~4 screen pixels per tile is noise: hide it then.
-    const double* vp = scene_->GetViewport();
-    const double tilePx = g.tileSize * (vp[2] - vp[0]) * width() / std::max(1u, cam.width);
-    gridActor_->SetVisibility(tilePx >= 6.0);
+    updateGridVisibility();
 
     const std::string what = run->custom ? "custom " + std::filesystem::path(run->custom->source).filename().string() +
                                                " (" + run->custom->lists + ")"
@@ -557,21 +698,24 @@ void CameraView::updateImage() {
                             : imageMode_ == ImageMode::ShadedAll  ? allPicture_.Get()
                                                                   : diffPicture_.Get();
     imageActor_->SetInputData(picture);
-    // Pixel (i, j) of the picture is centred at (i, j); frame it exactly.
-    const double W = picturesRun_->depth.width, H = picturesRun_->depth.height;
-    vtkCamera* ic = image_->GetActiveCamera();
-    ic->SetFocalPoint((W - 1) / 2, (H - 1) / 2, 0);
-    ic->SetPosition((W - 1) / 2, (H - 1) / 2, 10);
-    ic->SetViewUp(0, 1, 0);
-    ic->SetParallelScale(H / 2);
-    ic->SetClippingRange(1, 20);
+    frameImageCamera();
 }
 
 void CameraView::updateLegendAndCaption() {
     const auto run = doc_->runOutput();
     legend_->SetVisibility(run && imageMode_ == ImageMode::Heat);
     diffLegend_->SetVisibility(false);
-    caption_->SetInput(heatCaption_.c_str());
+    {
+        // The caption says the zoom, and how to get back.
+        std::string text = heatCaption_;
+        if (zoom_ > 1.0 + 1e-9) {
+            char z[96];
+            std::snprintf(z, sizeof z, "  zoom %.3gx (Ctrl+0 fits)", zoom_);
+            text += z;
+        }
+        caption_->SetInput(text.c_str());
+        caption_->SetDisplayPosition(6, legendPlace_ == LegendPlace::Below ? 4 : 6);
+    }
     imageLabel_->SetVisibility(run && imageMode_ != ImageMode::Heat);
     if (!imageLabel_->GetVisibility()) return;
     QString text = imageMode_ == ImageMode::ShadedCulled ? tr("shaded, culled lists")
@@ -598,7 +742,7 @@ void CameraView::updateLegendAndCaption() {
 }
 
 void CameraView::updateReverseLookup() {
-    reverseData_->Initialize();
+    clearOverlay(reverseData_);
     reverseTiles_.clear();
     const auto run = doc_->runOutput();
     const int light = doc_->currentLight();
@@ -625,7 +769,7 @@ void CameraView::updateReverseLookup() {
 }
 
 void CameraView::updateSelectedTile() {
-    selData_->Initialize();
+    clearOverlay(selData_);
     const auto run = doc_->runOutput();
     const int tile = doc_->selectedTile();
     if (!run || tile < 0 || std::uint32_t(tile) >= run->result.grid.tileCount()) return;
@@ -675,7 +819,48 @@ QString CameraView::tileTooltip(int tile) const {
     return text;
 }
 
+bool CameraView::handleZoomPanEvent(QEvent* e) {
+    switch (e->type()) {
+    case QEvent::Wheel: {
+        auto* we = static_cast<QWheelEvent*>(e);
+        const int steps = we->angleDelta().y();
+        if (steps == 0) return false;
+        // 1.25x a notch (120 eighths of a degree), about the cursor.
+        zoomAt(we->position().toPoint(), std::pow(1.25, steps / 120.0));
+        return true;
+    }
+    case QEvent::MouseButtonPress: {
+        auto* me = static_cast<QMouseEvent*>(e);
+        if (me->button() != Qt::RightButton && me->button() != Qt::MiddleButton) return false;
+        panning_ = true;
+        panFrom_ = me->pos();
+        return true;
+    }
+    case QEvent::MouseMove: {
+        if (!panning_) return false;
+        auto* me = static_cast<QMouseEvent*>(e);
+        panBy(me->pos() - panFrom_);
+        panFrom_ = me->pos();
+        return true;
+    }
+    case QEvent::MouseButtonRelease: {
+        auto* me = static_cast<QMouseEvent*>(e);
+        if (me->button() != Qt::RightButton && me->button() != Qt::MiddleButton) return false;
+        panning_ = false;
+        return true;
+    }
+    case QEvent::MouseButtonDblClick: {
+        auto* me = static_cast<QMouseEvent*>(e);
+        if (me->button() != Qt::MiddleButton) return false;
+        fitImage();
+        return true;
+    }
+    default: return false;
+    }
+}
+
 bool CameraView::event(QEvent* e) {
+    if (handleZoomPanEvent(e)) return true;
     if (e->type() == QEvent::ToolTip) {
         auto* help = static_cast<QHelpEvent*>(e);
         const QString text = tileTooltip(tileAtWidgetPos(help->pos()));
@@ -691,8 +876,11 @@ int CameraView::tileAtWidgetPos(const QPoint& pos) const {
     const double nxw = (pos.x() + 0.5) / std::max(1, width());
     const double nyw = 1.0 - (pos.y() + 0.5) / std::max(1, height());
     const double* vp = scene_->GetViewport();
-    const double u = (nxw - vp[0]) / (vp[2] - vp[0]);
-    const double v = (nyw - vp[1]) / (vp[3] - vp[1]);
+    const double vu = (nxw - vp[0]) / (vp[2] - vp[0]);
+    const double vv = (nyw - vp[1]) / (vp[3] - vp[1]);
+    if (vu < 0 || vu >= 1 || vv <= 0 || vv > 1) return -1;
+    // The image point shown there (zoom and pan).
+    const double u = centreU_ + (vu - 0.5) / zoom_, v = centreV_ + (vv - 0.5) / zoom_;
     if (u < 0 || u >= 1 || v <= 0 || v > 1) return -1;
     const auto px = std::uint32_t(u * cam.width), py = std::uint32_t((1 - v) * cam.height);
     const lc::TileGrid g = lc::TileGrid::make(cam.width, cam.height, cam.tileSize);

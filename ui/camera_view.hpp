@@ -23,10 +23,14 @@
 
 #include <vtkNew.h>
 #include <vtkSmartPointer.h>
+#include <vtkTransform.h>
 
+#include <QPointF>
+#include <QRect>
 #include <QString>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 class vtkActor;
@@ -38,6 +42,7 @@ class vtkPolyData;
 class vtkRenderer;
 class vtkScalarBarActor;
 class vtkTextActor;
+class vtkTransform;
 
 namespace lc {
 struct RunOutput;
@@ -100,6 +105,27 @@ public:
     // The label over an image mode's picture (mode, exposure or difference
     // scale, image RMSE and max error, backend); empty in Heat mode.
     QString imageLabelText() const;
+    // Zoom and pan of the picture (the wheel zooms about the cursor, a right
+    // or middle drag pans, View > Fit camera image or a middle double-click
+    // fits). zoom() 1 shows the whole image; the centre is the image point,
+    // in normalised image coordinates (u right, v up, 0..1), at the middle of
+    // the viewport. Tiles, overlays, pictures and picking all follow it.
+    double zoom() const { return zoom_; }
+    QPointF viewCentre() const { return {centreU_, centreV_}; }
+    void setZoom(double zoom, QPointF centre);
+    // Zooms by `factor` keeping the image point under `pos` (widget pixels) there.
+    void zoomAt(const QPoint& pos, double factor);
+    // Moves the picture by `delta` widget pixels (as a drag does).
+    void panBy(const QPoint& delta);
+    void fitImage();
+    static constexpr double kMaxZoom = 64.0;
+    // Where the legend sits: a band right of the image, or under it when
+    // that leaves the image larger (a wide, short view).
+    enum class LegendPlace { Right, Below };
+    LegendPlace legendPlace() const { return legendPlace_; }
+    // The letterboxed image's rectangle in widget pixels (y down).
+    QRect imageRect() const;
+
     // Re-renders now (tests, screenshots).
     void renderNow();
     // Renders once when control returns to the event loop, however many
@@ -109,12 +135,25 @@ public:
 signals:
     void tileClicked(int tile);
     void imageModeChanged(ImageMode mode);
+    void zoomChanged(double zoom);
 
 protected:
     void resizeEvent(QResizeEvent* e) override;
 
 private:
     bool renderPending_ = false;
+    // Zoom and pan (setZoom); the overlay's normalised points go through
+    // overlayTransform_ into the zoomed viewport.
+    double zoom_ = 1.0, centreU_ = 0.5, centreV_ = 0.5;
+    QPoint panFrom_;
+    bool panning_ = false;
+    LegendPlace legendPlace_ = LegendPlace::Right;
+    vtkNew<vtkTransform> overlayTransform_;
+    void applyZoom();
+    void frameImageCamera();
+    void updateGridVisibility();
+    bool handleZoomPanEvent(QEvent* e);
+    std::string legendTitle_;
     // Heat mode during a Live drag: the meshes do not change, the overlay
     // does. The meshes' pixels are read back once per camera, meshes and
     // viewport (a meshes-only frame) and drawn as a picture after that;

@@ -16,6 +16,7 @@
 #include "report_dock.hpp"
 
 #include "culling/core/errors.hpp"
+#include "culling/scene/gltf_io.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <QAction>
@@ -152,6 +153,9 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     connect(doc_, &Document::filePathChanged, this, &MainWindow::updateTitle);
     connect(doc_, &Document::runOutputChanged, this, &MainWindow::updateStatus);
     connect(doc_, &Document::runWentStale, this, &MainWindow::updateStatus);
+    // The cut-off label follows the scene (a new file, an undone cut-off).
+    connect(doc_, &Document::sceneReset, this, &MainWindow::updateStatus);
+    connect(doc_, &Document::lightsChanged, this, &MainWindow::updateStatus);
 
     resize(1600, 900);
     // First start: views get the room, the log stays a strip at the bottom,
@@ -332,7 +336,8 @@ void MainWindow::buildActions() {
         double v = gltfOptions.minIntensity;
         if (prompts.askNumber(this, tr("glTF light cut-off"),
                               tr("I_min (lux) for glTF lights without a range:\nradius = sqrt(intensity x colour / "
-                                 "I_min). Applies to the next glTF opened."),
+                                 "I_min). Applies to the open scene's lights without a range (one undo step) "
+                                 "and to the next glTF opened."),
                               1e-6, 1e6, v))
             setGltfMinIntensity(v);
     });
@@ -376,6 +381,9 @@ void MainWindow::buildActions() {
             });
     connect(make(tr("&Look through the culling camera"), "actionLookThrough", QKeySequence(Qt::Key_C)),
             &QAction::triggered, this, [this] { inspectorView_->lookThroughCullingCamera(); });
+    // The camera view's zoom (the wheel zooms, a right or middle drag pans).
+    connect(make(tr("Fit camera &image"), "actionFitCameraImage", QKeySequence(tr("Ctrl+0"))), &QAction::triggered,
+            this, [this] { cameraView_->fitImage(); });
     QAction* tabbed = make(tr("Tabbed views"), "actionTabbedViews");
     tabbed->setCheckable(true);
     connect(tabbed, &QAction::toggled, this, &MainWindow::setTabbedViews);
@@ -437,6 +445,7 @@ void MainWindow::buildMenus() {
     view->addAction(action("actionResetView"));
     view->addAction(action("actionFrameSelected"));
     view->addAction(action("actionLookThrough"));
+    view->addAction(action("actionFitCameraImage"));
     view->addSeparator();
     for (auto* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());
     buildOverlayMenus(overlayFileMenu, view);
@@ -470,7 +479,6 @@ void MainWindow::buildToolbar() {
 
     // Culling controls, generated from the one parameter table (lc::cullParams)
     // that also defines CullSettings and the CLI's flags.
-    addToolBarBreak(); // the generated controls get a row of their own
     QToolBar* bar = addToolBar(tr("Culling"));
     bar->setObjectName("cullToolbar");
     for (const lc::ParamSpec& p : lc::cullParams()) {
@@ -514,6 +522,15 @@ void MainWindow::buildToolbar() {
     // height are camera edits), as in the properties panel.
     (new UndoKeysToWindow(bar))->watch(bar);
 
+    // What runs the culling (custom shader, backend, device) sits on the
+    // first row beside the file actions: with it on the parameter row, a
+    // 1280-pixel window hid Height, Custom shader, backend and device
+    // behind the toolbar's extension arrow.
+    QToolBar* runBar = new QToolBar(tr("Run target"));
+    runBar->setObjectName("runToolbar");
+    insertToolBar(bar, runBar);
+    insertToolBarBreak(bar);
+    bar = runBar;
     bar->addAction(action("actionCustomShader"));
     bar->addSeparator();
     bar->addWidget(new QLabel(tr("backend ")));
@@ -550,6 +567,7 @@ void MainWindow::buildStatusBar() {
     statusFn_ = label("statusFalseNegatives");
     statusEfficiency_ = label("statusEfficiency");
     statusLists_ = label("statusLists");
+    statusCutoff_ = label("statusCutoff");
 }
 
 // --- parameters --------------------------------------------------------------------
@@ -704,6 +722,17 @@ void MainWindow::onRunFailed(quint64 generation, const QString& message) {
 }
 
 void MainWindow::updateStatus() {
+    {
+        // The cut-off that sized the lights without a range: a radius the
+        // file did not give, so the user should see where it came from.
+        const std::size_t cut = lc::gltfCutoffLights(doc_->scene()).size();
+        statusCutoff_->setVisible(cut > 0);
+        statusCutoff_->setText(tr("cut-off %1 lux (%2 lights)").arg(doc_->scene().origin.gltfMinIntensity).arg(cut));
+        statusCutoff_->setToolTip(tr("%1 lights have no glTF range: their radius is sqrt(intensity x colour / I_min) "
+                                     "at I_min = %2 lux. File > glTF light cut-off... changes it.")
+                                      .arg(cut)
+                                      .arg(doc_->scene().origin.gltfMinIntensity));
+    }
     const auto run = doc_->runOutput();
     const QString backend = run ? QString::fromStdString(run->result.backend) : lastBackendName_;
     const QString device = run ? QString::fromStdString(run->result.device) : lastDeviceName_;
@@ -1117,7 +1146,22 @@ void MainWindow::setGltfMinIntensity(double lux) {
     if (!(lux > 0.0) || !std::isfinite(lux)) return;
     gltfOptions.minIntensity = lux;
     QSettings().setValue("gltf/minIntensity", lux);
-    log(tr("glTF light cut-off I_min = %1 lux (for the next glTF opened)").arg(lux));
+    // The open scene's lights without a range take their radius from the
+    // cut-off they were read with: re-derive them now (undoable), so the
+    // setting does what it says on the scene in front of the user.
+    const int n = doc_->setGltfCutoff(lux);
+    if (n > 0) {
+        log(tr("glTF light cut-off I_min = %1 lux: radii of %2 lights without a range re-derived (Ctrl+Z undoes), "
+               "and for the next glTF opened")
+                .arg(lux)
+                .arg(n));
+        if (const std::string w = lc::cutoffCoverageWarning(doc_->scene()); !w.empty()) warn(QString::fromStdString(w));
+    } else {
+        log(tr("glTF light cut-off I_min = %1 lux (for the next glTF opened; the open scene has no glTF light "
+               "without a range)")
+                .arg(lux));
+    }
+    updateStatus();
 }
 
 void MainWindow::restoreSettings() {

@@ -156,10 +156,18 @@ class CameraPictureTest : public QObject {
             const double vw = (vp[2] - vp[0]) * w, vh = (vp[3] - vp[1]) * h;
             const double aspect = doc_->scene().camera.aspect();
             QVERIFY2(std::abs(vw / vh - aspect) < 0.02 * aspect, qPrintable(QString("%1x%2").arg(vw).arg(vh)));
-            // Fitted: as wide as the room beside the legend, or as tall as the view.
-            const double room = w - 110;
-            QVERIFY2(std::abs(vw - room) < 1.5 || std::abs(vh - h) < 1.5,
+            // Fitted to the room the legend leaves: beside it (as wide as
+            // that room or as tall as the view), or under it (as wide as the
+            // view or as tall as the room above the legend's band), whichever
+            // is the larger image.
+            const bool below = view_->legendPlace() == CameraView::LegendPlace::Below;
+            const double roomW = below ? w : w - 110, roomH = below ? h - 76 : h;
+            QVERIFY2(std::abs(vw - roomW) < 1.5 || std::abs(vh - roomH) < 1.5,
                      qPrintable(QString("%1x%2 in %3x%4").arg(vw).arg(vh).arg(w).arg(h)));
+            const double other = below ? std::min(w - 110, (h) * aspect) * std::min(w - 110, h * aspect) / aspect
+                                       : std::min(w, (h - 76) * aspect) * std::min(w, (h - 76) * aspect) / aspect;
+            QVERIFY2(vw * vh >= other - 1.0, qPrintable(QString("%1x%2 is smaller than the other placement's image")
+                                                            .arg(vw).arg(vh)));
         }
     }
 };
