@@ -339,15 +339,19 @@ void CameraView::updateViewport() {
     for (vtkScalarBarActor* bar : {legend_.Get(), diffLegend_.Get()}) {
         if (below) {
             // Right-aligned under the image; the caption keeps the left.
+            // Labels under the bar, the title over it; 14 px kept free at
+            // the right for the last label's overhang.
             const double lw = std::min(vw * 0.55, 340.0);
             bar->SetOrientationToHorizontal();
-            bar->SetPosition((x0 + vw - lw) / w, 22 / h);
+            bar->SetTextPositionToPrecedeScalarBar();
+            bar->SetPosition((x0 + vw - lw - 14) / w, 22 / h);
             bar->SetWidth(lw / w);
             bar->SetHeight((kLegendHeightPx - 26) / h);
             bar->SetMaximumWidthInPixels(int(lw));
             bar->SetMaximumHeightInPixels(kLegendHeightPx - 26);
         } else {
             bar->SetOrientationToVertical();
+            bar->SetTextPositionToSucceedScalarBar();
             bar->SetPosition((w - kLegendWidthPx + 6) / w, 0.08);
             bar->SetWidth((kLegendWidthPx - 10) / w);
             bar->SetHeight(0.84);
