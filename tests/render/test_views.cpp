@@ -10,6 +10,14 @@
 // blended colours by a few levels; a real regression (camera framing, colour
 // map, a missing or misplaced actor, a wrong tile) changes far more than 0.5%.
 //
+// The whole-image limit alone lets a small wrong region through: one tile of
+// a 320x180 image at 16 px covers 0.4% of a 720x360 view, so a tile in the
+// wrong colour, or the selected outline on the wrong tile, passed. Camera
+// views are therefore also compared tile by tile: no tile may have more than
+// 10% of its pixels differ (a mesh edge moved by a pixel across a tile
+// changes about 3%; a tile recoloured by one heat step, or losing or gaining
+// the selection outline, changes 20% or more).
+//
 // A missing baseline FAILS and writes the candidate (and, on a mismatch, a
 // diff image) to LC_RENDER_OUT_DIR in the build tree; look at it, then copy it
 // to tests/render/baselines/.
@@ -42,6 +50,24 @@ namespace {
 
 constexpr int kChannelTolerance = 40;
 constexpr double kMaxDifferingFraction = 0.005;
+constexpr double kMaxDifferingFractionPerTile = 0.10;
+
+// The rectangles of the culling image's tiles in a camera view's framebuffer
+// (device pixels, Qt rows going down), as the view draws them.
+std::vector<std::pair<QString, QRect>> tileRegions(const CameraView& view, const lc::TileGrid& g) {
+    std::vector<std::pair<QString, QRect>> out;
+    const QRect img = view.imageRect();
+    const double dpr = view.devicePixelRatioF();
+    const double sx = img.width() * dpr / g.width, sy = img.height() * dpr / g.height;
+    for (std::uint32_t ty = 0; ty < g.tilesY; ++ty)
+        for (std::uint32_t tx = 0; tx < g.tilesX; ++tx) {
+            const auto r = g.tileRect(tx, ty);
+            const QRect px(QPoint(int(img.left() * dpr + r.x0 * sx), int(img.top() * dpr + r.y0 * sy)),
+                           QPoint(int(img.left() * dpr + r.x1 * sx) - 1, int(img.top() * dpr + r.y1 * sy) - 1));
+            out.emplace_back(QString("tile %1,%2").arg(tx).arg(ty), px);
+        }
+    return out;
+}
 
 void addBox(lc::Mesh& m, glm::vec3 lo, glm::vec3 hi) {
     const auto base = std::uint32_t(m.vertexCount());
@@ -115,10 +141,13 @@ struct Comparison {
     QString message;
 };
 
-Comparison compareWithBaseline(const QImage& shot, const QString& name) {
+Comparison compareWithBaseline(const QImage& shot, const QString& name,
+                               const std::vector<std::pair<QString, QRect>>& regions = {},
+                               const QString& candidateName = {}) {
     const QString baselinePath = QString(LC_RENDER_BASELINES) + "/" + name + ".png";
     QDir().mkpath(LC_RENDER_OUT_DIR);
-    const QString candidatePath = QString(LC_RENDER_OUT_DIR) + "/" + name + ".png";
+    const QString candidatePath =
+        QString(LC_RENDER_OUT_DIR) + "/" + (candidateName.isEmpty() ? name : candidateName) + ".png";
     const QImage img = shot.convertToFormat(QImage::Format_RGB32);
     img.save(candidatePath);
     QImage base;
@@ -144,6 +173,20 @@ Comparison compareWithBaseline(const QImage& shot, const QString& name) {
         }
     }
     const double fraction = double(differing) / (double(img.width()) * img.height());
+    for (const auto& [what, rect] : regions) {
+        const QRect r = rect.intersected(img.rect());
+        qint64 n = 0;
+        for (int y = r.top(); y <= r.bottom(); ++y)
+            for (int x = r.left(); x <= r.right(); ++x) n += diff.pixel(x, y) != qRgb(0, 0, 0);
+        const double f = r.isEmpty() ? 0.0 : double(n) / (double(r.width()) * r.height());
+        if (f > kMaxDifferingFractionPerTile) {
+            const QString diffPath = QString(LC_RENDER_OUT_DIR) + "/" + name + "_diff.png";
+            diff.save(diffPath);
+            return {false, QString("%1: %2 differs in %3% of its pixels (limit %4%); candidate %5, diff %6")
+                               .arg(name, what).arg(f * 100, 0, 'f', 1).arg(kMaxDifferingFractionPerTile * 100)
+                               .arg(candidatePath, diffPath)};
+        }
+    }
     if (fraction > kMaxDifferingFraction) {
         const QString diffPath = QString(LC_RENDER_OUT_DIR) + "/" + name + "_diff.png";
         diff.save(diffPath);
@@ -181,9 +224,36 @@ private slots:
         const QImage shot = view.grabFramebuffer();
         QVERIFY(!shot.isNull());
         QCOMPARE(shot.size(), QSize(720, 360) * view.devicePixelRatio());
-        const Comparison c = compareWithBaseline(shot, "camera_view");
+        const Comparison c =
+            compareWithBaseline(shot, "camera_view", tileRegions(view, doc_->runOutput()->result.grid));
         QVERIFY2(c.ok, qPrintable(c.message));
         qInfo("%s", qPrintable(c.message));
+    }
+
+    // The tile-by-tile comparison is what catches a small wrong region: the
+    // selection outline on the neighbouring tile changes too few pixels of
+    // the whole view for the whole-image limit, and fails the tile check.
+    void selectionOnTheWrongTileFailsTheComparison() {
+        Document doc;
+        const auto run = cullFixedScene(doc, doc.settings().algorithm);
+        QVERIFY(run);
+        doc.setSelectedLights({1});
+        doc.setSelectedTile(int(run->result.grid.tileIndex(10, 6))); // the baseline has 9,6
+        CameraView view(&doc);
+        view.resize(720, 360);
+        view.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&view));
+        view.renderNow();
+        QTest::qWait(50);
+        view.renderNow();
+        const QImage shot = view.grabFramebuffer();
+        const Comparison whole = compareWithBaseline(shot, "camera_view", {}, "camera_view_wrong_tile");
+        QVERIFY2(whole.ok, qPrintable("the whole-image limit alone: " + whole.message));
+        const Comparison tiles =
+            compareWithBaseline(shot, "camera_view", tileRegions(view, run->result.grid), "camera_view_wrong_tile");
+        QVERIFY2(!tiles.ok, qPrintable(tiles.message));
+        QVERIFY2(tiles.message.contains("tile 9,6") || tiles.message.contains("tile 10,6"), qPrintable(tiles.message));
+        qInfo("%s", qPrintable(tiles.message));
     }
 
     void inspectorView() {
@@ -248,7 +318,7 @@ private slots:
         cv.renderNow();
         QTest::qWait(50);
         cv.renderNow();
-        c = compareWithBaseline(cv.grabFramebuffer(), "camera_efficiency_reverse");
+        c = compareWithBaseline(cv.grabFramebuffer(), "camera_efficiency_reverse", tileRegions(cv, run->result.grid));
         QVERIFY2(c.ok, qPrintable(c.message));
         qInfo("%s", qPrintable(c.message));
     }
@@ -318,7 +388,8 @@ private slots:
         cv.renderNow();
         QTest::qWait(50);
         cv.renderNow();
-        const Comparison c = compareWithBaseline(cv.grabFramebuffer(), "camera_difference");
+        const Comparison c =
+            compareWithBaseline(cv.grabFramebuffer(), "camera_difference", tileRegions(cv, run->result.grid));
         QVERIFY2(c.ok, qPrintable(c.message));
         qInfo("%s", qPrintable(c.message));
     }
