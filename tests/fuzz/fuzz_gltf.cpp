@@ -2,7 +2,10 @@
 // temporary .glb (bytes starting "glTF") or .gltf file. Any input must load
 // into a scene that validates or throw lc::InputError; a crash, a sanitizer
 // report, a hang, an allocation past the RSS limit or any other exception is
-// a bug. Loaded scenes are also written back as GLB (the writer must accept
+// a bug. So is a scene the reader returns that fails Scene::validate(): the
+// reader's contract is a valid scene or an error, and validate() throws
+// InputError for a bad mesh, which must not pass for "bad input" here.
+// Loaded scenes are also written back as GLB (the writer must accept
 // whatever the reader produced), and the depth pre-pass's host side (its
 // closed solids) runs on every mesh.
 #include "culling/core/errors.hpp"
@@ -23,6 +26,11 @@ std::string scratchPath(const char* ext) {
     return std::string(dir && *dir ? dir : "/tmp") + "/lightcull-fuzz-" + std::to_string(getpid()) + ext;
 }
 
+[[noreturn]] void finding(const char* what, const char* detail) {
+    std::fprintf(stderr, "fuzz_gltf: %s: %s\n", what, detail);
+    std::abort();
+}
+
 } // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -32,14 +40,26 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!f) std::abort();
     if (size && std::fwrite(data, 1, size, f) != size) std::abort();
     std::fclose(f);
+    lc::Scene scene;
     try {
-        const lc::Scene scene = lc::loadGltfScene(path);
-        scene.validate(); // by contract: a loaded scene is valid
-        for (const lc::Mesh& m : scene.meshes) fuzzClosedSolids(m);
-        const std::string glb = lc::serializeGltf(scene, true);
-        if (glb.size() < 12) std::abort();
+        scene = lc::loadGltfScene(path);
     } catch (const lc::InputError&) {
+        std::remove(path.c_str()); // bad input: the typed error is the expected outcome
+        return 0;
     }
     std::remove(path.c_str());
+    // From here on nothing may fail: the reader said the scene is good.
+    try {
+        scene.validate();
+    } catch (const std::exception& e) {
+        finding("the reader returned a scene that fails validate()", e.what());
+    }
+    for (const lc::Mesh& m : scene.meshes) fuzzClosedSolids(m);
+    try {
+        const std::string glb = lc::serializeGltf(scene, true);
+        if (glb.size() < 12) finding("the writer", "wrote fewer than 12 bytes");
+    } catch (const std::exception& e) {
+        finding("the writer refused a scene the reader returned", e.what());
+    }
     return 0;
 }

@@ -549,6 +549,32 @@ TEST(Gltf, WithoutACameraTheSceneIsFramed) {
     }
 }
 
+// Found by fuzz_gltf: without a camera, a model far from the origin (a 1 m
+// triangle at 1e20, or a triangle collapsed to one point there) was framed
+// from a distance that vanished in rounding: the camera sat on its target and
+// the reader returned a scene that fails validate().
+TEST(Gltf, WithoutACameraAModelFarFromTheOriginIsFramedByAValidCamera) {
+    ScratchDir s;
+    for (const double at : {1e8, 1e16, 1e20}) {
+        for (const bool point : {false, true}) {
+            SCOPED_TRACE(std::to_string(at) + (point ? " point" : " triangle"));
+            GltfBuilder b;
+            const int pos = b.positions(point ? std::vector<float>(9, 0.0f) : std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0});
+            b.mesh(json::array({{{"attributes", {{"POSITION", pos}}}}}));
+            b.scene({b.node({{"mesh", 0}, {"translation", {at, at, at}}})});
+            const fs::path p = s.path / "far.gltf";
+            writeBytes(p, b.gltfText());
+            const lc::Scene sc = lc::loadGltfScene(p.string());
+            EXPECT_NO_THROW(sc.validate());
+            const lc::Camera& c = sc.camera;
+            EXPECT_EQ(c.validate(), "");
+            // Still looking at the model.
+            const auto [lo, hi] = sc.bounds();
+            EXPECT_LE(glm::length(c.target - 0.5 * (lo + hi)), 1e-12 * at);
+        }
+    }
+}
+
 // ---------------------------------------------------------------- bad input
 
 struct BadCase {

@@ -283,6 +283,26 @@ TEST(SceneJson, FileLevelErrors) {
     fs::remove_all(dir);
 }
 
+// Found by fuzz_scene_json: a scene without a camera whose mesh lies far from
+// the origin (the fuzzer's shape: a triangle collapsed to one point at 1e20;
+// also a 1 m triangle moved there by its transform) got a framing camera on
+// its own target, and parseScene returned a scene that fails validate().
+TEST(SceneJson, WithoutACameraAMeshFarFromTheOriginIsFramedByAValidCamera) {
+    for (const char* mesh : {R"("positions": [1e20, 1e20, 1e20, 1e20, 1e20, 1e20, 1e20, 1e20, 1e20], "indices": [0, 1, 2])",
+                             R"("positions": [1e16, 1e16, 1e16, 1e16, 1e16, 1e16, 1e16, 1e16, 1e16], "indices": [0, 1, 2])",
+                             R"("positions": [0, 0, 0, 1, 0, 0, 0, 1, 0], "indices": [0, 1, 2],
+                                "transform": {"translate": [1e20, 1e20, 1e20]})"}) {
+        SCOPED_TRACE(mesh);
+        const Scene s = parseScene(std::string(R"({"format": "lightcull-scene", "version": 1, "meshes": [{)") + mesh + "}]}",
+                                   "far.json");
+        EXPECT_NO_THROW(s.validate());
+        EXPECT_EQ(s.camera.validate(), "");
+        // Still looking at the mesh.
+        const auto [lo, hi] = s.bounds();
+        EXPECT_LE(glm::length(s.camera.target - 0.5 * (lo + hi)), 1e-12 * glm::length(lo));
+    }
+}
+
 TEST(SceneJson, ExampleScenesInResourcesLoadAndValidate) {
     int n = 0;
     for (const auto& e : fs::directory_iterator(std::string(LC_SOURCE_DIR) + "/resources/scenes")) {
