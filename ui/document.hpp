@@ -73,6 +73,20 @@ public:
         bool reverseLookup = true;    // tiles whose lists hold the current light
         bool explainMarkers = true;   // Explain in 3D: the deciding plane, the nearest or needing pixel
         lc::HeatMode heat = lc::HeatMode::ListLength;
+        // The inspector inside a building (View > Meshes, View > Lights; docs/STUDIO.md):
+        // meshes drawn as they are, translucent without depth writes (x-ray:
+        // they hide and block nothing), or not at all.
+        enum class MeshDisplay { Normal, XRay, Hidden };
+        MeshDisplay meshes = MeshDisplay::Normal;
+        // Lights: filled spheres up to sphereCap and silhouette rings above it
+        // (Auto), spheres only (at most sphereCap, "+N more" for the rest), or
+        // rings only. showLights hides them and the spot cones together;
+        // onlyTileLights draws only the selected tile's (cell's) listed lights.
+        enum class LightDisplay { Auto, Spheres, Outlines };
+        LightDisplay lights = LightDisplay::Auto;
+        bool showLights = true;
+        bool onlyTileLights = false;
+        int sphereCap = 256;
         bool operator==(const OverlayOptions&) const = default;
     };
     const OverlayOptions& overlays() const { return overlays_; }

@@ -9,10 +9,12 @@
 
 #include "culling/math/projection.hpp"
 
+#include <QStringList>
 #include <QTimer>
 
 #include "culling/diagnostics/overlays.hpp"
 
+#include <functional>
 #include <optional>
 #include <vtkActor.h>
 #include <vtkCamera.h>
@@ -38,12 +40,15 @@
 #include <vtkRenderer.h>
 #include <vtkSequencePass.h>
 #include <vtkSphereSource.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
 #include <vtkTranslucentPass.h>
 #include <vtkVolumetricPass.h>
 #include <QVTKInteractor.h>
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace lcui {
 
@@ -64,6 +69,13 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     renderer_->SetBackground2(0.05, 0.05, 0.07);
     renderer_->GradientBackgroundOn();
     rw->AddRenderer(renderer_);
+    // Handles: a layer above the scene with the same camera. A layer above 0
+    // keeps the colour below and clears depth, so a wall never hides a handle.
+    rw->SetNumberOfLayers(2);
+    handleLayer_->SetLayer(1);
+    handleLayer_->InteractiveOff(); // orbits and picks go to the scene's renderer
+    handleLayer_->SetActiveCamera(renderer_->GetActiveCamera());
+    rw->AddRenderer(handleLayer_);
 
     // Light spheres: one glyph actor. Sphere of radius 1 scaled by "radius",
     // coloured by "color"; 12x8 facets keep 10k lights interactive.
@@ -174,6 +186,7 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     handleRep_->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
     handleRep_->ActiveRepresentationOff();
     handle_->SetInteractor(interactor());
+    handle_->SetDefaultRenderer(handleLayer_);
     handle_->SetRepresentation(handleRep_);
     handle_->AddObserver(vtkCommand::StartInteractionEvent, this, &InspectorView::onHandleStart);
     handle_->AddObserver(vtkCommand::InteractionEvent, this, &InspectorView::onHandleMove);
@@ -187,6 +200,7 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     radiusRep_->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
     radiusRep_->ActiveRepresentationOff();
     radiusHandle_->SetInteractor(interactor());
+    radiusHandle_->SetDefaultRenderer(handleLayer_);
     radiusHandle_->SetRepresentation(radiusRep_);
     radiusHandle_->AddObserver(vtkCommand::StartInteractionEvent, this, &InspectorView::onRadiusStart);
     radiusHandle_->AddObserver(vtkCommand::InteractionEvent, this, &InspectorView::onRadiusMove);
@@ -194,7 +208,19 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     radiusHandle_->EnabledOff();
     // After an orbit, the radius handle goes back to the right of the centre.
     style->AddObserver(vtkCommand::EndInteractionEvent, this, &InspectorView::placeRadiusHandle);
-    spotHandles_ = std::make_unique<SpotHandles>(doc_, renderer_, interactor());
+    spotHandles_ = std::make_unique<SpotHandles>(doc_, renderer_, interactor(), handleLayer_);
+
+    // "+N more" and which tile's lights are shown: top left, small.
+    lightNote_->GetTextProperty()->SetFontSize(13);
+    lightNote_->GetTextProperty()->SetColor(1.0, 1.0, 0.85);
+    lightNote_->GetTextProperty()->SetBackgroundColor(0, 0, 0);
+    lightNote_->GetTextProperty()->SetBackgroundOpacity(0.55);
+    lightNote_->GetTextProperty()->SetVerticalJustificationToTop();
+    lightNote_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+    lightNote_->SetPosition(0.01, 0.985);
+    lightNote_->SetVisibility(false);
+    lightNote_->PickableOff();
+    renderer_->AddActor2D(lightNote_);
 
     picker_->SetTolerance(0.0005);
     picker_->PickFromListOn();
@@ -216,6 +242,10 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     });
     connect(doc_, &Document::meshesChanged, this, [this] {
         rebuildMeshes();
+        scheduleRender();
+    });
+    connect(doc_, &Document::overlaysChanged, this, [this] {
+        applyMeshDisplay();
         scheduleRender();
     });
     connect(doc_, &Document::lightsChanged, this, [this] {
@@ -241,10 +271,12 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
     for (auto sig : {&Document::runOutputChanged, &Document::overlaysChanged, &Document::selectionChanged,
                      &Document::lightsChanged, &Document::runWentStale})
         connect(doc_, sig, this, [this] {
+            refreshLightSet();
             updateOverlays();
             scheduleRender();
         });
     connect(doc_, &Document::tileSelectionChanged, this, [this] {
+        refreshLightSet();
         updateOverlays();
         scheduleRender();
     });
@@ -262,8 +294,24 @@ void InspectorView::updateOverlays() {
     overlays_->update(*doc_);
     // Dim the other lights while a tile's listed lights are highlighted.
     lightActor_->GetProperty()->SetOpacity(overlays_->dimLights() ? 0.06 : 0.22);
-    const double rings = ringOpacity(doc_->scene().lights.size());
+    const double rings = ringOpacity(drawn_.size());
     ringActor_->GetProperty()->SetOpacity(overlays_->dimLights() ? 0.15 * rings : rings);
+    spotCones_->actor()->GetProperty()->SetOpacity(overlays_->dimLights() ? 0.25 : 1.0);
+    // The note: which tile's lights are shown, and what the sphere cap left out.
+    const auto& ov = doc_->overlays();
+    QStringList note;
+    if (ov.showLights && ov.onlyTileLights) {
+        if (drawnAreTileLights_)
+            note << tr("only tile %1's %2 listed lights").arg(doc_->selectedTile()).arg(drawn_.size() + leftOut_);
+        else
+            note << tr("only the selected tile's lights: select a tile (after a run)");
+    }
+    if (leftOut_ > 0)
+        note << tr("+%1 more lights not drawn (sphere cap %2: View > Lights)").arg(leftOut_).arg(ov.sphereCap);
+    if (overlays_->listedLeftOut() > 0)
+        note << tr("+%1 more listed lights not drawn (sphere cap %2)").arg(overlays_->listedLeftOut()).arg(ov.sphereCap);
+    lightNote_->SetInput(note.join('\n').toUtf8().constData());
+    lightNote_->SetVisibility(!note.isEmpty());
 }
 
 vtkRenderer* InspectorView::renderer() const { return renderer_.Get(); }
@@ -272,6 +320,8 @@ vtkPointHandleRepresentation3D* InspectorView::handleRepresentation() const { re
 vtkHandleWidget* InspectorView::radiusHandleWidget() const { return radiusHandle_.Get(); }
 vtkPointHandleRepresentation3D* InspectorView::radiusHandleRepresentation() const { return radiusRep_.Get(); }
 vtkActor* InspectorView::lightActor() const { return silhouettes_ ? ringActor_.Get() : lightActor_.Get(); }
+vtkTextActor* InspectorView::lightNote() const { return lightNote_.Get(); }
+vtkRenderer* InspectorView::handleLayer() const { return handleLayer_.Get(); }
 
 void InspectorView::scheduleRender() {
     if (renderPending_) return;
@@ -339,6 +389,11 @@ std::pair<glm::dvec3, glm::dvec3> InspectorView::viewRay(const QPoint& pos) cons
 }
 
 bool InspectorView::frameSelected(int ms) {
+    // What to frame (world points, for the view basis they are seen in) and
+    // the point that must not be hidden: the chunk's near face centre (the
+    // tile's nearest geometry lies on that face), or the light's centre.
+    std::function<std::vector<glm::dvec3>(const ViewBasis&)> pointsFor;
+    glm::dvec3 anchor(0.0);
     const auto run = doc_->runOutput();
     const int tile = doc_->selectedTile();
     if (run && tile >= 0 && std::uint32_t(tile) < run->result.grid.tileCount()) {
@@ -353,6 +408,7 @@ bool InspectorView::frameSelected(int ms) {
             const glm::dmat4 world = lc::worldFromView(doc_->scene().camera);
             std::vector<glm::dvec3> corners;
             for (const glm::dvec3& v : chunk->corners) corners.push_back(glm::dvec3(world * glm::dvec4(v, 1.0)));
+            anchor = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
             // With Explain's markers shown: the pixel that matters (and the
             // nearest point of the light's sphere) come into view too.
             vtkPolyData* marker = overlays_->explainPixel();
@@ -361,17 +417,104 @@ bool InspectorView::frameSelected(int ms) {
                 marker->GetPoint(i, p);
                 corners.push_back({p[0], p[1], p[2]});
             }
-            flyToPoints(corners, ms);
-            return true;
+            pointsFor = [corners](const ViewBasis&) { return corners; };
         }
     }
     const int light = doc_->currentLight();
-    if (light >= 0 && std::size_t(light) < doc_->scene().lights.size()) {
+    if (!pointsFor && light >= 0 && std::size_t(light) < doc_->scene().lights.size()) {
         const lc::PointLight& l = doc_->scene().lights[std::size_t(light)];
-        flyTo(l.position, std::max(l.radius(), 1e-3), ms);
+        const glm::dvec3 c = l.position;
+        const double r = std::max(l.radius(), 1e-3);
+        anchor = c;
+        // The sphere's six extreme points along the view axes bound it well enough.
+        pointsFor = [c, r](const ViewBasis& b) {
+            return std::vector<glm::dvec3>{c + r * b.right, c - r * b.right, c + r * b.up,
+                                           c - r * b.up,    c + r * b.dir,   c - r * b.dir};
+        };
+    }
+    if (!pointsFor) return false;
+
+    framedFromCullingSide_ = false;
+    const ViewBasis b = viewBasis();
+    glm::dvec3 center;
+    const double distance = fitDistance(pointsFor(b), b, &center);
+    const glm::dvec3 eye = center - b.dir * distance;
+    const lc::Scene& scene = doc_->scene();
+    // The kept direction works unless a shown mesh stands between the eye and
+    // the selection (the roof of a building framed from outside). Nearly at
+    // the anchor does not count: that is the selection's own surface.
+    const bool meshesShown = doc_->overlays().meshes != Document::OverlayOptions::MeshDisplay::Hidden;
+    auto blocked = [&](const glm::dvec3& from) {
+        const auto hit = firstMeshHit(scene, from, anchor);
+        return hit && *hit < 1.0 - 1e-3;
+    };
+    if (!meshesShown || !blocked(eye)) {
+        flyToEye(eye, center, b.up, ms);
         return true;
     }
-    return false;
+    // From the culling camera's side: along the line from its eye through the
+    // anchor (orthographic: along its direction). The culling camera sees the
+    // tile's geometry, so that line is free up to the anchor's depth.
+    const lc::Camera& cam = scene.camera;
+    glm::dvec3 dir = anchor - cam.position;
+    if (lc::isOrthographic(cam.projection) || glm::length(dir) < 1e-9) dir = cam.target - cam.position;
+    if (glm::length(dir) < 1e-12) dir = b.dir;
+    ViewBasis cb;
+    cb.dir = glm::normalize(dir);
+    cb.right = glm::cross(cb.dir, glm::normalize(cam.up));
+    if (glm::length(cb.right) < 1e-9) cb.right = glm::cross(cb.dir, b.up);
+    if (glm::length(cb.right) < 1e-9) cb.right = b.right;
+    cb.right = glm::normalize(cb.right);
+    cb.up = glm::cross(cb.right, cb.dir);
+    glm::dvec3 sideCenter;
+    const double sideDistance = fitDistance(pointsFor(cb), cb, &sideCenter);
+    // The eye on the line through the anchor (the fit's centre lies near it),
+    // pulled in to just before the first surface between them.
+    glm::dvec3 sideEye = anchor - cb.dir * (sideDistance + glm::dot(anchor - sideCenter, cb.dir));
+    const glm::dvec3 back = sideEye - anchor;
+    const glm::dvec3 start = anchor + 1e-3 * back;
+    if (const auto hit = firstMeshHit(scene, start, sideEye)) {
+        const double along = glm::length(sideEye - start) * *hit;
+        sideEye = start + glm::normalize(back) * (0.9 * along);
+    }
+    cb.eye = sideEye;
+    framedFromCullingSide_ = true;
+    flyToEye(sideEye, anchor + cb.dir * std::max(glm::dot(sideCenter - anchor, cb.dir), 0.0), cb.up, ms);
+    return true;
+}
+
+std::optional<double> InspectorView::firstMeshHit(const lc::Scene& scene, const glm::dvec3& a, const glm::dvec3& b) {
+    // Moller-Trumbore against every triangle; a few rays per F, so no
+    // acceleration structure (a 260k-triangle glTF takes milliseconds).
+    const glm::dvec3 d = b - a;
+    double best = 2.0;
+    for (const lc::Mesh& m : scene.meshes) {
+        const bool identity = m.transform == glm::dmat4(1.0);
+        auto vert = [&](std::uint32_t i) {
+            const glm::dvec3 v(m.vertex(i));
+            return identity ? v : glm::dvec3(m.transform * glm::dvec4(v, 1.0));
+        };
+        for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+            if (m.indices[t] >= m.vertexCount() || m.indices[t + 1] >= m.vertexCount() ||
+                m.indices[t + 2] >= m.vertexCount())
+                continue;
+            const glm::dvec3 v0 = vert(m.indices[t]), e1 = vert(m.indices[t + 1]) - v0, e2 = vert(m.indices[t + 2]) - v0;
+            const glm::dvec3 p = glm::cross(d, e2);
+            const double det = glm::dot(e1, p);
+            if (std::abs(det) < 1e-300) continue;
+            const double inv = 1.0 / det;
+            const glm::dvec3 s = a - v0;
+            const double u = glm::dot(s, p) * inv;
+            if (u < 0.0 || u > 1.0) continue;
+            const glm::dvec3 q = glm::cross(s, e1);
+            const double v = glm::dot(d, q) * inv;
+            if (v < 0.0 || u + v > 1.0) continue;
+            const double h = glm::dot(e2, q) * inv;
+            if (h >= 0.0 && h <= 1.0 && h < best) best = h;
+        }
+    }
+    if (best > 1.0) return std::nullopt;
+    return best;
 }
 
 void InspectorView::flyTo(const glm::dvec3& center, double radius, int ms) {
@@ -401,39 +544,59 @@ InspectorView::ViewBasis InspectorView::viewBasis() const {
     return b;
 }
 
-void InspectorView::flyToPoints(const std::vector<glm::dvec3>& points, int ms) {
-    if (points.empty()) return;
+double InspectorView::fitDistance(const std::vector<glm::dvec3>& points, const ViewBasis& b, glm::dvec3* centerOut) {
     vtkCamera* vc = renderer_->GetActiveCamera();
-    const ViewBasis b = viewBasis();
-    const glm::dvec3 fromEye = b.eye, fromFocal = b.focal, dir = b.dir, up = b.up, right = b.right;
     glm::dvec3 center(0.0);
     for (const glm::dvec3& p : points) center += p;
-    center /= double(points.size());
-    // Keep the direction; the nearest eye distance from `center` at which every
-    // point projects inside the view, with a 10% margin: x / (d + z) <= tan.
+    center /= double(std::max<std::size_t>(points.size(), 1));
+    // The nearest eye distance from `center` at which every point projects
+    // inside the view, with a 10% margin: x / (d + z) <= tan.
     const double halfY = 0.5 * vc->GetViewAngle() * 3.14159265358979323846 / 180.0;
     const double aspect = height() > 0 ? double(width()) / double(height()) : 1.0;
     const double tanY = std::tan(halfY) / 1.1, tanX = std::tan(halfY) * aspect / 1.1;
     double distance = 1e-6, extentX = 1e-6, extentY = 1e-6;
     for (const glm::dvec3& p : points) {
         const glm::dvec3 q = p - center;
-        const double x = std::abs(glm::dot(q, right)), y = std::abs(glm::dot(q, up)), z = glm::dot(q, dir);
+        const double x = std::abs(glm::dot(q, b.right)), y = std::abs(glm::dot(q, b.up)), z = glm::dot(q, b.dir);
         distance = std::max({distance, x / tanX - z, y / tanY - z});
         extentX = std::max(extentX, x);
         extentY = std::max(extentY, y);
     }
     if (vc->GetParallelProjection()) vc->SetParallelScale(1.1 * std::max(extentY, extentX / aspect));
-    const glm::dvec3 toEye = center - dir * distance;
+    *centerOut = center;
+    return distance;
+}
+
+void InspectorView::flyToPoints(const std::vector<glm::dvec3>& points, int ms) {
+    if (points.empty()) return;
+    // Keep the direction.
+    const ViewBasis b = viewBasis();
+    glm::dvec3 center;
+    const double distance = fitDistance(points, b, &center);
+    flyToEye(center - b.dir * distance, center, b.up, ms);
+}
+
+void InspectorView::flyToEye(const glm::dvec3& toEye, const glm::dvec3& toFocal, const glm::dvec3& toUp, int ms) {
+    vtkCamera* vc = renderer_->GetActiveCamera();
+    const ViewBasis b = viewBasis();
+    const glm::dvec3 fromEye = b.eye, fromFocal = b.focal, fromUp = b.up;
     const int steps = std::max(1, ms / 25);
-    auto apply = [this, vc, fromEye, fromFocal, toEye, center](double t) {
+    auto apply = [this, vc, fromEye, fromFocal, fromUp, toEye, toFocal, toUp](double t) {
         const double s = t * t * (3.0 - 2.0 * t); // ease in and out
-        const glm::dvec3 e = glm::mix(fromEye, toEye, s), f = glm::mix(fromFocal, center, s);
+        const glm::dvec3 e = glm::mix(fromEye, toEye, s), f = glm::mix(fromFocal, toFocal, s);
+        glm::dvec3 u = glm::mix(fromUp, toUp, s);
+        if (glm::length(u) < 1e-9) u = toUp;
         vc->SetFocalPoint(f.x, f.y, f.z);
         vc->SetPosition(e.x, e.y, e.z);
+        vc->SetViewUp(u.x, u.y, u.z);
+        vc->OrthogonalizeViewUp();
         renderer_->ResetCameraClippingRange();
+        placeRadiusHandle();
+        spotHandles_->update();
         renderNow();
     };
     if (ms <= 0) {
+        ++flight_; // stops a flight in progress
         apply(1.0);
         return;
     }
@@ -479,39 +642,144 @@ void InspectorView::rebuildMeshes() {
         meshActors_.push_back(actor);
         picker_->AddPickList(actor);
     }
+    applyMeshDisplay();
+}
+
+void InspectorView::applyMeshDisplay() {
+    using MD = Document::OverlayOptions::MeshDisplay;
+    const MD mode = doc_->overlays().meshes;
+    for (auto& a : meshActors_) {
+        // X-ray: translucent, so VTK draws it in the translucent pass without
+        // depth writes: it shades what lies behind and hides none of it.
+        a->SetVisibility(mode != MD::Hidden);
+        a->GetProperty()->SetOpacity(mode == MD::XRay ? 0.12 : 1.0);
+        a->GetProperty()->SetBackfaceCulling(false);
+    }
+}
+
+void InspectorView::refreshLightSet() {
+    // Rebuilt only when what chooses the drawn lights changed, so a Live drag
+    // (a run per step) does not rebuild them when they do not depend on the run.
+    if (lightSetKey() != lightSetKey_) rebuildLights();
+}
+
+std::vector<long long> InspectorView::lightSetKey() const {
+    const auto& ov = doc_->overlays();
+    std::vector<long long> key = {(long long)doc_->scene().lights.size(), int(ov.lights), ov.showLights,
+                                  ov.onlyTileLights, ov.sphereCap, int(ov.meshes)};
+    if (ov.onlyTileLights || leftOut_ > 0) {
+        key.push_back(doc_->selectedTile());
+        key.push_back(doc_->selectedCell());
+        key.push_back((long long)(std::intptr_t)doc_->runOutput().get());
+        key.push_back(doc_->runIsStale());
+    }
+    if (leftOut_ > 0) // the selection is drawn first
+        key.insert(key.end(), doc_->selectedLights().begin(), doc_->selectedLights().end());
+    return key;
 }
 
 void InspectorView::rebuildLights() {
-    const std::size_t n = doc_->scene().lights.size();
-    renderer_->SetUseDepthPeeling(n <= kMaxPeeledLights ? 1 : 0);
-    silhouettes_ = n > kMaxFilledLights;
-    renderer_->SetPass(silhouettes_ ? blendedPasses_.Get() : nullptr);
-    lightActor_->SetVisibility(!silhouettes_);
-    ringActor_->SetVisibility(silhouettes_);
-    lightData_ = lightsToPolyData(doc_->scene().lights);
+    const auto& lights = doc_->scene().lights;
+    const auto& ov = doc_->overlays();
+    using LD = Document::OverlayOptions::LightDisplay;
+    using MD = Document::OverlayOptions::MeshDisplay;
+    // Which lights: every one, or the selected tile's listed ones.
+    std::vector<int> set;
+    drawnAreTileLights_ = false;
+    if (ov.onlyTileLights)
+        if (auto tileLights = InspectorOverlays::tileListLights(*doc_)) {
+            set = std::move(*tileLights);
+            drawnAreTileLights_ = true;
+        }
+    if (!drawnAreTileLights_) {
+        set.resize(lights.size());
+        std::iota(set.begin(), set.end(), 0);
+    }
+    // How: filled spheres (at most the cap) or silhouette rings.
+    const std::size_t cap = std::size_t(std::max(ov.sphereCap, 1));
+    silhouettes_ = ov.lights == LD::Outlines || (ov.lights == LD::Auto && set.size() > cap);
+    leftOut_ = 0;
+    if (!silhouettes_ && set.size() > cap) {
+        // The selected lights first, then the nearest to what is looked at:
+        // the selected tile's frustum, else the current light, else the view's
+        // focal point.
+        glm::dvec3 focus = viewBasis().focal;
+        const auto run = doc_->runOutput();
+        const int tile = doc_->selectedTile();
+        if (run && tile >= 0 && std::uint32_t(tile) < run->result.grid.tileCount() && !doc_->runIsStale()) {
+            const lc::Projection proj(doc_->scene().camera);
+            if (const auto chunk = lc::tileFrustum(run->result, proj, run->lights, std::uint32_t(tile))) {
+                glm::dvec3 c(0.0);
+                for (const glm::dvec3& v : chunk->corners) c += v;
+                focus = glm::dvec3(lc::worldFromView(doc_->scene().camera) * glm::dvec4(c / 8.0, 1.0));
+            }
+        } else if (doc_->currentLight() >= 0 && std::size_t(doc_->currentLight()) < lights.size()) {
+            focus = lights[std::size_t(doc_->currentLight())].position;
+        }
+        std::vector<char> selected(lights.size(), 0);
+        for (int i : doc_->selectedLights())
+            if (i >= 0 && std::size_t(i) < lights.size()) selected[std::size_t(i)] = 1;
+        std::stable_sort(set.begin(), set.end(), [&](int a, int b) {
+            if (selected[std::size_t(a)] != selected[std::size_t(b)]) return selected[std::size_t(a)] > selected[std::size_t(b)];
+            return glm::length(lights[std::size_t(a)].position - focus) < glm::length(lights[std::size_t(b)].position - focus);
+        });
+        leftOut_ = set.size() - cap;
+        set.resize(cap);
+        std::sort(set.begin(), set.end());
+    }
+    drawn_ = std::move(set);
+    slot_.assign(lights.size(), -1);
+    for (std::size_t k = 0; k < drawn_.size(); ++k) slot_[std::size_t(drawn_[k])] = int(k);
+
+    // Peeling only for few filled spheres, and not under x-ray meshes (every
+    // peel would redraw every translucent triangle of the scene).
+    const bool peel = !silhouettes_ && drawn_.size() <= kMaxPeeledLights && ov.meshes != MD::XRay;
+    renderer_->SetUseDepthPeeling(peel ? 1 : 0);
+    renderer_->SetPass(peel ? nullptr : blendedPasses_.Get());
+    lightActor_->SetVisibility(ov.showLights && !silhouettes_);
+    ringActor_->SetVisibility(ov.showLights && silhouettes_);
+    spotCones_->actor()->SetVisibility(ov.showLights);
+    if (drawn_.size() == lights.size()) {
+        lightData_ = lightsToPolyData(lights);
+        spotCones_->update(lights);
+    } else {
+        std::vector<lc::PointLight> sub;
+        sub.reserve(drawn_.size());
+        for (int i : drawn_) sub.push_back(lights[std::size_t(i)]);
+        lightData_ = lightsToPolyData(sub);
+        spotCones_->update(sub);
+    }
     glyph_->SetInputData(lightData_);
     rings_->SetInputData(lightData_);
-    spotCones_->update(doc_->scene().lights);
+    lightSetKey_ = lightSetKey(); // what chose them (refreshLightSet)
 }
 
 void InspectorView::updateLight(int index) {
     const auto& lights = doc_->scene().lights;
-    if (index < 0 || index >= int(lights.size()) || lightData_->GetNumberOfPoints() != vtkIdType(lights.size())) {
+    if (index < 0 || index >= int(lights.size()) || slot_.size() != lights.size()) {
         rebuildLights();
         return;
     }
+    const int s = slot_[std::size_t(index)];
+    if (s < 0) return; // not drawn
     const auto& l = lights[std::size_t(index)];
-    lightData_->GetPoints()->SetPoint(index, l.position.x, l.position.y, l.position.z);
+    lightData_->GetPoints()->SetPoint(s, l.position.x, l.position.y, l.position.z);
     lightData_->GetPoints()->Modified();
-    lightData_->GetPointData()->GetArray("radius")->SetTuple1(index, lightDisplayRadius(l));
+    lightData_->GetPointData()->GetArray("radius")->SetTuple1(s, lightDisplayRadius(l));
     lightData_->GetPointData()->GetArray("radius")->Modified();
     unsigned char rgb[3];
     lightDisplayColor(l, rgb);
     auto* color = lightData_->GetPointData()->GetArray("color");
-    for (int c = 0; c < 3; ++c) color->SetComponent(index, c, rgb[c]);
+    for (int c = 0; c < 3; ++c) color->SetComponent(s, c, rgb[c]);
     color->Modified();
     lightData_->Modified();
-    spotCones_->update(lights);
+    if (drawn_.size() == lights.size()) {
+        spotCones_->update(lights);
+    } else {
+        std::vector<lc::PointLight> sub;
+        for (int i : drawn_) sub.push_back(lights[std::size_t(i)]);
+        spotCones_->update(sub);
+    }
 }
 
 void InspectorView::updateSelection() {
@@ -651,17 +919,23 @@ int InspectorView::pickLight(const QPoint& pos, glm::dvec3* hit) {
     double nearest = glm::length(farPoint - origin);
     if (!(nearest > 0)) return -1;
     const glm::dvec3 dir = (farPoint - origin) / nearest;
-    // A mesh surface in front hides the spheres behind it.
-    if (picker_->Pick(x, y, 0, renderer_) && picker_->GetActor()) {
+    // A mesh surface in front hides the spheres behind it (not an x-ray one:
+    // what the view shows through it can be clicked; a hidden one is not picked).
+    if (!doc_->overlays().showLights) return -1;
+    if (doc_->overlays().meshes == Document::OverlayOptions::MeshDisplay::Normal && picker_->Pick(x, y, 0, renderer_) &&
+        picker_->GetActor()) {
         double p[3];
         picker_->GetPickPosition(p);
         nearest = std::min(nearest, glm::dot(glm::dvec3(p[0], p[1], p[2]) - origin, dir));
     }
     // The first sphere the ray enters. A sphere around the ray's origin is
     // skipped: its surface is behind the viewer, nothing of it is in view.
+    // Only the lights drawn (View > Lights) can be clicked.
     int best = -1;
     const auto& lights = doc_->scene().lights;
-    for (std::size_t i = 0; i < lights.size(); ++i) {
+    for (int k : drawn_) {
+        const std::size_t i = std::size_t(k);
+        if (i >= lights.size()) continue;
         const double r = lightDisplayRadius(lights[i]);
         if (!(r > 0)) continue;
         const glm::dvec3 oc = lights[i].position - origin;

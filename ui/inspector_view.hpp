@@ -13,14 +13,26 @@
 // Picking: a click (press and release without moving) selects the light whose
 // sphere the view ray through the cursor enters first, unless a mesh surface
 // is nearer (exact spheres in world space, whichever way they are drawn).
+//
+// Inside a building (Document::OverlayOptions, View > Meshes and View >
+// Lights): the meshes can be drawn as x-ray (translucent, no depth writes;
+// they then hide no light from a click) or hidden; the lights drawn can be
+// only the selected tile's listed ones, as spheres, rings or automatic, with
+// at most sphereCap filled spheres (a "+N more" note in the view's corner
+// says what was left out); lights and spot cones hide together. The current
+// light's handles live in a renderer layer above the scene (handleLayer()),
+// so walls never hide them. Frame selected looks from the culling camera's
+// side when a mesh would stand between the kept direction and the selection.
 
 #include <QVTKOpenGLNativeWidget.h>
 
 #include <glm/glm.hpp>
 #include <vtkNew.h>
 #include <vtkSmartPointer.h>
+#include <vtkTextActor.h>
 
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -33,6 +45,10 @@ class vtkPointHandleRepresentation3D;
 class vtkPolyData;
 class vtkRenderer;
 class vtkSphereSource;
+
+namespace lc {
+struct Scene;
+}
 
 namespace lcui {
 
@@ -62,8 +78,18 @@ public:
     // Flies (animated, `ms` milliseconds) to the selection so it fills the
     // view, keeping the viewing direction: the selected cell's or tile's
     // frustum chunk of the latest run, else the current light's sphere.
-    // False when nothing is selected.
+    // When a shown mesh would lie between that eye and the selection (its
+    // near face's centre, or the light's centre), it looks from the culling
+    // camera's side instead: along the line from the culling camera through
+    // that point, no farther back than the first surface on it (so the eye
+    // stays inside the room the culling camera sees). False when nothing is
+    // selected.
     bool frameSelected(int ms = 300);
+    // Whether the last frameSelected turned to the culling camera's side.
+    bool framedFromCullingSide() const { return framedFromCullingSide_; }
+    // Where the segment a -> b first crosses a triangle of the scene's meshes,
+    // as a fraction of its length in [0, 1]; nullopt when it crosses none.
+    static std::optional<double> firstMeshHit(const lc::Scene& scene, const glm::dvec3& a, const glm::dvec3& b);
     // The view becomes the culling camera (position, direction, up, field of
     // view or orthographic height): tile frustums line up with the camera
     // view's grid. Orbiting starts from there.
@@ -98,6 +124,18 @@ public:
     vtkActor* lightActor() const;
     bool silhouettes() const { return silhouettes_; }
     SpotConesActor* spotCones() const { return spotCones_.get(); }
+    // The lights the light actor draws (ascending indices; every light unless
+    // only the tile's are shown or the sphere cap left some out), and how many
+    // of the lights it should show were left out by the cap.
+    const std::vector<int>& drawnLights() const { return drawn_; }
+    std::size_t lightsLeftOut() const { return leftOut_; }
+    // The note in the view's top-left corner ("+N more ...", the tile whose
+    // lights are shown); hidden when there is nothing to say.
+    vtkTextActor* lightNote() const;
+    // The renderer layer above the scene that holds every handle (depth
+    // cleared before it draws: geometry never hides a handle).
+    vtkRenderer* handleLayer() const;
+    const std::vector<vtkSmartPointer<vtkActor>>& meshActors() const { return meshActors_; }
     // The selected spot light's direction and outer-angle handles (ui/spot_handles.hpp).
     SpotHandles* spotHandles() const { return spotHandles_.get(); }
     // Tile frustums, cells, reverse look-up and list highlights (overlay_actors.hpp).
@@ -118,7 +156,17 @@ private:
     };
     ViewBasis viewBasis() const;
     void rebuildMeshes();
+    void applyMeshDisplay();
     void rebuildLights();
+    // Rebuilds the drawn lights when what chooses them changed (options, tile,
+    // run, the selection while the cap leaves lights out).
+    void refreshLightSet();
+    std::vector<long long> lightSetKey() const;
+    // Animates the camera to (eye, focal, up).
+    void flyToEye(const glm::dvec3& eye, const glm::dvec3& focal, const glm::dvec3& up, int ms);
+    // The eye distance from the points' centre at which every point fits the
+    // view along `dir` (10% margin); also sets the parallel scale.
+    double fitDistance(const std::vector<glm::dvec3>& points, const ViewBasis& b, glm::dvec3* center);
     void updateLight(int index);
     void updateSelection();
     void updateFrustum();
@@ -148,6 +196,14 @@ private:
     // order-independent pass (float buffers and a full-view resolve per
     // frame); this sequence blends it in actor order instead.
     vtkNew<vtkCameraPass> blendedPasses_;
+    vtkNew<vtkRenderer> handleLayer_;
+    vtkNew<vtkTextActor> lightNote_;
+    std::vector<int> drawn_; // light indices in lightData_'s order
+    std::vector<int> slot_;  // per light: its point in lightData_, or -1
+    std::size_t leftOut_ = 0;
+    bool drawnAreTileLights_ = false; // drawn_ is the selected tile's list
+    std::vector<long long> lightSetKey_; // what chose drawn_ (refreshLightSet)
+    bool framedFromCullingSide_ = false;
     vtkSmartPointer<vtkPolyData> selData_;
     vtkNew<vtkGlyph3D> selGlyph_;
     vtkNew<vtkActor> selActor_;

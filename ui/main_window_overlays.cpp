@@ -15,6 +15,11 @@
 #include <QActionGroup>
 #include <QImage>
 #include <QMenu>
+#include <QSignalBlocker>
+
+#include <functional>
+#include <tuple>
+#include <vector>
 
 namespace lcui {
 
@@ -32,6 +37,10 @@ lc::RgbImage toRgb(const QImage& image) {
 }
 
 } // namespace
+
+// View > Meshes and View > Lights: the inspector inside a building. Every
+// pick goes to the document's overlay options; the checks follow them.
+static void buildInsideMenus(MainWindow* w, Document* doc, QMenu* view);
 
 void MainWindow::buildOverlayMenus(QMenu* file, QMenu* view) {
     QAction* exportAction = new QAction(tr("E&xport diagnostics..."), this);
@@ -78,6 +87,8 @@ void MainWindow::buildOverlayMenus(QMenu* file, QMenu* view) {
         inspectorView_->scheduleRender();
     });
 
+    buildInsideMenus(this, doc_, view);
+
     QMenu* heat = view->addMenu(tr("&Heat map"));
     auto* group = new QActionGroup(this);
     const std::pair<QString, lc::HeatMode> modes[] = {{tr("List length"), lc::HeatMode::ListLength},
@@ -97,6 +108,95 @@ void MainWindow::buildOverlayMenus(QMenu* file, QMenu* view) {
             doc_->setOverlays(o);
         });
     }
+}
+
+static void buildInsideMenus(MainWindow* w, Document* doc, QMenu* view) {
+    using Options = Document::OverlayOptions;
+    using MD = Options::MeshDisplay;
+    using LD = Options::LightDisplay;
+    // Re-checks every action from the options (they change from elsewhere too).
+    std::vector<std::function<void()>> syncs;
+    auto radio = [&](QMenu* menu, QActionGroup* group, const QString& text, const char* name, auto pick,
+                     auto isChecked) {
+        QAction* a = menu->addAction(text);
+        a->setObjectName(name);
+        a->setCheckable(true);
+        group->addAction(a);
+        QObject::connect(a, &QAction::triggered, w, [doc, pick] {
+            Options o = doc->overlays();
+            pick(o);
+            doc->setOverlays(o);
+        });
+        syncs.push_back([a, doc, isChecked] {
+            const QSignalBlocker block(a);
+            a->setChecked(isChecked(doc->overlays()));
+        });
+        return a;
+    };
+    auto toggle = [&](QMenu* menu, const QString& text, const char* name, bool Options::*field) {
+        QAction* a = menu->addAction(text);
+        a->setObjectName(name);
+        a->setCheckable(true);
+        QObject::connect(a, &QAction::toggled, w, [doc, field](bool on) {
+            Options o = doc->overlays();
+            o.*field = on;
+            doc->setOverlays(o);
+        });
+        syncs.push_back([a, doc, field] {
+            const QSignalBlocker block(a);
+            a->setChecked(doc->overlays().*field);
+        });
+        return a;
+    };
+
+    QMenu* meshes = view->addMenu(QObject::tr("&Meshes"));
+    meshes->setObjectName("menuMeshes");
+    auto* meshGroup = new QActionGroup(meshes);
+    const std::tuple<QString, const char*, MD> meshModes[] = {
+        {QObject::tr("Normal"), "actionMeshesNormal", MD::Normal},
+        {QObject::tr("X-ray (see through walls)"), "actionMeshesXRay", MD::XRay},
+        {QObject::tr("Hidden"), "actionMeshesHidden", MD::Hidden}};
+    for (const auto& [text, name, mode] : meshModes) {
+        const MD m = mode;
+        // X-ray (key X) toggles: picked again it goes back to normal.
+        QAction* a = radio(
+            meshes, meshGroup, text, name,
+            [m](Options& o) { o.meshes = m == MD::XRay && o.meshes == MD::XRay ? MD::Normal : m; },
+            [m](const Options& o) { return o.meshes == m; });
+        if (m == MD::XRay) a->setShortcut(QKeySequence(Qt::Key_X));
+    }
+
+    QMenu* lights = view->addMenu(QObject::tr("&Lights"));
+    lights->setObjectName("menuLights");
+    toggle(lights, QObject::tr("Show lights and spot cones"), "actionLightsShow", &Options::showLights);
+    toggle(lights, QObject::tr("Only the selected tile's lights"), "actionLightsOnlyTile", &Options::onlyTileLights);
+    lights->addSeparator();
+    auto* styleGroup = new QActionGroup(lights);
+    const std::tuple<QString, const char*, LD> styles[] = {
+        {QObject::tr("Spheres up to the cap, outlines above"), "actionLightsAuto", LD::Auto},
+        {QObject::tr("Spheres (at most the cap)"), "actionLightsSpheres", LD::Spheres},
+        {QObject::tr("Outlines (silhouette rings)"), "actionLightsOutlines", LD::Outlines}};
+    for (const auto& [text, name, style] : styles) {
+        const LD st = style;
+        radio(
+            lights, styleGroup, text, name, [st](Options& o) { o.lights = st; },
+            [st](const Options& o) { return o.lights == st; });
+    }
+    QMenu* cap = lights->addMenu(QObject::tr("Sphere &cap"));
+    cap->setObjectName("menuSphereCap");
+    auto* capGroup = new QActionGroup(cap);
+    for (int n : {16, 32, 64, 128, 256, 1024}) {
+        const QByteArray name = "actionSphereCap" + QByteArray::number(n);
+        QAction* a = radio(
+            cap, capGroup, QObject::tr("%1 spheres").arg(n), name.constData(), [n](Options& o) { o.sphereCap = n; },
+            [n](const Options& o) { return o.sphereCap == n; });
+        a->setObjectName(QString::fromLatin1(name));
+    }
+    auto syncAll = [syncs] {
+        for (const auto& s : syncs) s();
+    };
+    syncAll();
+    QObject::connect(doc, &Document::overlaysChanged, w, syncAll);
 }
 
 bool MainWindow::exportDiagnostics(const QString& dir) {

@@ -2,9 +2,11 @@
 
 #include "document.hpp"
 #include "explain_panel.hpp"
+#include "light_silhouettes.hpp"
 #include "vtk_adapters.hpp"
 
 #include <vtkActor.h>
+#include <vtkCamera.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkDoubleArray.h>
@@ -126,7 +128,51 @@ struct InspectorOverlays::Impl {
     vtkSmartPointer<vtkPolyData> listedData, missingData;
     vtkNew<vtkGlyph3D> listedGlyph, missingGlyph;
     vtkNew<vtkActor> listedA, missingA;
+    // The listed lights as silhouette rings (many of them, or View > Lights > Outlines).
+    vtkNew<LightSilhouettes> listedRings;
+    vtkSmartPointer<vtkMapper> listedGlyphMapper;
+    vtkNew<vtkPolyDataMapper> listedRingMapper;
 };
+
+namespace {
+
+// The run still describes the scene and its grid is the camera's.
+bool usableRun(const Document& doc) {
+    const auto run = doc.runOutput();
+    const lc::Camera& cam = doc.scene().camera;
+    return run && !doc.runIsStale() && run->result.grid.width == cam.width && run->result.grid.height == cam.height &&
+           run->result.grid.tileSize == cam.tileSize && cam.validate().empty();
+}
+
+} // namespace
+
+std::optional<std::vector<int>> InspectorOverlays::tileListLights(const Document& doc) {
+    const int tile = doc.selectedTile();
+    if (!usableRun(doc) || tile < 0) return std::nullopt;
+    const auto run = doc.runOutput();
+    const lc::CullResult& r = run->result;
+    if (std::uint32_t(tile) >= r.grid.tileCount()) return std::nullopt;
+    auto [first, count] = lc::tileLists(r, std::uint32_t(tile));
+    // As the tile inspector's rows (lc::tileLightRows): a cell of halfz or
+    // clustered has a list of its own.
+    const int cell = doc.selectedCell();
+    if (cell >= 0 && (r.algorithm == lc::Algorithm::HalfZ || r.algorithm == lc::Algorithm::Clustered) &&
+        std::uint32_t(cell) < count) {
+        first += std::uint32_t(cell);
+        count = 1;
+    }
+    const std::size_t n = doc.scene().lights.size();
+    std::vector<char> in(n, 0);
+    for (std::uint32_t l = first; l < first + count && l < r.listCountTotal(); ++l)
+        for (std::uint32_t k = 0; k < r.listCount[l]; ++k) {
+            const std::uint32_t light = r.lightIndices[r.listOffset[l] + k];
+            if (light < n) in[light] = 1;
+        }
+    std::vector<int> out;
+    for (std::size_t i = 0; i < n; ++i)
+        if (in[i]) out.push_back(int(i));
+    return out;
+}
 
 InspectorOverlays::InspectorOverlays(vtkRenderer* renderer, vtkSphereSource* sphere) : d_(new Impl) {
     d_->renderer = renderer;
@@ -207,6 +253,14 @@ InspectorOverlays::InspectorOverlays(vtkRenderer* renderer, vtkSphereSource* sph
     };
     glyphActor(d_->listedGlyph, d_->listedData, d_->listedA, true);
     d_->listedA->GetProperty()->SetOpacity(0.45);
+    d_->listedGlyphMapper = d_->listedA->GetMapper();
+    d_->listedRings->SetInputData(d_->listedData);
+    d_->listedRings->SetCamera(renderer->GetActiveCamera());
+    d_->listedRingMapper->SetInputConnection(d_->listedRings->GetOutputPort());
+    d_->listedRingMapper->SetScalarModeToUsePointFieldData();
+    d_->listedRingMapper->SelectColorArray("color");
+    d_->listedRingMapper->SetColorModeToDirectScalars();
+    d_->listedRingMapper->ScalarVisibilityOn();
     glyphActor(d_->missingGlyph, d_->missingData, d_->missingA, false);
     d_->missingA->GetProperty()->SetColor(1.0, 0.1, 0.1);
     d_->missingA->GetProperty()->SetOpacity(0.7);
@@ -230,6 +284,7 @@ vtkPolyData* InspectorOverlays::lightRange() const { return d_->lightRange; }
 vtkPolyData* InspectorOverlays::allTiles() const { return d_->allTiles; }
 vtkPolyData* InspectorOverlays::reverse() const { return d_->reverse; }
 vtkActor* InspectorOverlays::allTilesActor() const { return d_->allTilesA; }
+vtkActor* InspectorOverlays::listedActor() const { return d_->listedA; }
 vtkPolyData* InspectorOverlays::spotCullSphere() const { return d_->spotSphere; }
 vtkPolyData* InspectorOverlays::spotChunksPassed() const { return d_->spotPassed; }
 vtkPolyData* InspectorOverlays::spotChunksRejected() const { return d_->spotRejected; }
@@ -247,6 +302,8 @@ void InspectorOverlays::update(const Document& doc) {
     missing_.clear();
     reverseLists_.clear();
     dim_ = false;
+    listedRings_ = false;
+    listedLeftOut_ = 0;
 
     const auto run = doc.runOutput();
     const lc::Camera& cam = doc.scene().camera;
@@ -363,23 +420,56 @@ void InspectorOverlays::update(const Document& doc) {
 
     // Listed lights of the selected tile (or cell) highlighted, missing in red.
     const auto& lights = doc.scene().lights;
+    bool drawListed = false;
     if (opt.listHighlight && tileOk) {
         const auto rows = lc::tileLightRows(*run, proj, std::uint32_t(tile), doc.selectedCell());
-        std::vector<lc::PointLight> listedL, missingL;
+        std::vector<lc::PointLight> missingL;
         for (const auto& row : rows) {
             if (row.light >= lights.size()) continue;
             auto& ids = row.verdict == lc::Verdict::Missing ? missing_ : listed_;
             if (std::find(ids.begin(), ids.end(), int(row.light)) != ids.end()) continue;
             ids.push_back(int(row.light));
-            (row.verdict == lc::Verdict::Missing ? missingL : listedL).push_back(lights[row.light]);
+            if (row.verdict == lc::Verdict::Missing) missingL.push_back(lights[row.light]);
         }
+        // View > Lights: with only the tile's lights shown the view draws the
+        // listed ones itself (undimmed); hidden lights hide these too.
+        drawListed = opt.showLights && !opt.onlyTileLights;
+        using LD = Document::OverlayOptions::LightDisplay;
+        const std::size_t cap = std::size_t(std::max(opt.sphereCap, 1));
+        listedRings_ = opt.lights == LD::Outlines || (opt.lights == LD::Auto && listed_.size() > cap);
+        std::vector<int> shown = listed_;
+        if (!listedRings_ && shown.size() > cap) {
+            // The spheres nearest the tile's frustum first.
+            glm::dvec3 centre(0.0);
+            if (const auto chunk = lc::tileFrustum(r, proj, run->lights, std::uint32_t(tile))) {
+                for (const glm::dvec3& v : chunk->corners) centre += v;
+                centre = glm::dvec3(w * glm::dvec4(centre / 8.0, 1.0));
+            }
+            std::stable_sort(shown.begin(), shown.end(), [&](int a, int b) {
+                return glm::length(lights[std::size_t(a)].position - centre) <
+                       glm::length(lights[std::size_t(b)].position - centre);
+            });
+            listedLeftOut_ = drawListed ? shown.size() - cap : 0;
+            shown.resize(cap);
+        }
+        std::vector<lc::PointLight> listedL;
+        for (int i : shown) listedL.push_back(lights[std::size_t(i)]);
         d_->listedData = lightsToPolyData(listedL);
         d_->missingData = lightsToPolyData(missingL);
         d_->listedGlyph->SetInputData(d_->listedData);
+        d_->listedRings->SetInputData(d_->listedData);
         d_->missingGlyph->SetInputData(d_->missingData);
-        dim_ = true;
+        // Rings are lines: bright and opaque enough to stand out over the
+        // dimmed rings of the other lights; spheres stay translucent.
+        d_->listedA->SetMapper(listedRings_ ? static_cast<vtkMapper*>(d_->listedRingMapper.Get())
+                                            : d_->listedGlyphMapper.Get());
+        d_->listedA->GetProperty()->SetOpacity(listedRings_ ? 0.9 : 0.45);
+        d_->listedA->GetProperty()->SetLighting(!listedRings_);
+        d_->listedA->GetProperty()->SetLineWidth(listedRings_ ? 2.0 : 1.0);
+        d_->listedRings->SetCamera(d_->renderer->GetActiveCamera());
+        dim_ = drawListed;
     }
-    show(d_->listedA, !listed_.empty());
+    show(d_->listedA, drawListed && !listed_.empty());
     show(d_->missingA, !missing_.empty());
 
     // Every tile's frustum: rebuilt only for a new run (or when turned on).

@@ -12,7 +12,11 @@
 // - reverse look-up: the frustums (halfz/clustered: the cells) whose lists
 //   hold the current light, magenta;
 // - the selected tile's listed lights highlighted (the light glyph actor is
-//   dimmed meanwhile), missing lights in red.
+//   dimmed meanwhile), missing lights in red. They follow View > Lights: as
+//   filled spheres up to the sphere cap and as bright silhouette rings above
+//   it (Auto) or always (Outlines); as at most sphereCap spheres, the nearest
+//   the tile first (Spheres). With only the tile's lights shown the view's own
+//   light actor draws them and only the missing ones are added here.
 // - the primitive the run's spot test used for the current spot light (View >
 //   Overlays > Spot test primitive, off by default; lc::spotTestPrimitive):
 //   its culling sphere (apex or tight sphere, pink), and for the selected
@@ -35,6 +39,7 @@
 #include <vtkSmartPointer.h>
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 class vtkActor;
@@ -58,6 +63,15 @@ public:
     void update(const Document& doc);
     // Whether the light glyphs should be dimmed (a tile's lists are highlighted).
     bool dimLights() const { return dim_; }
+    // The lights in the lists of the document's selected tile (for halfz and
+    // clustered with a cell selected: that cell's list), ascending; nullopt
+    // without a tile or a run that still describes the scene.
+    static std::optional<std::vector<int>> tileListLights(const Document& doc);
+    // The highlighted listed lights: drawn as rings (else filled spheres), and
+    // how many the sphere cap left out.
+    bool listedAsRings() const { return listedRings_; }
+    std::size_t listedLeftOut() const { return listedLeftOut_; }
+    vtkActor* listedActor() const;
 
     // --- for tests and screenshots ---------------------------------------------
     vtkPolyData* tileSolid() const;
@@ -95,6 +109,8 @@ private:
     struct Impl;
     std::unique_ptr<Impl> d_;
     bool dim_ = false;
+    bool listedRings_ = false;
+    std::size_t listedLeftOut_ = 0;
     std::vector<int> listed_, missing_;
     std::vector<std::uint32_t> reverseLists_;
     const void* allTilesRun_ = nullptr; // run the all-tiles wireframe was built for

@@ -58,7 +58,8 @@ void setPosition(vtkPointHandleRepresentation3D* rep, const glm::dvec3& p) {
 
 } // namespace
 
-SpotHandles::SpotHandles(Document* doc, vtkRenderer* renderer, vtkRenderWindowInteractor* interactor)
+SpotHandles::SpotHandles(Document* doc, vtkRenderer* renderer, vtkRenderWindowInteractor* interactor,
+                         vtkRenderer* handleLayer)
     : doc_(doc), renderer_(renderer) {
     auto setUp = [&](vtkHandleWidget* w, vtkPointHandleRepresentation3D* rep, double r, double g, double b) {
         rep->SetHandleSize(25);
@@ -68,6 +69,7 @@ SpotHandles::SpotHandles(Document* doc, vtkRenderer* renderer, vtkRenderWindowIn
         rep->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
         rep->ActiveRepresentationOff();
         w->SetInteractor(interactor);
+        if (handleLayer) w->SetDefaultRenderer(handleLayer);
         w->SetRepresentation(rep);
         w->EnabledOff();
     };

@@ -36,7 +36,10 @@ public:
     // The property panel's lower bound for the outer angle (degrees).
     static constexpr double kMinOuterAngleDeg = 0.01;
 
-    SpotHandles(Document* doc, vtkRenderer* renderer, vtkRenderWindowInteractor* interactor);
+    // `renderer` gives the view's camera; the handles are drawn in
+    // `handleLayer` when given (a layer above the scene: never hidden).
+    SpotHandles(Document* doc, vtkRenderer* renderer, vtkRenderWindowInteractor* interactor,
+                vtkRenderer* handleLayer = nullptr);
     ~SpotHandles();
 
     // Re-places or hides both handles from the document's selection and
