@@ -537,30 +537,8 @@ void CameraView::updateCamera() {
     updateViewport();
 }
 
-std::vector<int> CameraView::tileHeatValues(const lc::RunOutput& run) {
-    const lc::CullResult& r = run.result;
-    const std::uint32_t tiles = r.grid.tileCount();
-    std::vector<int> heat(tiles, -1);
-    for (std::uint32_t t = 0; t < tiles; ++t) {
-        const bool geometry = t < r.tileDepthMin.size() && r.tileDepthMin[t] <= r.tileDepthMax[t];
-        if (!geometry) continue;
-        if (r.algorithm == lc::Algorithm::All) {
-            heat[t] = r.listCount.empty() ? 0 : int(r.listCount[0]);
-            continue;
-        }
-        int m = 0;
-        for (std::uint32_t s = 0; s < r.listsPerTile; ++s) {
-            const std::size_t l = std::size_t(t) * r.listsPerTile + s;
-            if (l < r.listCount.size()) m = std::max(m, int(r.listCount[l]));
-        }
-        heat[t] = m;
-    }
-    return heat;
-}
-
 void CameraView::updateOverlay() {
     const auto run = doc_->runOutput();
-    const lc::Camera& cam = doc_->scene().camera;
     clearOverlay(heatData_);
     clearOverlay(gridData_);
     if (!run) {

@@ -74,10 +74,6 @@ public:
     // The hover tooltip of a tile of the latest run: its list lengths, view
     // depth range, geometry pixels, efficiency and misses; empty without a run.
     QString tileTooltip(int tile) const;
-    // The heat value of every tile (what the map colours): for `all` the one
-    // list's length everywhere; otherwise the longest of the tile's lists (the
-    // longest loop a pixel of the tile can run). Tiles without geometry: -1.
-    static std::vector<int> tileHeatValues(const lc::RunOutput& run);
 
     // Tiles outlined by the reverse look-up: those whose lists hold the
     // current light (ascending; empty when no light or the toggle is off).

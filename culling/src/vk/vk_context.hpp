@@ -186,7 +186,6 @@ public:
     // (device-local buffers behind staging copies, subgroup work layout, GPU
     // timestamps) so that tests exercise them on lavapipe.
     bool isCpuDevice() const { return props_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU && !emulateGpu_; }
-    bool emulatesGpu() const { return emulateGpu_; }
     // The queue writes timestamps in compute and graphics (and the device
     // reports a tick period): GPU timing is possible.
     bool timestampsSupported() const { return timestamps_; }
