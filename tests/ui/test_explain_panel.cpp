@@ -149,13 +149,15 @@ private slots:
 
         // A light far from the tile: rejected, and the panel says by what.
         std::uint32_t far = 0;
+        bool farFound = false;
         for (std::uint32_t i = 0; i < run->lights.size(); ++i) {
             const auto b = run->result.lightIndices.begin() + run->result.listOffset[tile];
             if (!std::binary_search(b, b + run->result.listCount[tile], i)) {
-                far = i;
+                far = i, farFound = true;
                 break;
             }
         }
+        QVERIFY2(farFound, "the busiest tile lists every light: no rejected light to explain");
         w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(far)));
         QVERIFY(panel->explanation());
         QCOMPARE(panel->explanation()->listed, false);
@@ -232,16 +234,29 @@ private slots:
                 run->lights.radii[neededLight] * (1 + 1e-9));
 
         // A light the tile's planes reject: the plane drawn is one that failed.
-        for (std::uint32_t i = 0; i < run->lights.size(); ++i) {
+        // Such a light must exist (asserted: the check below is the point).
+        int rejected = -1;
+        for (std::uint32_t i = 0; i < run->lights.size() && rejected < 0; ++i) {
             const auto ex = lc::explainLight(*run, proj, tile, i);
-            if (ex.testsPass || ex.decisiveMargin >= 0) continue;
-            w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(i)));
-            QVERIFY(ov->explanation());
+            if (!ex.testsPass && ex.decisiveMargin < 0) rejected = int(i);
+        }
+        QVERIFY2(rejected >= 0, "no light of the scene is rejected by a plane of this tile");
+        w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(rejected));
+        QVERIFY(ov->explanation());
+        QVERIFY(!ov->explanation()->listed);
+        QVERIFY(ov->explanation()->decisiveMargin < 0);
+        {
             const std::string failed = lc::chunkPlaneName(ov->explanation()->decisivePlane);
             bool stepFailed = false;
             for (const auto& st : ov->explanation()->steps) stepFailed = stepFailed || (st.test == failed && !st.passed);
             QVERIFY2(stepFailed, failed.c_str());
-            break;
+            // The marker drawn is that plane's face, not the kept light's.
+            const auto face = lc::chunkFace(ov->explanation()->chunkCorners, ov->explanation()->decisivePlane);
+            const glm::dvec3 mid = 0.25 * (face[0] + face[1] + face[2] + face[3]);
+            QCOMPARE(ov->explainPlane()->GetNumberOfPoints(), vtkIdType(4));
+            for (int i = 0; i < 4; ++i)
+                QVERIFY(near(point(ov->explainPlane(), i),
+                             toWorld(mid + InspectorOverlays::kExplainPlaneScale * (face[std::size_t(i)] - mid))));
         }
 
         // The View > Overlays toggle removes both.
