@@ -5,6 +5,8 @@
 //                 [--backend cpu|vulkan] [--device D] [--no-image-error] --out DIR
 //   lightcull bench (--scene FILE | --builtin NAME) [run flags] [--repeat N] [--warmup N]
 //                   [--sweep KEY=V1,V2,...]... [--json FILE]
+//   lightcull hunt [--scene FILE | --builtin NAME] [culling flags | --shader FILE] [--seed S]
+//                  [--trials N] [--budget SECONDS] [--vary DIMS] [--overflow] --out DIR
 //   lightcull convert IN OUT        (IN: scene JSON, .gltf, .glb; OUT by extension: .json, .gltf, .glb)
 //
 // FILE is scene JSON, .gltf or .glb (with --camera and --min-intensity for glTF).
@@ -21,6 +23,7 @@
 #include "culling/core/pipeline.hpp"
 #include "culling/scene/scene_io.hpp"
 #include "custom.hpp"
+#include "hunt.hpp"
 #include "report.hpp"
 #include "scene_source.hpp"
 
@@ -552,6 +555,9 @@ int main(int argc, char** argv) {
     lcli::ReportCommand report;
     report.add(app);
 
+    lcli::HuntCommand hunt;
+    hunt.add(app);
+
     CLI::App* explain = app.add_subcommand(
         "explain", "Why is a light in a tile's list, or why not: the algorithm's tests with their numbers and the "
                    "ground truth of the list's pixels");
@@ -577,9 +583,9 @@ int main(int argc, char** argv) {
     if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "scenes" && std::string(argv[1]) != "run" &&
         std::string(argv[1]) != "bench" && std::string(argv[1]) != "report" &&
         std::string(argv[1]) != "convert" && std::string(argv[1]) != "check" &&
-        std::string(argv[1]) != "explain")
+        std::string(argv[1]) != "explain" && std::string(argv[1]) != "hunt")
         return fail(2, std::string("unknown command '") + argv[1] +
-                           "' (commands: scenes, run, bench, report, convert, check, explain; see --help)");
+                           "' (commands: scenes, run, bench, report, convert, check, explain, hunt; see --help)");
 
     try {
         app.parse(argc, argv);
@@ -604,6 +610,8 @@ int main(int argc, char** argv) {
         }
 
         if (report.chosen()) return report.run();
+
+        if (hunt.chosen()) return hunt.run();
 
         if (app.got_subcommand("convert")) {
             lcli::SceneSource::checkSceneExtension("OUT", convertOut); // before reading IN

@@ -1,0 +1,219 @@
+// lightcull hunt [--scene FILE | --builtin NAME] [culling flags | --shader FILE ...]
+//                [--seed S] [--trials N] [--budget SECONDS] [--vary DIMS] [--overflow] --out DIR
+#include "hunt.hpp"
+
+#include "culling/core/errors.hpp"
+#include "culling/core/params.hpp"
+#include "culling/diagnostics/export.hpp"
+#include "culling/diagnostics/hunt.hpp"
+#include "culling/scene/scene_io.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <set>
+
+namespace fs = std::filesystem;
+
+namespace lcli {
+
+namespace {
+
+int usage(const std::string& message) {
+    std::cerr << "lightcull: error: " << message << "\n";
+    return 2;
+}
+
+std::string shellQuote(const std::string& a) {
+    if (!a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_./:=,+@%") ==
+                          std::string::npos)
+        return a;
+    std::string q = "'";
+    for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+// What the hunt writes into --out; a folder holding anything else is refused.
+const std::set<std::string> kOutputs = {"scene.json", "repro.sh", "verdict.txt", "summary.json", "run"};
+
+std::string outProblem(const std::string& dir) {
+    const fs::path p(dir);
+    const fs::path parent = p.has_parent_path() ? p.parent_path() : fs::path(".");
+    if (!fs::is_directory(parent)) return dir + ": its parent folder does not exist";
+    if (!fs::exists(p)) return {};
+    if (!fs::is_directory(p)) return dir + ": is a file, not a folder";
+    for (const auto& e : fs::directory_iterator(p))
+        if (!kOutputs.count(e.path().filename().string()))
+            return dir + ": holds " + e.path().filename().string() + ", which is not an earlier hunt's output";
+    return {};
+}
+
+void writeText(const fs::path& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+    if (!out.flush()) throw lc::Error(path.string() + ": cannot write");
+}
+
+} // namespace
+
+void HuntCommand::add(CLI::App& app) {
+    cmd_ = app.add_subcommand(
+        "hunt", "Search random small trials (camera, projection, screen, lights, spots, scene) for one where the "
+                "culling misses a light; shrink it and write the repro into --out DIR (exit 3 when found)");
+    source_.addTo(cmd_);
+    for (const lc::ParamSpec& p : lc::cullParams()) {
+        if (p.name == "width" || p.name == "height") continue; // the hunt varies the screen
+        CLI::Option* o = cmd_->add_option("--" + p.name, paramValues_[p.name],
+                                          p.name == "tile" ? "Tile size when the screen is not varied (default: the scene's)"
+                                                           : p.help + " (default: " + p.defaultValue + ")");
+        o->type_name(p.type == lc::ParamType::Int ? "INT" : p.type == lc::ParamType::Bool ? "BOOL" : "CHOICE");
+        paramOptions_.emplace_back(p.name, o);
+    }
+    CLI::Option* s = cmd_->add_option("--shader", shader_,
+                                      "Hunt in your own culling shader instead of a built-in algorithm "
+                                      "(docs/CUSTOM_CULLING.md)")
+                         ->type_name("FILE");
+    cmd_->add_option("--layout", layout_, "Custom shader: fixed:N, compact[:N] or bitmask (default: its first line)")
+        ->type_name("LAYOUT")
+        ->needs(s);
+    cmd_->add_option("--lists", lists_, "Custom shader: tile, halfz, froxel:N[:log|linear], cells:N[:log|linear]")
+        ->type_name("RULE")
+        ->needs(s);
+    cmd_->add_flag("--no-validation", noValidation_, "Custom shader: without the Khronos validation layer")->needs(s);
+    cmd_->add_option("--timeout-ms", timeoutMs_, "Custom shader: a dispatch running this long is a hang (default 10000)")
+        ->type_name("MS")
+        ->check(CLI::Range(1.0, 3600000.0))
+        ->needs(s);
+    cmd_->add_option("--seed", seed_, "Seed of the search: the same seed gives the same trials (default: 1)")->type_name("S");
+    cmd_->add_option("--trials", trials_, "Stop after N trials (default: 200 unless --budget is given)")->type_name("N");
+    cmd_->add_option("--budget", budget_, "Stop after this many seconds")->type_name("SECONDS")->check(CLI::Range(0.0, 1e7));
+    cmd_->add_option("--vary", vary_,
+                     "What trials vary, comma-separated: camera, projection, screen, lights, spots, scene (default: all)")
+        ->type_name("DIMS");
+    cmd_->add_flag("--overflow", overflow_,
+                   "A list over the custom layout's declared capacity is a failure too (default: counted apart)");
+    std::string backendHelp = "Backend of the depth pre-pass (and of a built-in algorithm's culling): ";
+    for (const std::string& b : lc::availableBackends()) backendHelp += b + " ";
+    cmd_->add_option("--backend", backend_, backendHelp + "(default: vulkan where available, else cpu)")->type_name("NAME");
+    cmd_->add_option("--device", device_, "Vulkan device: index or name substring")->type_name("D");
+    cmd_->add_option("--out", outDir_, "Folder for the repro (scene.json, repro.sh, summary.json, verdict.txt)")
+        ->type_name("DIR")
+        ->required();
+}
+
+int HuntCommand::run() {
+    lc::HuntOptions options;
+    options.seed = seed_;
+    options.vary = lc::parseHuntDims(vary_);
+    options.maxSeconds = budget_;
+    options.maxTrials = trials_ ? trials_ : budget_ > 0 ? 0 : 200;
+    options.overflowIsFailure = overflow_;
+    lc::Camera scratchCamera;
+    std::vector<std::string> cullingFlags; // for the repro command
+    for (const auto& [name, opt] : paramOptions_) {
+        if (!opt->count()) continue;
+        if (!shader_.empty() && name != "tile")
+            return usage(opt->get_name() + ": has no effect with --shader: the shader culls");
+        lc::setParam(options.settings, scratchCamera, name, paramValues_.at(name));
+    }
+    if (const std::string why = outProblem(outDir_); !why.empty()) return usage("--out: " + why);
+
+    std::optional<lc::Scene> base;
+    if (source_.given()) base = source_.load();
+    if (base) {
+        base->validate();
+        if (paramOptions_.size() && std::any_of(paramOptions_.begin(), paramOptions_.end(), [](const auto& p) {
+                return p.first == "tile" && p.second->count();
+            }))
+            base->camera.tileSize = scratchCamera.tileSize;
+        options.baseScene = &*base;
+    }
+    if (!shader_.empty()) {
+        lc::CustomShaderOptions so = lc::shaderOptionsFromFile(shader_, layout_, lists_);
+        so.device = device_;
+        so.validation = !noValidation_;
+        so.timeoutMs = timeoutMs_;
+        options.shader = so;
+    }
+
+    std::unique_ptr<lc::CullBackend> backend;
+    if (!backend_.empty()) {
+        backend = lc::makeBackend(backend_, device_);
+    } else {
+        const auto avail = lc::availableBackends();
+        if (std::find(avail.begin(), avail.end(), "vulkan") != avail.end()) {
+            try {
+                backend = lc::makeBackend("vulkan", device_);
+            } catch (const lc::Error& e) {
+                if (!device_.empty()) throw;
+                std::cerr << "lightcull: note: no Vulkan device, using the cpu backend\n";
+            }
+        }
+        if (!backend) backend = lc::makeBackend("cpu");
+    }
+
+    options.progress = [](const lc::HuntCoverage& c, double seconds) {
+        std::fprintf(stderr, "hunt: %llu trials in %.1f s, %.1f trials/s; covered: %s\n",
+                     static_cast<unsigned long long>(c.trials), seconds, seconds > 0 ? double(c.trials) / seconds : 0.0,
+                     c.text().c_str());
+    };
+    const lc::HuntResult result = lc::hunt(options, *backend);
+
+    fs::create_directories(outDir_);
+    for (const std::string& name : kOutputs) fs::remove_all(fs::path(outDir_) / name);
+    if (result.firstOverCapacityTrial)
+        std::cout << "over capacity (not a failure without --overflow): " << result.coverage.overCapacity
+                  << " trials, the first trial " << *result.firstOverCapacityTrial << "\n";
+    if (!result.failure) {
+        const std::string line = "no miss in " + std::to_string(result.coverage.trials) + " trials of seed " +
+                                 std::to_string(seed_) + " (coverage: " + result.coverage.text() + ")\n";
+        writeText(fs::path(outDir_) / "verdict.txt", line);
+        std::cout << line;
+        return 0;
+    }
+
+    // The repro: the shrunk scene, the `lightcull run` that shows the miss,
+    // that run's diagnostics and the verdict.
+    const lc::HuntFailure& f = *result.failure;
+    std::string command = "lightcull run --scene scene.json --backend " + backend->name();
+    if (!device_.empty()) command += " --device " + shellQuote(device_);
+    if (options.shader) {
+        command += " --shader " + shellQuote(fs::absolute(shader_).string()) + " --layout " +
+                   lc::toString(options.shader->layout) + " --lists " + lc::toString(options.shader->lists);
+        if (noValidation_) command += " --no-validation";
+    } else {
+        for (const lc::ParamSpec& p : lc::cullParams())
+            if (p.name != "tile" && p.name != "width" && p.name != "height")
+                command += " --" + p.name + " " + shellQuote(lc::getParam(options.settings, scratchCamera, p.name));
+    }
+    command += " --no-image-error --out run";
+
+    lc::Scene scene = f.shrunk;
+    const fs::path out(outDir_);
+    lc::saveSceneFile(scene, (out / "scene.json").string());
+    scene.origin.file = fs::absolute(out / "scene.json").string();
+    scene.origin.command = command;
+    lc::RunOutput run;
+    lc::judgeHuntTrial(scene, options, *backend, &run);
+    lc::exportDiagnostics(scene, options.settings, run, (out / "run").string());
+    fs::copy_file(out / "run" / "summary.json", out / "summary.json", fs::copy_options::overwrite_existing);
+    const std::string verdict = lc::huntVerdictText(f, options);
+    writeText(out / "verdict.txt", verdict);
+    writeText(out / "repro.sh", "#!/bin/sh\n# lightcull hunt, seed " + std::to_string(seed_) + ", trial " +
+                                    std::to_string(f.trial) + ": " + f.verdict.property +
+                                    " (verdict.txt). Exits 3 while the miss is there.\n"
+                                    "# Set LIGHTCULL to the binary when lightcull is not on PATH.\n"
+                                    "cd \"$(dirname \"$0\")\" || exit 1\n# " +
+                                    command + "\nexec \"${LIGHTCULL:-lightcull}\"" + command.substr(9) + "\n");
+    fs::permissions(out / "repro.sh", fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
+                    fs::perm_options::add);
+    std::cout << "COUNTEREXAMPLE after " << f.trial + 1 << " trials (" << result.seconds << " s):\n"
+              << verdict << "repro: " << (out / "repro.sh").string() << "  (" << command << ")\n"
+              << "wrote " << outDir_ << "/scene.json, repro.sh, summary.json, verdict.txt, run/\n";
+    std::cerr << "lightcull: the culling fails the hunt: " << f.verdict.property << " (exit 3)\n";
+    return 3;
+}
+
+} // namespace lcli

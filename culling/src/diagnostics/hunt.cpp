@@ -1,0 +1,510 @@
+// The hunt: random small trials judged by ground truth, and the shrinking of
+// the first failing one (culling/diagnostics/hunt.hpp).
+#include "culling/diagnostics/hunt.hpp"
+
+#include "culling/core/errors.hpp"
+#include "culling/math/projection.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace lc {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// splitmix64: a trial's numbers depend only on (seed, index), the same on
+// every machine (no std distributions).
+struct Rng {
+    std::uint64_t s;
+    std::uint64_t next() {
+        std::uint64_t z = (s += 0x9e3779b97f4a7c15ull);
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+        return z ^ (z >> 31);
+    }
+    double uniform() { return double(next() >> 11) * 0x1.0p-53; }          // [0, 1)
+    double uniform(double a, double b) { return a + (b - a) * uniform(); }
+    double logUniform(double a, double b) { return a * std::pow(b / a, uniform()); }
+    std::uint32_t below(std::uint32_t n) { return std::uint32_t(next() % n); } // [0, n)
+    bool chance(double p) { return uniform() < p; }
+    glm::dvec3 unitVector() {
+        const double z = uniform(-1, 1), a = uniform(0, 2 * kPi), r = std::sqrt(std::max(0.0, 1 - z * z));
+        return {r * std::cos(a), r * std::sin(a), z};
+    }
+};
+
+std::uint64_t mix(std::uint64_t a, std::uint64_t b) {
+    Rng r{a ^ (b * 0xd1b54a32d192ed03ull)};
+    r.next();
+    return r.next();
+}
+
+void addBox(Mesh& m, glm::dvec3 lo, glm::dvec3 hi) {
+    const auto base = std::uint32_t(m.vertexCount());
+    for (int i = 0; i < 8; ++i) {
+        m.positions.push_back(float(i & 1 ? hi.x : lo.x));
+        m.positions.push_back(float(i & 2 ? hi.y : lo.y));
+        m.positions.push_back(float(i & 4 ? hi.z : lo.z));
+    }
+    // Corner index = x + 2y + 4z; each quad counter-clockwise seen from outside.
+    static const std::uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                              {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    for (const auto& q : quads)
+        for (std::uint32_t t : {q[0], q[1], q[2], q[0], q[2], q[3]}) m.indices.push_back(base + t);
+}
+
+void addGround(Mesh& m, double half) {
+    const auto base = std::uint32_t(m.vertexCount());
+    for (int i = 0; i < 4; ++i) {
+        m.positions.push_back(float(i & 1 ? half : -half));
+        m.positions.push_back(0.0f);
+        m.positions.push_back(float(i & 2 ? half : -half));
+    }
+    for (std::uint32_t t : {0u, 2u, 3u, 0u, 3u, 1u}) m.indices.push_back(base + t); // facing +y
+}
+
+double diagonalOf(const Scene& s) {
+    const auto [lo, hi] = s.bounds();
+    return std::max(glm::length(hi - lo), 1e-3);
+}
+
+glm::dvec3 pointIn(Rng& r, glm::dvec3 lo, glm::dvec3 hi) {
+    return {r.uniform(lo.x, hi.x), r.uniform(lo.y, hi.y), r.uniform(lo.z, hi.z)};
+}
+
+PointLight randomLight(Rng& r, const Scene& s, const std::vector<PointLight>& earlier, bool spots, double diag) {
+    const auto [lo, hi] = s.bounds();
+    const glm::dvec3 centre = 0.5 * (lo + hi);
+    const Camera& c = s.camera;
+    const glm::dvec3 eye = c.position, dir = glm::normalize(c.target - c.position);
+    PointLight l;
+    l.explicitRadius = r.logUniform(diag * 2e-3, diag * 1.5);
+    const double where = r.uniform();
+    if (where < 0.35) {
+        l.position = pointIn(r, lo - 0.05 * diag, hi + 0.05 * diag);
+    } else if (where < 0.6) { // in view, at some depth
+        l.position = eye + dir * r.logUniform(1e-3 * diag, 2 * diag) + r.unitVector() * r.uniform(0, 0.3 * diag);
+    } else if (where < 0.72) { // behind the camera
+        l.position = eye - dir * r.logUniform(1e-3 * diag, diag) + r.unitVector() * r.uniform(0, 0.2 * diag);
+    } else if (where < 0.84) { // around the near plane: its sphere crosses it
+        const double d = c.nearPlane * r.uniform(0.2, 3.0);
+        l.position = eye + dir * d + r.unitVector() * r.uniform(0, 0.05 * diag);
+        l.explicitRadius = std::max(l.explicitRadius, c.nearPlane * r.uniform(0.5, 4.0));
+    } else if (where < 0.92 && !earlier.empty()) { // coincident with another light
+        l.position = earlier[r.below(std::uint32_t(earlier.size()))].position;
+    } else { // far away
+        l.position = centre + r.unitVector() * diag * r.uniform(1.0, 5.0);
+    }
+    l.intensity = r.uniform(1, 10);
+    l.color = {r.uniform(0.2, 1), r.uniform(0.2, 1), r.uniform(0.2, 1)};
+    if (spots && r.chance(0.35)) {
+        l.kind = LightKind::Spot;
+        const double a = r.uniform();
+        l.outerAngleDeg = a < 0.2 ? 90.0 : a < 0.35 ? r.uniform(80, 90) : r.uniform(1, 90);
+        l.innerAngleDeg = r.chance(0.2) ? l.outerAngleDeg : r.uniform(0, l.outerAngleDeg);
+        const double d = r.uniform();
+        l.direction = d < 0.15 ? dir : d < 0.25 ? -dir : r.unitVector();
+    }
+    return l;
+}
+
+} // namespace
+
+unsigned parseHuntDims(const std::string& text) {
+    static const std::pair<const char*, unsigned> names[] = {
+        {"camera", HuntCamera}, {"projection", HuntProjection}, {"screen", HuntScreen},
+        {"lights", HuntLights}, {"spots", HuntSpots},           {"scene", HuntSceneDim},
+        {"all", HuntAll}};
+    unsigned dims = 0;
+    std::stringstream in(text);
+    for (std::string word; std::getline(in, word, ',');) {
+        bool known = false;
+        for (const auto& [name, bit] : names)
+            if (word == name) dims |= bit, known = true;
+        if (!known)
+            throw SettingsError("vary", "unknown dimension '" + word +
+                                            "' (camera, projection, screen, lights, spots, scene, all)");
+    }
+    return dims;
+}
+
+std::string huntDimsToString(unsigned dims) {
+    static const std::pair<const char*, unsigned> names[] = {
+        {"camera", HuntCamera}, {"projection", HuntProjection}, {"screen", HuntScreen},
+        {"lights", HuntLights}, {"spots", HuntSpots},           {"scene", HuntSceneDim}};
+    std::string s;
+    for (const auto& [name, bit] : names)
+        if (dims & bit) s += (s.empty() ? "" : ",") + std::string(name);
+    return s.empty() ? "nothing" : s;
+}
+
+std::string HuntCoverage::text() const {
+    std::ostringstream o;
+    o << orthographic << " orthographic, " << reversedZ << " reversed-Z (" << infiniteFar << " infinite far), "
+      << glDepth << " GL depth, " << nonMultipleScreens << " non-multiple screens (" << tinyScreens << " tiny), "
+      << cameraInsideBounds << " camera inside the scene, " << spotTrials << " with spots (" << wideSpots
+      << " wider than 90 degrees), " << lightsBehindCamera << " lights behind the camera, " << lightsCrossingNear
+      << " crossing the near plane, " << lightsLargerThanScene << " larger than the scene, " << generatedScenes
+      << " generated scenes, " << emptyViews << " seeing no geometry";
+    if (overCapacity) o << ", " << overCapacity << " over capacity (not failures)";
+    return o.str();
+}
+
+Scene makeHuntScene(std::uint64_t seed) {
+    Rng r{mix(seed, 0x5ce4e)};
+    Scene s;
+    s.name = "hunt-" + std::to_string(seed);
+    Mesh m;
+    m.name = "ground-and-boxes";
+    addGround(m, 12.0);
+    const std::uint32_t boxes = 1 + r.below(6);
+    for (std::uint32_t i = 0; i < boxes; ++i) {
+        const glm::dvec3 c{r.uniform(-9, 9), 0, r.uniform(-9, 9)};
+        const glm::dvec3 half{r.logUniform(0.15, 2.0), r.logUniform(0.1, 2.5), r.logUniform(0.15, 2.0)};
+        const double lift = r.chance(0.25) ? r.uniform(0.5, 3.0) : 0.0; // some float above the ground
+        addBox(m, {c.x - half.x, lift, c.z - half.z}, {c.x + half.x, lift + 2 * half.y, c.z + half.z});
+    }
+    s.meshes.push_back(std::move(m));
+    s.camera.position = {0, 6, 16};
+    s.camera.target = {0, 0.5, 0};
+    s.camera.width = 160;
+    s.camera.height = 96;
+    s.camera.tileSize = 16;
+    s.camera.nearPlane = 0.1;
+    s.camera.farPlane = 100;
+    for (int i = 0; i < 8; ++i) s.lights.push_back(randomLight(r, s, s.lights, false, diagonalOf(s)));
+    return s;
+}
+
+Scene makeHuntTrial(const Scene* base, std::uint64_t seed, std::uint64_t index, unsigned vary) {
+    Rng r{mix(seed, index + 1)};
+    Scene s = base ? *base : makeHuntScene((vary & HuntSceneDim) ? mix(seed, ~index) : seed);
+    s.origin = {};
+    s.name = (base ? base->name : std::string("hunt")) + "-trial-" + std::to_string(index);
+    const auto [lo, hi] = s.bounds();
+    const glm::dvec3 centre = 0.5 * (lo + hi);
+    const double diag = diagonalOf(s);
+    Camera& c = s.camera;
+
+    if (vary & HuntCamera) {
+        if (r.chance(0.25)) {
+            c.position = pointIn(r, lo, hi) + glm::dvec3(0, r.uniform(0.05, 0.3) * diag * 0.2, 0);
+        } else {
+            glm::dvec3 d = r.unitVector();
+            if (r.chance(0.8)) d.y = std::abs(d.y); // mostly from above the ground
+            c.position = centre + d * diag * r.uniform(0.3, 2.0);
+        }
+        const double t = r.uniform();
+        if (t < 0.3 || s.lights.empty())
+            c.target = centre + r.unitVector() * r.uniform(0, 0.1 * diag);
+        else if (t < 0.55)
+            c.target = s.lights[r.below(std::uint32_t(s.lights.size()))].position;
+        else if (t < 0.8) // a corner of the bounds: geometry edges
+            c.target = {r.chance(0.5) ? lo.x : hi.x, r.chance(0.5) ? lo.y : hi.y, r.chance(0.5) ? lo.z : hi.z};
+        else
+            c.target = pointIn(r, lo, hi);
+        if (glm::length(c.target - c.position) < 1e-6 * diag) c.target = c.position + glm::dvec3(0, 0, -1);
+        c.up = {0, 1, 0};
+        const glm::dvec3 view = glm::normalize(c.target - c.position);
+        if (glm::length(glm::cross(view, c.up)) < 1e-3) c.up = {1, 0, 0};
+    }
+    if (vary & HuntProjection) {
+        const std::uint32_t k = r.below(8); // perspective kinds twice as often as orthographic
+        static const ProjectionKind kinds[8] = {
+            ProjectionKind::Perspective, ProjectionKind::Perspective,   ProjectionKind::PerspectiveGL,
+            ProjectionKind::ReversedZ,   ProjectionKind::ReversedZ,     ProjectionKind::PerspectiveGL,
+            ProjectionKind::Orthographic, ProjectionKind::OrthographicGL};
+        c.projection = kinds[k];
+        const double f = r.uniform();
+        c.fovYDeg = f < 0.1 ? r.uniform(0.5, 5) : f < 0.2 ? r.uniform(140, 175) : r.uniform(20, 120);
+        c.orthoHeight = r.logUniform(0.05 * diag, 1.5 * diag);
+        const double dist = glm::length(centre - c.position);
+        c.nearPlane = r.logUniform(1e-4 * diag, 0.3 * std::max(dist, 0.1 * diag));
+        const double far = r.uniform();
+        if (c.projection == ProjectionKind::ReversedZ && far < 0.5)
+            c.farPlane = std::numeric_limits<double>::infinity();
+        else if (far < 0.3) // a far plane that cuts the scene
+            c.farPlane = c.nearPlane + r.uniform(0.1, 1.0) * (dist + 0.5 * diag);
+        else
+            c.farPlane = c.nearPlane + (dist + diag) * r.uniform(1.0, 50.0);
+    }
+    if (vary & HuntScreen) {
+        static const std::uint32_t tiles[4] = {8, 16, 16, 32};
+        c.tileSize = tiles[r.below(4)];
+        auto side = [&](std::uint32_t maxSide) -> std::uint32_t {
+            const double u = r.uniform();
+            if (u < 0.12) return 1 + r.below(24);                                           // tiny
+            if (u < 0.45) return c.tileSize * (1 + r.below(std::max(1u, maxSide / c.tileSize))); // whole tiles
+            return 1 + r.below(maxSide);
+        };
+        c.width = side(400);
+        c.height = side(300);
+    }
+    if (vary & HuntLights) {
+        s.lights.clear();
+        const std::uint32_t n = r.chance(0.3) ? 1 + r.below(4) : 1 + r.below(32);
+        for (std::uint32_t i = 0; i < n; ++i) s.lights.push_back(randomLight(r, s, s.lights, vary & HuntSpots, diag));
+    } else if (vary & HuntSpots) {
+        for (PointLight& l : s.lights) {
+            if (!r.chance(0.35)) continue;
+            l.kind = LightKind::Spot;
+            l.outerAngleDeg = r.chance(0.3) ? 90.0 : r.uniform(1, 90);
+            l.innerAngleDeg = r.uniform(0, l.outerAngleDeg);
+            l.direction = r.unitVector();
+        }
+    }
+    for (std::size_t i = 0; i < s.lights.size(); ++i) s.lights[i].name = "L" + std::to_string(i);
+    if (const std::string bad = c.validate(); !bad.empty()) throw Error("hunt: generated an invalid camera: " + bad);
+    return s;
+}
+
+HuntVerdict judgeHuntTrial(const Scene& scene, const HuntOptions& options, CullBackend& backend, RunOutput* runOut) {
+    scene.validate();
+    HuntVerdict v;
+    RunOptions ro;
+    ro.truthOptions.imageError = false;
+    RunOutput run;
+    try {
+        if (options.shader) {
+            CustomCullReport report;
+            run = runCustomPipeline(scene, *options.shader, backend, ro, report);
+        } else {
+            run = runPipeline(scene, options.settings, backend, ro);
+        }
+    } catch (const SettingsError&) {
+        throw;
+    } catch (const Error& e) {
+        v.fails = true;
+        v.property = std::string("error: ") + e.what();
+        return v;
+    }
+    v.falseNegatives = run.truthComputed ? run.truth.metrics.falseNegatives : 0;
+    v.geometryPixels = run.truthComputed ? run.truth.metrics.geometryPixels : 0;
+    v.invalidIndices = run.custom ? run.custom->invalidIndices : 0;
+    v.overflowLists = run.custom ? run.custom->overflowLists : 0;
+    v.overCapacity = v.overflowLists > 0;
+    std::vector<MissedLight> missed;
+    if (v.falseNegatives) missed = locateFalseNegatives(run, Projection(scene.camera));
+    const bool testMiss = !missed.empty() && missed.front().cause == MissCause::CullingTest;
+    if (v.invalidIndices) {
+        v.fails = true;
+        v.property = "invalid indices";
+    } else if (testMiss || (v.falseNegatives && !v.overCapacity)) {
+        v.fails = true;
+        v.property = "false negatives";
+    } else if (v.overCapacity && options.overflowIsFailure) {
+        v.fails = true;
+        v.property = "overflow";
+    }
+    if (!missed.empty()) v.miss = missed.front();
+    if (runOut) *runOut = std::move(run);
+    return v;
+}
+
+namespace {
+
+// Rounds x to `digits` significant decimal digits (0: leaves it).
+double roundSig(double x, int digits) {
+    if (x == 0 || !std::isfinite(x)) return x;
+    const double scale = std::pow(10.0, digits - 1 - std::floor(std::log10(std::abs(x))));
+    return std::round(x * scale) / scale;
+}
+glm::dvec3 roundTo(glm::dvec3 v, double step) { return glm::round(v / step) * step; }
+
+} // namespace
+
+Scene shrinkHuntFailure(const Scene& failing, const HuntOptions& options, CullBackend& backend, std::size_t* runs) {
+    std::size_t count = 0;
+    const HuntVerdict first = judgeHuntTrial(failing, options, backend);
+    ++count;
+    Scene best = failing;
+    auto stillFails = [&](const Scene& s) {
+        if (!s.camera.validate().empty()) return false;
+        ++count;
+        try {
+            return judgeHuntTrial(s, options, backend).fails;
+        } catch (const Error&) {
+            return false; // a shrink step made a scene the tool refuses: not a smaller repro
+        }
+    };
+    // Lights: the missed one alone, else drop the others one at a time.
+    if (first.miss && best.lights.size() > 1) {
+        Scene alone = best;
+        alone.lights = {best.lights[first.miss->light]};
+        if (stillFails(alone)) best = alone;
+    }
+    for (std::size_t i = best.lights.size(); i-- > 0 && best.lights.size() > 1;) {
+        Scene fewer = best;
+        fewer.lights.erase(fewer.lights.begin() + std::ptrdiff_t(i));
+        if (stillFails(fewer)) best = fewer;
+    }
+    // Screen: halve each side while it still fails.
+    for (int axis = 0; axis < 2; ++axis)
+        for (;;) {
+            Scene smaller = best;
+            std::uint32_t& side = axis == 0 ? smaller.camera.width : smaller.camera.height;
+            if (side <= 1) break;
+            side = (side + 1) / 2;
+            if (!stillFails(smaller)) break;
+            best = smaller;
+        }
+    // Camera values: the roundest that still fails, coarsest first.
+    const double diag = diagonalOf(best);
+    for (double step : {1.0, 0.1, 0.01}) {
+        Scene round = best;
+        Camera& c = round.camera;
+        c.position = roundTo(c.position, step * std::max(1.0, std::floor(diag / 10)));
+        c.target = roundTo(c.target, step * std::max(1.0, std::floor(diag / 10)));
+        if (stillFails(round)) {
+            best = round;
+            break;
+        }
+    }
+    for (int digits : {1, 2, 3}) {
+        Scene round = best;
+        Camera& c = round.camera;
+        c.fovYDeg = roundSig(c.fovYDeg, digits + 1);
+        c.orthoHeight = roundSig(c.orthoHeight, digits);
+        c.nearPlane = roundSig(c.nearPlane, digits);
+        c.farPlane = roundSig(c.farPlane, digits);
+        if (stillFails(round)) {
+            best = round;
+            break;
+        }
+    }
+    // The lights' numbers too, where that keeps the miss.
+    for (int digits : {2, 3, 4}) {
+        Scene round = best;
+        for (PointLight& l : round.lights) {
+            for (int k = 0; k < 3; ++k) l.position[k] = roundSig(l.position[k], digits);
+            l.explicitRadius = roundSig(l.explicitRadius, digits);
+            l.intensity = roundSig(l.intensity, 2);
+            l.color = roundTo(l.color, 0.01);
+            l.outerAngleDeg = std::min(90.0, roundSig(l.outerAngleDeg, digits));
+            l.innerAngleDeg = std::min(l.outerAngleDeg, roundSig(l.innerAngleDeg, digits));
+            for (int k = 0; k < 3; ++k) l.direction[k] = roundSig(l.direction[k], digits);
+        }
+        bool valid = true;
+        for (const PointLight& l : round.lights) valid = valid && l.validate().empty();
+        if (valid && stillFails(round)) {
+            best = round;
+            break;
+        }
+    }
+    for (std::size_t i = 0; i < best.lights.size(); ++i) best.lights[i].name = "L" + std::to_string(i);
+    if (runs) *runs = count;
+    return best;
+}
+
+HuntResult hunt(const HuntOptions& options, CullBackend& backend) {
+    if (options.maxTrials == 0 && !(options.maxSeconds > 0))
+        throw SettingsError("trials", "give a trial count or a time budget");
+    HuntResult result;
+    HuntCoverage& cov = result.coverage;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+    double lastReport = 0;
+    for (std::uint64_t i = 0;; ++i) {
+        if (options.maxTrials && i >= options.maxTrials) break;
+        if (options.maxSeconds > 0 && elapsed() >= options.maxSeconds) break;
+        const Scene s = makeHuntTrial(options.baseScene, options.seed, i, options.vary);
+        // Coverage of what this trial is.
+        const Camera& c = s.camera;
+        ++cov.trials;
+        cov.orthographic += isOrthographic(c.projection);
+        cov.reversedZ += c.projection == ProjectionKind::ReversedZ;
+        cov.infiniteFar += std::isinf(c.farPlane);
+        cov.glDepth += c.projection == ProjectionKind::PerspectiveGL || c.projection == ProjectionKind::OrthographicGL;
+        cov.nonMultipleScreens += c.width % c.tileSize != 0 || c.height % c.tileSize != 0;
+        cov.tinyScreens += c.width <= 24 || c.height <= 24;
+        cov.generatedScenes += !options.baseScene;
+        const auto [lo, hi] = s.bounds();
+        cov.cameraInsideBounds += glm::all(glm::greaterThanEqual(c.position, lo)) &&
+                                  glm::all(glm::lessThanEqual(c.position, hi));
+        const glm::dmat4 view = c.viewFromWorld();
+        const double diag = diagonalOf(s);
+        bool spot = false, wide = false;
+        for (const PointLight& l : s.lights) {
+            spot = spot || l.isSpot();
+            wide = wide || (l.isSpot() && l.outerAngleDeg > 45.0);
+            const glm::dvec3 v = glm::dvec3(view * glm::dvec4(l.position, 1.0));
+            const double r = l.radius();
+            cov.lightsBehindCamera += v.z > 0;
+            cov.lightsCrossingNear += std::abs(-v.z - c.nearPlane) < r;
+            cov.lightsLargerThanScene += r > diag;
+        }
+        cov.spotTrials += spot;
+        cov.wideSpots += wide;
+
+        const HuntVerdict v = judgeHuntTrial(s, options, backend);
+        cov.emptyViews += v.geometryPixels == 0 && !v.fails;
+        if (v.overCapacity && !v.fails) {
+            ++cov.overCapacity;
+            if (!result.firstOverCapacityTrial) result.firstOverCapacityTrial = i;
+        }
+        if (v.fails) {
+            HuntFailure f;
+            f.trial = i;
+            f.original = s;
+            f.varied = huntDimsToString(options.vary);
+            f.shrunk = shrinkHuntFailure(s, options, backend, &f.shrinkRuns);
+            f.verdict = judgeHuntTrial(f.shrunk, options, backend);
+            if (!f.verdict.fails) { // shrinking never keeps a passing scene; belt and braces
+                f.shrunk = s;
+                f.verdict = v;
+            }
+            result.failure = std::move(f);
+            break;
+        }
+        if (options.progress && elapsed() - lastReport >= 1.0) {
+            lastReport = elapsed();
+            options.progress(cov, lastReport);
+        }
+    }
+    result.seconds = elapsed();
+    if (options.progress) options.progress(cov, result.seconds);
+    return result;
+}
+
+std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
+    const Scene& s = f.shrunk;
+    const Camera& c = s.camera;
+    const HuntVerdict& v = f.verdict;
+    std::ostringstream o;
+    o << "The culling under test ("
+      << (options.shader ? "custom shader " + options.shader->path + ", layout " + toString(options.shader->layout) +
+                               ", lists " + toString(options.shader->lists)
+                         : std::string("built-in ") + toString(options.settings.algorithm))
+      << ") fails the hunt's property (" << v.property << ") at trial " << f.trial << " of seed " << options.seed
+      << " (varying " << f.varied << ").";
+    if (v.miss) {
+        const TileGrid grid = TileGrid::make(c.width, c.height, c.tileSize);
+        const std::uint32_t tx = v.miss->tile % grid.tilesX, ty = v.miss->tile / grid.tilesX;
+        const PointLight& l = s.lights.at(v.miss->light);
+        char pos[160];
+        std::snprintf(pos, sizeof pos, "(%g, %g, %g), radius %g", l.position.x, l.position.y, l.position.z,
+                      l.radius());
+        o << " Light " << v.miss->light << " ('" << l.name << "', a " << toString(l.kind) << " light at " << pos
+          << (l.isSpot() ? ", outer angle " + std::to_string(l.outerAngleDeg) + " degrees" : std::string()) << ")"
+          << " is missing from the list of tile " << tx << "," << ty << " (list " << v.miss->list << ", cause "
+          << toString(v.miss->cause) << ") where " << v.miss->pixels << " geometry pixels need it; "
+          << v.falseNegatives << " false negatives in all.";
+    } else {
+        o << " " << v.falseNegatives << " false negatives, " << v.invalidIndices << " invalid indices, "
+          << v.overflowLists << " overflowed lists.";
+    }
+    o << " Shrunk from " << f.original.lights.size() << " lights at " << f.original.camera.width << "x"
+      << f.original.camera.height << " to " << s.lights.size() << " light" << (s.lights.size() == 1 ? "" : "s")
+      << " at " << c.width << "x" << c.height << " (tile " << c.tileSize << ", " << toString(c.projection)
+      << (isOrthographic(c.projection) ? ", height " + std::to_string(c.orthoHeight)
+                                       : ", fov " + std::to_string(c.fovYDeg) + " degrees")
+      << ", near " << c.nearPlane << ", far " << c.farPlane << ") in " << f.shrinkRuns << " runs.\n";
+    return o.str();
+}
+
+} // namespace lc
