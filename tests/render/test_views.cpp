@@ -367,6 +367,40 @@ private slots:
         qInfo("%s", qPrintable(c.message));
     }
 
+    // The spot handles of the current light (a spot behind the tall column,
+    // seen from where the column hides its apex): the direction and angle
+    // handles in their layer above the scene, over the column; the cone
+    // and the selected light's wireframe. A baseline, not only a picture to
+    // look at: handles hidden by geometry, in the wrong place or colour,
+    // or a missing cone change far more than the tolerance.
+    void spotHandlesOverGeometry() {
+        Document doc;
+        lc::Scene s = fixedScene();
+        lc::PointLight& spot = s.lights[3]; // above the column's top
+        spot.kind = lc::LightKind::Spot;
+        spot.position = {-1, 3.5, -3.2};
+        spot.direction = {0.2, -1, 0.3};
+        spot.outerAngleDeg = 35;
+        doc.resetScene(std::move(s), {});
+        doc.setSelectedLights({3});
+        InspectorView iv(&doc);
+        iv.resize(640, 480);
+        iv.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&iv));
+        // From behind the column (the column between the eye and the apex).
+        vtkCamera* cam = iv.renderer()->GetActiveCamera();
+        cam->SetFocalPoint(-1, 3, -3);
+        cam->SetPosition(1, 7, 16);
+        cam->SetViewUp(0, 1, 0);
+        iv.renderer()->ResetCameraClippingRange();
+        iv.renderNow();
+        QTest::qWait(50);
+        iv.renderNow();
+        const Comparison c = compareWithBaseline(iv.grabFramebuffer(), "inspector_spot_handles");
+        QVERIFY2(c.ok, qPrintable(c.message));
+        qInfo("%s", qPrintable(c.message));
+    }
+
     // Difference mode (issue 7): |culled - all| of the shading pass drawn 1:1
     // in the letterboxed viewport (the largest error white), the grey legend
     // from 0 to that error, the caption with the image error, and the tile
