@@ -200,7 +200,7 @@ Scene makeHuntTrial(const Scene* base, std::uint64_t seed, std::uint64_t index, 
             c.position = centre + d * diag * r.uniform(0.3, 2.0);
         }
         const double t = r.uniform();
-        if (t < 0.3 || s.lights.empty())
+        if (t < 0.4 || s.lights.empty())
             c.target = centre + r.unitVector() * r.uniform(0, 0.1 * diag);
         else if (t < 0.55)
             c.target = s.lights[r.below(std::uint32_t(s.lights.size()))].position;
@@ -228,7 +228,7 @@ Scene makeHuntTrial(const Scene* base, std::uint64_t seed, std::uint64_t index, 
         const double far = r.uniform();
         if (c.projection == ProjectionKind::ReversedZ && far < 0.5)
             c.farPlane = std::numeric_limits<double>::infinity();
-        else if (far < 0.3) // a far plane that cuts the scene
+        else if (far < 0.2) // a far plane that cuts the scene
             c.farPlane = c.nearPlane + r.uniform(0.1, 1.0) * (dist + 0.5 * diag);
         else
             c.farPlane = c.nearPlane + (dist + diag) * r.uniform(1.0, 50.0);

@@ -1,0 +1,135 @@
+// The hunt (issue 35) on the CPU backend: every built-in algorithm (and every
+// spot test) hunts a fixed number of trials with no counterexample, a trial
+// is a pure function of its seed and index, and `lightcull hunt` reports,
+// writes its verdict and refuses bad flags like the other commands.
+#include "cli_support.hpp"
+
+#include "culling/core/errors.hpp"
+#include "culling/core/params.hpp"
+#include "culling/diagnostics/hunt.hpp"
+#include "culling/scene/scene_io.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+using namespace lc;
+using lc_test::CliResult;
+using lc_test::runCli;
+using lc_test::ScratchDir;
+
+namespace {
+
+// What a counterexample says, so that a failure of these tests is a repro.
+std::string describe(const HuntResult& r, const HuntOptions& o) {
+    if (!r.failure) return {};
+    return huntVerdictText(*r.failure, o) + "\nshrunk scene:\n" + serializeScene(r.failure->shrunk);
+}
+
+} // namespace
+
+// A built-in algorithm's false negative found here is a bug to fix, with its
+// repro as a new hard case: never a reason to shrink the budget.
+TEST(Hunt, EveryBuiltinAlgorithmOnTheCpuBackendHasNoCounterexample) {
+    auto cpu = makeCpuBackend();
+    for (const std::string& name : cullParam("algorithm").choices) {
+        HuntOptions o;
+        o.settings.algorithm = algorithmFromString(name);
+        o.seed = 35;
+        o.maxTrials = 150;
+        const HuntResult r = hunt(o, *cpu);
+        EXPECT_FALSE(r.failure) << name << ": " << describe(r, o);
+        EXPECT_EQ(r.coverage.trials, r.failure ? r.failure->trial + 1 : 150u) << name;
+        EXPECT_GT(r.coverage.orthographic, 0u) << name;
+        EXPECT_GT(r.coverage.reversedZ, 0u) << name;
+        EXPECT_GT(r.coverage.nonMultipleScreens, 0u) << name;
+        EXPECT_GT(r.coverage.wideSpots, 0u) << name;
+        EXPECT_LT(r.coverage.emptyViews, r.coverage.trials / 2) << name << ": most trials must see geometry";
+    }
+}
+
+TEST(Hunt, EverySpotTestOnTheCpuBackendHasNoCounterexample) {
+    auto cpu = makeCpuBackend();
+    for (const std::string& algorithm : {"minmax", "2.5d", "clustered"})
+        for (const std::string& test : cullParam("spot-test").choices) {
+            HuntOptions o;
+            Camera unused;
+            setParam(o.settings, unused, "algorithm", algorithm);
+            setParam(o.settings, unused, "spot-test", test);
+            o.seed = 8;
+            o.maxTrials = 60;
+            const HuntResult r = hunt(o, *cpu);
+            EXPECT_FALSE(r.failure) << algorithm << " " << test << ": " << describe(r, o);
+        }
+}
+
+TEST(Hunt, GivenSceneKeepsItsMeshesAndVariesTheRest) {
+    auto cpu = makeCpuBackend();
+    const Scene atrium = makeBuiltinScene("atrium");
+    HuntOptions o;
+    o.baseScene = &atrium;
+    o.maxTrials = 30;
+    o.seed = 3;
+    const Scene t = makeHuntTrial(&atrium, 3, 4, HuntAll);
+    EXPECT_EQ(t.triangleCount(), atrium.triangleCount());
+    EXPECT_LE(t.camera.width, 400u);
+    const HuntResult r = hunt(o, *cpu);
+    EXPECT_FALSE(r.failure) << describe(r, o);
+    EXPECT_EQ(r.coverage.generatedScenes, 0u);
+    // Only lights varied: the camera is the scene's.
+    const Scene l = makeHuntTrial(&atrium, 3, 4, HuntLights);
+    EXPECT_EQ(l.camera, atrium.camera);
+    EXPECT_NE(serializeScene(l), serializeScene(atrium));
+}
+
+TEST(Hunt, TheSameSeedGivesTheSameTrialsAndResult) {
+    for (std::uint64_t i : {0u, 1u, 17u, 99u}) {
+        EXPECT_EQ(serializeScene(makeHuntTrial(nullptr, 5, i, HuntAll)), serializeScene(makeHuntTrial(nullptr, 5, i, HuntAll)))
+            << i;
+        EXPECT_NE(serializeScene(makeHuntTrial(nullptr, 5, i, HuntAll)), serializeScene(makeHuntTrial(nullptr, 6, i, HuntAll)))
+            << i;
+    }
+    EXPECT_NE(serializeScene(makeHuntTrial(nullptr, 5, 1, HuntAll)), serializeScene(makeHuntTrial(nullptr, 5, 2, HuntAll)));
+    auto cpu = makeCpuBackend();
+    HuntOptions o;
+    o.settings.algorithm = Algorithm::HalfZ;
+    o.seed = 11;
+    o.maxTrials = 40;
+    const HuntResult a = hunt(o, *cpu), b = hunt(o, *cpu);
+    EXPECT_EQ(a.coverage.text(), b.coverage.text());
+    EXPECT_EQ(a.coverage.trials, 40u);
+    EXPECT_EQ(bool(a.failure), bool(b.failure));
+}
+
+TEST(Hunt, VaryParsesItsDimensionsAndRefusesUnknownOnes) {
+    EXPECT_EQ(parseHuntDims("all"), unsigned(HuntAll));
+    EXPECT_EQ(parseHuntDims("camera,screen"), unsigned(HuntCamera | HuntScreen));
+    EXPECT_EQ(huntDimsToString(HuntLights | HuntSpots), "lights,spots");
+    EXPECT_THROW(parseHuntDims("camera,colour"), SettingsError);
+}
+
+TEST(HuntCli, NoCounterexampleExitsZeroWithCoverage) {
+    ScratchDir s;
+    const auto out = s.path / "hunt";
+    const CliResult r = runCli({"hunt", "--backend", "cpu", "--algorithm", "minmax", "--trials", "40", "--seed", "2",
+                                "--out", out.string()},
+                               s.path);
+    ASSERT_EQ(r.code, 0) << r.err << r.out;
+    EXPECT_NE(r.out.find("no miss in 40 trials"), std::string::npos) << r.out;
+    EXPECT_NE(r.err.find("trials/s"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("orthographic"), std::string::npos) << r.err;
+    EXPECT_NE(lc_test::slurp(out / "verdict.txt").find("no miss"), std::string::npos);
+    EXPECT_FALSE(std::filesystem::exists(out / "repro.sh"));
+}
+
+TEST(HuntCli, BadFlagsExitTwo) {
+    ScratchDir s;
+    EXPECT_EQ(runCli({"hunt", "--backend", "cpu", "--vary", "colour", "--out", (s.path / "h").string()}, s.path).code, 2);
+    EXPECT_EQ(runCli({"hunt", "--backend", "cpu", "--out", (s.path / "no" / "such" / "h").string()}, s.path).code, 2);
+    std::ofstream(s.path / "keep.txt") << "mine";
+    const CliResult r = runCli({"hunt", "--backend", "cpu", "--trials", "1", "--out", s.path.string()}, s.path);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_TRUE(std::filesystem::exists(s.path / "keep.txt"));
+    EXPECT_EQ(runCli({"hunt", "--shader", "x.comp", "--algorithm", "naive", "--out", (s.path / "h").string()}, s.path).code,
+              2);
+}
