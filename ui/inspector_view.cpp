@@ -389,10 +389,13 @@ std::pair<glm::dvec3, glm::dvec3> InspectorView::viewRay(const QPoint& pos) cons
 }
 
 bool InspectorView::frameSelected(int ms) {
-    // What to frame (world points, for the view basis they are seen in) and
-    // the point that must not be hidden: the chunk's near face centre (the
-    // tile's nearest geometry lies on that face), or the light's centre.
+    // What to frame (world points, for the view basis they are seen in), the
+    // point to look from the culling camera's side at, and the points whose
+    // view must not be blocked: the chunk's near face centre and corners (the
+    // tile's nearest geometry lies on that face, and the culling camera sees
+    // them), or the light's centre and four points halfway to its sphere.
     std::function<std::vector<glm::dvec3>(const ViewBasis&)> pointsFor;
+    std::function<std::vector<glm::dvec3>(const ViewBasis&)> samplesFor;
     glm::dvec3 anchor(0.0);
     const auto run = doc_->runOutput();
     const int tile = doc_->selectedTile();
@@ -409,6 +412,10 @@ bool InspectorView::frameSelected(int ms) {
             std::vector<glm::dvec3> corners;
             for (const glm::dvec3& v : chunk->corners) corners.push_back(glm::dvec3(world * glm::dvec4(v, 1.0)));
             anchor = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+            // Pulled a little towards the face's centre: a corner can touch a wall.
+            const std::vector<glm::dvec3> samples = {anchor, glm::mix(anchor, corners[0], 0.9), glm::mix(anchor, corners[1], 0.9),
+                                                     glm::mix(anchor, corners[2], 0.9), glm::mix(anchor, corners[3], 0.9)};
+            samplesFor = [samples](const ViewBasis&) { return samples; };
             // With Explain's markers shown: the pixel that matters (and the
             // nearest point of the light's sphere) come into view too.
             vtkPolyData* marker = overlays_->explainPixel();
@@ -431,6 +438,10 @@ bool InspectorView::frameSelected(int ms) {
             return std::vector<glm::dvec3>{c + r * b.right, c - r * b.right, c + r * b.up,
                                            c - r * b.up,    c + r * b.dir,   c - r * b.dir};
         };
+        samplesFor = [c, r](const ViewBasis& b) {
+            const double h = 0.5 * r;
+            return std::vector<glm::dvec3>{c, c + h * b.right, c - h * b.right, c + h * b.up, c - h * b.up};
+        };
     }
     if (!pointsFor) return false;
 
@@ -440,16 +451,22 @@ bool InspectorView::frameSelected(int ms) {
     const double distance = fitDistance(pointsFor(b), b, &center);
     const glm::dvec3 eye = center - b.dir * distance;
     const lc::Scene& scene = doc_->scene();
-    // The kept direction works unless a shown mesh stands between the eye and
-    // the selection (the roof of a building framed from outside). Nearly at
-    // the anchor does not count: that is the selection's own surface.
+    // The kept direction works unless shown meshes stand between the eye and
+    // most of the selection (the roof of a building framed from outside; a
+    // block hiding a corner of a tile is no reason to turn). Nearly at a
+    // sample does not count: that is the selection's own surface.
     const bool meshesShown = doc_->overlays().meshes != Document::OverlayOptions::MeshDisplay::Hidden;
     auto blocked = [&](const glm::dvec3& from) {
-        const auto hit = firstMeshHit(scene, from, anchor);
-        return hit && *hit < 1.0 - 1e-3;
+        const std::vector<glm::dvec3> samples = samplesFor(b);
+        std::size_t hidden = 0;
+        for (const glm::dvec3& p : samples) {
+            const auto hit = firstMeshHit(scene, from, p);
+            hidden += hit && *hit < 1.0 - 1e-3;
+        }
+        return 2 * hidden > samples.size();
     };
     if (!meshesShown || !blocked(eye)) {
-        flyToEye(eye, center, b.up, ms);
+        flyToEye(eye, center, std::nullopt, ms);
         return true;
     }
     // From the culling camera's side: along the line from its eye through the
@@ -573,10 +590,11 @@ void InspectorView::flyToPoints(const std::vector<glm::dvec3>& points, int ms) {
     const ViewBasis b = viewBasis();
     glm::dvec3 center;
     const double distance = fitDistance(points, b, &center);
-    flyToEye(center - b.dir * distance, center, b.up, ms);
+    flyToEye(center - b.dir * distance, center, std::nullopt, ms);
 }
 
-void InspectorView::flyToEye(const glm::dvec3& toEye, const glm::dvec3& toFocal, const glm::dvec3& toUp, int ms) {
+void InspectorView::flyToEye(const glm::dvec3& toEye, const glm::dvec3& toFocal, std::optional<glm::dvec3> toUp,
+                             int ms) {
     vtkCamera* vc = renderer_->GetActiveCamera();
     const ViewBasis b = viewBasis();
     const glm::dvec3 fromEye = b.eye, fromFocal = b.focal, fromUp = b.up;
@@ -584,12 +602,16 @@ void InspectorView::flyToEye(const glm::dvec3& toEye, const glm::dvec3& toFocal,
     auto apply = [this, vc, fromEye, fromFocal, fromUp, toEye, toFocal, toUp](double t) {
         const double s = t * t * (3.0 - 2.0 * t); // ease in and out
         const glm::dvec3 e = glm::mix(fromEye, toEye, s), f = glm::mix(fromFocal, toFocal, s);
-        glm::dvec3 u = glm::mix(fromUp, toUp, s);
-        if (glm::length(u) < 1e-9) u = toUp;
         vc->SetFocalPoint(f.x, f.y, f.z);
         vc->SetPosition(e.x, e.y, e.z);
-        vc->SetViewUp(u.x, u.y, u.z);
-        vc->OrthogonalizeViewUp();
+        // The view up is left alone when the direction is kept (an orbit
+        // turns about it).
+        if (toUp) {
+            glm::dvec3 u = glm::mix(fromUp, *toUp, s);
+            if (glm::length(u) < 1e-9) u = *toUp;
+            vc->SetViewUp(u.x, u.y, u.z);
+            vc->OrthogonalizeViewUp();
+        }
         renderer_->ResetCameraClippingRange();
         placeRadiusHandle();
         spotHandles_->update();

@@ -78,9 +78,9 @@ public:
     // Flies (animated, `ms` milliseconds) to the selection so it fills the
     // view, keeping the viewing direction: the selected cell's or tile's
     // frustum chunk of the latest run, else the current light's sphere.
-    // When a shown mesh would lie between that eye and the selection (its
-    // near face's centre, or the light's centre), it looks from the culling
-    // camera's side instead: along the line from the culling camera through
+    // When shown meshes would hide most of the selection from that eye (of
+    // the chunk's near face: its centre and corners; of a light: its centre
+    // and four points around it), it looks from the culling camera's side: along the line from the culling camera through
     // that point, no farther back than the first surface on it (so the eye
     // stays inside the room the culling camera sees). False when nothing is
     // selected.
@@ -162,8 +162,8 @@ private:
     // run, the selection while the cap leaves lights out).
     void refreshLightSet();
     std::vector<long long> lightSetKey() const;
-    // Animates the camera to (eye, focal, up).
-    void flyToEye(const glm::dvec3& eye, const glm::dvec3& focal, const glm::dvec3& up, int ms);
+    // Animates the camera to (eye, focal, up); no `up`: the view up stays.
+    void flyToEye(const glm::dvec3& eye, const glm::dvec3& focal, std::optional<glm::dvec3> up, int ms);
     // The eye distance from the points' centre at which every point fits the
     // view along `dir` (10% margin); also sets the parallel scale.
     double fitDistance(const std::vector<glm::dvec3>& points, const ViewBasis& b, glm::dvec3* center);
