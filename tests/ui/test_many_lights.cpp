@@ -12,6 +12,7 @@
 #include "document.hpp"
 #include "inspector_view.hpp"
 #include "light_silhouettes.hpp"
+#include "overlay_actors.hpp"
 #include "main_window.hpp"
 #include "studio_test_support.hpp"
 
@@ -241,6 +242,43 @@ class ManyLightsTest : public QObject {
         QVERIFY2(added > 2.0 * rpx,
                  qPrintable(QString("only %1 outline pixels for a %2 px sphere").arg(added).arg(rpx)));
         QVERIFY(addedOutside <= added / 50);
+    }
+
+    // A tile listing many lights (a glTF Sponza's busiest tile listed 264 of
+    // 340, and filled the view with translucent spheres): with more listed
+    // lights than the sphere cap the highlight is rings; only the tile's
+    // lights draws exactly its list.
+    void busyTileIsHighlightedWithRings() {
+        openWithLights(1024);
+        const auto run = doc()->runOutput();
+        const lc::CullResult& r = run->result;
+        QCOMPARE(r.listsPerTile, 1u);
+        int tile = -1;
+        for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t)
+            if (tile < 0 || r.listCount[t] > r.listCount[std::size_t(tile)]) tile = int(t);
+        const std::uint32_t count = r.listCount[std::size_t(tile)];
+        QVERIFY(count > 20);
+        Document::OverlayOptions o = doc()->overlays();
+        o.sphereCap = int(std::min<std::uint32_t>(count - 1, 256));
+        doc()->setOverlays(o);
+        doc()->setSelectedTile(tile);
+        InspectorOverlays* ov = view()->overlays();
+        QVERIFY(ov->listedActor()->GetVisibility());
+        QVERIFY(ov->listedAsRings());
+        auto* rings = LightSilhouettes::SafeDownCast(ov->listedActor()->GetMapper()->GetInputAlgorithm());
+        QVERIFY(rings);
+        view()->renderNow();
+        QCOMPARE(rings->GetOutput()->GetNumberOfLines(), vtkIdType(ov->listedLights().size()));
+
+        o.onlyTileLights = true;
+        doc()->setOverlays(o);
+        view()->renderNow();
+        QCOMPARE(view()->drawnLights().size(), std::size_t(count));
+        QVERIFY(view()->silhouettes()); // more than the cap: rings
+        auto* drawn = LightSilhouettes::SafeDownCast(view()->lightActor()->GetMapper()->GetInputAlgorithm());
+        QVERIFY(drawn);
+        QCOMPARE(drawn->GetOutput()->GetNumberOfLines(), vtkIdType(count));
+        QVERIFY(!ov->listedActor()->GetVisibility()); // the view draws them itself
     }
 
     // A real mouse click on the view selects the light whose sphere the click
