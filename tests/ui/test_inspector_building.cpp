@@ -261,6 +261,9 @@ private slots:
         QVERIFY2(!hit || *hit > 0.999, qPrintable(QString("a triangle at %1 of the way to the tile").arg(hit.value_or(-1))));
         QVERIFY(inView(nearCentre));
         for (const glm::dvec3& c : corners) QVERIFY(inView(c)); // the whole chunk is in view
+        view()->renderNow();
+        QDir().mkpath(LC_RENDER_OUT_DIR);
+        view()->grabFramebuffer().save(LC_RENDER_OUT_DIR "/inspector_framed_in_room.png"); // to look at
 
         // F from a view that sees the tile keeps its direction, as before.
         double dopBefore[3];
