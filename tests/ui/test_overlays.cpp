@@ -425,7 +425,9 @@ private slots:
         CameraView* cv = w_->cameraView();
         w_->action("actionHeat_false-positives")->trigger();
         QVERIFY(doc()->overlays().heat == lc::HeatMode::FalsePositives);
-        QCOMPARE(QString(cv->legend()->GetTitle()), QString("false\npositives"));
+        // Two lines beside the image, one under it (CameraView::legendPlace).
+        const QString sep = cv->legendPlace() == CameraView::LegendPlace::Below ? " " : "\n";
+        QCOMPARE(QString(cv->legend()->GetTitle()), "false" + sep + "positives");
         double fpSum = 0;
         for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t) {
             const double v = cv->shownHeat()[t];
@@ -440,7 +442,7 @@ private slots:
         }
         QCOMPARE(fpSum, double(gt.metrics.shadingWork - gt.metrics.exactWork));
         w_->action("actionHeat_efficiency")->trigger();
-        QCOMPARE(QString(cv->legend()->GetTitle()), QString("efficiency\nper tile"));
+        QCOMPARE(QString(cv->legend()->GetTitle()), "efficiency" + sep + "per tile");
         for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t) {
             if (!(r.tileDepthMin[t] <= r.tileDepthMax[t])) continue;
             const double w = double(gt.listShadingWork[2 * t] + gt.listShadingWork[2 * t + 1]);
