@@ -36,10 +36,10 @@ TEST(Hunt, EveryBuiltinAlgorithmOnTheCpuBackendHasNoCounterexample) {
         HuntOptions o;
         o.settings.algorithm = algorithmFromString(name);
         o.seed = 35;
-        o.maxTrials = 150;
+        o.maxTrials = 500;
         const HuntResult r = hunt(o, *cpu);
         EXPECT_FALSE(r.failure) << name << ": " << describe(r, o);
-        EXPECT_EQ(r.coverage.trials, r.failure ? r.failure->trial + 1 : 150u) << name;
+        EXPECT_EQ(r.coverage.trials, r.failure ? r.failure->trial + 1 : 500u) << name;
         EXPECT_GT(r.coverage.orthographic, 0u) << name;
         EXPECT_GT(r.coverage.reversedZ, 0u) << name;
         EXPECT_GT(r.coverage.nonMultipleScreens, 0u) << name;
@@ -57,7 +57,7 @@ TEST(Hunt, EverySpotTestOnTheCpuBackendHasNoCounterexample) {
             setParam(o.settings, unused, "algorithm", algorithm);
             setParam(o.settings, unused, "spot-test", test);
             o.seed = 8;
-            o.maxTrials = 60;
+            o.maxTrials = 150;
             const HuntResult r = hunt(o, *cpu);
             EXPECT_FALSE(r.failure) << algorithm << " " << test << ": " << describe(r, o);
         }

@@ -475,6 +475,11 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
     const Scene& s = f.shrunk;
     const Camera& c = s.camera;
     const HuntVerdict& v = f.verdict;
+    auto g = [](double x) {
+        char b[32];
+        std::snprintf(b, sizeof b, "%g", x);
+        return std::string(b);
+    };
     std::ostringstream o;
     o << "The culling under test ("
       << (options.shader ? "custom shader " + options.shader->path + ", layout " + toString(options.shader->layout) +
@@ -490,7 +495,7 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
         std::snprintf(pos, sizeof pos, "(%g, %g, %g), radius %g", l.position.x, l.position.y, l.position.z,
                       l.radius());
         o << " Light " << v.miss->light << " ('" << l.name << "', a " << toString(l.kind) << " light at " << pos
-          << (l.isSpot() ? ", outer angle " + std::to_string(l.outerAngleDeg) + " degrees" : std::string()) << ")"
+          << (l.isSpot() ? ", outer angle " + g(l.outerAngleDeg) + " degrees" : std::string()) << ")"
           << " is missing from the list of tile " << tx << "," << ty << " (list " << v.miss->list << ", cause "
           << toString(v.miss->cause) << ") where " << v.miss->pixels << " geometry pixels need it; "
           << v.falseNegatives << " false negatives in all.";
@@ -501,8 +506,8 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
     o << " Shrunk from " << f.original.lights.size() << " lights at " << f.original.camera.width << "x"
       << f.original.camera.height << " to " << s.lights.size() << " light" << (s.lights.size() == 1 ? "" : "s")
       << " at " << c.width << "x" << c.height << " (tile " << c.tileSize << ", " << toString(c.projection)
-      << (isOrthographic(c.projection) ? ", height " + std::to_string(c.orthoHeight)
-                                       : ", fov " + std::to_string(c.fovYDeg) + " degrees")
+      << (isOrthographic(c.projection) ? ", height " + g(c.orthoHeight)
+                                       : ", fov " + g(c.fovYDeg) + " degrees")
       << ", near " << c.nearPlane << ", far " << c.farPlane << ") in " << f.shrinkRuns << " runs.\n";
     return o.str();
 }
