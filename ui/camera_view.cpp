@@ -515,14 +515,9 @@ void CameraView::rebuildMeshes() {
 void CameraView::updateCamera() {
     const lc::Camera& c = doc_->scene().camera;
     vtkCamera* vc = scene_->GetActiveCamera();
-    vc->SetPosition(c.position.x, c.position.y, c.position.z);
-    vc->SetFocalPoint(c.target.x, c.target.y, c.target.z);
-    vc->SetViewUp(c.up.x, c.up.y, c.up.z);
-    vc->OrthogonalizeViewUp();
-    const bool ortho = lc::isOrthographic(c.projection);
-    vc->SetParallelProjection(ortho);
-    // View angle (VTK's is vertical) and parallel scale (half the viewport
-    // height) come from the camera with the zoom: applyZoom, via updateViewport.
+    // View angle and parallel scale are then narrowed by the zoom (applyZoom,
+    // via updateViewport).
+    applyCullingCamera(vc, c);
     // Near plane = the culling camera's; far = its far plane, pulled in to the
     // scene's extent (an infinite or very far plane would waste depth precision).
     const auto [lo, hi] = doc_->scene().bounds();

@@ -633,18 +633,7 @@ void InspectorView::flyToEye(const glm::dvec3& toEye, const glm::dvec3& toFocal,
 void InspectorView::lookThroughCullingCamera() {
     ++flight_; // stops a flight in progress
     const lc::Camera& c = doc_->scene().camera;
-    vtkCamera* vc = renderer_->GetActiveCamera();
-    vc->SetPosition(c.position.x, c.position.y, c.position.z);
-    vc->SetFocalPoint(c.target.x, c.target.y, c.target.z);
-    vc->SetViewUp(c.up.x, c.up.y, c.up.z);
-    if (lc::isOrthographic(c.projection)) {
-        vc->ParallelProjectionOn();
-        vc->SetParallelScale(0.5 * c.orthoHeight);
-    } else {
-        vc->ParallelProjectionOff();
-        vc->SetViewAngle(c.fovYDeg);
-    }
-    vc->OrthogonalizeViewUp();
+    applyCullingCamera(renderer_->GetActiveCamera(), c);
     renderer_->ResetCameraClippingRange();
     renderNow();
 }

@@ -14,6 +14,7 @@
 #include "tile_inspector.hpp"
 #include "field_events.hpp"
 #include "report_dock.hpp"
+#include "vtk_adapters.hpp"
 
 #include "culling/core/errors.hpp"
 #include "culling/scene/gltf_io.hpp"
@@ -1045,18 +1046,8 @@ bool MainWindow::generateLights(const lc::LightGenSettings& g) {
 }
 
 void MainWindow::setCullingCameraFromInspector() {
-    vtkCamera* vc = inspectorView_->renderer()->GetActiveCamera();
-    lc::Camera c = doc_->scene().camera;
-    double p[3], f[3], u[3];
-    vc->GetPosition(p);
-    vc->GetFocalPoint(f);
-    vc->GetViewUp(u);
-    c.position = {p[0], p[1], p[2]};
-    c.target = {f[0], f[1], f[2]};
-    c.up = {u[0], u[1], u[2]};
-    c.fovYDeg = vc->GetViewAngle();
-    if (vc->GetParallelProjection()) c.orthoHeight = 2 * vc->GetParallelScale();
-    doc_->setCamera(c, tr("Set culling camera from view"));
+    doc_->setCamera(cullingCameraFromVtk(inspectorView_->renderer()->GetActiveCamera(), doc_->scene().camera),
+                    tr("Set culling camera from view"));
 }
 
 // --- window ------------------------------------------------------------------------------

@@ -1,5 +1,7 @@
 #include "vtk_adapters.hpp"
 
+#include <vtkCamera.h>
+
 #include <vtkCellArray.h>
 #include <vtkDoubleArray.h>
 #include <vtkPointData.h>
@@ -66,6 +68,31 @@ vtkSmartPointer<vtkPolyData> lightsToPolyData(const std::vector<lc::PointLight>&
     pd->GetPointData()->AddArray(color);
     pd->GetPointData()->SetActiveScalars("radius");
     return pd;
+}
+
+void applyCullingCamera(vtkCamera* vc, const lc::Camera& c) {
+    vc->SetPosition(c.position.x, c.position.y, c.position.z);
+    vc->SetFocalPoint(c.target.x, c.target.y, c.target.z);
+    vc->SetViewUp(c.up.x, c.up.y, c.up.z);
+    vc->OrthogonalizeViewUp();
+    const bool ortho = lc::isOrthographic(c.projection);
+    vc->SetParallelProjection(ortho);
+    vc->SetParallelScale(0.5 * c.orthoHeight); // VTK: half the viewport height
+    vc->SetViewAngle(c.fovYDeg);               // VTK's view angle is vertical
+}
+
+lc::Camera cullingCameraFromVtk(const vtkCamera* cvc, lc::Camera c) {
+    auto* vc = const_cast<vtkCamera*>(cvc); // VTK's getters are not const
+    double p[3], f[3], u[3];
+    vc->GetPosition(p);
+    vc->GetFocalPoint(f);
+    vc->GetViewUp(u);
+    c.position = {p[0], p[1], p[2]};
+    c.target = {f[0], f[1], f[2]};
+    c.up = {u[0], u[1], u[2]};
+    c.fovYDeg = vc->GetViewAngle();
+    if (vc->GetParallelProjection()) c.orthoHeight = 2 * vc->GetParallelScale();
+    return c;
 }
 
 } // namespace lcui

@@ -6,6 +6,7 @@
 
 #include <vtkSmartPointer.h>
 
+class vtkCamera;
 class vtkPolyData;
 
 namespace lcui {
@@ -25,5 +26,15 @@ void lightDisplayColor(const lc::PointLight& l, unsigned char rgb[3]);
 
 // Radius of a light for display; 0 when the light does not validate.
 double lightDisplayRadius(const lc::PointLight& l);
+
+// The culling camera as a VTK camera: position, focal point = target, view
+// up (orthogonalised), parallel projection for the orthographic kinds with
+// parallel scale = half the ortho height, else the vertical view angle =
+// fovY. Clipping is left to the caller (VTK's depth range is not the
+// culling's).
+void applyCullingCamera(vtkCamera* vc, const lc::Camera& c);
+// The inverse for the fields VTK holds: `base` with position, target, up and
+// fovY (or, for a parallel VTK camera, orthoHeight) taken from `vc`.
+lc::Camera cullingCameraFromVtk(const vtkCamera* vc, lc::Camera base);
 
 } // namespace lcui
