@@ -65,3 +65,29 @@ TEST(HuntCustom, FindsTheFlawedTileEdgesAndItsReproReproduces) {
     EXPECT_EQ(slurp(out2 / "scene.json"), slurp(out / "scene.json"));
     EXPECT_EQ(slurp(out2 / "verdict.txt"), verdict);
 }
+
+// A declared capacity is a limit the user chose: lists over fixed:2 are
+// counted apart, not failures, unless --overflow asks for them; then the
+// repro is shrunk to a few lights and `run` shows the overflow (exit 3).
+TEST(HuntCustom, OverCapacityIsCountedApartUnlessOverflowIsHunted) {
+    ScratchDir s;
+    const std::string good = std::string(LC_SOURCE_DIR) + "/resources/culling-examples/tiled_fixed.comp";
+    const CliResult quiet = runCli({"hunt", "--shader", good, "--layout", "fixed:2", "--backend", "cpu", "--trials",
+                                    "12", "--seed", "1", "--out", (s.path / "a").string()},
+                                   s.path);
+    ASSERT_EQ(quiet.code, 0) << quiet.out << quiet.err;
+    EXPECT_NE(quiet.out.find("over capacity"), std::string::npos) << quiet.out;
+
+    const fs::path out = s.path / "b";
+    const CliResult r = runCli({"hunt", "--shader", good, "--layout", "fixed:2", "--overflow", "--backend", "cpu",
+                                "--trials", "12", "--seed", "1", "--out", out.string()},
+                               s.path);
+    ASSERT_EQ(r.code, 3) << r.out << r.err;
+    EXPECT_NE(slurp(out / "verdict.txt").find("(overflow)"), std::string::npos);
+    EXPECT_LE(nlohmann::json::parse(slurp(out / "scene.json"))["lights"].size(), 5u);
+    const std::string cmd = "LIGHTCULL='" + std::string(LC_CLI_PATH) + "' sh '" + (out / "repro.sh").string() +
+                            "' >/dev/null 2>&1";
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 3);
+}

@@ -498,7 +498,11 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
           << (l.isSpot() ? ", outer angle " + g(l.outerAngleDeg) + " degrees" : std::string()) << ")"
           << " is missing from the list of tile " << tx << "," << ty << " (list " << v.miss->list << ", cause "
           << toString(v.miss->cause) << ") where " << v.miss->pixels << " geometry pixels need it; "
-          << v.falseNegatives << " false negatives in all.";
+          << v.falseNegatives << " false negatives in all";
+        if (v.overflowLists || v.invalidIndices)
+            o << ", " << v.overflowLists << " lists over the layout's capacity, " << v.invalidIndices
+              << " invalid indices";
+        o << ".";
     } else {
         o << " " << v.falseNegatives << " false negatives, " << v.invalidIndices << " invalid indices, "
           << v.overflowLists << " overflowed lists.";
