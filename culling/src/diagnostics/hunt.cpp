@@ -353,6 +353,26 @@ Scene shrinkHuntFailure(const Scene& failing, const HuntOptions& options, CullBa
             if (!stillFails(smaller)) break;
             best = smaller;
         }
+    // Then whole tiles off each side (keeping a partial edge tile partial),
+    // in steps halved when a step loses the failure.
+    for (int axis = 0; axis < 2; ++axis) {
+        const std::uint32_t tile = best.camera.tileSize;
+        std::uint32_t side = axis == 0 ? best.camera.width : best.camera.height;
+        for (std::uint32_t step = side / tile / 2; step >= 1 && side > tile;) {
+            if (step * tile >= side) {
+                step /= 2;
+                continue;
+            }
+            Scene smaller = best;
+            (axis == 0 ? smaller.camera.width : smaller.camera.height) = side - step * tile;
+            if (stillFails(smaller)) {
+                best = smaller;
+                side -= step * tile;
+            } else {
+                step /= 2;
+            }
+        }
+    }
     // Camera values: the roundest that still fails, coarsest first.
     const double diag = diagonalOf(best);
     for (double step : {1.0, 0.1, 0.01}) {
