@@ -330,21 +330,19 @@ void CameraView::updateViewport() {
     const auto [bw, bh] = fit(w, h - kLegendHeightPx);
     legendPlace_ = bw * bh > rw * rh ? LegendPlace::Below : LegendPlace::Right;
     const bool below = legendPlace_ == LegendPlace::Below;
+    // The room for the image (widget pixels, y down) and the image fitted in it.
+    area_ = below ? QRectF(0, 0, w, std::max(1.0, h - kLegendHeightPx))
+                  : QRectF(0, 0, std::max(1.0, w - kLegendWidthPx), h);
     const double vw = below ? bw : rw, vh = below ? bh : rh;
-    const double x0 = below ? (w - vw) / 2 : (w - kLegendWidthPx - vw) / 2;
-    const double y0 = below ? kLegendHeightPx + (h - kLegendHeightPx - vh) / 2 : (h - vh) / 2;
-    scene_->SetViewport(x0 / w, y0 / h, (x0 + vw) / w, (y0 + vh) / h);
-    image_->SetViewport(scene_->GetViewport());
-    meshes_->SetViewport(scene_->GetViewport());
+    fitRect_ = QRectF(area_.center().x() - vw / 2, area_.center().y() - vh / 2, vw, vh);
     for (vtkScalarBarActor* bar : {legend_.Get(), diffLegend_.Get()}) {
         if (below) {
-            // Right-aligned under the image; the caption keeps the left.
             // Labels under the bar, the title over it; 14 px kept free at
             // the right for the last label's overhang.
             const double lw = std::min(vw * 0.55, 340.0);
             bar->SetOrientationToHorizontal();
             bar->SetTextPositionToPrecedeScalarBar();
-            bar->SetPosition((x0 + vw - lw - 14) / w, 22 / h);
+            bar->SetPosition((fitRect_.right() - lw - 14) / w, 22 / h);
             bar->SetWidth(lw / w);
             bar->SetHeight((kLegendHeightPx - 26) / h);
             bar->SetMaximumWidthInPixels(int(lw));
@@ -371,6 +369,14 @@ QRect CameraView::imageRect() const {
                  QPoint(int(std::lround(vp[2] * w)) - 1, int(std::lround((1 - vp[1]) * h)) - 1));
 }
 
+QRectF CameraView::zoomedImageRect() const {
+    // The whole image at the zoom, placed so that the image point centre_
+    // sits mid-area (widget pixels, y down; v runs up).
+    const double W = fitRect_.width() * zoom_, H = fitRect_.height() * zoom_;
+    const QPointF mid = area_.center();
+    return QRectF(mid.x() - centreU_ * W, mid.y() - (1.0 - centreV_) * H, W, H);
+}
+
 void CameraView::setZoom(double zoom, QPointF centre) {
     const double before = zoom_;
     zoom_ = std::isfinite(zoom) ? std::clamp(zoom, 1.0, kMaxZoom) : 1.0;
@@ -381,44 +387,65 @@ void CameraView::setZoom(double zoom, QPointF centre) {
 }
 
 void CameraView::zoomAt(const QPoint& pos, double factor) {
-    const QRect r = imageRect();
-    if (r.width() <= 0 || r.height() <= 0 || !(factor > 0)) return;
-    // The viewport point under the cursor, and the image point it shows.
-    const double u = (pos.x() + 0.5 - r.left()) / r.width();
-    const double v = 1.0 - (pos.y() + 0.5 - r.top()) / r.height();
-    const double iu = centreU_ + (u - 0.5) / zoom_, iv = centreV_ + (v - 0.5) / zoom_;
+    const QRectF img = zoomedImageRect();
+    if (img.width() <= 0 || img.height() <= 0 || !(factor > 0)) return;
+    // The image point under the cursor stays under it.
+    const double iu = (pos.x() + 0.5 - img.left()) / img.width();
+    const double iv = 1.0 - (pos.y() + 0.5 - img.top()) / img.height();
     const double z = std::clamp(zoom_ * factor, 1.0, kMaxZoom);
-    setZoom(z, QPointF(iu - (u - 0.5) / z, iv - (v - 0.5) / z));
+    const double W = fitRect_.width() * z, H = fitRect_.height() * z;
+    const QPointF mid = area_.center();
+    setZoom(z, QPointF(iu + (mid.x() - pos.x() - 0.5) / W, iv - (mid.y() - pos.y() - 0.5) / H));
 }
 
 void CameraView::panBy(const QPoint& delta) {
-    const QRect r = imageRect();
-    if (r.width() <= 0 || r.height() <= 0) return;
-    setZoom(zoom_, QPointF(centreU_ - double(delta.x()) / r.width() / zoom_,
-                           centreV_ + double(delta.y()) / r.height() / zoom_));
+    const QRectF img = zoomedImageRect();
+    if (img.width() <= 0 || img.height() <= 0) return;
+    setZoom(zoom_, QPointF(centreU_ - delta.x() / img.width(), centreV_ + delta.y() / img.height()));
 }
 
 void CameraView::fitImage() { setZoom(1.0, QPointF(0.5, 0.5)); }
 
 void CameraView::applyZoom() {
-    // The window onto the image stays inside it: at zoom z it is 1/z wide.
-    const double half = 0.5 / zoom_;
-    centreU_ = std::clamp(centreU_, half, 1.0 - half);
-    centreV_ = std::clamp(centreV_, half, 1.0 - half);
-    // Overlay points: image coordinates -> viewport, p' = (p - c) z + 0.5.
+    // Keep the image over as much of the area as it can cover: a direction
+    // in which the zoomed image is narrower than the area is centred, else
+    // no edge of the image comes inside the area.
+    const double W = fitRect_.width() * zoom_, H = fitRect_.height() * zoom_;
+    auto clampCentre = [](double c, double extent, double room) {
+        if (extent <= room) return 0.5;
+        const double half = room / (2 * extent);
+        return std::clamp(c, half, 1.0 - half);
+    };
+    centreU_ = clampCentre(centreU_, W, area_.width());
+    centreV_ = clampCentre(centreV_, H, area_.height());
+    // The viewport: the part of the zoomed image inside the area, and the
+    // window [u0,u1] x [v0,v1] of the image it shows.
+    const QRectF img = zoomedImageRect();
+    QRectF vp = img.intersected(area_);
+    if (vp.width() < 1 || vp.height() < 1) vp = fitRect_;
+    const double u0 = (vp.left() - img.left()) / img.width(), u1 = (vp.right() - img.left()) / img.width();
+    const double v0 = 1.0 - (vp.bottom() - img.top()) / img.height(), v1 = 1.0 - (vp.top() - img.top()) / img.height();
+    window_ = QRectF(QPointF(u0, v0), QPointF(u1, v1));
+    const double w = std::max(1, width()), h = std::max(1, height());
+    scene_->SetViewport(vp.left() / w, 1.0 - vp.bottom() / h, vp.right() / w, 1.0 - vp.top() / h);
+    image_->SetViewport(scene_->GetViewport());
+    meshes_->SetViewport(scene_->GetViewport());
+    // Overlay points: image coordinates -> viewport, p' = (p - p0) / (p1 - p0).
     overlayTransform_->Identity();
-    overlayTransform_->Translate(0.5, 0.5, 0);
-    overlayTransform_->Scale(zoom_, zoom_, 1);
-    overlayTransform_->Translate(-centreU_, -centreV_, 0);
-    // The culling camera's projection, narrowed by z and shifted so that the
-    // image point c sits mid-viewport. VTK's window centre is in units of the
-    // zoomed half-extent: NDC c' = 2c - 1 of the whole image is z (2c - 1).
+    overlayTransform_->Scale(1.0 / (u1 - u0), 1.0 / (v1 - v0), 1);
+    overlayTransform_->Translate(-u0, -v0, 0);
+    // The culling camera's projection narrowed to the window: the whole
+    // image spans NDC -1..1; the window's half height is v1 - v0 of that
+    // and its centre (u0 + u1 - 1, v0 + v1 - 1). VTK's window centre is in
+    // units of the window's half extents; its horizontal extent follows
+    // from the viewport's aspect, which is the window's.
     const lc::Camera& c = doc_->scene().camera;
     vtkCamera* vc = scene_->GetActiveCamera();
-    const double tanHalf = std::tan(c.fovYDeg * M_PI / 360.0) / zoom_;
+    const double hv = v1 - v0, hu = u1 - u0;
+    const double tanHalf = std::tan(c.fovYDeg * M_PI / 360.0) * hv;
     vc->SetViewAngle(std::atan(tanHalf) * 360.0 / M_PI);
-    vc->SetParallelScale(c.orthoHeight / 2 / zoom_);
-    vc->SetWindowCenter(zoom_ * (2 * centreU_ - 1), zoom_ * (2 * centreV_ - 1));
+    vc->SetParallelScale(c.orthoHeight / 2 * hv);
+    vc->SetWindowCenter((u0 + u1 - 1) / hu, (v0 + v1 - 1) / hv);
     frameImageCamera();
     updateGridVisibility();
     updateLegendAndCaption();
@@ -428,14 +455,14 @@ void CameraView::applyZoom() {
 void CameraView::frameImageCamera() {
     if (!picturesRun_) return;
     // Pixel (i, j) of the picture is centred at (i, j); the whole picture
-    // spans -0.5 .. W - 0.5. Frame the zoomed window of it exactly.
+    // spans -0.5 .. W - 0.5. Frame the window of it exactly.
     const double W = picturesRun_->depth.width, H = picturesRun_->depth.height;
-    const double fx = centreU_ * W - 0.5, fy = centreV_ * H - 0.5;
+    const double fx = window_.center().x() * W - 0.5, fy = window_.center().y() * H - 0.5;
     vtkCamera* ic = image_->GetActiveCamera();
     ic->SetFocalPoint(fx, fy, 0);
     ic->SetPosition(fx, fy, 10);
     ic->SetViewUp(0, 1, 0);
-    ic->SetParallelScale(H / 2 / zoom_);
+    ic->SetParallelScale(H * window_.height() / 2);
     ic->SetClippingRange(1, 20);
 }
 
@@ -444,8 +471,7 @@ void CameraView::updateGridVisibility() {
     const auto run = doc_->runOutput();
     if (!run) return;
     const double* vp = scene_->GetViewport();
-    const double tilePx =
-        run->result.grid.tileSize * zoom_ * (vp[2] - vp[0]) * width() / std::max(1u, run->result.grid.width);
+    const double tilePx = run->result.grid.tileSize * zoomedImageRect().width() / std::max(1u, run->result.grid.width);
     gridActor_->SetVisibility(tilePx >= 6.0);
 }
 
@@ -687,7 +713,7 @@ void CameraView::updateLegendAndCaption() {
         std::string text = heatCaption_;
         if (zoom_ > 1.0 + 1e-9) {
             char z[96];
-            std::snprintf(z, sizeof z, "  zoom %.3gx (Ctrl+0 fits)", zoom_);
+            std::snprintf(z, sizeof z, "  zoom %.3gx", zoom_);
             text += z;
         }
         caption_->SetInput(text.c_str());
@@ -857,7 +883,7 @@ int CameraView::tileAtWidgetPos(const QPoint& pos) const {
     const double vv = (nyw - vp[1]) / (vp[3] - vp[1]);
     if (vu < 0 || vu >= 1 || vv <= 0 || vv > 1) return -1;
     // The image point shown there (zoom and pan).
-    const double u = centreU_ + (vu - 0.5) / zoom_, v = centreV_ + (vv - 0.5) / zoom_;
+    const double u = window_.left() + vu * window_.width(), v = window_.top() + vv * window_.height();
     if (u < 0 || u >= 1 || v <= 0 || v > 1) return -1;
     const auto px = std::uint32_t(u * cam.width), py = std::uint32_t((1 - v) * cam.height);
     const lc::TileGrid g = lc::TileGrid::make(cam.width, cam.height, cam.tileSize);

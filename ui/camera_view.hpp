@@ -103,9 +103,12 @@ public:
     QString imageLabelText() const;
     // Zoom and pan of the picture (the wheel zooms about the cursor, a right
     // or middle drag pans, View > Fit camera image or a middle double-click
-    // fits). zoom() 1 shows the whole image; the centre is the image point,
-    // in normalised image coordinates (u right, v up, 0..1), at the middle of
-    // the viewport. Tiles, overlays, pictures and picking all follow it.
+    // fits). zoom() 1 shows the whole image letterboxed; zoomed, the image
+    // grows over the whole view beside the legend. The centre is the image
+    // point, in normalised image coordinates (u right, v up, 0..1), at the
+    // middle of that room (kept so that no image edge comes inside the room
+    // where the image could cover it). Tiles, overlays, pictures and picking
+    // follow.
     double zoom() const { return zoom_; }
     QPointF viewCentre() const { return {centreU_, centreV_}; }
     void setZoom(double zoom, QPointF centre);
@@ -119,8 +122,13 @@ public:
     // that leaves the image larger (a wide, short view).
     enum class LegendPlace { Right, Below };
     LegendPlace legendPlace() const { return legendPlace_; }
-    // The letterboxed image's rectangle in widget pixels (y down).
+    // The viewport: the part of the image on screen, in widget pixels (y
+    // down); at zoom 1 the letterboxed image, zoomed the part of the zoomed
+    // image inside the view (beside or above the legend).
     QRect imageRect() const;
+    // Where the whole image lies at the current zoom and pan (widget pixels,
+    // y down; may reach beyond the view).
+    QRectF zoomedImageRect() const;
 
     // Re-renders now (tests, screenshots).
     void renderNow();
@@ -141,6 +149,9 @@ private:
     // Zoom and pan (setZoom); the overlay's normalised points go through
     // overlayTransform_ into the zoomed viewport.
     double zoom_ = 1.0, centreU_ = 0.5, centreV_ = 0.5;
+    QRectF area_{0, 0, 1, 1};    // the room for the image (widget pixels, y down)
+    QRectF fitRect_{0, 0, 1, 1}; // the whole image at zoom 1 (letterboxed in area_)
+    QRectF window_{0, 0, 1, 1};  // the image window the viewport shows (u right, v up)
     QPoint panFrom_;
     bool panning_ = false;
     LegendPlace legendPlace_ = LegendPlace::Right;

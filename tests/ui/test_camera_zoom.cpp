@@ -78,18 +78,13 @@ class CameraZoomTest : public QObject {
     CameraView* view() const { return w_->findChild<CameraView*>("cameraView"); }
     Document* doc() const { return w_->document(); }
 
-    // Widget position of an image pixel at the view's zoom and pan.
+    // Widget position of an image pixel at the view's zoom and pan: where
+    // the view says the whole zoomed image lies (its size is checked against
+    // the zoom in the tests).
     QPointF widgetPosOf(QPointF px) const {
-        // The viewport's exact edges (imageRect() rounds them to pixels).
         const lc::Camera& c = doc()->scene().camera;
-        const double* vp = view()->sceneRenderer()->GetViewport();
-        const double W = view()->width(), H = view()->height();
-        const double left = vp[0] * W, top = (1 - vp[3]) * H, vw = (vp[2] - vp[0]) * W, vh = (vp[3] - vp[1]) * H;
-        const double u = px.x() / c.width, v = 1.0 - px.y() / c.height;
-        const double z = view()->zoom();
-        const QPointF cen = view()->viewCentre();
-        const double vu = (u - cen.x()) * z + 0.5, vv = (v - cen.y()) * z + 0.5;
-        return {left + vu * vw, top + (1.0 - vv) * vh};
+        const QRectF img = view()->zoomedImageRect();
+        return {img.left() + px.x() / c.width * img.width(), img.top() + px.y() / c.height * img.height()};
     }
 
 private slots:
@@ -112,11 +107,18 @@ private slots:
         CameraView* v = view();
         QCOMPARE(v->zoom(), 1.0);
         const QRect r = v->imageRect();
-        const QPoint cursor(r.left() + r.width() / 3, r.top() + r.height() / 4);
+        // On the middle row: in a direction where the zoomed image is still
+        // smaller than the room it is centred (as image viewers do), so
+        // only the middle row keeps its place there.
+        const QPoint cursor(r.left() + r.width() / 3, r.center().y());
         const int tileBefore = v->tileAtWidgetPos(cursor);
         QVERIFY(tileBefore >= 0);
         wheel(v, cursor, 3 * 120);
         QVERIFY2(std::abs(v->zoom() - std::pow(1.25, 3)) < 1e-9, qPrintable(QString::number(v->zoom())));
+        // The image grew by the zoom, and over the room beside the legend:
+        // the viewport is larger than the letterbox it started in.
+        QVERIFY(std::abs(v->zoomedImageRect().width() - std::pow(1.25, 3) * r.width()) <= 1.5 * std::pow(1.25, 3));
+        QVERIFY(v->imageRect().width() * v->imageRect().height() > r.width() * r.height());
         QCOMPARE(v->tileAtWidgetPos(cursor), tileBefore);
         wheel(v, cursor, 4 * 120);
         QCOMPARE(v->tileAtWidgetPos(cursor), tileBefore);
@@ -134,7 +136,7 @@ private slots:
             // pixels, which differs from the image's by up to 1/300: a
             // quarter of an image pixel at the view's edge (a zoom or pan
             // gone wrong is off by many image pixels).
-            const double tolerance = std::max(1.0, 0.25 * v->zoom() * v->imageRect().width() / cam.width);
+            const double tolerance = std::max(1.0, 0.25 * v->zoomedImageRect().width() / cam.width);
             QVERIFY2(std::hypot(got.x() - expect.x(), got.y() - expect.y()) < tolerance,
                      qPrintable(QString("light %1 drawn at %2,%3, its pixel at %4,%5 (zoom %6)")
                                     .arg(QString::fromStdString(l.name))
@@ -177,15 +179,19 @@ private slots:
         CameraView* v = view();
         const QRect r = v->imageRect();
         v->setZoom(4.0, QPointF(0.5, 0.5));
+        const QRectF img = v->zoomedImageRect();
+        QVERIFY(std::abs(img.width() - 4 * r.width()) <= 4 * 1.5);
         const QPoint mid = r.center();
         drag(v, Qt::RightButton, mid, mid + QPoint(40, -20));
-        // 40 px right on a viewport r.width() wide at 4x: the centre moves
-        // 40 / width / 4 of the image to the left.
-        QVERIFY(std::abs(v->viewCentre().x() - (0.5 - 40.0 / r.width() / 4)) < 1e-9);
-        QVERIFY(std::abs(v->viewCentre().y() - (0.5 - 20.0 / r.height() / 4)) < 1e-9);
+        // 40 px right on an image img.width() wide: the centre moves
+        // 40 / width of the image to the left (and 20 px up, down the image).
+        QVERIFY(std::abs(v->viewCentre().x() - (0.5 - 40.0 / img.width())) < 1e-9);
+        QVERIFY(std::abs(v->viewCentre().y() - (0.5 - 20.0 / img.height())) < 1e-9);
         QCOMPARE(doc()->selectedTile(), -1); // a pan is not a click
         drag(v, Qt::MiddleButton, mid, mid + QPoint(10 * r.width(), 10 * r.height()));
-        QCOMPARE(v->viewCentre(), QPointF(0.125, 0.875)); // clamped: the window's corner at the image's
+        // Clamped: the image's top-left corner stops at the viewport's.
+        QVERIFY(std::abs(v->zoomedImageRect().left() - v->imageRect().left()) <= 1.0);
+        QVERIFY(std::abs(v->zoomedImageRect().top() - v->imageRect().top()) <= 1.0);
         w_->action("actionFitCameraImage")->trigger();
         QCOMPARE(v->zoom(), 1.0);
         QCOMPARE(v->viewCentre(), QPointF(0.5, 0.5));
