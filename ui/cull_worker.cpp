@@ -276,8 +276,13 @@ void CullWorker::drain() {
                 out = std::make_shared<lc::RunOutput>(
                     lc::runPipeline(*runScene, req.settings, *backend_, options, cancel.get()));
             }
-            if (out->depthReused) out->depthFrom = "the previous run's pre-pass (camera and meshes unchanged)";
+            // A reused depth names the rasteriser that drew it: a custom
+            // shader or another algorithm reuses a pre-pass drawn by the
+            // backend of an earlier run, and rasterisers differ at edges.
+            if (out->depthReused) out->depthFrom = "the previous run's " + depthSource_ + " (camera and meshes unchanged)";
             if (!out->depthReused) {
+                depthSource_ = out->depthFrom.empty() ? "pre-pass on " + backend_->name() + " (" + backend_->deviceName() + ")"
+                                                      : out->depthFrom;
                 depth_ = std::make_shared<const lc::DepthImage>(out->depth);
                 depthCamera_ = req.scene->camera;
                 depthMeshes_ = req.meshes;

@@ -114,6 +114,7 @@ private:
     std::shared_ptr<const std::vector<lc::Mesh>> depthMeshes_;
     quint64 depthRevision_ = 0;
     std::shared_ptr<const lc::DepthImage> depth_;
+    std::string depthSource_; // who drew depth_: "pre-pass on cpu (device)"
     // The last finished run (its most complete output) and its request: what
     // requestShading() shades.
     quint64 lastGeneration_ = 0;
