@@ -66,6 +66,12 @@ struct SceneSource {
         lc::Scene s = lc::loadSceneAny(sceneFile, gltf, &report);
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         for (const std::string& w : report.warnings) std::cerr << "lightcull: warning: " << w << "\n";
+        // An explicit cut-off that sizes no light changes nothing: say so
+        // (summary.json records gltf_cutoff_lights 0 beside it).
+        if (lc::isGltfPath(sceneFile) && optMinIntensity_ && optMinIntensity_->count() &&
+            lc::gltfCutoffLights(s).empty())
+            std::cerr << "lightcull: warning: --min-intensity applies to no light: every light of " << sceneFile
+                      << " has a range\n";
         if (lc::isGltfPath(sceneFile))
             std::cerr << "lightcull: " << sceneFile << ": " << s.triangleCount() << " triangles, " << s.lights.size()
                       << " lights, camera " << report.camera << "; loaded in " << std::lround(ms) << " ms\n";

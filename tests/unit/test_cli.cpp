@@ -5,6 +5,7 @@
 
 #include "culling/core/params.hpp"
 #include "culling/core/pipeline.hpp"
+#include "culling/scene/gltf_io.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
@@ -209,6 +210,37 @@ TEST(Cli, AnEmptyViewIsSaidAndAMissingCameraFramesTheMeshes) {
     EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
     const auto j = nlohmann::json::parse(lc_test::slurp(s.path / "o2" / "summary.json"));
     EXPECT_GT(j["metrics"]["geometry_pixels"].get<std::uint64_t>(), 200u);
+}
+
+// --min-intensity sizes the glTF lights without a range; summary.json says
+// how many, and a cut-off that sizes none is warned about (it changed
+// nothing, though the summary would otherwise record it as if it had).
+TEST(Cli, MinIntensityCountsTheLightsItSizedAndWarnsWhenItSizedNone) {
+    ScratchDir s;
+    lc::Scene scene = lc::makeBuiltinScene("wall");
+    scene.lights.resize(2);
+    for (auto& l : scene.lights) {
+        l.kind = lc::LightKind::Point;
+        l.explicitRadius = 2.0;
+    }
+    auto j = nlohmann::json::parse(lc::serializeGltf(scene, false));
+    std::ofstream(s.path / "ranged.gltf") << j.dump();
+    auto& light = j["extensions"]["KHR_lights_punctual"]["lights"][0];
+    light.erase("range");
+    light.erase("extras");
+    std::ofstream(s.path / "one_without.gltf") << j.dump();
+    for (const auto& [file, sized] : {std::pair{"ranged.gltf", 0}, std::pair{"one_without.gltf", 1}}) {
+        const fs::path out = s.path / (std::string("out_") + file);
+        const CliResult r = runCli({"run", "--scene", (s.path / file).string(), "--min-intensity", "0.5", "--backend",
+                                    "cpu", "--width", "64", "--height", "36", "--no-image-error", "--out", out.string()},
+                                   s.path);
+        ASSERT_EQ(r.code, 0) << r.err;
+        const bool warned = r.err.find("--min-intensity applies to no light") != std::string::npos;
+        EXPECT_EQ(warned, sized == 0) << file << ": " << r.err;
+        const auto summary = nlohmann::json::parse(lc_test::slurp(out / "summary.json"));
+        EXPECT_EQ(summary["scene_source"]["gltf_min_intensity"].get<double>(), 0.5) << file;
+        EXPECT_EQ(summary["scene_source"]["gltf_cutoff_lights"].get<int>(), sized) << file;
+    }
 }
 
 // An output the command could not write is a bad command line, said before

@@ -3,6 +3,7 @@
 // documented in docs/CLI.md.
 
 #include "culling/diagnostics/export.hpp"
+#include "culling/scene/gltf_io.hpp"
 
 #include "culling/custom/custom_cull.hpp"
 #include "culling/core/file_io.hpp"
@@ -151,6 +152,10 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     src["gltf_camera"] = o.gltfCamera.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(o.gltfCamera);
     src["gltf_min_intensity"] =
         o.gltfMinIntensity > 0 ? nlohmann::ordered_json(o.gltfMinIntensity) : nlohmann::ordered_json(nullptr);
+    // How many lights that cut-off sized (those without a glTF range): 0
+    // says the cut-off changed nothing.
+    src["gltf_cutoff_lights"] = o.gltfMinIntensity > 0 ? nlohmann::ordered_json(gltfCutoffLights(scene).size())
+                                                       : nlohmann::ordered_json(nullptr);
     src["command"] = o.command.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(o.command);
     src["edited"] = o.edited;
     src["edited_scene"] = o.edited ? nlohmann::ordered_json("scene.json") : nlohmann::ordered_json(nullptr);
