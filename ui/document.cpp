@@ -66,6 +66,7 @@ void Document::setSelectedLights(std::vector<int> lights) {
         if (std::find(unique.begin(), unique.end(), i) == unique.end()) unique.push_back(i);
     lights = std::move(unique);
     if (lights == selectedLights_ && !cameraSelected_) return;
+    lightSelectedLast_ = !lights.empty();
     selectedLights_ = std::move(lights);
     cameraSelected_ = false;
     emit selectionChanged();
@@ -80,6 +81,7 @@ void Document::selectCamera() {
 void Document::setSelectedTile(int tile) {
     if (tile == selectedTile_) return;
     selectedTile_ = tile;
+    if (tile >= 0) lightSelectedLast_ = false;
     selectedCell_ = -1;
     explainedList_ = -1;
     emit tileSelectionChanged(tile);

@@ -57,6 +57,9 @@ public:
     // Tile of the culling grid selected in the camera view (-1: none).
     int selectedTile() const { return selectedTile_; }
     void setSelectedTile(int tile);
+    // Whether the current light was picked after the selected tile (Frame
+    // selected then frames the light, unless the tile lists it).
+    bool lightSelectedLast() const { return lightSelectedLast_; }
 
     // Depth cell of the selected tile (tileCells order, -1: the whole tile).
     // Emits tileSelectionChanged; selecting another tile clears it.
@@ -180,6 +183,7 @@ private:
     std::vector<int> selectedLights_;
     bool cameraSelected_ = false;
     int selectedTile_ = -1;
+    bool lightSelectedLast_ = false;
     int selectedCell_ = -1;
     OverlayOptions overlays_;
     int dragCounter_ = 0;

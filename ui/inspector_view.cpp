@@ -397,9 +397,20 @@ bool InspectorView::frameSelected(int ms) {
     std::function<std::vector<glm::dvec3>(const ViewBasis&)> pointsFor;
     std::function<std::vector<glm::dvec3>(const ViewBasis&)> samplesFor;
     glm::dvec3 anchor(0.0);
+    double keepOutside = 0; // a light's radius: an eye inside its sphere sees only its wireframe
+    frameNote_.clear();
     const auto run = doc_->runOutput();
     const int tile = doc_->selectedTile();
-    if (run && tile >= 0 && std::uint32_t(tile) < run->result.grid.tileCount()) {
+    // A light picked after the tile (the scene tree, a click in 3D) is what
+    // the user looks at now, unless the tile lists it (Explain's question:
+    // the tile's framing then takes in the light's nearest point).
+    bool lightFirst = false;
+    if (run && doc_->lightSelectedLast() && doc_->currentLight() >= 0 && tile >= 0 &&
+        std::uint32_t(tile) < run->result.grid.tileCount()) {
+        const auto held = lc::tilesHoldingLight(run->result, std::uint32_t(doc_->currentLight()));
+        lightFirst = std::find(held.begin(), held.end(), std::uint32_t(tile)) == held.end();
+    }
+    if (!lightFirst && run && tile >= 0 && std::uint32_t(tile) < run->result.grid.tileCount()) {
         const lc::Projection proj(doc_->scene().camera);
         std::optional<lc::FrustumChunk> chunk;
         const int cell = doc_->selectedCell();
@@ -433,6 +444,7 @@ bool InspectorView::frameSelected(int ms) {
         const glm::dvec3 c = l.position;
         const double r = std::max(l.radius(), 1e-3);
         anchor = c;
+        keepOutside = r;
         // The sphere's six extreme points along the view axes bound it well enough.
         pointsFor = [c, r](const ViewBasis& b) {
             return std::vector<glm::dvec3>{c + r * b.right, c - r * b.right, c + r * b.up,
@@ -492,7 +504,21 @@ bool InspectorView::frameSelected(int ms) {
     const glm::dvec3 start = anchor + 1e-3 * back;
     if (const auto hit = firstMeshHit(scene, start, sideEye)) {
         const double along = glm::length(sideEye - start) * *hit;
-        sideEye = start + glm::normalize(back) * (0.9 * along);
+        const glm::dvec3 pulled = start + glm::normalize(back) * (0.9 * along);
+        if (glm::length(pulled - anchor) > keepOutside) {
+            sideEye = pulled;
+        } else {
+            // The room is smaller than the light's sphere: an eye pulled in
+            // to the wall would sit inside it and see a wall of wireframe.
+            // Frame the whole sphere through the wall, with the meshes in
+            // x-ray so that the wall hides nothing.
+            Document::OverlayOptions o = doc_->overlays();
+            if (o.meshes == Document::OverlayOptions::MeshDisplay::Normal) {
+                o.meshes = Document::OverlayOptions::MeshDisplay::XRay;
+                doc_->setOverlays(o);
+                frameNote_ = tr("Walls stand closer to the light than its radius: meshes in x-ray (X toggles)");
+            }
+        }
     }
     cb.eye = sideEye;
     framedFromCullingSide_ = true;

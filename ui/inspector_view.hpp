@@ -87,6 +87,9 @@ public:
     bool frameSelected(int ms = 300);
     // Whether the last frameSelected turned to the culling camera's side.
     bool framedFromCullingSide() const { return framedFromCullingSide_; }
+    // What the last frameSelected changed besides the camera, for the status
+    // bar (it turned the meshes to x-ray); empty when nothing.
+    QString frameNote() const { return frameNote_; }
     // Where the segment a -> b first crosses a triangle of the scene's meshes,
     // as a fraction of its length in [0, 1]; nullopt when it crosses none.
     static std::optional<double> firstMeshHit(const lc::Scene& scene, const glm::dvec3& a, const glm::dvec3& b);
@@ -204,6 +207,7 @@ private:
     bool drawnAreTileLights_ = false; // drawn_ is the selected tile's list
     std::vector<long long> lightSetKey_; // what chose drawn_ (refreshLightSet)
     bool framedFromCullingSide_ = false;
+    QString frameNote_;
     vtkSmartPointer<vtkPolyData> selData_;
     vtkNew<vtkGlyph3D> selGlyph_;
     vtkNew<vtkActor> selActor_;

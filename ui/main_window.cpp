@@ -379,6 +379,8 @@ void MainWindow::buildActions() {
             [this] {
                 if (!inspectorView_->frameSelected())
                     statusBar()->showMessage(tr("Nothing selected to frame: click a tile or pick a light"), 4000);
+                else if (!inspectorView_->frameNote().isEmpty())
+                    statusBar()->showMessage(inspectorView_->frameNote(), 6000);
             });
     connect(make(tr("&Look through the culling camera"), "actionLookThrough", QKeySequence(Qt::Key_C)),
             &QAction::triggered, this, [this] { inspectorView_->lookThroughCullingCamera(); });

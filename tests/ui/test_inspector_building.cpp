@@ -26,6 +26,7 @@
 
 #include <QAction>
 #include <QDir>
+#include <QStatusBar>
 #include <QImage>
 #include <QUndoStack>
 
@@ -295,6 +296,54 @@ private slots:
         QVERIFY(glm::dot(e - light, doc()->scene().camera.position - light) > 0);
         QVERIFY(!segmentHit(doc()->scene(), e, light));
         QVERIFY(inView(light));
+    }
+
+    // F on a light whose sphere is wider than its room: the eye pulled in
+    // to the partition would sit inside the sphere (a view of wireframe). It
+    // frames the whole sphere instead and turns the meshes to x-ray, saying so.
+    void frameLightWiderThanItsRoomUsesXRay() {
+        lc::Scene s = roomScene();
+        s.lights[kSideLight].explicitRadius = 3.0; // the side room is 2.4 wide
+        doc()->resetScene(std::move(s), {});
+        QVERIFY(lctest::waitRun(*w_, w_->runCulling()));
+        const glm::dvec3 light = doc()->scene().lights[kSideLight].position;
+        doc()->setSelectedLights({kSideLight});
+        lookFromBehind(light);
+        QVERIFY(doc()->overlays().meshes == Document::OverlayOptions::MeshDisplay::Normal);
+        trigger("actionFrameSelected");
+        QTest::qWait(600);
+        const glm::dvec3 e = eye();
+        QVERIFY2(glm::length(e - light) > 3.0, qPrintable(QString("eye %1 from the light").arg(glm::length(e - light))));
+        QVERIFY(doc()->overlays().meshes == Document::OverlayOptions::MeshDisplay::XRay);
+        QVERIFY2(w_->statusBar()->currentMessage().contains("x-ray"), qPrintable(w_->statusBar()->currentMessage()));
+        // The whole sphere in view.
+        for (const glm::dvec3& d : {glm::dvec3(1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 1)}) {
+            QVERIFY(inView(light + 2.9 * d));
+            QVERIFY(inView(light - 2.9 * d));
+        }
+    }
+
+    // A light picked after the tile (from the scene tree, say) is framed,
+    // unless the tile lists it (then the tile, as Explain frames it).
+    void frameFramesTheLightPickedAfterTheTile() {
+        const int tile = busiestTile();
+        doc()->setSelectedTile(tile);
+        const auto held = lc::tilesHoldingLight(doc()->runOutput()->result, kSideLight);
+        QVERIFY(std::find(held.begin(), held.end(), std::uint32_t(tile)) == held.end());
+        doc()->setSelectedLights({kSideLight});
+        QVERIFY(doc()->lightSelectedLast());
+        QVERIFY(view()->frameSelected(0));
+        const glm::dvec3 light = doc()->scene().lights[kSideLight].position;
+        double fp[3];
+        view()->renderer()->GetActiveCamera()->GetFocalPoint(fp);
+        QVERIFY2(glm::length(glm::dvec3(fp[0], fp[1], fp[2]) - light) < 1.0, "F did not frame the light picked last");
+        // Picking the tile again makes it the subject.
+        doc()->setSelectedTile(-1);
+        doc()->setSelectedTile(tile);
+        QVERIFY(!doc()->lightSelectedLast());
+        QVERIFY(view()->frameSelected(0));
+        view()->renderer()->GetActiveCamera()->GetFocalPoint(fp);
+        QVERIFY(glm::length(glm::dvec3(fp[0], fp[1], fp[2]) - light) > 1.0);
     }
 
     // View > Meshes: x-ray draws them translucent and lets a click through to
