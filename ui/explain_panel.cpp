@@ -90,7 +90,7 @@ void ExplainPanel::refresh() {
                               ? tr("Waiting for the ground truth of run %1 (a Live edit shows its lists first)...")
                                     .arg(doc_->runGeneration())
                               : tr("Select a tile (click the camera view) and a light (the scene tree or "
-                                   "a row of the tile inspector) to see why the light is, or is not, in "
+                                   "a double-click on a row of the tile inspector) to see why the light is, or is not, in "
                                    "that tile's list."));
         verdict_->setStyleSheet({});
         text_->clear();

@@ -413,7 +413,8 @@ std::string reportMarkdown(const Report& rep) {
                            ", " + std::to_string(r.falseNegatives) + ")";
         md += fnRows == 0 ? "- Every configuration has zero false negatives.\n"
                           : "- **" + std::to_string(fnRows) +
-                                " configurations have false negatives** (lights missing where they matter): " +
+                                (fnRows == 1 ? " configuration has" : " configurations have") +
+                                " false negatives** (lights missing where they matter): " +
                                 fnNames + (fnRows > 5 ? " and " + std::to_string(fnRows - 5) + " more" : "") +
                                 "; they are left off the Pareto fronts and are not ranked below.\n";
         for (const auto& [backend, device] : rep.backendDevices) {
