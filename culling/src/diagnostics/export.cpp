@@ -328,6 +328,33 @@ std::vector<double> depthGrey(const DepthImage& depth) {
     return grey;
 }
 
+// The heat map pictures' common part: each pixel `shade(tile, grey)` (the
+// pixel's tile, 0 without a grid, and its depthGrey), a faint tile grid over
+// it, and a dark band of `legendH` rows under the image for the legend.
+template <class Shade>
+RgbImage tintedTiles(const RunOutput& run, int legendH, Shade shade) {
+    const DepthImage& depth = run.depth;
+    const CullResult& r = run.result;
+    const std::uint32_t W = depth.width, H = depth.height;
+    RgbImage img;
+    img.width = W;
+    img.height = H + std::uint32_t(legendH);
+    img.rgb.assign(std::size_t(img.width) * img.height * 3, 0);
+    Canvas cv{img};
+    const std::vector<double> grey = depthGrey(depth);
+    const std::uint32_t ts = std::max(r.grid.tileSize, 1u);
+    const bool tiled = r.grid.tileCount() > 0;
+    for (std::uint32_t y = 0; y < H; ++y)
+        for (std::uint32_t x = 0; x < W; ++x) {
+            const std::size_t t = tiled ? r.grid.tileOfPixel(x, y) : 0;
+            glm::dvec3 c = shade(t, grey[std::size_t(y) * W + x]);
+            if (x % ts == 0 || y % ts == 0) c = c * 0.8 + glm::dvec3(0.2); // faint tile grid
+            cv.set(int(x), int(y), c);
+        }
+    cv.fill(0, int(H), int(W), int(H) + legendH, glm::dvec3(0.1));
+    return img;
+}
+
 } // namespace
 
 RgbImage heatmapImage(const RunOutput& run) {
@@ -336,11 +363,6 @@ RgbImage heatmapImage(const RunOutput& run) {
     const std::uint32_t W = depth.width, H = depth.height;
     const int scale = std::max(1, int(W) / 480);
     const int legendH = scale * 29;
-    RgbImage img;
-    img.width = W;
-    img.height = H + std::uint32_t(legendH);
-    img.rgb.assign(std::size_t(img.width) * img.height * 3, 0);
-    Canvas cv{img};
 
     // List-length range over all lists, for the colour scale.
     std::uint32_t minList = std::numeric_limits<std::uint32_t>::max(), maxList = 0;
@@ -383,20 +405,14 @@ RgbImage heatmapImage(const RunOutput& run) {
         tileValue[t] = px ? double(work) / px : longest;
     }
 
-    const std::vector<double> grey = depthGrey(depth);
-    const std::uint32_t ts = std::max(r.grid.tileSize, 1u);
-    for (std::uint32_t y = 0; y < H; ++y)
-        for (std::uint32_t x = 0; x < W; ++x) {
-            const std::size_t t = tiles ? r.grid.tileOfPixel(x, y) : 0;
-            glm::dvec3 c = colourOf(t < tileValue.size() ? tileValue[t] : 0.0) * grey[std::size_t(y) * W + x];
-            if (x % ts == 0 || y % ts == 0) c = c * 0.8 + glm::dvec3(0.2); // faint tile grid
-            cv.set(int(x), int(y), c);
-        }
+    RgbImage img = tintedTiles(run, legendH, [&](std::size_t t, double grey) {
+        return colourOf(t < tileValue.size() ? tileValue[t] : 0.0) * grey;
+    });
+    Canvas cv{img};
 
     // Legend band: colour bar from the shortest to the longest list, a white
     // tick above it at the mean, and the three numbers.
     const int y0 = int(H), m = 4 * scale;
-    cv.fill(0, y0, int(W), y0 + legendH, glm::dvec3(0.1));
     const int bx0 = int(W) > 2 * m + 1 ? m : 0, bx1 = int(W) > 2 * m + 1 ? int(W) - m : int(W);
     for (int x = bx0; x < bx1; ++x) {
         const double t = bx1 - bx0 > 1 ? double(x - bx0) / double(bx1 - bx0 - 1) : 0.0;
@@ -423,16 +439,9 @@ RgbImage heatmapImage(const RunOutput& run) {
 }
 
 RgbImage missHeatmapImage(const RunOutput& run) {
-    const DepthImage& depth = run.depth;
-    const CullResult& r = run.result;
-    const std::uint32_t W = depth.width, H = depth.height;
+    const std::uint32_t W = run.depth.width, H = run.depth.height;
     const int scale = std::max(1, int(W) / 480);
     const int legendH = scale * 16;
-    RgbImage img;
-    img.width = W;
-    img.height = H + std::uint32_t(legendH);
-    img.rgb.assign(std::size_t(img.width) * img.height * 3, 0);
-    Canvas cv{img};
     const std::vector<double> fn = tileHeat(run, HeatMode::FalseNegatives);
     double most = 0;
     std::size_t tilesMissing = 0;
@@ -440,23 +449,14 @@ RgbImage missHeatmapImage(const RunOutput& run) {
         if (v > 0) most = std::max(most, v), ++tilesMissing;
     // Grey depth; a tile with misses red, brighter with more (log scale, so
     // that a tile missing one light at a few pixels still stands out).
-    const std::vector<double> grey = depthGrey(depth);
-    const std::uint32_t ts = std::max(r.grid.tileSize, 1u);
-    for (std::uint32_t y = 0; y < H; ++y)
-        for (std::uint32_t x = 0; x < W; ++x) {
-            const std::size_t t = r.grid.tileCount() ? r.grid.tileOfPixel(x, y) : 0;
-            const double v = t < fn.size() && fn[t] > 0 ? fn[t] : 0.0;
-            const double g = grey[std::size_t(y) * W + x];
-            glm::dvec3 c(g * 0.6);
-            if (v > 0) {
-                const double k = most > 1 ? 0.45 + 0.55 * std::log(v) / std::log(most) : 1.0;
-                c = glm::dvec3(0.35 + 0.65 * k, 0.08, 0.08) * (0.55 + 0.45 * g);
-            }
-            if (x % ts == 0 || y % ts == 0) c = c * 0.8 + glm::dvec3(0.2); // faint tile grid
-            cv.set(int(x), int(y), c);
-        }
+    RgbImage img = tintedTiles(run, legendH, [&](std::size_t t, double g) {
+        const double v = t < fn.size() && fn[t] > 0 ? fn[t] : 0.0;
+        if (!(v > 0)) return glm::dvec3(g * 0.6);
+        const double k = most > 1 ? 0.45 + 0.55 * std::log(v) / std::log(most) : 1.0;
+        return glm::dvec3(0.35 + 0.65 * k, 0.08, 0.08) * (0.55 + 0.45 * g);
+    });
+    Canvas cv{img};
     const int y0 = int(H), m = 4 * scale;
-    cv.fill(0, y0, int(W), y0 + legendH, glm::dvec3(0.1));
     const std::string text =
         !run.truthComputed ? "NO GROUND TRUTH: MISSES NOT COUNTED"
         : tilesMissing == 0
