@@ -13,6 +13,7 @@
 // A screenshot of the room in x-ray is written to look at.
 
 #include "studio_test_support.hpp"
+#include "../support/box_mesh.hpp"
 
 #include "document.hpp"
 #include "inspector_view.hpp"
@@ -51,18 +52,7 @@ using namespace lcui;
 
 namespace {
 
-void addBox(lc::Mesh& m, glm::vec3 lo, glm::vec3 hi) {
-    const auto base = std::uint32_t(m.vertexCount());
-    for (int i = 0; i < 8; ++i) {
-        m.positions.push_back((i & 1) ? hi.x : lo.x);
-        m.positions.push_back((i & 2) ? hi.y : lo.y);
-        m.positions.push_back((i & 4) ? hi.z : lo.z);
-    }
-    const std::uint32_t faces[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
-                                        {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
-    for (const auto& f : faces)
-        for (std::uint32_t v : f) m.indices.push_back(base + v);
-}
+using lctest::addBox;
 
 // The room: inside x, z in (-5, 5), y in (0, 3); walls, floor and roof are
 // 0.2 thick slabs. A partition at x = 2.5 (z from -5 to 2) closes off a side
