@@ -2,6 +2,8 @@
 //                [--seed S] [--trials N] [--budget SECONDS] [--vary DIMS] [--overflow] --out DIR
 #include "hunt.hpp"
 
+#include "culling/core/file_io.hpp"
+
 #include "culling/core/errors.hpp"
 #include "culling/core/params.hpp"
 #include "culling/diagnostics/export.hpp"
@@ -11,7 +13,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <set>
 
@@ -48,12 +49,6 @@ std::string outProblem(const std::string& dir) {
         if (!kOutputs.count(e.path().filename().string()))
             return dir + ": holds " + e.path().filename().string() + ", which is not an earlier hunt's output";
     return {};
-}
-
-void writeText(const fs::path& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-    if (!out.flush()) throw lc::Error(path.string() + ": cannot write");
 }
 
 } // namespace
@@ -169,7 +164,7 @@ int HuntCommand::run() {
     if (!result.failure) {
         const std::string line = "no miss in " + std::to_string(result.coverage.trials) + " trials of seed " +
                                  std::to_string(seed_) + " (coverage: " + result.coverage.text() + ")\n";
-        writeText(fs::path(outDir_) / "verdict.txt", line);
+        lc::writeFileSynced((fs::path(outDir_) / "verdict.txt").string(), line);
         std::cout << line;
         return 0;
     }
@@ -200,8 +195,8 @@ int HuntCommand::run() {
     lc::exportDiagnostics(scene, options.settings, run, (out / "run").string());
     fs::copy_file(out / "run" / "summary.json", out / "summary.json", fs::copy_options::overwrite_existing);
     const std::string verdict = lc::huntVerdictText(f, options);
-    writeText(out / "verdict.txt", verdict);
-    writeText(out / "repro.sh", "#!/bin/sh\n# lightcull hunt, seed " + std::to_string(seed_) + ", trial " +
+    lc::writeFileSynced((out / "verdict.txt").string(), verdict);
+    lc::writeFileSynced((out / "repro.sh").string(), "#!/bin/sh\n# lightcull hunt, seed " + std::to_string(seed_) + ", trial " +
                                     std::to_string(f.trial) + ": " + f.verdict.property +
                                     " (verdict.txt). Exits 3 while the miss is there.\n"
                                     "# Set LIGHTCULL to the binary when lightcull is not on PATH.\n"
