@@ -378,12 +378,10 @@ QRectF CameraView::zoomedImageRect() const {
 }
 
 void CameraView::setZoom(double zoom, QPointF centre) {
-    const double before = zoom_;
     zoom_ = std::isfinite(zoom) ? std::clamp(zoom, 1.0, kMaxZoom) : 1.0;
     centreU_ = std::isfinite(centre.x()) ? centre.x() : 0.5;
     centreV_ = std::isfinite(centre.y()) ? centre.y() : 0.5;
     applyZoom();
-    if (zoom_ != before) emit zoomChanged(zoom_);
 }
 
 void CameraView::zoomAt(const QPoint& pos, double factor) {
@@ -470,7 +468,6 @@ void CameraView::updateGridVisibility() {
     // A grid finer than ~6 screen pixels per tile is noise: hide it then.
     const auto run = doc_->runOutput();
     if (!run) return;
-    const double* vp = scene_->GetViewport();
     const double tilePx = run->result.grid.tileSize * zoomedImageRect().width() / std::max(1u, run->result.grid.width);
     gridActor_->SetVisibility(tilePx >= 6.0);
 }

@@ -139,7 +139,6 @@ public:
 signals:
     void tileClicked(int tile);
     void imageModeChanged(ImageMode mode);
-    void zoomChanged(double zoom);
 
 protected:
     void resizeEvent(QResizeEvent* e) override;
