@@ -155,8 +155,8 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     connect(doc_, &Document::runOutputChanged, this, &MainWindow::updateStatus);
     connect(doc_, &Document::runWentStale, this, &MainWindow::updateStatus);
     // The cut-off label follows the scene (a new file, an undone cut-off).
-    connect(doc_, &Document::sceneReset, this, &MainWindow::updateStatus);
-    connect(doc_, &Document::lightsChanged, this, &MainWindow::updateStatus);
+    connect(doc_, &Document::sceneReset, this, &MainWindow::updateCutoffStatus);
+    connect(doc_, &Document::lightsChanged, this, &MainWindow::updateCutoffStatus);
 
     resize(1600, 900);
     // First start: views get the room, the log stays a strip at the bottom,
@@ -171,6 +171,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     syncParamWidgets();
     updateTitle();
     updateStatus();
+    updateCutoffStatus();
 }
 
 MainWindow::~MainWindow() = default;
@@ -724,18 +725,19 @@ void MainWindow::onRunFailed(quint64 generation, const QString& message) {
     emit runFailed(generation, message);
 }
 
+void MainWindow::updateCutoffStatus() {
+    // The cut-off that sized the lights without a range: a radius the file
+    // did not give, so the user should see where it came from.
+    const std::size_t cut = lc::gltfCutoffLights(doc_->scene()).size();
+    statusCutoff_->setVisible(cut > 0);
+    statusCutoff_->setText(tr("cut-off %1 lux (%2 lights)").arg(doc_->scene().origin.gltfMinIntensity).arg(cut));
+    statusCutoff_->setToolTip(tr("%1 lights have no glTF range: their radius is sqrt(intensity x colour / I_min) "
+                                 "at I_min = %2 lux. File > glTF light cut-off... changes it.")
+                                  .arg(cut)
+                                  .arg(doc_->scene().origin.gltfMinIntensity));
+}
+
 void MainWindow::updateStatus() {
-    {
-        // The cut-off that sized the lights without a range: a radius the
-        // file did not give, so the user should see where it came from.
-        const std::size_t cut = lc::gltfCutoffLights(doc_->scene()).size();
-        statusCutoff_->setVisible(cut > 0);
-        statusCutoff_->setText(tr("cut-off %1 lux (%2 lights)").arg(doc_->scene().origin.gltfMinIntensity).arg(cut));
-        statusCutoff_->setToolTip(tr("%1 lights have no glTF range: their radius is sqrt(intensity x colour / I_min) "
-                                     "at I_min = %2 lux. File > glTF light cut-off... changes it.")
-                                      .arg(cut)
-                                      .arg(doc_->scene().origin.gltfMinIntensity));
-    }
     const auto run = doc_->runOutput();
     const QString backend = run ? QString::fromStdString(run->result.backend) : lastBackendName_;
     const QString device = run ? QString::fromStdString(run->result.device) : lastDeviceName_;
@@ -1154,7 +1156,7 @@ void MainWindow::setGltfMinIntensity(double lux) {
                "without a range)")
                 .arg(lux));
     }
-    updateStatus();
+    updateCutoffStatus();
 }
 
 void MainWindow::restoreSettings() {

@@ -169,6 +169,7 @@ private:
     void onRunFinished(quint64 generation, std::shared_ptr<const lc::RunOutput> out);
     void onRunFailed(quint64 generation, const QString& message);
     void updateStatus();
+    void updateCutoffStatus(); // the glTF cut-off label: the scene, not the run
     void updateTitle();
     void addRecentFile(const QString& path);
     void rebuildRecentMenu();
