@@ -2,11 +2,8 @@
 //                [--seed S] [--trials N] [--budget SECONDS] [--vary DIMS] [--overflow] --out DIR
 #include "hunt.hpp"
 
-#include "culling/core/file_io.hpp"
-
 #include "culling/core/errors.hpp"
 #include "culling/core/params.hpp"
-#include "culling/diagnostics/export.hpp"
 #include "culling/diagnostics/hunt.hpp"
 #include "culling/scene/scene_io.hpp"
 
@@ -14,7 +11,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <set>
 
 namespace fs = std::filesystem;
 
@@ -25,30 +21,6 @@ namespace {
 int usage(const std::string& message) {
     std::cerr << "lightcull: error: " << message << "\n";
     return 2;
-}
-
-std::string shellQuote(const std::string& a) {
-    if (!a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_./:=,+@%") ==
-                          std::string::npos)
-        return a;
-    std::string q = "'";
-    for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-// What the hunt writes into --out; a folder holding anything else is refused.
-const std::set<std::string> kOutputs = {"scene.json", "repro.sh", "verdict.txt", "summary.json", "run"};
-
-std::string outProblem(const std::string& dir) {
-    const fs::path p(dir);
-    const fs::path parent = p.has_parent_path() ? p.parent_path() : fs::path(".");
-    if (!fs::is_directory(parent)) return dir + ": its parent folder does not exist";
-    if (!fs::exists(p)) return {};
-    if (!fs::is_directory(p)) return dir + ": is a file, not a folder";
-    for (const auto& e : fs::directory_iterator(p))
-        if (!kOutputs.count(e.path().filename().string()))
-            return dir + ": holds " + e.path().filename().string() + ", which is not an earlier hunt's output";
-    return {};
 }
 
 } // namespace
@@ -113,7 +85,7 @@ int HuntCommand::run() {
             return usage(opt->get_name() + ": has no effect with --shader: the shader culls");
         lc::setParam(options.settings, scratchCamera, name, paramValues_.at(name));
     }
-    if (const std::string why = outProblem(outDir_); !why.empty()) return usage("--out: " + why);
+    if (const std::string why = lc::huntOutputProblem(outDir_); !why.empty()) return usage("--out: " + why);
 
     std::optional<lc::Scene> base;
     if (source_.given()) base = source_.load();
@@ -156,54 +128,17 @@ int HuntCommand::run() {
     };
     const lc::HuntResult result = lc::hunt(options, *backend);
 
-    fs::create_directories(outDir_);
-    for (const std::string& name : kOutputs) fs::remove_all(fs::path(outDir_) / name);
     if (result.firstOverCapacityTrial)
         std::cout << "over capacity (not a failure without --overflow): " << result.coverage.overCapacity
                   << " trials, the first trial " << *result.firstOverCapacityTrial << "\n";
+    const std::string command = lc::writeHuntRepro(result, options, *backend, outDir_, device_);
     if (!result.failure) {
-        const std::string line = "no miss in " + std::to_string(result.coverage.trials) + " trials of seed " +
-                                 std::to_string(seed_) + " (coverage: " + result.coverage.text() + ")\n";
-        lc::writeFileSynced((fs::path(outDir_) / "verdict.txt").string(), line);
-        std::cout << line;
+        std::cout << lc::huntNoMissText(result, options);
         return 0;
     }
-
-    // The repro: the shrunk scene, the `lightcull run` that shows the miss,
-    // that run's diagnostics and the verdict.
     const lc::HuntFailure& f = *result.failure;
-    std::string command = "lightcull run --scene scene.json --backend " + backend->name();
-    if (!device_.empty()) command += " --device " + shellQuote(device_);
-    if (options.shader) {
-        command += " --shader " + shellQuote(fs::absolute(shader_).string()) + " --layout " +
-                   lc::toString(options.shader->layout) + " --lists " + lc::toString(options.shader->lists);
-        if (noValidation_) command += " --no-validation";
-    } else {
-        for (const lc::ParamSpec& p : lc::cullParams())
-            if (p.name != "tile" && p.name != "width" && p.name != "height")
-                command += " --" + p.name + " " + shellQuote(lc::getParam(options.settings, scratchCamera, p.name));
-    }
-    command += " --no-image-error --out run";
-
-    lc::Scene scene = f.shrunk;
     const fs::path out(outDir_);
-    lc::saveSceneFile(scene, (out / "scene.json").string());
-    scene.origin.file = fs::absolute(out / "scene.json").string();
-    scene.origin.command = command;
-    lc::RunOutput run;
-    lc::judgeHuntTrial(scene, options, *backend, &run);
-    lc::exportDiagnostics(scene, options.settings, run, (out / "run").string());
-    fs::copy_file(out / "run" / "summary.json", out / "summary.json", fs::copy_options::overwrite_existing);
     const std::string verdict = lc::huntVerdictText(f, options);
-    lc::writeFileSynced((out / "verdict.txt").string(), verdict);
-    lc::writeFileSynced((out / "repro.sh").string(), "#!/bin/sh\n# lightcull hunt, seed " + std::to_string(seed_) + ", trial " +
-                                    std::to_string(f.trial) + ": " + f.verdict.property +
-                                    " (verdict.txt). Exits 3 while the miss is there.\n"
-                                    "# Set LIGHTCULL to the binary when lightcull is not on PATH.\n"
-                                    "cd \"$(dirname \"$0\")\" || exit 1\n# " +
-                                    command + "\nexec \"${LIGHTCULL:-lightcull}\"" + command.substr(9) + "\n");
-    fs::permissions(out / "repro.sh", fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
-                    fs::perm_options::add);
     std::cout << "COUNTEREXAMPLE after " << f.trial + 1 << " trials (" << result.seconds << " s):\n"
               << verdict << "repro: " << (out / "repro.sh").string() << "  (" << command << ")\n"
               << "wrote " << outDir_ << "/scene.json, repro.sh, summary.json, verdict.txt, run/\n";

@@ -3,13 +3,20 @@
 #include "culling/diagnostics/hunt.hpp"
 
 #include "culling/core/errors.hpp"
+#include "culling/core/file_io.hpp"
+#include "culling/diagnostics/export.hpp"
 #include "culling/math/projection.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <set>
 #include <sstream>
+
+namespace fs = std::filesystem;
 
 namespace lc {
 
@@ -302,6 +309,36 @@ HuntVerdict judgeHuntTrial(const Scene& scene, const HuntOptions& options, CullB
         v.property = "overflow";
     }
     if (!missed.empty()) v.miss = missed.front();
+    // A built-in algorithm off the CPU: its lists must hold the CPU
+    // reference's over the same depth (a superset: float rounding may add).
+    if (!options.shader && backend.name() != "cpu" && !v.fails) {
+        const Projection proj(scene.camera);
+        const CullResult ref = makeCpuBackend()->cull(
+            run.depth, proj, TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize),
+            run.lights, options.settings);
+        const CullResult& got = run.result;
+        if (ref.listCount.size() != got.listCount.size()) {
+            v.fails = true;
+            v.property = "lists differ from the CPU reference (" + std::to_string(got.listCount.size()) +
+                         " lists, the reference " + std::to_string(ref.listCount.size()) + ")";
+        } else {
+            for (std::size_t l = 0; l < ref.listCount.size(); ++l) {
+                const auto rb = ref.lightIndices.begin() + ref.listOffset[l], re = rb + ref.listCount[l];
+                const auto gb = got.lightIndices.begin() + got.listOffset[l], ge = gb + got.listCount[l];
+                std::vector<std::uint32_t> lost;
+                std::set_difference(rb, re, gb, ge, std::back_inserter(lost));
+                if (!lost.empty() && !v.missingReferenceEntries) {
+                    v.referenceList = std::uint32_t(l);
+                    v.referenceLight = lost.front();
+                }
+                v.missingReferenceEntries += lost.size();
+            }
+            if (v.missingReferenceEntries) {
+                v.fails = true;
+                v.property = "lists lack the CPU reference's entries";
+            }
+        }
+    }
     if (runOut) *runOut = std::move(run);
     return v;
 }
@@ -324,6 +361,7 @@ Scene shrinkHuntFailure(const Scene& failing, const HuntOptions& options, CullBa
     ++count;
     Scene best = failing;
     auto stillFails = [&](const Scene& s) {
+        if (options.cancel && options.cancel->cancelled) return false; // keep what was shrunk so far
         if (!s.camera.validate().empty()) return false;
         ++count;
         try {
@@ -432,6 +470,10 @@ HuntResult hunt(const HuntOptions& options, CullBackend& backend) {
     for (std::uint64_t i = 0;; ++i) {
         if (options.maxTrials && i >= options.maxTrials) break;
         if (options.maxSeconds > 0 && elapsed() >= options.maxSeconds) break;
+        if (options.cancel && options.cancel->cancelled) {
+            result.cancelled = true;
+            break;
+        }
         const Scene s = makeHuntTrial(options.baseScene, options.seed, i, options.vary);
         // Coverage of what this trial is.
         const Camera& c = s.camera;
@@ -523,6 +565,12 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
             o << ", " << v.overflowLists << " lists over the layout's capacity, " << v.invalidIndices
               << " invalid indices";
         o << ".";
+    } else if (v.missingReferenceEntries) {
+        o << " Its lists lack " << v.missingReferenceEntries
+          << " entries the CPU reference lists over the same depth image; the first: light " << v.referenceLight
+          << " in list " << v.referenceList
+          << " (no false negative: the reference lists more than the pixels need; compare `lightcull run "
+             "--backend cpu` with the repro's run).";
     } else {
         o << " " << v.falseNegatives << " false negatives, " << v.invalidIndices << " invalid indices, "
           << v.overflowLists << " overflowed lists.";
@@ -534,6 +582,88 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
                                        : ", fov " + g(c.fovYDeg) + " degrees")
       << ", near " << c.nearPlane << ", far " << c.farPlane << ") in " << f.shrinkRuns << " runs.\n";
     return o.str();
+}
+
+namespace {
+
+std::string shellQuote(const std::string& a) {
+    if (!a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_./:=,+@%") ==
+                          std::string::npos)
+        return a;
+    std::string q = "'";
+    for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+// What a repro folder holds; a folder holding anything else is refused.
+const std::set<std::string> kReproFiles = {"scene.json", "repro.sh", "verdict.txt", "summary.json", "run"};
+
+} // namespace
+
+std::string huntOutputProblem(const std::string& dir) {
+    const fs::path p(dir);
+    const fs::path parent = p.has_parent_path() ? p.parent_path() : fs::path(".");
+    if (dir.empty()) return "no folder given";
+    if (!fs::is_directory(parent)) return dir + ": its parent folder does not exist";
+    if (!fs::exists(p)) return {};
+    if (!fs::is_directory(p)) return dir + ": is a file, not a folder";
+    for (const auto& e : fs::directory_iterator(p))
+        if (!kReproFiles.count(e.path().filename().string()))
+            return dir + ": holds " + e.path().filename().string() + ", which is not an earlier hunt's output";
+    return {};
+}
+
+std::string huntNoMissText(const HuntResult& result, const HuntOptions& options) {
+    return std::string(result.cancelled ? "cancelled: " : "") + "no miss in " +
+           std::to_string(result.coverage.trials) + " trials of seed " + std::to_string(options.seed) +
+           " (coverage: " + result.coverage.text() + ")\n";
+}
+
+std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options, CullBackend& backend,
+                           const std::string& dir, const std::string& device) {
+    if (const std::string why = huntOutputProblem(dir); !why.empty()) throw SettingsError("out", why);
+    const fs::path out(dir);
+    fs::create_directories(out);
+    for (const std::string& name : kReproFiles) fs::remove_all(out / name);
+    if (!result.failure) {
+        writeFileSynced((out / "verdict.txt").string(), huntNoMissText(result, options));
+        return {};
+    }
+    // The `lightcull run` that shows the miss, run from the folder.
+    const HuntFailure& f = *result.failure;
+    std::string command = "lightcull run --scene scene.json --backend " + backend.name();
+    if (!device.empty()) command += " --device " + shellQuote(device);
+    if (options.shader) {
+        command += " --shader " + shellQuote(fs::absolute(options.shader->path).string()) + " --layout " +
+                   toString(options.shader->layout) + " --lists " + toString(options.shader->lists);
+        if (!options.shader->validation) command += " --no-validation";
+    } else {
+        Camera scratch;
+        for (const ParamSpec& p : cullParams())
+            if (p.name != "tile" && p.name != "width" && p.name != "height")
+                command += " --" + p.name + " " + shellQuote(getParam(options.settings, scratch, p.name));
+    }
+    command += " --no-image-error --out run";
+
+    Scene scene = f.shrunk;
+    saveSceneFile(scene, (out / "scene.json").string());
+    scene.origin.file = fs::absolute(out / "scene.json").string();
+    scene.origin.command = command;
+    RunOutput run;
+    judgeHuntTrial(scene, options, backend, &run);
+    exportDiagnostics(scene, options.settings, run, (out / "run").string());
+    fs::copy_file(out / "run" / "summary.json", out / "summary.json", fs::copy_options::overwrite_existing);
+    writeFileSynced((out / "verdict.txt").string(), huntVerdictText(f, options));
+    writeFileSynced((out / "repro.sh").string(),
+                    "#!/bin/sh\n# lightcull hunt, seed " + std::to_string(options.seed) + ", trial " +
+                        std::to_string(f.trial) + ": " + f.verdict.property +
+                        " (verdict.txt). Exits 3 while the miss is there.\n"
+                        "# Set LIGHTCULL to the binary when lightcull is not on PATH.\n"
+                        "cd \"$(dirname \"$0\")\" || exit 1\n# " +
+                        command + "\nexec \"${LIGHTCULL:-lightcull}\"" + command.substr(9) + "\n");
+    fs::permissions(out / "repro.sh", fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
+                    fs::perm_options::add);
+    return command;
 }
 
 } // namespace lc

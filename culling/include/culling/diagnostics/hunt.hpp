@@ -8,7 +8,9 @@
 //
 // The property is the one `lightcull run` judges with its exit code 3: no
 // false negatives, and for custom shaders no index past the light count and
-// (with overflowIsFailure) no list over the layout's declared capacity.
+// (with overflowIsFailure) no list over the layout's declared capacity; for a
+// built-in algorithm on a backend other than the CPU reference, also every
+// entry the CPU reference lists over the same depth image.
 
 #include "culling/core/backend.hpp"
 #include "culling/core/params.hpp"
@@ -70,6 +72,10 @@ struct HuntOptions {
     const Scene* baseScene = nullptr;
     // Called about once a second and at the end.
     std::function<void(const HuntCoverage&, double seconds)> progress;
+    // Checked between trials and between the shrinking's runs: a cancelled
+    // hunt returns what it covered (HuntResult::cancelled), and a failure
+    // found before, shrunk as far as it got.
+    const CancelToken* cancel = nullptr;
 };
 
 // One judged trial.
@@ -78,6 +84,10 @@ struct HuntVerdict {
     bool overCapacity = false; // lists overflowed a declared capacity (custom)
     std::string property;      // what failed: "false negatives", "invalid indices", "overflow", "error: ..."
     std::uint64_t falseNegatives = 0, invalidIndices = 0, overflowLists = 0;
+    // Built-in algorithm on Vulkan: entries of the CPU reference's lists (over
+    // the same depth image) its lists lack; the first such list and light.
+    std::uint64_t missingReferenceEntries = 0;
+    std::uint32_t referenceList = 0, referenceLight = 0;
     std::uint64_t geometryPixels = 0;
     std::optional<MissedLight> miss; // the first located miss (culling test first)
 };
@@ -95,6 +105,7 @@ struct HuntResult {
     double seconds = 0;
     std::optional<HuntFailure> failure;
     std::optional<std::uint64_t> firstOverCapacityTrial;
+    bool cancelled = false;
 };
 
 // The scene of trial `index` (pure: the same arguments give the same scene).
@@ -121,5 +132,25 @@ Scene shrinkHuntFailure(const Scene& failing, const HuntOptions& options, CullBa
 
 // The one-paragraph verdict of a failure (verdict.txt).
 std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options);
+
+// The repro folder (`lightcull hunt --out`, the studio's Culling > Hunt):
+// what it may already hold, and writing it.
+//
+// Empty when `dir` can take a repro: it does not exist yet (its parent does)
+// or holds nothing but an earlier hunt's output; else why not, naming `dir`.
+std::string huntOutputProblem(const std::string& dir);
+
+// Writes the repro into `dir` (created; an earlier hunt's output there is
+// replaced): scene.json (the shrunk scene), repro.sh (the `lightcull run`
+// that shows the miss; exits 3 while it is there), run/ (that run's
+// diagnostics), summary.json (run/'s) and verdict.txt. Without a failure,
+// only verdict.txt ("no miss in N trials ..."). `device` and `validation`
+// (custom shaders) go into the command as given to the hunt. Returns the
+// command (starting "lightcull run"), empty without a failure.
+std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options, CullBackend& backend,
+                           const std::string& dir, const std::string& device = {});
+
+// "no miss in N trials of seed S (coverage: ...)".
+std::string huntNoMissText(const HuntResult& result, const HuntOptions& options);
 
 } // namespace lc
