@@ -401,6 +401,15 @@ void MainWindow::buildActions() {
     });
     connect(make(tr("&Built-in algorithm"), "actionBuiltinAlgorithm"), &QAction::triggered, this,
             [this] { setCustomShader({}); });
+    connect(make(tr("&Hunt for a miss..."), "actionHunt", QKeySequence(tr("Ctrl+H"))), &QAction::triggered, this,
+            &MainWindow::huntFromDialog);
+    // A hunt's repro opens with its miss selected once its run has the truth.
+    connect(this, &MainWindow::runFinished, this, [this] {
+        const auto run = doc_->runOutput();
+        if (!pendingHuntMiss_ || !run || !run->truthComputed || doc_->runIsStale()) return;
+        pendingHuntMiss_ = false;
+        misses_->step(+1);
+    });
     QAction* live = make(tr("Live"), "actionLive");
     live->setCheckable(true);
     live->setToolTip(tr("Re-run culling after every edit"));
@@ -461,6 +470,7 @@ void MainWindow::buildMenus() {
     cull->addSeparator();
     cull->addAction(misses_->nextAction());
     cull->addAction(misses_->previousAction());
+    cull->addAction(action("actionHunt"));
     cull->addSeparator();
     cull->addAction(action("actionCustomShader"));
     cull->addAction(action("actionBuiltinAlgorithm"));

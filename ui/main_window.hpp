@@ -38,6 +38,7 @@ class QFileSystemWatcher;
 namespace lcui {
 
 class MissNavigator;
+struct HuntRequest; // hunt_dialog.hpp
 
 class CameraView;
 class CullService;
@@ -125,6 +126,12 @@ public:
     int addLightAtCentre();
     // Generates lights as one undo step (progress + cancel for large counts).
     bool generateLights(const lc::LightGenSettings& settings);
+    // Culling > Hunt for a miss... (main_window_hunt.cpp): hunts the window's
+    // culling (its settings or custom shader, on its backend) with the status
+    // bar's progress and Cancel, writes the repro into r.folder and, when a
+    // miss is found, opens the repro scene with the miss selected and
+    // Explain showing it. False when nothing was found, on error or cancel.
+    bool hunt(const HuntRequest& r);
     void setCullingCameraFromInspector();
 
     // Export diagnostics (File menu): summary.json, tiles.csv, heatmap.png,
@@ -157,6 +164,7 @@ private:
     // The time, `level` ("ERROR ", "WARNING " or none) and the message.
     void logLine(const QString& level, const QString& message);
     void reloadCustomShader(); // the watched file changed
+    void huntFromDialog();     // Culling > Hunt for a miss... (main_window_hunt.cpp)
     void buildActions();
     void buildMenus();
     void buildToolbar();
@@ -213,6 +221,7 @@ private:
     std::shared_ptr<const lc::CustomShaderOptions> customShader_;
     QFileSystemWatcher* shaderWatcher_ = nullptr;
     quint64 pendingRuns_ = 0;
+    bool pendingHuntMiss_ = false; // select the first miss of the next run with ground truth
 };
 
 } // namespace lcui

@@ -14,7 +14,7 @@ namespace lcui {
 
 void runWithProgress(StatusProgress* status, const QString& label,
                      const std::function<void(const lc::CancelToken&, const lc::Progress&)>& work,
-                     int showAfterMs) {
+                     int showAfterMs, const std::function<QString()>& liveLabel) {
     lc::CancelToken cancel;
     std::atomic<double> fraction{-1.0};
     std::exception_ptr error;
@@ -34,7 +34,9 @@ void runWithProgress(StatusProgress* status, const QString& label,
     QEventLoop loop;
     QObject::connect(thread, &QThread::finished, &loop, &QEventLoop::quit);
     QTimer poll;
-    QObject::connect(&poll, &QTimer::timeout, [&] { status->setProgress(key, fraction.load()); });
+    QObject::connect(&poll, &QTimer::timeout, [&] {
+        status->setProgress(key, fraction.load(), liveLabel ? liveLabel() : QString());
+    });
     poll.start(50);
     thread->start();
     loop.exec(); // "finished" is queued to this thread, so it cannot be missed

@@ -23,10 +23,12 @@ class StatusProgress;
 // the window ignores clicks meanwhile, and the row says why.
 // Cancel sets the token; work that does not check it still runs to its end,
 // and its result is then discarded. Rethrows the work's exception; throws
-// lc::Cancelled when cancelled.
+// lc::Cancelled when cancelled. `liveLabel`, when set, is asked for the row's
+// label as often as the progress is shown (it must be safe to call while the
+// work runs).
 void runWithProgress(StatusProgress* status, const QString& label,
                      const std::function<void(const lc::CancelToken&, const lc::Progress&)>& work,
-                     int showAfterMs = 0);
+                     int showAfterMs = 0, const std::function<QString()>& liveLabel = {});
 
 template <class T>
 T runWithProgressResult(StatusProgress* status, const QString& label,
