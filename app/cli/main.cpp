@@ -111,16 +111,22 @@ std::string commandLine(int argc, char** argv) {
 }
 
 // docs/CLI.md, "Errors and exit codes": exit 3 when the judged culling misses
-// lights, overflows a list or writes an index past the light count, so that a
-// CI job fails on a miss without reading summary.json.
+// lights, overflows a list, writes an index past the light count or a light
+// twice in one list (shaded twice), or set off the validation layer, so that
+// a CI job fails on a miss without reading summary.json.
 constexpr int kExitMisses = 3;
 int verdictExit(const lc::RunOutput& run) {
     const std::uint64_t fn = run.truthComputed ? run.truth.metrics.falseNegatives : 0;
     const std::uint64_t overflow = run.custom ? run.custom->overflowLists : 0;
     const std::uint64_t invalid = run.custom ? run.custom->invalidIndices : 0;
-    if (fn == 0 && overflow == 0 && invalid == 0) return 0;
+    const std::uint64_t duplicate = run.custom ? run.custom->duplicateIndices : 0;
+    const std::size_t validation = run.custom ? run.custom->validationMessages.size() : 0;
+    if (fn == 0 && overflow == 0 && invalid == 0 && duplicate == 0 && validation == 0) return 0;
     std::cerr << "lightcull: the culling fails: " << fn << " false negatives, " << overflow << " overflowed lists, "
-              << invalid << " invalid indices (exit " << kExitMisses << ")\n";
+              << invalid << " invalid indices";
+    if (duplicate) std::cerr << ", " << duplicate << " duplicate indices";
+    if (validation) std::cerr << ", " << validation << " validation messages";
+    std::cerr << " (exit " << kExitMisses << ")\n";
     return kExitMisses;
 }
 

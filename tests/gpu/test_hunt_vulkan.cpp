@@ -5,14 +5,21 @@
 // image (what test_vulkan_cull checks on its hand-picked frames).
 #include "gpu_test_env.hpp"
 
+#include "../unit/cli_support.hpp"
+
 #include "../support/box_mesh.hpp"
 #include "culling/core/params.hpp"
 #include "culling/diagnostics/hunt.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <filesystem>
 
 using namespace lc;
 using lc::gputest::GpuTest;
@@ -124,4 +131,29 @@ TEST_F(GpuTest, ListsShortOfTheCpuReferenceFailTheHunt) {
     const std::string text = huntVerdictText(f, o);
     EXPECT_NE(text.find("lack"), std::string::npos) << text;
     EXPECT_NE(text.find("light 1"), std::string::npos) << text;
+}
+
+// A custom shader that never misses a light but lists light 0 twice in every
+// tile (a shading pass adds it twice) fails the hunt at its first trial with
+// a light, and its repro's `lightcull run` exits 3 as the hunt says.
+TEST(HuntCustomProperties, ADuplicateIndexIsAFailureAndRunSaysSoToo) {
+    namespace fs = std::filesystem;
+    lc_test::ScratchDir s;
+    const fs::path out = s.path / "dup";
+    const lc_test::CliResult r =
+        lc_test::runCli({"hunt", "--shader", std::string(LC_TEST_DATA_DIR) + "/custom/duplicate_light.comp",
+                         "--backend", "cpu", "--trials", "10", "--seed", "3", "--out", out.string()},
+                        s.path);
+    ASSERT_EQ(r.code, 3) << r.out << r.err;
+    EXPECT_NE(r.err.find("duplicate indices"), std::string::npos) << r.err;
+    const std::string verdict = lc_test::slurp(out / "verdict.txt");
+    EXPECT_NE(verdict.find("(duplicate indices)"), std::string::npos) << verdict;
+    EXPECT_NE(verdict.find("0 false negatives"), std::string::npos) << verdict;
+    EXPECT_EQ(nlohmann::json::parse(lc_test::slurp(out / "scene.json"))["lights"].size(), 1u);
+    const std::string cmd = "LIGHTCULL='" + std::string(LC_CLI_PATH) + "' sh '" + (out / "repro.sh").string() +
+                            "' >'" + (s.path / "repro.log").string() + "' 2>&1";
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 3) << lc_test::slurp(s.path / "repro.log");
+    EXPECT_NE(lc_test::slurp(s.path / "repro.log").find("duplicate indices"), std::string::npos);
 }

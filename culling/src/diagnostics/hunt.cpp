@@ -298,9 +298,17 @@ HuntVerdict judgeHuntTrial(const Scene& scene, const HuntOptions& options, CullB
     std::vector<MissedLight> missed;
     if (v.falseNegatives) missed = locateFalseNegatives(run, Projection(scene.camera));
     const bool testMiss = !missed.empty() && missed.front().cause == MissCause::CullingTest;
+    v.duplicateIndices = run.custom ? run.custom->duplicateIndices : 0;
+    v.validationMessages = run.custom ? run.custom->validationMessages.size() : 0;
     if (v.invalidIndices) {
         v.fails = true;
         v.property = "invalid indices";
+    } else if (v.validationMessages) {
+        v.fails = true;
+        v.property = "validation messages: " + run.custom->validationMessages.front();
+    } else if (v.duplicateIndices) {
+        v.fails = true;
+        v.property = "duplicate indices";
     } else if (testMiss || (v.falseNegatives && !v.overCapacity)) {
         v.fails = true;
         v.property = "false negatives";
@@ -573,6 +581,7 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
              "--backend cpu` with the repro's run).";
     } else {
         o << " " << v.falseNegatives << " false negatives, " << v.invalidIndices << " invalid indices, "
+          << v.duplicateIndices << " duplicate indices, " << v.validationMessages << " validation messages, "
           << v.overflowLists << " overflowed lists.";
     }
     o << " Shrunk from " << f.original.lights.size() << " lights at " << f.original.camera.width << "x"

@@ -7,8 +7,9 @@
 // scene is a pure function of (base scene, seed, trial index, dimensions).
 //
 // The property is the one `lightcull run` judges with its exit code 3: no
-// false negatives, and for custom shaders no index past the light count and
-// (with overflowIsFailure) no list over the layout's declared capacity; for a
+// false negatives, and for custom shaders no index past the light count, no
+// light twice in one list, no validation message and (with
+// overflowIsFailure) no list over the layout's declared capacity; for a
 // built-in algorithm on a backend other than the CPU reference, also every
 // entry the CPU reference lists over the same depth image.
 
@@ -82,8 +83,10 @@ struct HuntOptions {
 struct HuntVerdict {
     bool fails = false;
     bool overCapacity = false; // lists overflowed a declared capacity (custom)
-    std::string property;      // what failed: "false negatives", "invalid indices", "overflow", "error: ..."
+    std::string property;      // what failed: "false negatives", "invalid indices", "validation messages: ...",
+                               // "duplicate indices", "overflow", "lists lack the CPU reference's entries", "error: ..."
     std::uint64_t falseNegatives = 0, invalidIndices = 0, overflowLists = 0;
+    std::uint64_t duplicateIndices = 0, validationMessages = 0; // custom shaders
     // Built-in algorithm on Vulkan: entries of the CPU reference's lists (over
     // the same depth image) its lists lack; the first such list and light.
     std::uint64_t missingReferenceEntries = 0;
