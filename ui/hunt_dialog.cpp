@@ -104,7 +104,7 @@ HuntDialog::HuntDialog(const HuntRequest& r, const QString& underTest, bool scen
     fl->setContentsMargins(0, 0, 0, 0);
     folder_ = new QLineEdit(r.folder);
     folder_->setObjectName("huntFolder");
-    folder_->setToolTip(tr("The repro goes here: scene.json, repro.sh, summary.json, verdict.txt, run/"));
+    folder_->setToolTip(tr("The repro goes here: scene.json, scene.glb, repro.sh, summary.json, verdict.txt, run/"));
     auto* browse = new QPushButton(tr("Browse..."));
     connect(browse, &QPushButton::clicked, this, [this] {
         const QString d = QFileDialog::getExistingDirectory(this, tr("Repro folder"), folder_->text());

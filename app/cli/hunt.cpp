@@ -65,7 +65,7 @@ void HuntCommand::add(CLI::App& app) {
     for (const std::string& b : lc::availableBackends()) backendHelp += b + " ";
     cmd_->add_option("--backend", backend_, backendHelp + "(default: vulkan where available, else cpu)")->type_name("NAME");
     cmd_->add_option("--device", device_, "Vulkan device: index or name substring")->type_name("D");
-    cmd_->add_option("--out", outDir_, "Folder for the repro (scene.json, repro.sh, summary.json, verdict.txt)")
+    cmd_->add_option("--out", outDir_, "Folder for the repro (scene.json, scene.glb, repro.sh, summary.json, verdict.txt)")
         ->type_name("DIR")
         ->required();
 }
@@ -141,7 +141,7 @@ int HuntCommand::run() {
     const std::string verdict = lc::huntVerdictText(f, options);
     std::cout << "COUNTEREXAMPLE after " << f.trial + 1 << " trials (" << result.seconds << " s):\n"
               << verdict << "repro: " << (out / "repro.sh").string() << "  (" << command << ")\n"
-              << "wrote " << outDir_ << "/scene.json, repro.sh, summary.json, verdict.txt, run/\n";
+              << "wrote " << outDir_ << "/scene.json, scene.glb, repro.sh, summary.json, verdict.txt, run/\n";
     std::cerr << "lightcull: the culling fails the hunt: " << f.verdict.property << " (exit 3)\n";
     return 3;
 }

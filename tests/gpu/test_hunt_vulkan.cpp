@@ -10,6 +10,7 @@
 #include "../support/box_mesh.hpp"
 #include "culling/core/params.hpp"
 #include "culling/diagnostics/hunt.hpp"
+#include "culling/scene/gltf_io.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
@@ -150,6 +151,16 @@ TEST(HuntCustomProperties, ADuplicateIndexIsAFailureAndRunSaysSoToo) {
     EXPECT_NE(verdict.find("(duplicate indices)"), std::string::npos) << verdict;
     EXPECT_NE(verdict.find("0 false negatives"), std::string::npos) << verdict;
     EXPECT_EQ(nlohmann::json::parse(lc_test::slurp(out / "scene.json"))["lights"].size(), 1u);
+    // scene.glb is the same scene for glTF tools: camera, lights, meshes.
+    const Scene json = loadSceneFile((out / "scene.json").string());
+    const Scene glb = loadSceneAny((out / "scene.glb").string());
+    ASSERT_EQ(glb.lights.size(), 1u);
+    EXPECT_NEAR(glm::distance(glb.lights[0].position, json.lights[0].position), 0.0, 1e-9);
+    EXPECT_NEAR(glb.lights[0].radius(), json.lights[0].radius(), 1e-9 * json.lights[0].radius());
+    EXPECT_EQ(glb.camera.width, json.camera.width);
+    EXPECT_EQ(glb.camera.height, json.camera.height);
+    EXPECT_EQ(glb.camera.projection, json.camera.projection);
+    EXPECT_EQ(glb.triangleCount(), json.triangleCount());
     const std::string cmd = "LIGHTCULL='" + std::string(LC_CLI_PATH) + "' sh '" + (out / "repro.sh").string() +
                             "' >'" + (s.path / "repro.log").string() + "' 2>&1";
     const int status = std::system(cmd.c_str());

@@ -6,6 +6,7 @@
 #include "culling/core/file_io.hpp"
 #include "culling/diagnostics/export.hpp"
 #include "culling/math/projection.hpp"
+#include "culling/scene/gltf_io.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <algorithm>
@@ -605,7 +606,8 @@ std::string shellQuote(const std::string& a) {
 }
 
 // What a repro folder holds; a folder holding anything else is refused.
-const std::set<std::string> kReproFiles = {"scene.json", "repro.sh", "verdict.txt", "summary.json", "run"};
+const std::set<std::string> kReproFiles = {"scene.json", "scene.glb", "repro.sh", "verdict.txt", "summary.json",
+                                           "run"};
 
 } // namespace
 
@@ -656,6 +658,7 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
 
     Scene scene = f.shrunk;
     saveSceneFile(scene, (out / "scene.json").string());
+    saveGltfScene(scene, (out / "scene.glb").string()); // for the user's engine and glTF viewers
     scene.origin.file = fs::absolute(out / "scene.json").string();
     scene.origin.command = command;
     RunOutput run;

@@ -144,7 +144,9 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options);
 std::string huntOutputProblem(const std::string& dir);
 
 // Writes the repro into `dir` (created; an earlier hunt's output there is
-// replaced): scene.json (the shrunk scene), repro.sh (the `lightcull run`
+// replaced): scene.json (the shrunk scene), scene.glb (the same as glTF, with
+// the camera and KHR_lights_punctual lights; extras.lightcull keeps what glTF
+// cannot say), repro.sh (the `lightcull run`
 // that shows the miss; exits 3 while it is there), run/ (that run's
 // diagnostics), summary.json (run/'s) and verdict.txt. Without a failure,
 // only verdict.txt ("no miss in N trials ..."). `device` and `validation`
