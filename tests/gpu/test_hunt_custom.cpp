@@ -4,7 +4,10 @@
 // is found within a small budget, without being told what to vary; the
 // shrunk repro holds a handful of lights at most, its repro.sh shows the same
 // miss through `lightcull run` (exit 3, false negatives in its summary.json),
-// and the same seed finds the same repro.
+// and the same seed finds the same repro. So are the flawed examples of the
+// other classes issue 35 names (reversed-Z linearisation, a spot test that
+// breaks on a 180-degree cone, a per-list cap below the declared one), each
+// with the default --vary.
 #include "../unit/cli_support.hpp"
 
 #include <gtest/gtest.h>
@@ -14,6 +17,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <ostream>
 
 namespace fs = std::filesystem;
 using lc_test::CliResult;
@@ -91,3 +95,64 @@ TEST(HuntCustom, OverCapacityIsCountedApartUnlessOverflowIsHunted) {
     ASSERT_TRUE(WIFEXITED(status));
     EXPECT_EQ(WEXITSTATUS(status), 3);
 }
+
+// The flawed examples of the classes issue 35 names, each hunted with the
+// default --vary (every dimension), so the hunt is not told what breaks them.
+// Each is found within 60 trials of seed 1 (trial 1, 1 and 13 when written),
+// its repro is as small as the flaw allows, no list overflows (a limit kept
+// silently is a miss, not overflow), and repro.sh exits 3.
+namespace {
+struct FlawedExample {
+    const char* testName;
+    const char* file;      // in resources/culling-examples
+    std::size_t maxLights; // in the shrunk repro
+    const char* clue;      // in verdict.txt: what the failing trial had
+};
+
+const FlawedExample kFlawedExamples[] = {
+    // Standard-Z linearisation: only a reversed-Z camera shows it.
+    {"ReversedZ", "flawed_reversed_z.comp", 5, ", reversed_z,"},
+    // The apex-and-rim sphere of spots up to 45 degrees for every spot: it
+    // holds every cone short of 90 degrees and none at 90.
+    {"WideSpot", "flawed_wide_spot.comp", 5, "outer angle 90 degrees"},
+    // A shared list of 8 under fixed:256: a tile needs 9 lights to show it,
+    // so 9 is the smallest repro.
+    {"SilentCap", "flawed_silent_cap.comp", 9, "to 9 lights at"},
+};
+
+// Test names show the file, not the struct's bytes.
+void PrintTo(const FlawedExample& e, std::ostream* os) { *os << e.file; }
+
+class HuntFlawedExample : public ::testing::TestWithParam<FlawedExample> {};
+} // namespace
+
+TEST_P(HuntFlawedExample, IsFoundWithoutBeingToldWhatToVaryAndItsReproReproduces) {
+    const FlawedExample& e = GetParam();
+    ScratchDir s;
+    const fs::path out = s.path / "hunt";
+    const std::string shader = std::string(LC_SOURCE_DIR) + "/resources/culling-examples/" + e.file;
+    const CliResult r = runCli({"hunt", "--shader", shader, "--backend", "cpu", "--trials", "60", "--seed",
+                                "1", "--out", out.string()},
+                               s.path);
+    ASSERT_EQ(r.code, 3) << r.out << r.err;
+    const std::string verdict = slurp(out / "verdict.txt");
+    EXPECT_NE(verdict.find("fails the hunt's property (false negatives)"), std::string::npos) << verdict;
+    EXPECT_NE(verdict.find("missing from the list of tile"), std::string::npos) << verdict;
+    EXPECT_NE(verdict.find(e.clue), std::string::npos) << verdict;
+    const auto scene = nlohmann::json::parse(slurp(out / "scene.json"));
+    EXPECT_GE(scene["lights"].size(), 1u);
+    EXPECT_LE(scene["lights"].size(), e.maxLights) << verdict;
+    const auto summary = nlohmann::json::parse(slurp(out / "summary.json"));
+    EXPECT_GT(summary["metrics"]["false_negatives"].get<std::uint64_t>(), 0u);
+    EXPECT_EQ(summary["custom"]["overflow_lists"], 0) << "the miss is the shader's own, not a full list";
+
+    fs::remove_all(out / "run");
+    const std::string cmd = "LIGHTCULL='" + std::string(LC_CLI_PATH) + "' sh '" + (out / "repro.sh").string() +
+                            "' >'" + (s.path / "repro.log").string() + "' 2>&1";
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 3) << slurp(s.path / "repro.log");
+}
+
+INSTANTIATE_TEST_SUITE_P(Issue35, HuntFlawedExample, ::testing::ValuesIn(kFlawedExamples),
+                         [](const auto& info) { return std::string(info.param.testName); });
