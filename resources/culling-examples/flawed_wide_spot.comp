@@ -11,9 +11,10 @@
 // (radius r at 60 degrees, 5.7 r at 85), up to the hemisphere spot of
 // a = 90 degrees: cos a is 0 there (-4.4e-8 for the float nearest pi / 2),
 // the sphere's centre and radius blow up, the radius negative, and the
-// light drops out of every tile. Point lights (angle 0) and spots up to
-// just short of 90 degrees are listed correctly, only wastefully. Seen when a spot test is copied from a sample tuned
-// for flashlights and the art team later places a 180-degree ceiling spot.
+// light drops out of every tile. Point lights (angle 0) and spots short of
+// 90 degrees are never missed (above 45 degrees only listed wastefully).
+// Seen when a spot test is copied from a sample tuned for flashlights and a
+// 180-degree ceiling spot is placed later.
 // The hunt finds it without being told to vary spots (90-degree spots are
 // among the angles it draws); its repro.sh shows it:
 //   lightcull hunt --shader flawed_wide_spot.comp --backend cpu --out out/hunt && sh out/hunt/repro.sh
