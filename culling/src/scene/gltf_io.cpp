@@ -2,6 +2,7 @@
 
 #include "culling/core/errors.hpp"
 #include "culling/core/file_io.hpp"
+#include "scene/gltf_internal.hpp"
 #include "scene/json_nesting.hpp"
 
 #include <tiny_gltf.h>
@@ -184,10 +185,7 @@ public:
     // Nodes of the scene in pre-order (the "scene's node order"), each with
     // its world matrix. glTF nodes form trees: a node reached twice (a cycle,
     // or two parents) is an error, which also bounds the walk by the node count.
-    struct Placed {
-        int node;
-        glm::dmat4 world;
-    };
+    using Placed = GltfPlacedNode;
     std::vector<Placed> walkScene() {
         std::vector<int> roots;
         if (!m_.scenes.empty()) {
@@ -293,12 +291,6 @@ public:
         return m_.accessors[std::size_t(i)];
     }
 
-private:
-    void checkNodeIndex(int n, const std::string& field) const {
-        if (n < 0 || std::size_t(n) >= m_.nodes.size())
-            fail(field, std::to_string(n) + " is not an index into nodes (" + std::to_string(m_.nodes.size()) + ")");
-    }
-
     glm::dmat4 localMatrix(std::size_t n) const {
         const tinygltf::Node& node = m_.nodes[n];
         const std::string np = idx("nodes", n);
@@ -368,6 +360,12 @@ private:
         if (!fits)
             fail(field + ".count", withCommas(count) + " " + what + " do not fit " + bvp + " (" + withCommas(viewBytes) + " bytes)");
         return {m_.buffers[std::size_t(bv.buffer)].data.data() + bv.byteOffset + offset, stride};
+    }
+
+private:
+    void checkNodeIndex(int n, const std::string& field) const {
+        if (n < 0 || std::size_t(n) >= m_.nodes.size())
+            fail(field, std::to_string(n) + " is not an index into nodes (" + std::to_string(m_.nodes.size()) + ")");
     }
 
     static std::size_t componentBytes(int type) {
@@ -658,8 +656,10 @@ bool extraNumber(const tinygltf::Value* x, const char* key, double& out) {
 
 glm::dvec3 columnDir(const glm::dmat4& m, const glm::dvec3& local) { return glm::dvec3(m * glm::dvec4(local, 0.0)); }
 
-Camera readCamera(const std::string& path, const tinygltf::Model& model, const std::vector<GltfReader::Placed>& placed,
-                  const GltfReadOptions& options, const Mesh& geometry, GltfReadReport& rep) {
+// The camera node GltfReadOptions::camera picks (see gltf_internal.hpp,
+// chooseGltfCamera); null when the scene places none.
+const GltfReader::Placed* chooseCamera(const std::string& path, const tinygltf::Model& model,
+                                       const std::vector<GltfReader::Placed>& placed, const std::string& want) {
     std::vector<const GltfReader::Placed*> cams;
     for (const auto& p : placed) {
         const int c = model.nodes[std::size_t(p.node)].camera;
@@ -669,19 +669,8 @@ Camera readCamera(const std::string& path, const tinygltf::Model& model, const s
                              std::to_string(c) + " is not an index into cameras (" + std::to_string(model.cameras.size()) + ")");
         cams.push_back(&p);
     }
-    auto bounds = [&] {
-        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-        for (std::size_t v = 0; v < geometry.positions.size(); v += 3) {
-            const glm::dvec3 p(geometry.positions[v], geometry.positions[v + 1], geometry.positions[v + 2]);
-            lo = glm::min(lo, p);
-            hi = glm::max(hi, p);
-        }
-        if (geometry.positions.empty()) lo = hi = glm::dvec3(0.0);
-        return std::pair{lo, hi};
-    };
     const GltfReader::Placed* chosen = nullptr;
-    if (!options.camera.empty()) {
-        const std::string& want = options.camera;
+    if (!want.empty()) {
         const bool numeric = want.find_first_not_of("0123456789") == std::string::npos && want.size() < 10;
         // By name, every placement that answers to it: more than one is a
         // question only the user can settle (by index), not the first.
@@ -713,6 +702,22 @@ Camera readCamera(const std::string& path, const tinygltf::Model& model, const s
     } else if (!cams.empty()) {
         chosen = cams.front();
     }
+    return chosen;
+}
+
+Camera readCamera(const std::string& path, const tinygltf::Model& model, const std::vector<GltfReader::Placed>& placed,
+                  const GltfReadOptions& options, const Mesh& geometry, GltfReadReport& rep) {
+    auto bounds = [&] {
+        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+        for (std::size_t v = 0; v < geometry.positions.size(); v += 3) {
+            const glm::dvec3 p(geometry.positions[v], geometry.positions[v + 1], geometry.positions[v + 2]);
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+        if (geometry.positions.empty()) lo = hi = glm::dvec3(0.0);
+        return std::pair{lo, hi};
+    };
+    const GltfReader::Placed* chosen = chooseCamera(path, model, placed, options.camera);
 
     Camera cam;
     if (!chosen) {
@@ -723,18 +728,17 @@ Camera readCamera(const std::string& path, const tinygltf::Model& model, const s
     const int ci = model.nodes[std::size_t(chosen->node)].camera;
     const tinygltf::Camera& gc = model.cameras[std::size_t(ci)];
     const std::string cp = idx("cameras", std::size_t(ci));
-    const glm::dmat4& w = chosen->world;
-    cam.position = glm::dvec3(w * glm::dvec4(0, 0, 0, 1));
-    const glm::dvec3 forward = columnDir(w, {0, 0, -1}), up = columnDir(w, {0, 1, 0});
-    if (!(glm::length(forward) > 0.0) || !(glm::length(up) > 0.0))
+    GltfCameraPose pose;
+    if (!gltfCameraPose(chosen->world, pose))
         throw InputError(path, idx("nodes", std::size_t(chosen->node)), 0, "the camera node's transform is singular");
-    const glm::dvec3 f = glm::normalize(forward);
+    cam.position = pose.position;
+    const glm::dvec3 f = pose.forward;
     // The look-at target only sets the orbit distance in the studio: the
     // distance to the middle of the geometry along the view, at least 1.
     const auto [lo, hi] = bounds();
     const double along = glm::dot((lo + hi) * 0.5 - cam.position, f);
     cam.target = cam.position + f * std::max(1.0, std::isfinite(along) ? along : 1.0);
-    cam.up = glm::normalize(up);
+    cam.up = pose.up;
     double aspect = 0.0;
     if (gc.type == "perspective") {
         const auto& p = gc.perspective;
@@ -924,6 +928,44 @@ std::vector<double> lookRotation(const glm::dvec3& dir, glm::dvec3 up) {
 }
 
 } // namespace
+
+// ---------------------------------------------------------------- shared with camera_path.cpp
+
+tinygltf::Model parseGltfModel(const std::string& path, GltfReadReport& rep) { return parseModel(path, rep); }
+
+std::vector<GltfPlacedNode> walkGltfScene(const std::string& path, const tinygltf::Model& model) {
+    GltfReadReport rep;
+    return GltfReader(path, model, rep, nullptr).walkScene();
+}
+
+glm::dmat4 gltfLocalMatrix(const std::string& path, const tinygltf::Model& model, std::size_t n) {
+    GltfReadReport rep;
+    return GltfReader(path, model, rep, nullptr).localMatrix(n);
+}
+
+int chooseGltfCamera(const std::string& path, const tinygltf::Model& model, const std::vector<GltfPlacedNode>& placed,
+                     const std::string& camera) {
+    const GltfPlacedNode* chosen = chooseCamera(path, model, placed, camera);
+    return chosen ? int(chosen - placed.data()) : -1;
+}
+
+bool gltfCameraPose(const glm::dmat4& world, GltfCameraPose& pose) {
+    pose.position = glm::dvec3(world * glm::dvec4(0, 0, 0, 1));
+    const glm::dvec3 forward = columnDir(world, {0, 0, -1}), up = columnDir(world, {0, 1, 0});
+    if (!(glm::length(forward) > 0.0) || !(glm::length(up) > 0.0)) return false;
+    pose.forward = glm::normalize(forward);
+    pose.up = glm::normalize(up);
+    return true;
+}
+
+GltfByteSpan gltfViewSpan(const std::string& path, const tinygltf::Model& model, int view, std::uint64_t offset,
+                          std::uint64_t count, std::size_t elemSize, const std::string& field, const std::string& what) {
+    GltfReadReport rep;
+    const auto span = GltfReader(path, model, rep, nullptr).viewSpan(view, offset, count, elemSize, elemSize, field, what);
+    return {span.data, span.stride};
+}
+
+// ---------------------------------------------------------------- public
 
 bool isGltfPath(const std::string& path) {
     const std::string e = lowerExt(path);

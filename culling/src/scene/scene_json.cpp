@@ -15,6 +15,7 @@
 #include "culling/scene/gltf_io.hpp"
 #include "culling/core/file_io.hpp"
 #include "scene/json_nesting.hpp"
+#include "scene/scene_json_reader.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -29,10 +30,10 @@
 
 namespace lc {
 
-namespace {
-
-using json = nlohmann::json;
 namespace fs = std::filesystem;
+
+namespace scene_json {
+namespace {
 
 // ------------------------------------------------------------ line tracking
 
@@ -77,35 +78,6 @@ public:
 private:
     const char* p_ = nullptr;
     LineState* s_ = nullptr;
-};
-
-// Lines of values by field path. Elements of arrays are kept per array in a
-// vector (an inline mesh has millions of numbers; a string key each would cost
-// far more than the mesh).
-class LineMap {
-public:
-    void set(const std::string& path, int line) { lines_.emplace(path, line); }
-    void setElement(const std::string& arrayPath, std::size_t index, int line) {
-        auto& v = elements_[arrayPath];
-        if (v.size() <= index) v.resize(index + 1, 0);
-        v[index] = line;
-    }
-    // Line of `path`; 0 when unknown.
-    int line(const std::string& path) const {
-        if (auto it = lines_.find(path); it != lines_.end()) return it->second;
-        if (!path.empty() && path.back() == ']') {
-            const auto open = path.rfind('[');
-            const std::string arr = path.substr(0, open);
-            const std::size_t idx = std::stoul(path.substr(open + 1));
-            if (auto it = elements_.find(arr); it != elements_.end() && idx < it->second.size())
-                return it->second[idx];
-        }
-        return 0;
-    }
-
-private:
-    std::map<std::string, int> lines_;
-    std::map<std::string, std::vector<int>> elements_;
 };
 
 // Builds the DOM through nlohmann's DOM parser and records the line of every
@@ -203,90 +175,18 @@ private:
     std::vector<Frame> frames_;
 };
 
-// ------------------------------------------------------------ typed reading
+} // namespace
 
-class SceneReader {
-public:
-    SceneReader(const std::string& file, const LineMap& lines) : file_(file), lines_(lines) {}
+void parseWithLines(const std::string& text, const std::string& file, json& root, LineMap& lines) {
+    if (const int line = jsonNestingTooDeep(text))
+        throw InputError(file, "", line, "arrays and objects nested more than " + std::to_string(kMaxJsonNesting) + " deep");
+    LineState ls;
+    LineSax sax(root, ls, lines, file);
+    LineCountingIterator first(text.data(), &ls), last(text.data() + text.size(), &ls);
+    json::sax_parse(first, last, &sax);
+}
 
-    [[noreturn]] void fail(const std::string& path, const std::string& what) const {
-        int line = lines_.line(path);
-        // A missing field has no line: use the enclosing object's.
-        for (std::string p = path; line == 0 && !p.empty();) {
-            const auto cut = p.find_last_of(".[");
-            p = cut == std::string::npos ? std::string() : p.substr(0, cut);
-            line = lines_.line(p);
-        }
-        throw InputError(file_, path, line, what);
-    }
-
-    static std::string at(const std::string& base, const std::string& key) {
-        return base.empty() ? key : base + "." + key;
-    }
-    static std::string at(const std::string& base, std::size_t i) {
-        return base + "[" + std::to_string(i) + "]";
-    }
-
-    static const char* typeName(const json& v) { return v.type_name(); }
-
-    void requireObject(const json& v, const std::string& path) const {
-        if (!v.is_object()) fail(path, std::string("must be an object, not ") + typeName(v));
-    }
-    void checkKeys(const json& obj, const std::string& path,
-                   std::initializer_list<const char*> known) const {
-        for (auto it = obj.begin(); it != obj.end(); ++it) {
-            bool ok = false;
-            for (const char* k : known) ok = ok || it.key() == k;
-            if (!ok) {
-                std::string list;
-                for (const char* k : known) list += std::string(list.empty() ? "" : ", ") + k;
-                fail(at(path, it.key()), "unknown field '" + it.key() + "' (known here: " + list + ")");
-            }
-        }
-    }
-    const json* find(const json& obj, const char* key) const {
-        auto it = obj.find(key);
-        return it == obj.end() ? nullptr : &*it;
-    }
-    const json& require(const json& obj, const std::string& path, const char* key) const {
-        const json* v = find(obj, key);
-        if (!v) fail(at(path, key), "missing required field");
-        return *v;
-    }
-    double number(const json& v, const std::string& path) const {
-        if (!v.is_number()) fail(path, std::string("must be a number, not ") + typeName(v));
-        return v.get<double>();
-    }
-    std::string string(const json& v, const std::string& path) const {
-        if (!v.is_string()) fail(path, std::string("must be a string, not ") + typeName(v));
-        return v.get<std::string>();
-    }
-    std::uint32_t uint(const json& v, const std::string& path) const {
-        // 640.0 is a whole number too (Python's json writes floats so).
-        if (v.is_number_float()) {
-            const double d = v.get<double>();
-            if (!(std::floor(d) == d)) fail(path, "must be a whole number, not " + v.dump());
-            if (!(d >= 0 && d <= 4294967295.0)) fail(path, "must be in [0, 4294967295]");
-            return std::uint32_t(d);
-        }
-        if (!v.is_number_integer()) fail(path, std::string("must be a whole number, not ") + typeName(v));
-        if (v.is_number_unsigned() ? v.get<std::uint64_t>() > 0xFFFFFFFFull : v.get<std::int64_t>() < 0)
-            fail(path, "must be in [0, 4294967295]");
-        return v.get<std::uint32_t>();
-    }
-    glm::dvec3 vec3(const json& v, const std::string& path) const {
-        if (!v.is_array() || v.size() != 3) fail(path, "must be an array of 3 numbers");
-        return {number(v[0], at(path, 0)), number(v[1], at(path, 1)), number(v[2], at(path, 2))};
-    }
-    double numberOr(const json& obj, const std::string& path, const char* key, double def) const {
-        const json* v = find(obj, key);
-        return v ? number(*v, at(path, key)) : def;
-    }
-
-private:
-    const std::string& file_;
-    const LineMap& lines_;
-};
+namespace {
 
 // Model-space transform: either 16 numbers (column-major, as glm stores
 // them: element k is column k/4, row k%4) or {"translate", "rotate_deg",
@@ -327,15 +227,24 @@ glm::dmat4 readTransform(const SceneReader& r, const json& v, const std::string&
     return T * rotAxis(rot.z, 2) * rotAxis(rot.y, 1) * rotAxis(rot.x, 0) * S;
 }
 
-Camera readCamera(const SceneReader& r, const json& v) {
-    const std::string p = "camera";
+} // namespace
+
+Camera readCamera(const SceneReader& r, const json& v, const std::string& p, const Camera& base, bool requirePlacement,
+                  const std::vector<const char*>& extraKeys) {
     r.requireObject(v, p);
-    r.checkKeys(v, p, {"position", "target", "up", "projection", "fov_y_deg", "ortho_height", "near",
-                       "far", "width", "height", "tile_size"});
-    Camera c;
+    std::vector<const char*> known = {"position", "target", "up", "projection", "fov_y_deg", "ortho_height", "near",
+                                      "far", "width", "height", "tile_size"};
+    known.insert(known.end(), extraKeys.begin(), extraKeys.end());
+    r.checkKeys(v, p, known);
+    Camera c = base;
     auto sub = [&](const char* k) { return SceneReader::at(p, k); };
-    c.position = r.vec3(r.require(v, p, "position"), sub("position"));
-    c.target = r.vec3(r.require(v, p, "target"), sub("target"));
+    if (requirePlacement) {
+        c.position = r.vec3(r.require(v, p, "position"), sub("position"));
+        c.target = r.vec3(r.require(v, p, "target"), sub("target"));
+    } else {
+        if (const json* x = r.find(v, "position")) c.position = r.vec3(*x, sub("position"));
+        if (const json* x = r.find(v, "target")) c.target = r.vec3(*x, sub("target"));
+    }
     if (const json* x = r.find(v, "up")) c.up = r.vec3(*x, sub("up"));
     if (const json* x = r.find(v, "projection")) {
         try {
@@ -358,12 +267,17 @@ Camera readCamera(const SceneReader& r, const json& v) {
     if (const json* x = r.find(v, "width")) c.width = r.uint(*x, sub("width"));
     if (const json* x = r.find(v, "height")) c.height = r.uint(*x, sub("height"));
     if (const json* x = r.find(v, "tile_size")) c.tileSize = r.uint(*x, sub("tile_size"));
+    // validate() names the field as "camera.near": the same key under `p`.
     if (std::string e = c.validate(); !e.empty()) {
         const auto colon = e.find(':');
-        r.fail(e.substr(0, colon), e.substr(colon + 2));
+        const std::string field = e.substr(0, colon);
+        const std::string key = field.rfind("camera.", 0) == 0 ? field.substr(7) : field;
+        r.fail(SceneReader::at(p, key), e.substr(colon + 2));
     }
     return c;
 }
+
+namespace {
 
 PointLight readLight(const SceneReader& r, const json& v, std::size_t i) {
     const std::string p = SceneReader::at("lights", i);
@@ -459,15 +373,8 @@ Mesh readMesh(const SceneReader& r, const json& v, std::size_t i, const fs::path
 Scene parseSceneImpl(const std::string& text, const std::string& file, const CancelToken* cancel,
                      const Progress& progress) {
     json root;
-    LineState ls;
     LineMap lines;
-    if (const int line = jsonNestingTooDeep(text))
-        throw InputError(file, "", line, "arrays and objects nested more than " + std::to_string(kMaxJsonNesting) + " deep");
-    {
-        LineSax sax(root, ls, lines, file);
-        LineCountingIterator first(text.data(), &ls), last(text.data() + text.size(), &ls);
-        json::sax_parse(first, last, &sax);
-    }
+    parseWithLines(text, file, root, lines);
     if (progress) progress(0.1);
     SceneReader r(file, lines);
     if (!root.is_object()) r.fail("", "a scene file must hold a JSON object");
@@ -482,7 +389,7 @@ Scene parseSceneImpl(const std::string& text, const std::string& file, const Can
     Scene s;
     s.name = fs::path(file).stem().string();
     if (const json* x = r.find(root, "name")) s.name = r.string(*x, "name");
-    if (const json* x = r.find(root, "camera")) s.camera = readCamera(r, *x);
+    if (const json* x = r.find(root, "camera")) s.camera = readCamera(r, *x, "camera", Camera{}, true);
     if (const json* x = r.find(root, "lights")) {
         if (!x->is_array()) r.fail("lights", "must be an array");
         for (std::size_t i = 0; i < x->size(); ++i) s.lights.push_back(readLight(r, (*x)[i], i));
@@ -508,9 +415,10 @@ Scene parseSceneImpl(const std::string& text, const std::string& file, const Can
 }
 
 } // namespace
+} // namespace scene_json
 
 Scene parseScene(const std::string& text, const std::string& path) {
-    return parseSceneImpl(text, path, nullptr, {});
+    return scene_json::parseSceneImpl(text, path, nullptr, {});
 }
 
 Scene loadSceneFile(const std::string& path, const CancelToken* cancel, const Progress& progress) {
@@ -524,7 +432,7 @@ Scene loadSceneFile(const std::string& path, const CancelToken* cancel, const Pr
     if (in.bad()) throw InputError(path, "", 0, "read error");
     const std::string text = ss.str();
     if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw InputError(path, "", 0, "empty file");
-    return parseSceneImpl(text, path, cancel, progress);
+    return scene_json::parseSceneImpl(text, path, cancel, progress);
 }
 
 namespace {
