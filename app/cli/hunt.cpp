@@ -5,6 +5,7 @@
 #include "culling/core/errors.hpp"
 #include "culling/core/params.hpp"
 #include "culling/diagnostics/hunt.hpp"
+#include "culling/scene/gltf_io.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <algorithm>
@@ -53,12 +54,33 @@ void HuntCommand::add(CLI::App& app) {
         ->type_name("MS")
         ->check(CLI::Range(1.0, 3600000.0))
         ->needs(s);
-    cmd_->add_option("--seed", seed_, "Seed of the search: the same seed gives the same trials (default: 1)")->type_name("S");
-    cmd_->add_option("--trials", trials_, "Stop after N trials (default: 200 unless --budget is given)")->type_name("N");
-    cmd_->add_option("--budget", budget_, "Stop after this many seconds")->type_name("SECONDS")->check(CLI::Range(0.0, 1e7));
-    cmd_->add_option("--vary", vary_,
-                     "What trials vary, comma-separated: camera, projection, screen, lights, spots, scene (default: all)")
-        ->type_name("DIMS");
+    searchOptions_.push_back(
+        cmd_->add_option("--seed", seed_, "Seed of the search: the same seed gives the same trials (default: 1)")
+            ->type_name("S"));
+    searchOptions_.push_back(
+        cmd_->add_option("--trials", trials_, "Stop after N trials (default: 200 unless --budget is given)")
+            ->type_name("N"));
+    searchOptions_.push_back(cmd_->add_option("--budget", budget_, "Stop after this many seconds")
+                                 ->type_name("SECONDS")
+                                 ->check(CLI::Range(0.0, 1e7)));
+    searchOptions_.push_back(
+        cmd_->add_option("--vary", vary_,
+                         "What trials vary, comma-separated: camera, projection, screen, lights, spots, scene "
+                         "(default: all)")
+            ->type_name("DIMS"));
+    CLI::Option* path =
+        cmd_->add_option("--path", path_,
+                         "Judge every frame of a camera path instead of random trials: a glTF file's camera "
+                         "animation or a JSON list of cameras (docs/FORMATS.md); writes path.csv and path.svg")
+            ->type_name("FILE");
+    cmd_->add_option("--fps", fps_, "--path from glTF: frames per second of the animation's sampling (default 30)")
+        ->type_name("N")
+        ->check(CLI::Range(1e-3, 1000.0))
+        ->needs(path);
+    cmd_->add_option("--animation", animation_, "--path from glTF: the animation (name or index; default: the first "
+                                                "that moves the camera)")
+        ->type_name("NAME")
+        ->needs(path);
     cmd_->add_flag("--overflow", overflow_,
                    "A list over the custom layout's declared capacity is a failure too (default: counted apart)");
     std::string backendHelp = "Backend of the depth pre-pass (and of a built-in algorithm's culling): ";
@@ -87,8 +109,16 @@ int HuntCommand::run() {
     }
     if (const std::string why = lc::huntOutputProblem(outDir_); !why.empty()) return usage("--out: " + why);
 
+    if (!path_.empty())
+        for (const CLI::Option* o : searchOptions_)
+            if (o->count())
+                return usage(o->get_name() + ": has no effect with --path: every frame of the path is judged");
+
     std::optional<lc::Scene> base;
     if (source_.given()) base = source_.load();
+    else if (!path_.empty() && lc::isGltfPath(path_)) base = lc::loadSceneAny(path_);
+    else if (!path_.empty())
+        return usage("--path: give the scene (--scene or --builtin): a JSON camera path holds only cameras");
     if (base) {
         base->validate();
         if (paramOptions_.size() && std::any_of(paramOptions_.begin(), paramOptions_.end(), [](const auto& p) {
@@ -121,6 +151,8 @@ int HuntCommand::run() {
         if (!backend) backend = lc::makeBackend("cpu");
     }
 
+    if (!path_.empty()) return runPath(options, *base, *backend);
+
     options.progress = [](const lc::HuntCoverage& c, double seconds) {
         std::fprintf(stderr, "hunt: %llu trials in %.1f s, %.1f trials/s; covered: %s\n",
                      static_cast<unsigned long long>(c.trials), seconds, seconds > 0 ? double(c.trials) / seconds : 0.0,
@@ -143,6 +175,34 @@ int HuntCommand::run() {
               << verdict << "repro: " << (out / "repro.sh").string() << "  (" << command << ")\n"
               << "wrote " << outDir_ << "/scene.json, scene.glb, repro.sh, summary.json, verdict.txt, run/\n";
     std::cerr << "lightcull: the culling fails the hunt: " << f.verdict.property << " (exit 3)\n";
+    return 3;
+}
+
+int HuntCommand::runPath(lc::HuntOptions& options, const lc::Scene& scene, lc::CullBackend& backend) {
+    const lc::CameraPath path = lc::loadCameraPath(path_, scene.camera, fps_, animation_, lc::kCameraPathMaxFrames,
+                                                     lc::isGltfPath(path_) ? source_.gltf.camera : std::string());
+    std::cerr << "hunt: " << path.description << "\n";
+    if (scene.lights.empty())
+        std::cerr << "lightcull: warning: the scene has no lights: no frame can miss one\n";
+    options.progress = [n = path.frames.size()](const lc::HuntCoverage& c, double seconds) {
+        std::fprintf(stderr, "hunt: frame %llu of %zu in %.1f s, %.1f frames/s\n",
+                     static_cast<unsigned long long>(c.trials), n, seconds,
+                     seconds > 0 ? double(c.trials) / seconds : 0.0);
+    };
+    const lc::HuntPathResult result = lc::huntPath(options, scene, path, backend);
+    const std::string command = lc::writeHuntRepro(lc::huntResultOf(result), options, backend, outDir_, device_);
+    lc::writeHuntPathReport(result, path, outDir_);
+    const fs::path out(outDir_);
+    std::cout << "path: " << result.frames.size() << " frames, " << result.failingFrames << " failing; per frame: "
+              << (out / "path.csv").string() << ", plot: " << (out / "path.svg").string() << "\n";
+    if (!result.failure) {
+        std::cout << lc::huntNoMissText(lc::huntResultOf(result), options);
+        return 0;
+    }
+    const std::string verdict = lc::huntVerdictText(*result.failure, options);
+    std::cout << "COUNTEREXAMPLE at frame " << *result.worst << " (the worst):\n"
+              << verdict << "repro: " << (out / "repro.sh").string() << "  (" << command << ")\n";
+    std::cerr << "lightcull: the culling fails along the path: " << result.failure->verdict.property << " (exit 3)\n";
     return 3;
 }
 

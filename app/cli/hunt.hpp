@@ -4,6 +4,8 @@
 // the search itself is culling/diagnostics/hunt.hpp).
 #include "scene_source.hpp"
 
+#include "culling/diagnostics/hunt.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <map>
@@ -23,11 +25,15 @@ public:
     int run();
 
 private:
+    // --path: every frame of the camera path through `scene`.
+    int runPath(lc::HuntOptions& options, const lc::Scene& scene, lc::CullBackend& backend);
     CLI::App* cmd_ = nullptr;
     SceneSource source_;
-    std::string outDir_, backend_, device_, shader_, layout_, lists_, vary_ = "all";
+    std::string outDir_, backend_, device_, shader_, layout_, lists_, vary_ = "all", path_, animation_;
     unsigned long long seed_ = 1, trials_ = 0;
-    double budget_ = 0, timeoutMs_ = 10000;
+    double budget_ = 0, timeoutMs_ = 10000, fps_ = 30;
+    // The random search's own flags, refused with --path.
+    std::vector<CLI::Option*> searchOptions_;
     bool overflow_ = false, noValidation_ = false;
     std::map<std::string, std::string> paramValues_;
     std::vector<std::pair<std::string, CLI::Option*>> paramOptions_;

@@ -3,14 +3,15 @@
 // DELIBERATELY FLAWED: tiled_fixed.comp gathering each tile's lights in
 // shared memory first, as many Forward+ samples do (one atomic on a shared
 // counter per light, then one copy of the whole list to the buffer), into
-// an array of 8 while the buffer holds 256 per list. Lights past the 8th
-// are dropped and the count written is clamped to 8, so the list looks
+// an array of 64 while the buffer holds 256 per list. Lights past the 64th
+// are dropped and the count written is clamped to 64, so the list looks
 // complete and well formed: no overflow is reported, and the lights that did not
 // fit show up only as false negatives where pixels needed them. Seen when
 // the shared array is sized for the scenes of the day (or for the shared
 // memory budget of one GPU) and the declared list size is raised later.
-// The atrium's default 512 lights put up to 56 in one tile:
-//   lightcull run --builtin atrium --shader flawed_silent_cap.comp --out out/flawed
+// The atrium's default 512 lights put at most 56 in one tile, so it passes
+// there; 1024 lights fill tiles past 64:
+//   lightcull run --builtin atrium --lights 1024 --shader flawed_silent_cap.comp --out out/flawed
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "lightcull.glsl"
@@ -19,7 +20,7 @@ layout(local_size_x = 64) in;
 
 // THE FLAW: the tile's list in shared memory holds fewer lights than the
 // declared fixed:256.
-#define SHARED_LIST_SIZE 8u
+#define SHARED_LIST_SIZE 64u
 
 shared uint sMinBits, sMaxBits; // view depths as float bits: positive floats order as uints
 shared uint sCount;

@@ -21,6 +21,8 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 using namespace lc;
 using lc::gputest::GpuTest;
@@ -167,4 +169,48 @@ TEST(HuntCustomProperties, ADuplicateIndexIsAFailureAndRunSaysSoToo) {
     ASSERT_TRUE(WIFEXITED(status));
     EXPECT_EQ(WEXITSTATUS(status), 3) << lc_test::slurp(s.path / "repro.log");
     EXPECT_NE(lc_test::slurp(s.path / "repro.log").find("duplicate indices"), std::string::npos);
+}
+
+// --path on the flawed tile-edge shader: the atrium panned past at 650 x 370
+// (not whole tiles) misses lights in some frames; the CSV marks them, the
+// plot names the worst frame, and its shrunk repro shows the miss (exit 3).
+TEST(HuntCustomProperties, ACameraPathFindsTheFramesWhereTheFlawedShaderMisses) {
+    namespace fs = std::filesystem;
+    lc_test::ScratchDir s;
+    const Camera c = makeBuiltinScene("atrium").camera;
+    std::ostringstream o;
+    o << "{\"cameras\": [";
+    for (int k = 0; k < 8; ++k)
+        o << (k ? ", " : "") << "{\"position\": [" << c.position.x + 0.5 * k << ", " << c.position.y << ", "
+          << c.position.z << "], \"target\": [" << c.target.x + 0.5 * k << ", " << c.target.y << ", " << c.target.z
+          << "], \"width\": 650, \"height\": 370}";
+    o << "]}";
+    std::ofstream(s.path / "pan.json") << o.str();
+    const fs::path out = s.path / "path";
+    const lc_test::CliResult r = lc_test::runCli(
+        {"hunt", "--builtin", "atrium", "--shader", std::string(LC_SOURCE_DIR) +
+                                                        "/resources/culling-examples/flawed_tile_edges.comp",
+         "--backend", "cpu", "--path", (s.path / "pan.json").string(), "--out", out.string()},
+        s.path);
+    ASSERT_EQ(r.code, 3) << r.out << r.err;
+    std::ifstream csv(out / "path.csv");
+    std::string line;
+    std::getline(csv, line);
+    int rows = 0, failing = 0;
+    while (std::getline(csv, line)) {
+        ++rows;
+        failing += line.find(",1,false negatives") != std::string::npos;
+    }
+    EXPECT_EQ(rows, 8);
+    EXPECT_GT(failing, 0);
+    EXPECT_NE(r.out.find("8 frames, " + std::to_string(failing) + " failing"), std::string::npos) << r.out;
+    const std::string verdict = lc_test::slurp(out / "verdict.txt");
+    EXPECT_NE(verdict.find("at frame "), std::string::npos) << verdict;
+    EXPECT_NE(verdict.find("of 8 (8 cameras"), std::string::npos) << verdict;
+    EXPECT_NE(lc_test::slurp(out / "path.svg").find("worst frame"), std::string::npos);
+    const std::string cmd = "LIGHTCULL='" + std::string(LC_CLI_PATH) + "' sh '" + (out / "repro.sh").string() +
+                            "' >/dev/null 2>&1";
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 3);
 }

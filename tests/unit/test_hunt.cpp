@@ -11,7 +11,9 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
+#include <sstream>
 
 using namespace lc;
 using lc_test::CliResult;
@@ -44,6 +46,7 @@ TEST(Hunt, EveryBuiltinAlgorithmOnTheCpuBackendHasNoCounterexample) {
         EXPECT_GT(r.coverage.reversedZ, 0u) << name;
         EXPECT_GT(r.coverage.nonMultipleScreens, 0u) << name;
         EXPECT_GT(r.coverage.wideSpots, 0u) << name;
+        EXPECT_GT(r.coverage.crowds, 0u) << name;
         EXPECT_LT(r.coverage.emptyViews, r.coverage.trials / 2) << name << ": most trials must see geometry";
     }
 }
@@ -132,4 +135,62 @@ TEST(HuntCli, BadFlagsExitTwo) {
     EXPECT_TRUE(std::filesystem::exists(s.path / "keep.txt"));
     EXPECT_EQ(runCli({"hunt", "--shader", "x.comp", "--algorithm", "naive", "--out", (s.path / "h").string()}, s.path).code,
               2);
+}
+
+namespace {
+// A JSON camera path (docs/FORMATS.md, "Camera paths"): `n` cameras panning
+// along x past the atrium's own camera, each keeping the scene's other values.
+std::filesystem::path writePanPath(const std::filesystem::path& dir, int n, const std::string& extra = {}) {
+    const Camera c = makeBuiltinScene("atrium").camera;
+    std::ostringstream o;
+    o << "{\"cameras\": [";
+    for (int k = 0; k < n; ++k)
+        o << (k ? ", " : "") << "{\"position\": [" << c.position.x + 0.4 * k << ", " << c.position.y << ", "
+          << c.position.z << "], \"target\": [" << c.target.x + 0.4 * k << ", " << c.target.y << ", " << c.target.z
+          << "]" << extra << "}";
+    o << "]}";
+    const auto p = dir / "pan.json";
+    std::ofstream(p) << o.str();
+    return p;
+}
+} // namespace
+
+// --path: every frame judged; a CSV row per frame and the plot; a built-in
+// algorithm misses nothing along the path (exit 0).
+TEST(HuntCli, CameraPathJudgesEveryFrame) {
+    ScratchDir s;
+    const auto out = s.path / "path";
+    const CliResult r = runCli({"hunt", "--builtin", "atrium", "--backend", "cpu", "--algorithm", "minmax", "--path",
+                                writePanPath(s.path, 6).string(), "--out", out.string()},
+                               s.path);
+    ASSERT_EQ(r.code, 0) << r.err << r.out;
+    EXPECT_NE(r.out.find("no miss in 6 frames of"), std::string::npos) << r.out;
+    std::ifstream csv(out / "path.csv");
+    std::string line;
+    std::getline(csv, line);
+    EXPECT_EQ(line.rfind("frame,time,false_negatives,geometry_pixels,", 0), 0u) << line;
+    int rows = 0;
+    while (std::getline(csv, line)) {
+        EXPECT_EQ(line.rfind(std::to_string(rows) + ",", 0), 0u) << line;
+        EXPECT_NE(line.find(",0,"), std::string::npos) << line; // no false negatives
+        ++rows;
+    }
+    EXPECT_EQ(rows, 6);
+    const std::string svg = lc_test::slurp(out / "path.svg");
+    EXPECT_NE(svg.find("<polyline"), std::string::npos);
+    EXPECT_NE(svg.find("no frame misses a light"), std::string::npos);
+}
+
+TEST(HuntCli, CameraPathRefusesTheSearchFlagsAndNeedsAScene) {
+    ScratchDir s;
+    const std::string path = writePanPath(s.path, 2).string();
+    const CliResult trials = runCli(
+        {"hunt", "--builtin", "atrium", "--path", path, "--trials", "5", "--out", (s.path / "a").string()}, s.path);
+    EXPECT_EQ(trials.code, 2);
+    EXPECT_NE(trials.err.find("--trials: has no effect with --path"), std::string::npos) << trials.err;
+    const CliResult noScene = runCli({"hunt", "--path", path, "--out", (s.path / "b").string()}, s.path);
+    EXPECT_EQ(noScene.code, 2);
+    EXPECT_NE(noScene.err.find("give the scene"), std::string::npos) << noScene.err;
+    const CliResult fps = runCli({"hunt", "--fps", "10", "--out", (s.path / "c").string()}, s.path);
+    EXPECT_EQ(fps.code, 2) << "--fps needs --path";
 }

@@ -76,6 +76,43 @@ void addGround(Mesh& m, double half) {
     for (std::uint32_t t : {0u, 2u, 3u, 0u, 3u, 1u}) m.indices.push_back(base + t); // facing +y
 }
 
+// A UV sphere: `rings` bands of `segments` quads, poles as fans; outward
+// counter-clockwise faces (a closed solid).
+void addSphere(Mesh& m, glm::dvec3 c, double radius, std::uint32_t rings, std::uint32_t segments) {
+    const auto base = std::uint32_t(m.vertexCount());
+    auto push = [&](glm::dvec3 p) {
+        for (int k = 0; k < 3; ++k) m.positions.push_back(float(p[k]));
+    };
+    push(c + glm::dvec3(0, radius, 0)); // north pole: vertex 0
+    for (std::uint32_t i = 1; i < rings; ++i) {
+        const double th = kPi * double(i) / double(rings);
+        for (std::uint32_t j = 0; j < segments; ++j) {
+            const double ph = 2 * kPi * double(j) / double(segments);
+            push(c + radius * glm::dvec3(std::sin(th) * std::cos(ph), std::cos(th), -std::sin(th) * std::sin(ph)));
+        }
+    }
+    push(c - glm::dvec3(0, radius, 0)); // south pole
+    const std::uint32_t south = base + 1 + (rings - 1) * segments;
+    auto ring = [&](std::uint32_t i, std::uint32_t j) { return base + 1 + (i - 1) * segments + j % segments; };
+    for (std::uint32_t j = 0; j < segments; ++j) {
+        for (std::uint32_t t : {base, ring(1, j), ring(1, j + 1)}) m.indices.push_back(t);
+        for (std::uint32_t i = 1; i + 1 < rings; ++i)
+            for (std::uint32_t t : {ring(i, j), ring(i + 1, j), ring(i + 1, j + 1), ring(i, j), ring(i + 1, j + 1),
+                                    ring(i, j + 1)})
+                m.indices.push_back(t);
+        for (std::uint32_t t : {ring(rings - 1, j), south, ring(rings - 1, j + 1)}) m.indices.push_back(t);
+    }
+}
+
+// A sliver: a long triangle a thousandth as wide, both faces (a thin pole
+// or wire that covers a tile in a few pixels, or none at its centre).
+void addSliver(Mesh& m, glm::dvec3 a, glm::dvec3 b, glm::dvec3 across) {
+    const auto base = std::uint32_t(m.vertexCount());
+    for (const glm::dvec3& p : {a, b, a + across})
+        for (int k = 0; k < 3; ++k) m.positions.push_back(float(p[k]));
+    for (std::uint32_t t : {0u, 1u, 2u, 0u, 2u, 1u}) m.indices.push_back(base + t);
+}
+
 double diagonalOf(const Scene& s) {
     const auto [lo, hi] = s.bounds();
     return std::max(glm::length(hi - lo), 1e-3);
@@ -156,7 +193,7 @@ std::string HuntCoverage::text() const {
     o << orthographic << " orthographic, " << reversedZ << " reversed-Z (" << infiniteFar << " infinite far), "
       << glDepth << " GL depth, " << nonMultipleScreens << " non-multiple screens (" << tinyScreens << " tiny), "
       << cameraInsideBounds << " camera inside the scene, " << spotTrials << " with spots (" << wideSpots
-      << " wider than 90 degrees), " << lightsBehindCamera << " lights behind the camera, " << lightsCrossingNear
+      << " with a cone wider than 90 degrees), " << crowds << " crowds of 33+ lights, " << lightsBehindCamera << " lights behind the camera, " << lightsCrossingNear
       << " crossing the near plane, " << lightsLargerThanScene << " larger than the scene, " << generatedScenes
       << " generated scenes, " << emptyViews << " seeing no geometry";
     if (overCapacity) o << ", " << overCapacity << " over capacity (not failures)";
@@ -168,7 +205,7 @@ Scene makeHuntScene(std::uint64_t seed) {
     Scene s;
     s.name = "hunt-" + std::to_string(seed);
     Mesh m;
-    m.name = "ground-and-boxes";
+    m.name = "generated";
     addGround(m, 12.0);
     const std::uint32_t boxes = 1 + r.below(6);
     for (std::uint32_t i = 0; i < boxes; ++i) {
@@ -176,6 +213,22 @@ Scene makeHuntScene(std::uint64_t seed) {
         const glm::dvec3 half{r.logUniform(0.15, 2.0), r.logUniform(0.1, 2.5), r.logUniform(0.15, 2.0)};
         const double lift = r.chance(0.25) ? r.uniform(0.5, 3.0) : 0.0; // some float above the ground
         addBox(m, {c.x - half.x, lift, c.z - half.z}, {c.x + half.x, lift + 2 * half.y, c.z + half.z});
+    }
+    // Spheres and slivers from numbers of their own: the boxes and lights of
+    // a seed stay what they were.
+    Rng g{mix(seed, 0x5b4e7e)};
+    for (std::uint32_t i = g.below(3); i > 0; --i) {
+        const double radius = g.logUniform(0.2, 2.0);
+        addSphere(m, {g.uniform(-9, 9), radius + (g.chance(0.3) ? g.uniform(0.2, 2) : 0.0), g.uniform(-9, 9)}, radius,
+                  4 + g.below(8), 6 + g.below(12));
+    }
+    for (std::uint32_t i = g.below(4); i > 0; --i) {
+        const glm::dvec3 a{g.uniform(-10, 10), g.uniform(0, 4), g.uniform(-10, 10)};
+        const glm::dvec3 along = g.unitVector() * g.uniform(2, 12);
+        glm::dvec3 side = glm::cross(along, g.unitVector());
+        if (!(glm::length(side) > 1e-6 * glm::length(along))) side = glm::cross(along, glm::dvec3(0, 1, 0));
+        if (!(glm::length(side) > 1e-6 * glm::length(along))) side = glm::cross(along, glm::dvec3(1, 0, 0));
+        addSliver(m, a, a + along, glm::normalize(side) * (1e-3 * glm::length(along)));
     }
     s.meshes.push_back(std::move(m));
     s.camera.position = {0, 6, 16};
@@ -253,7 +306,22 @@ Scene makeHuntTrial(const Scene* base, std::uint64_t seed, std::uint64_t index, 
         c.width = side(400);
         c.height = side(300);
     }
-    if (vary & HuntLights) {
+    // One trial in ten is a crowd (its own numbers, so the other trials stay
+    // as they were): 33..300 lights around the camera's target, wide enough
+    // to reach the geometry there together, so that lists need more lights
+    // than a limit a shader keeps below its declared capacity.
+    Rng crowd{mix(seed ^ 0xc40dull, index + 1)};
+    if ((vary & HuntLights) && crowd.chance(0.1)) {
+        s.lights.clear();
+        const auto n = std::uint32_t(crowd.logUniform(33, 301));
+        const glm::dvec3 at = c.target;
+        for (std::uint32_t i = 0; i < n; ++i) {
+            PointLight l = randomLight(crowd, s, s.lights, vary & HuntSpots, diag);
+            l.position = at + crowd.unitVector() * crowd.uniform(0, 0.05 * diag);
+            l.explicitRadius = crowd.logUniform(0.2, 0.6) * diag;
+            s.lights.push_back(l);
+        }
+    } else if (vary & HuntLights) {
         s.lights.clear();
         const std::uint32_t n = r.chance(0.3) ? 1 + r.below(4) : 1 + r.below(32);
         for (std::uint32_t i = 0; i < n; ++i) s.lights.push_back(randomLight(r, s, s.lights, vary & HuntSpots, diag));
@@ -385,10 +453,64 @@ Scene shrinkHuntFailure(const Scene& failing, const HuntOptions& options, CullBa
         alone.lights = {best.lights[first.miss->light]};
         if (stillFails(alone)) best = alone;
     }
-    for (std::size_t i = best.lights.size(); i-- > 0 && best.lights.size() > 1;) {
+    // Then runs of lights (halves, quarters, ... single ones: a crowd of 300
+    // shrinks in few runs), bounded like the triangles below.
+    constexpr std::size_t kLightRuns = 200;
+    const std::size_t lightRunsBefore = count;
+    for (std::size_t chunk = std::max<std::size_t>(1, best.lights.size() / 2); chunk >= 1; chunk /= 2) {
+        for (std::size_t start = 0; start < best.lights.size() && best.lights.size() > 1 &&
+                                    count - lightRunsBefore < kLightRuns;) {
+            const std::size_t end = std::min(best.lights.size(), start + chunk);
+            if (end - start == best.lights.size()) break; // never all of them
+            Scene fewer = best;
+            fewer.lights.erase(fewer.lights.begin() + std::ptrdiff_t(start), fewer.lights.begin() + std::ptrdiff_t(end));
+            if (stillFails(fewer)) best = std::move(fewer);
+            else start = end;
+        }
+        if (count - lightRunsBefore >= kLightRuns) break;
+    }
+    // Triangles: whole meshes, then runs of triangles (halves, quarters, ...
+    // down to single ones), each dropped where the miss stays; bounded, so a
+    // level of 100k triangles shrinks as far as the runs allow.
+    for (std::size_t i = best.meshes.size(); i-- > 0 && best.meshes.size() > 1;) {
         Scene fewer = best;
-        fewer.lights.erase(fewer.lights.begin() + std::ptrdiff_t(i));
+        fewer.meshes.erase(fewer.meshes.begin() + std::ptrdiff_t(i));
         if (stillFails(fewer)) best = fewer;
+    }
+    constexpr std::size_t kTriangleRuns = 160;
+    const std::size_t runsBefore = count;
+    for (std::size_t mi = 0; mi < best.meshes.size(); ++mi) {
+        for (std::size_t chunk = best.meshes[mi].triangleCount() / 2; chunk >= 1; chunk /= 2) {
+            for (std::size_t start = 0; start < best.meshes[mi].triangleCount() && count - runsBefore < kTriangleRuns;) {
+                const std::size_t n = best.meshes[mi].triangleCount();
+                if (n <= 1) break;
+                const std::size_t end = std::min(n, start + chunk);
+                Scene fewer = best;
+                std::vector<std::uint32_t>& idx = fewer.meshes[mi].indices;
+                idx.erase(idx.begin() + std::ptrdiff_t(3 * start), idx.begin() + std::ptrdiff_t(3 * end));
+                if (stillFails(fewer)) best = std::move(fewer); // the next run starts where this one was
+                else start = end;
+            }
+            if (count - runsBefore >= kTriangleRuns) break;
+        }
+    }
+    // A mesh that lost triangles is written inline, without the vertices
+    // nothing uses any more (not as its source file's path).
+    for (std::size_t mi = 0; mi < best.meshes.size(); ++mi) {
+        Mesh& m = best.meshes[mi];
+        if (mi < failing.meshes.size() && m.indices.size() == failing.meshes[mi].indices.size()) continue;
+        std::vector<std::uint32_t> remap(m.vertexCount(), ~0u);
+        std::vector<float> positions;
+        for (std::uint32_t& v : m.indices) {
+            if (remap[v] == ~0u) {
+                remap[v] = std::uint32_t(positions.size() / 3);
+                positions.insert(positions.end(), m.positions.begin() + 3 * v, m.positions.begin() + 3 * v + 3);
+            }
+            v = remap[v];
+        }
+        m.positions = std::move(positions);
+        m.sourcePath.clear();
+        m.resolvedPath.clear();
     }
     // Screen: halve each side while it still fails.
     for (int axis = 0; axis < 2; ++axis)
@@ -510,6 +632,7 @@ HuntResult hunt(const HuntOptions& options, CullBackend& backend) {
             cov.lightsLargerThanScene += r > diag;
         }
         cov.spotTrials += spot;
+        cov.crowds += s.lights.size() > 32;
         cov.wideSpots += wide;
 
         const HuntVerdict v = judgeHuntTrial(s, options, backend);
@@ -556,8 +679,11 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
       << (options.shader ? "custom shader " + options.shader->path + ", layout " + toString(options.shader->layout) +
                                ", lists " + toString(options.shader->lists)
                          : std::string("built-in ") + toString(options.settings.algorithm))
-      << ") fails the hunt's property (" << v.property << ") at trial " << f.trial << " of seed " << options.seed
-      << " (varying " << f.varied << ").";
+      << ") fails the hunt's property (" << v.property << ")";
+    if (!f.pathFrame.empty())
+        o << " at " << f.pathFrame << ".";
+    else
+        o << " at trial " << f.trial << " of seed " << options.seed << " (varying " << f.varied << ").";
     if (v.miss) {
         const TileGrid grid = TileGrid::make(c.width, c.height, c.tileSize);
         const std::uint32_t tx = v.miss->tile % grid.tilesX, ty = v.miss->tile / grid.tilesX;
@@ -607,7 +733,7 @@ std::string shellQuote(const std::string& a) {
 
 // What a repro folder holds; a folder holding anything else is refused.
 const std::set<std::string> kReproFiles = {"scene.json", "scene.glb", "repro.sh", "verdict.txt", "summary.json",
-                                           "run"};
+                                           "run", "path.csv", "path.svg"};
 
 } // namespace
 
@@ -625,9 +751,10 @@ std::string huntOutputProblem(const std::string& dir) {
 }
 
 std::string huntNoMissText(const HuntResult& result, const HuntOptions& options) {
-    return std::string(result.cancelled ? "cancelled: " : "") + "no miss in " +
-           std::to_string(result.coverage.trials) + " trials of seed " + std::to_string(options.seed) +
-           " (coverage: " + result.coverage.text() + ")\n";
+    const std::string head = std::string(result.cancelled ? "cancelled: " : "") + "no miss in " +
+                             std::to_string(result.coverage.trials);
+    if (!result.path.empty()) return head + " frames of " + result.path + "\n";
+    return head + " trials of seed " + std::to_string(options.seed) + " (coverage: " + result.coverage.text() + ")\n";
 }
 
 std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options, CullBackend& backend,

@@ -17,6 +17,7 @@
 #include "culling/core/params.hpp"
 #include "culling/core/pipeline.hpp"
 #include "culling/custom/custom_cull.hpp"
+#include "culling/scene/camera_path.hpp"
 #include "culling/scene/scene.hpp"
 
 #include <cstdint>
@@ -46,6 +47,7 @@ struct HuntCoverage {
     std::uint64_t trials = 0, orthographic = 0, reversedZ = 0, glDepth = 0, infiniteFar = 0;
     std::uint64_t nonMultipleScreens = 0, tinyScreens = 0, cameraInsideBounds = 0, generatedScenes = 0;
     std::uint64_t spotTrials = 0, wideSpots = 0; // wideSpots: a spot cone wider than 90 degrees
+    std::uint64_t crowds = 0;                     // trials of 33..300 lights around one point
     std::uint64_t lightsBehindCamera = 0, lightsCrossingNear = 0, lightsLargerThanScene = 0;
     std::uint64_t emptyViews = 0;   // trials whose camera saw no geometry (nothing to judge)
     std::uint64_t overCapacity = 0; // trials whose lists overflowed a declared capacity (not failures by default)
@@ -101,6 +103,9 @@ struct HuntFailure {
     HuntVerdict verdict;         // of `shrunk`
     std::string varied;          // what the trial varied, in words
     std::size_t shrinkRuns = 0;  // pipeline runs the shrinking took
+    // Set for a camera path's frame: where it failed, in words ("frame 12
+    // (t = 0.4 s) of ..."), said instead of the trial and seed.
+    std::string pathFrame;
 };
 
 struct HuntResult {
@@ -109,12 +114,15 @@ struct HuntResult {
     std::optional<HuntFailure> failure;
     std::optional<std::uint64_t> firstOverCapacityTrial;
     bool cancelled = false;
+    std::string path; // a camera path's description when the trials were its frames (huntResultOf)
 };
 
 // The scene of trial `index` (pure: the same arguments give the same scene).
 Scene makeHuntTrial(const Scene* base, std::uint64_t seed, std::uint64_t index, unsigned vary);
-// A generated scene: a ground plane and 1..6 boxes at several depths, with a
-// framing camera at 160x96 and 8 lights (deterministic in `seed`).
+// A generated scene: a ground plane, 1..6 boxes at several depths (some
+// floating), 0..2 spheres and 0..3 sliver triangles (a thousandth as wide as
+// long), with a framing camera at 160x96 and 8 lights (deterministic in
+// `seed`).
 Scene makeHuntScene(std::uint64_t seed);
 
 // Runs the culling on `scene` (depth pre-pass on `backend`, ground truth,
@@ -157,5 +165,43 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
 
 // "no miss in N trials of seed S (coverage: ...)".
 std::string huntNoMissText(const HuntResult& result, const HuntOptions& options);
+
+// --- camera paths (`lightcull hunt --path`) ----------------------------------
+// Bugs users report as flicker show along a camera path: every frame of the
+// path is judged (the scene's meshes, lights and screen; the frame's camera)
+// instead of random trials; the worst frame is shrunk into the repro.
+
+struct HuntPathFrameResult {
+    double time = 0;
+    HuntVerdict verdict;
+};
+
+struct HuntPathResult {
+    std::vector<HuntPathFrameResult> frames; // one per path frame, in order (fewer when cancelled)
+    std::size_t failingFrames = 0;
+    // The frame with the most false negatives among the failing ones (the
+    // first such frame on a tie); its shrunk repro in `failure` (its `trial`
+    // is the frame index). Empty when no frame fails.
+    std::optional<std::size_t> worst;
+    std::optional<HuntFailure> failure;
+    double seconds = 0;
+    bool cancelled = false;
+    std::string description; // the path's
+};
+
+// Judges `scene` through every camera of `path` with the culling under test
+// (options.settings or options.shader; options.cancel is honoured between
+// frames; options.progress gets the frames done as trials). Seeds, budgets
+// and dimensions of `options` are not used.
+HuntPathResult huntPath(const HuntOptions& options, const Scene& scene, const CameraPath& path, CullBackend& backend);
+
+// A path result as the random hunt's (coverage.trials = frames judged), for
+// writeHuntRepro and huntVerdictText.
+HuntResult huntResultOf(const HuntPathResult& r);
+
+// path.csv (frame, time, false negatives, ..., property) and path.svg (the
+// false negatives per frame, failing frames marked, the worst one named) into
+// `dir`, which writeHuntRepro prepared.
+void writeHuntPathReport(const HuntPathResult& r, const CameraPath& path, const std::string& dir);
 
 } // namespace lc
