@@ -403,11 +403,14 @@ void MainWindow::buildActions() {
             [this] { setCustomShader({}); });
     connect(make(tr("&Hunt for a miss..."), "actionHunt", QKeySequence(tr("Ctrl+H"))), &QAction::triggered, this,
             &MainWindow::huntFromDialog);
-    // A hunt's repro opens with its miss selected once its run has the truth.
+    // A hunt's repro opens with its miss selected once its run has the truth
+    // (selectFirstMissOfRun).
     connect(this, &MainWindow::runFinished, this, [this] {
         const auto run = doc_->runOutput();
-        if (!pendingHuntMiss_ || !run || !run->truthComputed || doc_->runIsStale()) return;
-        pendingHuntMiss_ = false;
+        if (!firstMissOfRun_ || doc_->runGeneration() < firstMissOfRun_ || !run || !run->truthComputed ||
+            doc_->runIsStale())
+            return;
+        firstMissOfRun_ = 0;
         misses_->step(+1);
     });
     QAction* live = make(tr("Live"), "actionLive");

@@ -132,6 +132,10 @@ public:
     // miss is found, opens the repro scene with the miss selected and
     // Explain showing it. False when nothing was found, on error or cancel.
     bool hunt(const HuntRequest& r);
+    // Once run `generation` (or a newer one) shows with its ground truth,
+    // selects its first miss as Culling > Next miss does and shows Explain
+    // (a hunt's repro; the studio's --first-miss).
+    void selectFirstMissOfRun(quint64 generation) { firstMissOfRun_ = generation; }
     void setCullingCameraFromInspector();
 
     // Export diagnostics (File menu): summary.json, tiles.csv, heatmap.png,
@@ -221,7 +225,7 @@ private:
     std::shared_ptr<const lc::CustomShaderOptions> customShader_;
     QFileSystemWatcher* shaderWatcher_ = nullptr;
     quint64 pendingRuns_ = 0;
-    bool pendingHuntMiss_ = false; // select the first miss of the next run with ground truth
+    quint64 firstMissOfRun_ = 0; // selectFirstMissOfRun's generation; 0: none
 };
 
 } // namespace lcui

@@ -7,6 +7,7 @@
 #include "document.hpp"
 #include "hunt_dialog.hpp"
 #include "miss_navigator.hpp"
+#include "cull_worker.hpp"
 #include "progress_task.hpp"
 
 #include "culling/core/errors.hpp"
@@ -149,8 +150,8 @@ bool MainWindow::hunt(const HuntRequest& r) {
         log(tr("the repro scene %1 was not opened").arg(scene));
         return true;
     }
-    pendingHuntMiss_ = true;
     if (!runOnOpen && !isLive()) runCulling();
+    selectFirstMissOfRun(service_->lastGeneration());
     statusBar()->showMessage(tr("Hunt: %1 at trial %2; the repro is open").arg(
                                  QString::fromStdString(f.verdict.property)).arg(f.trial),
                              15000);

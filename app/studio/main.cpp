@@ -15,8 +15,10 @@
 #include "document.hpp"
 #include "live_drag_probe.hpp"
 #include "main_window.hpp"
+#include "miss_navigator.hpp"
 #include "shading_probe.hpp"
 
+#include "culling/core/backend.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <QAction>
@@ -26,6 +28,7 @@
 #include <QTimer>
 #include <QVTKOpenGLNativeWidget.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -106,8 +109,16 @@ int main(int argc, char** argv) {
                                  "Cull with this custom culling shader (as Culling > Custom shader...; "
                                  "docs/CUSTOM_CULLING.md).",
                                  "FILE");
-    parser.addOptions(
-        {sceneOpt, builtinOpt, lightsOpt, seedOpt, shaderOpt, runOpt, shotOpt, quitOpt, dragOpt, shadingOpt, imageModeOpt});
+    QCommandLineOption paramOpt("param",
+                                "Set a culling parameter as the toolbar does, e.g. algorithm=minmax (repeatable; "
+                                "tile, width and height belong to the scene).",
+                                "NAME=VALUE");
+    QCommandLineOption firstMissOpt("first-miss",
+                                    "Once the run has its ground truth, select its first miss and explain it "
+                                    "(as Culling > Next miss; a hunt's studio.sh uses it).");
+    QCommandLineOption backendOpt("backend", "Culling backend (as the toolbar's; remembered): cpu or vulkan.", "NAME");
+    parser.addOptions({sceneOpt, builtinOpt, lightsOpt, seedOpt, shaderOpt, paramOpt, backendOpt, firstMissOpt, runOpt,
+                       shotOpt, quitOpt, dragOpt, shadingOpt, imageModeOpt});
     parser.process(app);
     if (parser.isSet(sceneOpt) && parser.isSet(builtinOpt)) {
         std::fprintf(stderr, "lightcull-studio: --scene and --builtin are exclusive\n");
@@ -170,6 +181,29 @@ int main(int argc, char** argv) {
     if (parser.isSet(imageModeOpt))
         window.action(QString("actionImage_%1").arg(lcui::CameraView::toString(imageMode)))->trigger();
 
+    if (parser.isSet(backendOpt)) {
+        const auto names = lc::availableBackends();
+        const std::string b = parser.value(backendOpt).toStdString();
+        if (std::find(names.begin(), names.end(), b) == names.end()) {
+            std::fprintf(stderr, "lightcull-studio: --backend: '%s' is not one of this build's backends\n", b.c_str());
+            return 2;
+        }
+        window.setBackend(parser.value(backendOpt));
+    }
+    // Culling parameters before the scene opens, so that its run uses them.
+    for (const QString& nv : parser.values(paramOpt)) {
+        const int eq = nv.indexOf('=');
+        const QString name = nv.left(eq), value = nv.mid(eq + 1);
+        if (eq <= 0 || name == "tile" || name == "width" || name == "height" ||
+            !window.setParamFromUi(name, value)) {
+            std::fprintf(stderr,
+                         "lightcull-studio: --param: '%s' is not NAME=VALUE of a culling parameter (tile, width "
+                         "and height belong to the scene)\n",
+                         qPrintable(nv));
+            return 2;
+        }
+    }
+
     // Opening a scene runs culling once (so does the default start).
     bool ok = true;
     if (parser.isSet(sceneOpt)) ok = window.openSceneFile(parser.value(sceneOpt));
@@ -190,8 +224,15 @@ int main(int argc, char** argv) {
     }
     if (ok && parser.isSet(shaderOpt) && !window.setCustomShader(parser.value(shaderOpt)) && scripted) return 1;
     const quint64 generation = window.cullService()->lastGeneration();
-    const bool wantRun = generation > 0 || parser.isSet(runOpt);
+    const bool wantRun = generation > 0 || parser.isSet(runOpt) || parser.isSet(firstMissOpt);
     if (wantRun && generation == 0) window.runCulling();
+    if (ok && parser.isSet(firstMissOpt)) {
+        window.selectFirstMissOfRun(window.cullService()->lastGeneration());
+        if (scripted) // the miss selected, for a script's log
+            QObject::connect(window.missNavigator(), &lcui::MissNavigator::message, &app, [](const QString& m) {
+                std::fprintf(stdout, "%s\n", qPrintable(m));
+            });
+    }
 
     if (dragSeconds > 0) {
         auto* probe = new LiveDragProbe(&window, dragSeconds);

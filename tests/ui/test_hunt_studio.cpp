@@ -27,6 +27,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QPlainTextEdit>
+#include <QProcess>
 #include <QPushButton>
 #include <QRadioButton>
 #include <QSpinBox>
@@ -172,6 +173,36 @@ private slots:
         const std::string verdict = readAll(folder + "/verdict.txt");
         QVERIFY2(verdict.find("Light " + std::to_string(missed.front().light) + " ") != std::string::npos,
                  verdict.c_str());
+    }
+
+    // The CLI's repro folder opens in the studio the same way: studio.sh
+    // starts it on scene.json with the hunted culling, and its first miss is
+    // the one the hunt's verdict names.
+    void cliReproOpensInTheStudioAtItsMiss() {
+        const QString folder = tmp_.path() + "/cli";
+        QProcess hunt;
+        hunt.start(LC_CLI_PATH, {"hunt", "--shader", kExamples + "flawed_tile_edges.comp", "--backend", "cpu",
+                                 "--trials", "60", "--seed", "1", "--out", folder});
+        QVERIFY(hunt.waitForFinished(lctest::kRunTimeoutMs));
+        QCOMPARE(hunt.exitCode(), 3);
+        QProcess studio;
+        QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+        env.insert("LIGHTCULL_STUDIO", LC_STUDIO_PATH);
+        studio.setProcessEnvironment(env);
+        studio.start("sh", {folder + "/studio.sh", "--screenshot", tmp_.path() + "/cli.png", "--quit"});
+        QVERIFY(studio.waitForFinished(lctest::kRunTimeoutMs));
+        const QString out = QString::fromUtf8(studio.readAllStandardOutput());
+        QVERIFY2(studio.exitCode() == 0, qPrintable(out + studio.readAllStandardError()));
+        const std::string verdict = readAll(folder + "/verdict.txt");
+        const auto light = verdict.find("Light ");
+        QVERIFY(light != std::string::npos);
+        const std::string lightId = verdict.substr(light + 6, verdict.find(' ', light + 6) - light - 6);
+        const auto tile = verdict.find("list of tile ");
+        const std::string tileId = verdict.substr(tile + 13, verdict.find(' ', tile + 13) - tile - 13);
+        QVERIFY2(out.contains(QString::fromStdString("miss 1 of ")) &&
+                     out.contains(QString::fromStdString(": light " + lightId + " ")) &&
+                     out.contains(QString::fromStdString("in tile " + tileId + " ")),
+                 qPrintable(out + "\nverdict: " + QString::fromStdString(verdict)));
     }
 
     void builtinWithoutAMissLeavesTheSceneAlone() {

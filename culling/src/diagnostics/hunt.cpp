@@ -732,8 +732,8 @@ std::string shellQuote(const std::string& a) {
 }
 
 // What a repro folder holds; a folder holding anything else is refused.
-const std::set<std::string> kReproFiles = {"scene.json", "scene.glb", "repro.sh", "verdict.txt", "summary.json",
-                                           "run", "path.csv", "path.svg"};
+const std::set<std::string> kReproFiles = {"scene.json", "scene.glb", "repro.sh", "studio.sh", "verdict.txt",
+                                           "summary.json", "run", "path.csv", "path.svg"};
 
 } // namespace
 
@@ -770,18 +770,25 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
     // The `lightcull run` that shows the miss, run from the folder.
     const HuntFailure& f = *result.failure;
     std::string command = "lightcull run --scene scene.json --backend " + backend.name();
+    // The same culling in the studio, its first miss selected and explained.
+    std::string studio = "lightcull-studio --scene scene.json --backend " + backend.name();
     if (!device.empty()) command += " --device " + shellQuote(device);
     if (options.shader) {
-        command += " --shader " + shellQuote(fs::absolute(options.shader->path).string()) + " --layout " +
-                   toString(options.shader->layout) + " --lists " + toString(options.shader->lists);
+        const std::string shader = shellQuote(fs::absolute(options.shader->path).string());
+        command += " --shader " + shader + " --layout " + toString(options.shader->layout) + " --lists " +
+                   toString(options.shader->lists);
         if (!options.shader->validation) command += " --no-validation";
+        studio += " --shader " + shader;
     } else {
         Camera scratch;
         for (const ParamSpec& p : cullParams())
-            if (p.name != "tile" && p.name != "width" && p.name != "height")
+            if (p.name != "tile" && p.name != "width" && p.name != "height") {
                 command += " --" + p.name + " " + shellQuote(getParam(options.settings, scratch, p.name));
+                studio += " --param " + shellQuote(p.name + "=" + getParam(options.settings, scratch, p.name));
+            }
     }
     command += " --no-image-error --out run";
+    studio += " --first-miss";
 
     Scene scene = f.shrunk;
     saveSceneFile(scene, (out / "scene.json").string());
@@ -800,8 +807,17 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
                         "# Set LIGHTCULL to the binary when lightcull is not on PATH.\n"
                         "cd \"$(dirname \"$0\")\" || exit 1\n# " +
                         command + "\nexec \"${LIGHTCULL:-lightcull}\"" + command.substr(9) + "\n");
-    fs::permissions(out / "repro.sh", fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
-                    fs::perm_options::add);
+    writeFileSynced((out / "studio.sh").string(),
+                    "#!/bin/sh\n# The repro in LightCull Studio: the scene opens, culls and selects the miss "
+                    "(Explain shows why).\n# Set LIGHTCULL_STUDIO to the binary when lightcull-studio is not on "
+                    "PATH.\n" +
+                        std::string(options.shader ? "# The shader's layout and lists come from its first line.\n"
+                                                   : "") +
+                        "cd \"$(dirname \"$0\")\" || exit 1\nexec \"${LIGHTCULL_STUDIO:-lightcull-studio}\"" +
+                        studio.substr(16) + " \"$@\"\n");
+    for (const char* script : {"repro.sh", "studio.sh"})
+        fs::permissions(out / script, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
+                        fs::perm_options::add);
     return command;
 }
 
