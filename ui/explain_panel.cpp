@@ -49,7 +49,7 @@ std::optional<lc::Explanation> explainSelection(const Document& doc) {
     if (r.listsPerTile <= 1) sub = -1;
     std::uint32_t list = 0;
     if (sub >= 0 || r.listsPerTile <= 1) {
-        list = lc::listOf(r, std::uint32_t(tile), sub);
+        list = r.listOf(std::uint32_t(tile), sub);
     } else {
         // A tile of several lists without a cell: the list picked in the
         // tile inspector, else the first that holds or needs the light, else

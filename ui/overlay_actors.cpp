@@ -152,7 +152,7 @@ std::optional<std::vector<int>> InspectorOverlays::tileListLights(const Document
     const auto run = doc.runOutput();
     const lc::CullResult& r = run->result;
     if (std::uint32_t(tile) >= r.grid.tileCount()) return std::nullopt;
-    auto [first, count] = lc::tileLists(r, std::uint32_t(tile));
+    auto [first, count] = r.tileLists(std::uint32_t(tile));
     // As the tile inspector's rows (lc::tileLightRows): a cell of halfz or
     // clustered has a list of its own.
     const int cell = doc.selectedCell();
@@ -399,11 +399,10 @@ void InspectorOverlays::update(const Document& doc) {
         g.worldFromView = w;
         const bool perCell = r.algorithm == lc::Algorithm::HalfZ || r.algorithm == lc::Algorithm::Clustered;
         if (r.algorithm != lc::Algorithm::All) {
-            const std::uint32_t per = std::max(r.listsPerTile, 1u);
             std::uint32_t lastTile = ~0u;
             std::vector<lc::DepthCell> tileCellsCache;
             for (std::uint32_t l : reverseLists_) {
-                const std::uint32_t t = l / per;
+                const std::uint32_t t = r.tileOfList(l);
                 if (perCell) {
                     if (t != lastTile) tileCellsCache = lc::tileCells(r, proj, t);
                     for (const auto& c : tileCellsCache)

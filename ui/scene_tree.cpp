@@ -99,13 +99,12 @@ void SceneTree::rebuildLights() {
         if (const auto run = doc_->runOutput(); run && run->result.algorithm != lc::Algorithm::All) {
             // One pass over the lists: each light's distinct tiles.
             const auto& res = run->result;
-            const std::uint32_t per = std::max(res.listsPerTile, 1u);
             std::vector<std::uint32_t> lastTile(lights.size(), UINT32_MAX);
             for (std::uint32_t l = 0; l < res.listCount.size(); ++l)
                 for (std::uint32_t k = 0; k < res.listCount[l]; ++k) {
                     const std::uint32_t light = res.lightIndices[res.listOffset[l] + k];
-                    if (light < lights.size() && lastTile[light] != l / per) {
-                        lastTile[light] = l / per;
+                    if (light < lights.size() && lastTile[light] != res.tileOfList(l)) {
+                        lastTile[light] = res.tileOfList(l);
                         ++tiles[light];
                     }
                 }

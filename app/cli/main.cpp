@@ -677,7 +677,7 @@ int main(int argc, char** argv) {
                 return fail(2, "--tile: " + explainTile + " is outside the " + std::to_string(r.grid.tilesX) + "x" +
                                    std::to_string(r.grid.tilesY) + " tiles");
             const lc::Projection proj(scene.camera);
-            const std::uint32_t list = lc::listOf(r, r.grid.tileIndex(tx, ty), explainCell);
+            const std::uint32_t list = r.listOf(r.grid.tileIndex(tx, ty), explainCell);
             const lc::Explanation e = lc::explainLight(run, proj, list, light);
             std::cout << "scene " << scene.name << ", " << r.grid.width << "x" << r.grid.height << ", backend "
                       << r.backend << ", tile " << tx << "," << ty << "\n"

@@ -47,9 +47,11 @@ public:
         lastDepthMs_ = inner_.lastDepthMs();
         return d;
     }
-    CullResult cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid, const ViewLights& lights,
-                    const CullSettings& settings) override {
-        CullResult r = inner_.cull(depth, proj, grid, lights, settings);
+
+protected:
+    CullResult cullFrame(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
+                         const ViewLights& lights, const CullSettings& settings) override {
+        CullResult r = inner_.cull(depth, proj, frame.grid, lights, settings);
         std::vector<std::uint32_t> kept;
         for (std::size_t l = 0; l < r.listCount.size(); ++l) {
             const std::uint32_t begin = r.listOffset[l], n = r.listCount[l];

@@ -274,7 +274,7 @@ private slots:
         std::uint32_t tile = 0;
         for (std::uint32_t t = 0; t < run->result.grid.tileCount(); ++t)
             if (run->result.listCount[t] > run->result.listCount[tile]) tile = t;
-        const std::uint32_t first = lc::tileLists(run->result, tile).first;
+        const std::uint32_t first = run->result.tileLists(tile).first;
         QVERIFY(run->result.listCount[first] >= 2); // the picture shows listed lights and dimmed others
         doc.setSelectedTile(int(tile));
         doc.setSelectedLights({int(run->result.lightIndices[run->result.listOffset[first]])});

@@ -149,7 +149,7 @@ TEST(Explain, GroundTruthCountsMatchTheTileInspector) {
         const auto needing = pixelsNeedingLights(run.depth, proj, run.lights, run.result.grid, t);
         neededChecked += needing.size();
         for (const auto& [light, count] : needing) {
-            const Explanation e = explainLight(run, proj, listOf(run.result, t, -1), light);
+            const Explanation e = explainLight(run, proj, run.result.listOf(t), light);
             EXPECT_EQ(e.pixelsNeeding, count) << "tile " << t << " light " << light;
             EXPECT_TRUE(e.listed);
             EXPECT_NE(e.verdict.find("needed"), std::string::npos) << e.verdict;

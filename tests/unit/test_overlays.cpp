@@ -134,7 +134,7 @@ TEST(Overlays, OverlayVolumesReproduceEveryList) {
             const Projection proj(run.scene.camera);
             std::size_t nonEmpty = 0;
             for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t) {
-                const auto [first, count] = tileLists(r, t);
+                const auto [first, count] = r.tileLists(t);
                 std::vector<std::vector<std::uint32_t>> expect(count);
                 const auto frustum = tileFrustum(r, proj, L, t);
                 const auto cells = tileCells(r, proj, t);
@@ -344,7 +344,7 @@ TEST(Overlays, TileHeatAddsUpToTheRunsMetrics) {
                 ++empty;
                 continue;
             }
-            const auto [first, count] = tileLists(r, t);
+            const auto [first, count] = r.tileLists(t);
             std::uint32_t longest = 0;
             for (std::uint32_t l = first; l < first + count; ++l) longest = std::max(longest, r.listCount[l]);
             EXPECT_EQ(len[t], longest);
@@ -423,7 +423,7 @@ TEST(Overlays, TileLightRowsAddUpToTheGroundTruth) {
         std::size_t falsePositives = 0;
         for (std::uint32_t t = 0; t < r.grid.tileCount(); t += 3) {
             const auto rows = tileLightRows(run.out, proj, t);
-            const auto [first, count] = tileLists(r, t);
+            const auto [first, count] = r.tileLists(t);
             std::vector<std::uint64_t> exact(count, 0), listed(count, 0);
             for (const TileLightRow& row : rows) {
                 ASSERT_GE(row.list, first);

@@ -79,7 +79,7 @@ void checkRun(const Scene& scene, Algorithm algo, SpotTest test, Tally& tally) {
         for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t) {
             const auto p = spotTestPrimitive(run, proj, l, int(t));
             ASSERT_TRUE(p.has_value());
-            const auto [first, count] = tileLists(r, t);
+            const auto [first, count] = r.tileLists(t);
             std::vector<char> covered(count, 0);
             for (const SpotTestChunk& c : p->chunks) {
                 ++tally.chunks;

@@ -5,7 +5,9 @@
 #include "culling/truth/shade.hpp"
 #include "vk/vulkan_backend.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 namespace lc {
 
@@ -37,6 +39,68 @@ ViewLights makeViewLights(const Scene& scene) {
         }
     }
     return out;
+}
+
+std::uint32_t listsPerTileOf(Algorithm algorithm, std::uint32_t cells, bool cellLists) {
+    if (algorithm == Algorithm::HalfZ) return 2;
+    if (algorithm == Algorithm::Clustered || (algorithm == Algorithm::TwoPointFiveD && cellLists)) return cells;
+    return 1;
+}
+
+double cameraFarDepth(const Projection& proj, const ViewLights& lights, SpotTest spotTest) {
+    if (std::isfinite(proj.farPlane())) return proj.farPlane();
+    double lightFar = 0.0;
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+        const BoundingSphere b = lights.cullSphere(l, spotTest);
+        lightFar = std::max(lightFar, -b.center.z + b.radius);
+    }
+    return std::max(lightFar, proj.nearPlane());
+}
+
+CullFrame makeCullFrame(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
+                        const ViewLights& lights, const CullSettings& settings) {
+    if (std::string e = settings.validate(); !e.empty()) throw SettingsError("settings", e);
+    if (depth.width != proj.width() || depth.height != proj.height() ||
+        depth.depth.size() != std::size_t(depth.width) * depth.height)
+        throw Error("depth image is " + std::to_string(depth.width) + "x" + std::to_string(depth.height) +
+                    ", the camera's resolution " + std::to_string(proj.width()) + "x" +
+                    std::to_string(proj.height()));
+    if (grid.width != proj.width() || grid.height != proj.height())
+        throw Error("tile grid does not match the camera's resolution");
+    if (lights.centers.size() != lights.radii.size()) throw Error("view lights: centres and radii differ in count");
+
+    CullFrame f;
+    f.grid = grid;
+    f.listsPerTile = listsPerTileOf(settings.algorithm, settings.cells);
+    f.listTotal = settings.algorithm == Algorithm::All ? 1 : std::uint64_t(grid.tileCount()) * f.listsPerTile;
+    f.cullSpheres.resize(lights.size());
+    double lightFar = 0.0;
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+        f.cullSpheres[l] = lights.cullSphere(l, settings.spotTest);
+        lightFar = std::max(lightFar, -f.cullSpheres[l].center.z + f.cullSpheres[l].radius);
+    }
+    const bool farInfinite = !std::isfinite(proj.farPlane());
+    f.cameraNear = f.clusterNear = proj.nearPlane();
+    f.cameraFar = farInfinite ? std::max(lightFar, f.cameraNear) : proj.farPlane();
+    f.clusterFar = farInfinite ? std::max(lightFar, 2.0 * f.cameraNear) : proj.farPlane();
+    return f;
+}
+
+CullResult CullBackend::cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
+                             const ViewLights& lights, const CullSettings& settings) {
+    const CullFrame frame = makeCullFrame(depth, proj, grid, lights, settings);
+    CullResult r = cullFrame(frame, depth, proj, lights, settings);
+    r.algorithm = settings.algorithm;
+    r.settings = settings;
+    r.grid = frame.grid;
+    r.listsPerTile = frame.listsPerTile;
+    r.cameraNear = frame.cameraNear;
+    r.cameraFar = frame.cameraFar;
+    if (settings.algorithm == Algorithm::Clustered) {
+        r.clusterNear = frame.clusterNear;
+        r.clusterFar = frame.clusterFar;
+    }
+    return r;
 }
 
 std::vector<float> CullBackend::shade(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled) {

@@ -1,6 +1,7 @@
 // CullResult helpers: size in bytes, the per-pixel list lookup, consistency check.
 #include "culling/core/cull_result.hpp"
 
+#include "culling/core/backend.hpp"
 #include "culling/core/depth.hpp"
 #include "culling/core/errors.hpp"
 
@@ -55,12 +56,36 @@ std::uint32_t CullResult::listOfPixel(std::uint32_t px, std::uint32_t py, double
     }
 }
 
+std::pair<std::uint32_t, std::uint32_t> CullResult::tileLists(std::uint32_t tile) const {
+    if (algorithm == Algorithm::All) return {0u, listCount.empty() ? 0u : 1u};
+    const std::uint32_t per = std::max(listsPerTile, 1u);
+    return {tile * per, per};
+}
+
+std::uint32_t CullResult::listOf(std::uint32_t tile, int sub) const {
+    if (algorithm == Algorithm::All) return 0;
+    if (tile >= grid.tileCount())
+        throw SettingsError("tile", std::to_string(tile) + " is outside the " + std::to_string(grid.tilesX) + "x" +
+                                        std::to_string(grid.tilesY) + " tiles");
+    const std::uint32_t per = std::max(listsPerTile, 1u);
+    if (sub < 0) {
+        if (per > 1)
+            throw SettingsError("cell", std::string(toString(algorithm)) + " has " + std::to_string(per) +
+                                            " lists per tile: give the cell (0.." + std::to_string(per - 1) + ")");
+        return tile;
+    }
+    if (std::uint32_t(sub) >= per)
+        throw SettingsError("cell", std::to_string(sub) + " is outside 0.." + std::to_string(per - 1));
+    return tile * per + std::uint32_t(sub);
+}
+
+std::uint32_t CullResult::tileOfList(std::uint32_t list) const {
+    return algorithm == Algorithm::All ? 0 : list / std::max(listsPerTile, 1u);
+}
+
 std::string CullResult::validate(std::size_t lightCount) const {
     const std::uint64_t tiles = grid.tileCount();
-    std::uint32_t expectPerTile = 1;
-    if (algorithm == Algorithm::HalfZ) expectPerTile = 2;
-    if (algorithm == Algorithm::Clustered) expectPerTile = settings.cells;
-    if (algorithm == Algorithm::TwoPointFiveD && cellLists) expectPerTile = settings.cells;
+    const std::uint32_t expectPerTile = listsPerTileOf(algorithm, settings.cells, cellLists);
     if (algorithm != Algorithm::All && listsPerTile != expectPerTile)
         return "listsPerTile is " + std::to_string(listsPerTile) + ", expected " +
                std::to_string(expectPerTile);

@@ -113,18 +113,10 @@ template <class Fn> void parallelRows(std::uint32_t rows, Fn fn) {
 
 } // namespace
 
-// The culling pass itself (the CPU backend's cull() without the timing).
-static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
-                   const ViewLights& lights, const CullSettings& settings) {
-    if (std::string e = settings.validate(); !e.empty()) throw SettingsError("settings", e);
-    if (depth.width != proj.width() || depth.height != proj.height() ||
-        depth.depth.size() != std::size_t(depth.width) * depth.height)
-        throw Error("depth image is " + std::to_string(depth.width) + "x" +
-                    std::to_string(depth.height) + ", the camera's resolution " +
-                    std::to_string(proj.width()) + "x" + std::to_string(proj.height()));
-    if (grid.width != proj.width() || grid.height != proj.height())
-        throw Error("tile grid does not match the camera's resolution");
-
+// The culling pass itself (the CPU backend's cullFrame() without the timing).
+static CullResult cullCpu(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
+                          const ViewLights& lights, const CullSettings& settings) {
+    const TileGrid& grid = frame.grid;
     const Algorithm algo = settings.algorithm;
     const std::uint32_t tiles = grid.tileCount();
     const std::uint32_t cells = settings.cells;
@@ -134,7 +126,7 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
     res.algorithm = algo;
     res.settings = settings;
     res.grid = grid;
-    res.listsPerTile = algo == Algorithm::HalfZ ? 2 : algo == Algorithm::Clustered ? cells : 1;
+    res.listsPerTile = frame.listsPerTile;
     res.tileDepthMin.assign(tiles, kInf);
     res.tileDepthMax.assign(tiles, -kInf);
 
@@ -155,27 +147,24 @@ static CullResult cullCpu(const DepthImage& depth, const Projection& proj, const
     }
     auto tileEmpty = [&](std::uint32_t t) { return !(res.tileDepthMin[t] <= res.tileDepthMax[t]); };
 
-    // Camera depth range for naive (and clustered): an infinite far plane is
-    // replaced by the farthest depth any light reaches.
-    // Each light's culling sphere: its range sphere, or for a spot light the
-    // sphere its spot test uses; spot tests may refine it per chunk below.
+    // Each light's culling sphere (the frame's: its range sphere, or for a
+    // spot light the sphere its spot test uses); spot tests may refine it per
+    // chunk below. The camera's and the clusters' depth ranges are the
+    // frame's too (an infinite far plane replaced by the farthest depth any
+    // light reaches).
     std::vector<glm::dvec3> sphereCenter(n);
     std::vector<double> sphereRadius(n);
     for (std::size_t l = 0; l < n; ++l) {
-        const BoundingSphere b = lights.cullSphere(l, settings.spotTest);
-        sphereCenter[l] = b.center;
-        sphereRadius[l] = b.radius;
+        sphereCenter[l] = frame.cullSpheres[l].center;
+        sphereRadius[l] = frame.cullSpheres[l].radius;
     }
     const bool coneRefines =
         settings.spotTest == SpotTest::ConeSphere || settings.spotTest == SpotTest::ConePlanes;
-    double lightFar = 0.0;
-    for (std::size_t l = 0; l < n; ++l) lightFar = std::max(lightFar, -sphereCenter[l].z + sphereRadius[l]);
-    const double camNear = proj.nearPlane();
-    const double naiveFar = std::isfinite(proj.farPlane()) ? proj.farPlane() : std::max(lightFar, camNear);
+    const double camNear = frame.cameraNear;
+    const double naiveFar = frame.cameraFar;
     if (algo == Algorithm::Clustered) {
-        res.clusterNear = camNear;
-        res.clusterFar = std::isfinite(proj.farPlane()) ? proj.farPlane()
-                                                        : std::max(lightFar, 2.0 * camNear);
+        res.clusterNear = frame.clusterNear;
+        res.clusterFar = frame.clusterFar;
     }
     if (algo == Algorithm::HalfZ) {
         res.halfzSplit.assign(tiles, kInf);
@@ -378,10 +367,11 @@ public:
         return img;
     }
 
-    CullResult cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
-                    const ViewLights& lights, const CullSettings& settings) override {
+protected:
+    CullResult cullFrame(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
+                         const ViewLights& lights, const CullSettings& settings) override {
         const auto t0 = std::chrono::steady_clock::now();
-        CullResult r = cullCpu(depth, proj, grid, lights, settings);
+        CullResult r = cullCpu(frame, depth, proj, lights, settings);
         r.timings.cullMs =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         r.timings.depthMs = lastDepthMs_;

@@ -47,23 +47,6 @@ std::array<glm::dvec3, 4> chunkFace(const std::array<glm::dvec3, 8>& c, int plan
             c[std::size_t(kFace[p][3])]};
 }
 
-std::uint32_t listOf(const CullResult& r, std::uint32_t tile, int sub) {
-    if (r.algorithm == Algorithm::All) return 0;
-    if (tile >= r.grid.tileCount())
-        throw SettingsError("tile", std::to_string(tile) + " is outside the " + std::to_string(r.grid.tilesX) + "x" +
-                                        std::to_string(r.grid.tilesY) + " tiles");
-    const std::uint32_t per = std::max(r.listsPerTile, 1u);
-    if (sub < 0) {
-        if (per > 1)
-            throw SettingsError("cell", std::string(toString(r.algorithm)) + " has " + std::to_string(per) +
-                                            " lists per tile: give the cell (0.." + std::to_string(per - 1) + ")");
-        return tile;
-    }
-    if (std::uint32_t(sub) >= per)
-        throw SettingsError("cell", std::to_string(sub) + " is outside 0.." + std::to_string(per - 1));
-    return tile * per + std::uint32_t(sub);
-}
-
 Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint32_t list, std::uint32_t light) {
     const CullResult& r = run.result;
     const ViewLights& lights = run.lights;
@@ -77,7 +60,7 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
     e.light = light;
     e.algorithm = run.custom ? "custom (" + std::string(toString(r.algorithm)) + " lists)" : toString(r.algorithm);
     const std::uint32_t per = std::max(r.listsPerTile, 1u);
-    e.tile = r.algorithm == Algorithm::All ? 0 : list / per;
+    e.tile = r.tileOfList(list);
     e.sub = per > 1 ? int(list % per) : -1;
     const auto first = r.lightIndices.begin() + r.listOffset[list];
     e.listed = std::binary_search(first, first + r.listCount[list], light);
@@ -109,15 +92,10 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
             switch (r.algorithm) {
             case Algorithm::ZBin: // the tile's mask: naive's screen-space volume
             case Algorithm::Naive: {
-                // As the reference: the camera's near and far, an infinite far
-                // replaced by the farthest depth any light reaches.
-                double lightFar = 0;
-                for (std::size_t l = 0; l < lights.size(); ++l) {
-                    const BoundingSphere b = lights.cullSphere(l, s.spotTest);
-                    lightFar = std::max(lightFar, -b.center.z + b.radius);
-                }
-                lo = proj.nearPlane();
-                hi = std::isfinite(proj.farPlane()) ? proj.farPlane() : std::max(lightFar, lo);
+                // The range the pass culled over: the camera's near and far,
+                // an infinite far replaced by the farthest reach of a light.
+                lo = r.cameraNear;
+                hi = r.cameraFar;
                 break;
             }
             case Algorithm::Fptl:

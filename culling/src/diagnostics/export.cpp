@@ -270,7 +270,7 @@ std::string tilesCsv(const RunOutput& run) {
             // The one list of `all` belongs to no tile: tile -1,-1, no depth range.
             row = "-1,-1,0,,,0,";
         } else {
-            const std::size_t t = l / per;
+            const std::size_t t = r.tileOfList(std::uint32_t(l));
             const std::uint32_t sub = std::uint32_t(l % per);
             const std::uint32_t tx = r.grid.tilesX ? std::uint32_t(t % r.grid.tilesX) : 0;
             const std::uint32_t ty = r.grid.tilesX ? std::uint32_t(t / r.grid.tilesX) : 0;

@@ -130,7 +130,7 @@ void writeHuntPathReport(const HuntPathResult& r, const CameraPath& path, const 
     auto x = [&](std::size_t i) { return L + (W - L - R) * (n == 1 ? 0.5 : double(i) / double(n - 1)); };
     auto y = [&](std::uint64_t fn) { return H - B - (H - T - B) * double(fn) / double(maxFn); };
     std::ostringstream svg;
-    char buf[256];
+    char buf[1024];
     svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" viewBox=\"0 0 " << W
         << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
         << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";

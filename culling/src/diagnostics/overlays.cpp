@@ -37,28 +37,12 @@ bool tileHasGeometry(const CullResult& r, std::uint32_t t) {
 
 glm::dmat4 worldFromView(const Camera& camera) { return glm::inverse(camera.viewFromWorld()); }
 
-double cameraFarDepth(const Projection& proj, const ViewLights& lights, SpotTest spotTest) {
-    if (std::isfinite(proj.farPlane())) return proj.farPlane();
-    double lightFar = 0.0;
-    for (std::size_t l = 0; l < lights.size(); ++l) {
-        const BoundingSphere b = lights.cullSphere(l, spotTest);
-        lightFar = std::max(lightFar, -b.center.z + b.radius);
-    }
-    return std::max(lightFar, proj.nearPlane());
-}
-
-std::pair<std::uint32_t, std::uint32_t> tileLists(const CullResult& r, std::uint32_t tile) {
-    if (r.algorithm == Algorithm::All) return {0u, r.listCount.empty() ? 0u : 1u};
-    const std::uint32_t per = std::max(r.listsPerTile, 1u);
-    return {tile * per, per};
-}
-
 std::optional<FrustumChunk> tileFrustum(const CullResult& r, const Projection& proj,
                                         const ViewLights& lights, std::uint32_t tile) {
     if (tile >= r.grid.tileCount()) return std::nullopt;
     const auto rect = r.grid.tileRect(tile % r.grid.tilesX, tile / r.grid.tilesX);
     if (r.algorithm == Algorithm::Naive || r.algorithm == Algorithm::All || r.algorithm == Algorithm::ZBin)
-        return makeFrustumChunk(proj, rect, proj.nearPlane(), cameraFarDepth(proj, lights, r.settings.spotTest));
+        return makeFrustumChunk(proj, rect, r.cameraNear, r.cameraFar); // the range its masks were culled over
     if (!tileHasGeometry(r, tile)) return std::nullopt;
     return makeFrustumChunk(proj, rect, r.tileDepthMin[tile], r.tileDepthMax[tile]);
 }
@@ -199,9 +183,8 @@ std::vector<std::uint32_t> tilesHoldingLight(const CullResult& r, std::uint32_t 
             for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t) out.push_back(t);
         return out;
     }
-    const std::uint32_t per = std::max(r.listsPerTile, 1u);
     for (std::uint32_t l : lists)
-        if (out.empty() || out.back() != l / per) out.push_back(l / per);
+        if (out.empty() || out.back() != r.tileOfList(l)) out.push_back(r.tileOfList(l));
     return out;
 }
 
@@ -264,7 +247,7 @@ std::vector<TileLightRow> tileLightRows(const RunOutput& run, const Projection& 
     const CullResult& r = run.result;
     const DepthImage& depth = run.depth;
     if (tile >= r.grid.tileCount() || depth.width != r.grid.width || depth.height != r.grid.height) return rows;
-    auto [first, count] = tileLists(r, tile);
+    auto [first, count] = r.tileLists(tile);
     const bool perCellLists = r.algorithm == Algorithm::HalfZ || r.algorithm == Algorithm::Clustered;
     if (cell >= 0 && perCellLists) {
         if (std::uint32_t(cell) >= count) return rows;
@@ -348,7 +331,7 @@ std::vector<double> tileHeat(const RunOutput& run, HeatMode mode) {
     std::vector<double> heat(tiles, kNaN);
     for (std::uint32_t t = 0; t < tiles; ++t) {
         if (!tileHasGeometry(r, t)) continue;
-        const auto [first, count] = tileLists(r, t);
+        const auto [first, count] = r.tileLists(t);
         if (mode == HeatMode::ListLength) {
             std::uint32_t m = 0;
             for (std::uint32_t l = first; l < first + count && l < r.listCount.size(); ++l)
@@ -574,7 +557,7 @@ void writeOverlaysVtm(const Scene& scene, const RunOutput& run, const std::strin
     // the edges to the eye.
     PolyPiece camera;
     {
-        const double farD = cameraFarDepth(proj, run.lights, run.result.settings.spotTest);
+        const double farD = run.result.cameraFar; // an infinite far: the reach naive's masks used
         const glm::dvec2 px[4] = {{0, 0}, {double(cam.width), 0}, {double(cam.width), double(cam.height)},
                                   {0, double(cam.height)}};
         for (double d : {proj.nearPlane(), farD})
@@ -606,7 +589,7 @@ void writeOverlaysVtm(const Scene& scene, const RunOutput& run, const std::strin
             const auto chunk = tileFrustum(r, proj, run.lights, t);
             if (!chunk) continue;
             addChunk(tileFr, *chunk, w);
-            const auto [first, count] = tileLists(r, t);
+            const auto [first, count] = r.tileLists(t);
             std::uint64_t entries = 0;
             std::uint32_t longest = 0;
             for (std::uint32_t l = first; l < first + count && l < r.listCount.size(); ++l) {

@@ -291,13 +291,15 @@ public:
     std::uint64_t deviceAllocations() const override { return ctx_.memoryStats().allocations; }
 
     DepthImage renderDepth(const Scene& scene, const Projection& proj) override;
-    CullResult cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
-                    const ViewLights& lights, const CullSettings& settings) override;
     // The Lambert shading pass (vk/shade_pass.cpp), created on first use.
     std::vector<float> shade(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled) override {
         if (!shadePass_) shadePass_ = std::make_unique<ShadePass>(ctx_);
         return shadePass_->run(in, lights, culled, lastShadeMs_);
     }
+
+protected:
+    CullResult cullFrame(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
+                         const ViewLights& lights, const CullSettings& settings) override;
 
 private:
     bool useGpuTimestamps() const { return !ctx_.isCpuDevice() && ctx_.timestampsSupported(); }
@@ -712,17 +714,9 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
     return out;
 }
 
-CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
-                               const ViewLights& lights, const CullSettings& settings) {
-    if (std::string e = settings.validate(); !e.empty()) throw SettingsError("settings", e);
-    if (depth.width != proj.width() || depth.height != proj.height() ||
-        depth.depth.size() != std::size_t(depth.width) * depth.height)
-        throw Error("depth image is " + std::to_string(depth.width) + "x" + std::to_string(depth.height) +
-                    ", the camera's resolution " + std::to_string(proj.width()) + "x" +
-                    std::to_string(proj.height()));
-    if (grid.width != proj.width() || grid.height != proj.height())
-        throw Error("tile grid does not match the camera's resolution");
-    if (lights.centers.size() != lights.size()) throw Error("view lights: centres and radii differ in count");
+CullResult VulkanBackend::cullFrame(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
+                                    const ViewLights& lights, const CullSettings& settings) {
+    const TileGrid& grid = frame.grid;
     // Spot lights: the sphere tests need only the chosen sphere (below); the
     // cone tests also upload each spot's cone (binding 9).
     const bool coneTests = settings.spotTest == SpotTest::ConeSphere || settings.spotTest == SpotTest::ConePlanes;
@@ -741,8 +735,8 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     res.algorithm = algo;
     res.settings = settings;
     res.grid = grid;
-    res.listsPerTile = algo == Algorithm::HalfZ ? 2 : algo == Algorithm::Clustered ? cells : 1;
-    const std::uint64_t listTotal64 = algo == Algorithm::All ? 1 : std::uint64_t(tiles) * res.listsPerTile;
+    res.listsPerTile = frame.listsPerTile;
+    const std::uint64_t listTotal64 = frame.listTotal;
     if (listTotal64 >= std::numeric_limits<std::uint32_t>::max())
         throw SettingsError("tile", "more than 2^32 light lists");
     const std::uint32_t listTotal = std::uint32_t(listTotal64);
@@ -770,20 +764,19 @@ CullResult VulkanBackend::cull(const DepthImage& depth, const Projection& proj, 
     if (binTotal64 * 4 > lim.maxStorageBufferRange)
         throw SettingsError("lights", "too many lights for the light bins of this device");
 
-    // The depth ranges of naive and clustered, exactly as the CPU reference.
-    double lightFar = 0.0, lightNear = kInf;
-    std::vector<BoundingSphere> cullSpheres(n); // range spheres, or each spot test's sphere
+    // The depth ranges of naive and clustered: the frame's, as the CPU reference's.
+    const std::vector<BoundingSphere>& cullSpheres = frame.cullSpheres; // range spheres, or each spot test's
+    double lightFar = 0.0, lightNear = kInf; // the light bins' depth span
     for (std::size_t l = 0; l < n; ++l) {
-        cullSpheres[l] = lights.cullSphere(l, settings.spotTest);
         lightFar = std::max(lightFar, -cullSpheres[l].center.z + cullSpheres[l].radius);
         lightNear = std::min(lightNear, -cullSpheres[l].center.z - cullSpheres[l].radius);
     }
-    const double camNear = proj.nearPlane();
     const bool farInfinite = !std::isfinite(proj.farPlane());
-    const double naiveFar = farInfinite ? std::max(lightFar, camNear) : proj.farPlane();
+    const double camNear = frame.cameraNear;
+    const double naiveFar = frame.cameraFar;
     if (algo == Algorithm::Clustered) {
-        res.clusterNear = camNear;
-        res.clusterFar = farInfinite ? std::max(lightFar, 2.0 * camNear) : proj.farPlane();
+        res.clusterNear = frame.clusterNear;
+        res.clusterFar = frame.clusterFar;
     }
     // zbin: the lights go up sorted by depth (as the CPU reference sorts them).
     std::vector<std::uint32_t> upOrder(n);

@@ -48,6 +48,42 @@ struct ViewLights {
 // Validates every light (LightError naming it) and transforms it to view space.
 ViewLights makeViewLights(const Scene& scene);
 
+// One frame's culling as every pass and every diagnostic sees it, worked out
+// once (makeCullFrame) and carried by the result: the grid, how many lists a
+// tile has, and the depth ranges that do not come from the depth image.
+struct CullFrame {
+    TileGrid grid;
+    std::uint32_t listsPerTile = 1; // listsPerTileOf(settings)
+    std::uint64_t listTotal = 1;    // `all`: 1; else tiles x listsPerTile
+    // The camera's view-depth range of naive and zbin's screen-space test
+    // (and the camera frustum overlay): near..far, an infinite far replaced by
+    // the farthest depth a light's culling sphere reaches (at least near).
+    double cameraNear = 0, cameraFar = 0;
+    // clustered: the slices' range; near..far, an infinite far replaced by
+    // that reach (at least twice near).
+    double clusterNear = 0, clusterFar = 0;
+    // Per light: the sphere the passes test (ViewLights::cullSphere under
+    // settings.spotTest).
+    std::vector<BoundingSphere> cullSpheres;
+};
+
+// The far view depth of the camera range that `naive` and zbin's masks (and
+// the camera frustum overlay) use: the far plane, or, when it is infinite
+// (reversed-Z), the farthest depth any light's culling sphere
+// (ViewLights::cullSphere under `spotTest`) reaches, never below the near
+// plane. CullFrame::cameraFar; a result carries it as cameraFar.
+double cameraFarDepth(const Projection& proj, const ViewLights& lights, SpotTest spotTest = SpotTest::ApexSphere);
+
+// Lists per tile of an algorithm: halfz 2, clustered `cells` slices, 2.5d
+// with one list per cell (custom culling's cells:N) `cells`, else 1.
+std::uint32_t listsPerTileOf(Algorithm algorithm, std::uint32_t cells, bool cellLists = false);
+
+// Checks a cull's inputs (settings, the depth image and the grid against the
+// camera's resolution, the lights' arrays) and builds its frame. Throws
+// SettingsError for settings, Error for inputs that do not fit together.
+CullFrame makeCullFrame(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
+                        const ViewLights& lights, const CullSettings& settings);
+
 class CullBackend {
 public:
     virtual ~CullBackend() = default;
@@ -56,8 +92,11 @@ public:
     // Depth pre-pass of the scene through the camera. Sets lastDepthMs().
     virtual DepthImage renderDepth(const Scene& scene, const Projection& proj) = 0;
     // Culling pass over a depth image (any backend's). Fills result timings.
-    virtual CullResult cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
-                            const ViewLights& lights, const CullSettings& settings) = 0;
+    // Validates and builds the frame once (makeCullFrame), then the backend's
+    // cullFrame culls it; the result carries the frame's grid, lists per tile
+    // and depth ranges, which diagnostics read instead of working them out.
+    CullResult cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid, const ViewLights& lights,
+                    const CullSettings& settings);
     double lastDepthMs() const { return lastDepthMs_; }
     // CPU wall-clock milliseconds of the last renderDepth() around its
     // submission (its readback included); where the depth time is a wall
@@ -91,6 +130,10 @@ public:
     double lastShadeMs() const { return lastShadeMs_; }
 
 protected:
+    // The culling pass of a frame makeCullFrame built from these inputs.
+    virtual CullResult cullFrame(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
+                                 const ViewLights& lights, const CullSettings& settings) = 0;
+
     double lastDepthMs_ = -1;
     double lastDepthWallMs_ = -1; // -1: the same as lastDepthMs_
     std::size_t lastDepthTriangles_ = 0, lastDepthTrianglesDrawn_ = 0;

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace lc {
@@ -41,6 +42,9 @@ struct CullResult {
     std::vector<std::uint32_t> cellMask;
     // Clustered depth range: slices are `settings.slicing` over [clusterNear, clusterFar].
     double clusterNear = 0, clusterFar = 0;
+    // The camera's depth range naive and zbin's masks were culled over (the
+    // infinite-far rule applied: CullFrame::cameraFar).
+    double cameraNear = 0, cameraFar = 0;
     // zbin (docs/ALGORITHMS.md): the list of a tile is its screen-space light
     // mask (the lights whose culling sphere passes the tile's side planes,
     // with the camera's near and far: naive's test), stored as light indices.
@@ -80,6 +84,15 @@ struct CullResult {
     std::size_t depthTriangles = 0, depthTrianglesDrawn = 0;
 
     std::uint32_t listCountTotal() const { return std::uint32_t(listCount.size()); }
+    // The lists of a tile as [first, first + count); for `all`, the one list
+    // every tile shares.
+    std::pair<std::uint32_t, std::uint32_t> tileLists(std::uint32_t tile) const;
+    // The list of `tile` that `sub` names (halfz 0/1, clustered slice, cell),
+    // or the tile's one list when sub < 0. Throws SettingsError for an index
+    // out of range or a missing sub where a tile has several lists.
+    std::uint32_t listOf(std::uint32_t tile, int sub = -1) const;
+    // The tile a list belongs to (0 for `all`).
+    std::uint32_t tileOfList(std::uint32_t list) const;
     std::uint64_t entries() const { return lightIndices.size(); }
     // Bytes of the light lists in the form a renderer uploads and reads while
     // shading: 4 per index and 8 per list (offset + count). halfz packs a

@@ -57,10 +57,6 @@ struct Explanation {
     std::string text(const std::string& lightName = {}) const;
 };
 
-// The list of tile `tile` that `sub` names (halfz 0/1, clustered slice, cell),
-// or the tile's one list when sub < 0. Throws SettingsError for an index out of range.
-std::uint32_t listOf(const CullResult& r, std::uint32_t tile, int sub);
-
 // Explains light `light` in list `list` of run.result. Needs run.depth and
 // run.lights; throws SettingsError for an index out of range.
 Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint32_t list, std::uint32_t light);

@@ -22,20 +22,8 @@ namespace lc {
 // World space from the culling camera's view space.
 glm::dmat4 worldFromView(const Camera& camera);
 
-// The far view depth of the camera range that `naive` (and `all`, and the
-// camera frustum overlay) use: the far plane, or, when it is infinite
-// (reversed-Z), the farthest depth any light's culling sphere
-// (ViewLights::cullSphere under `spotTest`) reaches, exactly as the passes
-// replace it (never below the near plane).
-double cameraFarDepth(const Projection& proj, const ViewLights& lights,
-                      SpotTest spotTest = SpotTest::ApexSphere);
-
-// The lists of a tile as [first, first + count) in CullResult numbering; for
-// `all`, the one list every tile shares.
-std::pair<std::uint32_t, std::uint32_t> tileLists(const CullResult& r, std::uint32_t tile);
-
 // The frustum a tile's lists were culled against, truncated in depth:
-// naive, zbin (its mask) and all: the camera's near..cameraFarDepth; minmax, halfz, 2.5d and
+// naive, zbin (its mask) and all: the result's cameraNear..cameraFar; minmax, halfz, 2.5d and
 // clustered: the tile's geometry min..max view depth. nullopt for a tile
 // without geometry (except naive/all, whose range does not depend on it).
 std::optional<FrustumChunk> tileFrustum(const CullResult& r, const Projection& proj,
