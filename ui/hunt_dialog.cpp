@@ -89,6 +89,10 @@ HuntDialog::HuntDialog(const HuntRequest& r, const QString& underTest, bool scen
     sl->addWidget(openScene_);
     sl->addWidget(generated_);
     form->addRow(tr("Scenes"), scenes);
+    // A new scene per trial only where the scenes are generated.
+    auto syncSceneDim = [this] { vary_[5]->setEnabled(!openScene_->isChecked()); };
+    connect(openScene_, &QRadioButton::toggled, this, syncSceneDim);
+    syncSceneDim();
 
     overflow_ = new QCheckBox(tr("a list over the layout's capacity is a failure too"));
     overflow_->setObjectName("huntOverflow");
@@ -145,7 +149,7 @@ void HuntDialog::accept() {
     QString why;
     if (r.trials == 0 && r.seconds <= 0)
         why = tr("Give a trial count or a time budget: a hunt without either never ends unless it finds a miss.");
-    else if (r.vary == 0)
+    else if (r.vary == 0 || (r.openScene && r.vary == lc::HuntSceneDim))
         why = tr("Vary at least one thing: every trial would be the same.");
     else if (r.folder.isEmpty())
         why = tr("Choose a repro folder.");

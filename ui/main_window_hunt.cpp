@@ -50,6 +50,9 @@ void MainWindow::huntFromDialog() {
     initial.seed = st.value("hunt/seed", 1).toULongLong();
     initial.trials = st.value("hunt/trials", 200).toULongLong();
     initial.seconds = st.value("hunt/seconds", 60.0).toDouble();
+    initial.vary = st.value("hunt/vary", lc::HuntAll).toUInt() & lc::HuntAll;
+    if (initial.vary == 0) initial.vary = lc::HuntAll;
+    initial.openScene = st.value("hunt/openScene", true).toBool();
     HuntDialog dlg(initial, underTestText(doc_->settings(), customShader_.get(), backendCombo_->currentText()),
                    !doc_->scene().meshes.empty(), customShader_ != nullptr, this);
     if (dlg.exec() != QDialog::Accepted) return;
@@ -58,6 +61,8 @@ void MainWindow::huntFromDialog() {
     st.setValue("hunt/seed", qulonglong(r.seed));
     st.setValue("hunt/trials", qulonglong(r.trials));
     st.setValue("hunt/seconds", r.seconds);
+    st.setValue("hunt/vary", r.vary);
+    st.setValue("hunt/openScene", r.openScene);
     hunt(r);
 }
 
@@ -76,7 +81,10 @@ bool MainWindow::hunt(const HuntRequest& r) {
     o.vary = r.vary;
     o.overflowIsFailure = r.overflow;
     const lc::Scene base = doc_->scene();
-    if (r.openScene && !base.meshes.empty()) o.baseScene = &base;
+    if (r.openScene && !base.meshes.empty()) {
+        o.baseScene = &base;
+        o.vary &= ~unsigned(lc::HuntSceneDim); // the open scene's meshes stay
+    }
     const std::string backendName = backendCombo_->currentText().toStdString();
     const std::string device = deviceEdit_->text().toStdString();
 

@@ -118,6 +118,12 @@ bool StatusProgress::eventFilter(QObject* watched, QEvent* event) {
         break;
     default: return false;
     }
+    // Input from the window system reaches a QWindow first and is then sent
+    // on to the widget under the cursor or with the focus, where this filter
+    // sees it again: judge it there (dropping it at the window dropped the
+    // clicks on Cancel itself; tests that sent them to the button directly
+    // did not see that).
+    if (!watched->isWidgetType()) return false;
     // The Cancel buttons (and their rows) take input; nothing else does.
     for (auto* w = qobject_cast<QWidget*>(watched); w; w = w->parentWidget())
         if (w == this) return false;

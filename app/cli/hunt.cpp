@@ -9,6 +9,8 @@
 #include "culling/scene/scene_io.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -18,6 +20,22 @@ namespace fs = std::filesystem;
 namespace lcli {
 
 namespace {
+
+// A whole number in [lo, hi] written in digits (CLI11 would wrap "-1" and
+// clamp 2^64 into an unsigned option).
+CLI::Validator wholeNumber(unsigned long long lo, unsigned long long hi) {
+    return CLI::Validator(
+        [lo, hi](std::string& v) -> std::string {
+            const std::string range = "a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+            if (v.empty() || v.size() > 20 || v.find_first_not_of("0123456789") != std::string::npos)
+                return "must be " + range + ", got '" + v + "'";
+            errno = 0;
+            const unsigned long long x = std::strtoull(v.c_str(), nullptr, 10);
+            if (errno == ERANGE || x < lo || x > hi) return "must be " + range + ", got '" + v + "'";
+            return {};
+        },
+        "N");
+}
 
 int usage(const std::string& message) {
     std::cerr << "lightcull: error: " << message << "\n";
@@ -56,13 +74,23 @@ void HuntCommand::add(CLI::App& app) {
         ->needs(s);
     searchOptions_.push_back(
         cmd_->add_option("--seed", seed_, "Seed of the search: the same seed gives the same trials (default: 1)")
-            ->type_name("S"));
+            ->type_name("S")
+            ->check(wholeNumber(0, 18446744073709551615ull)));
     searchOptions_.push_back(
         cmd_->add_option("--trials", trials_, "Stop after N trials (default: 200 unless --budget is given)")
-            ->type_name("N"));
+            ->type_name("N")
+            ->check(wholeNumber(1, 1000000000000ull)));
     searchOptions_.push_back(cmd_->add_option("--budget", budget_, "Stop after this many seconds")
                                  ->type_name("SECONDS")
-                                 ->check(CLI::Range(0.0, 1e7)));
+                                 ->check(CLI::Validator(
+                                     [](std::string& v) -> std::string {
+                                         char* end = nullptr;
+                                         const double x = std::strtod(v.c_str(), &end);
+                                         if (v.empty() || *end || !(x > 0 && x <= 1e7))
+                                             return "must be a number of seconds in (0, 10000000], got '" + v + "'";
+                                         return {};
+                                     },
+                                     "SECONDS")));
     searchOptions_.push_back(
         cmd_->add_option("--vary", vary_,
                          "What trials vary, comma-separated: camera, projection, screen, lights, spots, scene "
@@ -96,6 +124,7 @@ int HuntCommand::run() {
     lc::HuntOptions options;
     options.seed = seed_;
     options.vary = lc::parseHuntDims(vary_);
+    if (options.vary == 0) return usage("--vary: name at least one of camera, projection, screen, lights, spots, scene");
     options.maxSeconds = budget_;
     options.maxTrials = trials_ ? trials_ : budget_ > 0 ? 0 : 200;
     options.overflowIsFailure = overflow_;
@@ -119,7 +148,11 @@ int HuntCommand::run() {
     else if (!path_.empty() && lc::isGltfPath(path_)) base = lc::loadSceneAny(path_);
     else if (!path_.empty())
         return usage("--path: give the scene (--scene or --builtin): a JSON camera path holds only cameras");
+    if (base && path_.empty() && options.vary == lc::HuntSceneDim)
+        return usage("--vary scene: with --scene or --builtin every trial keeps that scene's meshes; vary something "
+                     "else, or leave out the scene to hunt in generated ones");
     if (base) {
+        if (path_.empty()) options.vary &= ~unsigned(lc::HuntSceneDim); // the given scene's meshes stay
         base->validate();
         if (paramOptions_.size() && std::any_of(paramOptions_.begin(), paramOptions_.end(), [](const auto& p) {
                 return p.first == "tile" && p.second->count();

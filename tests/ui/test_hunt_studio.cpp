@@ -34,6 +34,7 @@
 #include <QTimer>
 #include <QToolButton>
 #include <QUndoStack>
+#include <QWindow>
 
 #include <fstream>
 #include <functional>
@@ -211,7 +212,11 @@ private slots:
         huntThroughDialog([&](QDialog* d) {
             QVERIFY(d->findChild<QLabel*>("huntUnderTest")->text().contains("built-in algorithm 2.5d"));
             QVERIFY(!d->findChild<QCheckBox*>("huntOverflow")->isEnabled());
-            QVERIFY(d->findChild<QRadioButton*>("huntOpenScene")->isChecked()); // atrium has meshes
+            auto* openScene = d->findChild<QRadioButton*>("huntOpenScene");
+            QVERIFY(openScene->isEnabled()); // atrium has meshes
+            QTest::mouseClick(openScene, Qt::LeftButton);
+            QVERIFY(openScene->isChecked());
+            QVERIFY(!d->findChild<QCheckBox*>("huntVary_scene")->isEnabled()); // its meshes stay
             d->findChild<QSpinBox*>("huntTrials")->setValue(15);
             d->findChild<QDoubleSpinBox*>("huntSeconds")->setValue(0);
             setText(d, "huntFolder", folder);
@@ -234,7 +239,11 @@ private slots:
             auto* label = w_->findChild<QLabel*>("statusTask_load");
             // Pressed once the hunt has reported some trials.
             if (!cancel || !cancel->isVisible() || cancelled || !label || !label->text().contains("trials")) return;
-            QTest::mouseClick(cancel, Qt::LeftButton);
+            // Through the window, as the window system delivers a real click
+            // (a click sent to the button itself skips the window's filter).
+            QWindow* window = w_->windowHandle();
+            const QPoint at = cancel->mapTo(w_.get(), cancel->rect().center());
+            QTest::mouseClick(window, Qt::LeftButton, Qt::NoModifier, at);
             cancelled = true;
         });
         poll.start(20);

@@ -42,6 +42,7 @@
 #include <QPushButton>
 #include <QRegularExpression>
 #include <QTimer>
+#include <QWindow>
 #include <QUndoStack>
 #include <QWheelEvent>
 
@@ -916,9 +917,11 @@ private slots:
         connect(&poll, &QTimer::timeout, [&] {
             auto* cancel = w_->findChild<QToolButton*>("statusCancel_load");
             if (!cancel || !cancel->isVisible() || clicked) return;
-            QTest::mouseClick(addLight, Qt::LeftButton);
+            // Through the window, as the window system delivers real clicks.
+            QWindow* window = w_->windowHandle();
+            QTest::mouseClick(window, Qt::LeftButton, Qt::NoModifier, addLight->mapTo(w_.get(), addLight->rect().center()));
             blockedClickSent = true;
-            QTest::mouseClick(cancel, Qt::LeftButton);
+            QTest::mouseClick(window, Qt::LeftButton, Qt::NoModifier, cancel->mapTo(w_.get(), cancel->rect().center()));
             clicked = true;
         });
         poll.start(10);

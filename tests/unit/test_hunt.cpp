@@ -135,6 +135,53 @@ TEST(HuntCli, BadFlagsExitTwo) {
     EXPECT_TRUE(std::filesystem::exists(s.path / "keep.txt"));
     EXPECT_EQ(runCli({"hunt", "--shader", "x.comp", "--algorithm", "naive", "--out", (s.path / "h").string()}, s.path).code,
               2);
+    // Numbers that CLI11 would wrap or clamp, and nothing to vary.
+    for (const std::vector<std::string>& bad :
+         {std::vector<std::string>{"--trials", "-1"}, {"--trials", "0"}, {"--trials", "1.5"}, {"--seed", "-1"},
+          {"--seed", "18446744073709551616"}, {"--budget", "0"}, {"--budget", "nan"}, {"--vary", ""}}) {
+        std::vector<std::string> args{"hunt", "--backend", "cpu", "--out", (s.path / "n").string()};
+        args.insert(args.end(), bad.begin(), bad.end());
+        const CliResult r2 = runCli(args, s.path);
+        EXPECT_EQ(r2.code, 2) << bad[0] << " " << bad[1] << ": " << r2.err;
+        EXPECT_NE(r2.err.find(bad[0]), std::string::npos) << r2.err;
+    }
+}
+
+// --out never replaces what a hunt did not write: a folder of the user's
+// holding a scene.json (the very scene hunted, say) or a run/ is refused and
+// left as it was; a folder a hunt wrote is reused.
+TEST(HuntCli, OutNeverReplacesTheUsersFiles) {
+    ScratchDir s;
+    const auto mine = s.path / "myproj";
+    std::filesystem::create_directories(mine / "run" / "deep");
+    std::ofstream(mine / "run" / "deep" / "notes.txt") << "mine";
+    const CliResult r = runCli({"hunt", "--builtin", "atrium", "--backend", "cpu", "--trials", "2", "--out",
+                                mine.string()},
+                               s.path);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("no hunt wrote them"), std::string::npos) << r.err;
+    EXPECT_TRUE(std::filesystem::exists(mine / "run" / "deep" / "notes.txt"));
+
+    const auto again = s.path / "again";
+    for (int k = 0; k < 2; ++k) {
+        const CliResult a = runCli({"hunt", "--backend", "cpu", "--trials", "3", "--out", again.string()}, s.path);
+        EXPECT_EQ(a.code, 0) << k << ": " << a.err;
+    }
+}
+
+// A shader that does not compile is the user's file, not a trial's failure:
+// one line naming the file and line, exit 1, no repro folder.
+TEST(HuntCli, AShaderThatDoesNotCompileIsAnErrorNotACounterexample) {
+    ScratchDir s;
+    std::ofstream(s.path / "broken.comp") << "// lightcull: --layout fixed:8 --lists tile\n#version 450\n"
+                                              "layout(local_size_x = 1) in;\nvoid main() { nope(); }\n";
+    const CliResult r = runCli({"hunt", "--shader", (s.path / "broken.comp").string(), "--backend", "cpu",
+                                "--trials", "3", "--out", (s.path / "h").string()},
+                               s.path);
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_NE(r.err.find("broken.comp:4"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("compile error"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(s.path / "h"));
 }
 
 namespace {

@@ -334,7 +334,10 @@ Scene makeHuntTrial(const Scene* base, std::uint64_t seed, std::uint64_t index, 
             l.direction = r.unitVector();
         }
     }
-    for (std::size_t i = 0; i < s.lights.size(); ++i) s.lights[i].name = "L" + std::to_string(i);
+    // Generated lights are named by index; a given scene's keep their names
+    // (the verdict then names the user's light, even after shrinking).
+    if (!base || (vary & HuntLights))
+        for (std::size_t i = 0; i < s.lights.size(); ++i) s.lights[i].name = "L" + std::to_string(i);
     if (const std::string bad = c.validate(); !bad.empty()) throw Error("hunt: generated an invalid camera: " + bad);
     return s;
 }
@@ -354,6 +357,8 @@ HuntVerdict judgeHuntTrial(const Scene& scene, const HuntOptions& options, CullB
         }
     } catch (const SettingsError&) {
         throw;
+    } catch (const InputError&) {
+        throw; // the user's file (a shader that does not compile): no trial can pass, nothing to shrink
     } catch (const Error& e) {
         v.fails = true;
         v.property = std::string("error: ") + e.what();
@@ -722,6 +727,12 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
 
 namespace {
 
+std::string oneLine(std::string s) {
+    for (char& c : s)
+        if (c == '\n' || c == '\r') c = ' ';
+    return s;
+}
+
 std::string shellQuote(const std::string& a) {
     if (!a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_./:=,+@%") ==
                           std::string::npos)
@@ -735,6 +746,9 @@ std::string shellQuote(const std::string& a) {
 const std::set<std::string> kReproFiles = {"scene.json", "scene.glb", "repro.sh", "studio.sh", "verdict.txt",
                                            "summary.json", "run", "path.csv", "path.svg"};
 
+// Written first into every repro folder: the folder is a hunt's to replace.
+constexpr const char* kReproMarker = ".lightcull-hunt";
+
 } // namespace
 
 std::string huntOutputProblem(const std::string& dir) {
@@ -744,9 +758,19 @@ std::string huntOutputProblem(const std::string& dir) {
     if (!fs::is_directory(parent)) return dir + ": its parent folder does not exist";
     if (!fs::exists(p)) return {};
     if (!fs::is_directory(p)) return dir + ": is a file, not a folder";
-    for (const auto& e : fs::directory_iterator(p))
-        if (!kReproFiles.count(e.path().filename().string()))
-            return dir + ": holds " + e.path().filename().string() + ", which is not an earlier hunt's output";
+    // A folder is reused only when a hunt wrote it (its marker file) and it
+    // holds nothing but a hunt's outputs: a user's own scene.json or run/
+    // in a folder of theirs is never replaced.
+    bool empty = true;
+    for (const auto& e : fs::directory_iterator(p)) {
+        empty = false;
+        const std::string name = e.path().filename().string();
+        if (name != kReproMarker && !kReproFiles.count(name))
+            return dir + ": holds " + name + ", which is not an earlier hunt's output";
+    }
+    if (!empty && !fs::exists(p / kReproMarker))
+        return dir + ": holds files of the names a hunt writes, but no hunt wrote them (no " +
+               std::string(kReproMarker) + "); give a new or empty folder";
     return {};
 }
 
@@ -762,6 +786,7 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
     if (const std::string why = huntOutputProblem(dir); !why.empty()) throw SettingsError("out", why);
     const fs::path out(dir);
     fs::create_directories(out);
+    writeFileSynced((out / kReproMarker).string(), "a lightcull hunt wrote this folder and may replace it\n");
     for (const std::string& name : kReproFiles) fs::remove_all(out / name);
     if (!result.failure) {
         writeFileSynced((out / "verdict.txt").string(), huntNoMissText(result, options));
@@ -796,23 +821,47 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
     scene.origin.file = fs::absolute(out / "scene.json").string();
     scene.origin.command = command;
     RunOutput run;
-    judgeHuntTrial(scene, options, backend, &run);
-    exportDiagnostics(scene, options.settings, run, (out / "run").string());
-    fs::copy_file(out / "run" / "summary.json", out / "summary.json", fs::copy_options::overwrite_existing);
+    const HuntVerdict again = judgeHuntTrial(scene, options, backend, &run);
+    // A run that failed (a hang, a device error) has no lists to export:
+    // the repro is the scene and the command that fails the same way.
+    const bool runFailed = again.property.rfind("error: ", 0) == 0;
+    if (!runFailed) {
+        exportDiagnostics(scene, options.settings, run, (out / "run").string());
+        fs::copy_file(out / "run" / "summary.json", out / "summary.json", fs::copy_options::overwrite_existing);
+    }
     writeFileSynced((out / "verdict.txt").string(), huntVerdictText(f, options));
     writeFileSynced((out / "repro.sh").string(),
                     "#!/bin/sh\n# lightcull hunt, seed " + std::to_string(options.seed) + ", trial " +
-                        std::to_string(f.trial) + ": " + f.verdict.property +
-                        " (verdict.txt). Exits 3 while the miss is there.\n"
+                        std::to_string(f.trial) + ": " + oneLine(f.verdict.property) + " (verdict.txt). " +
+                        (runFailed ? "Fails (exit 1) while the error is there.\n"
+                                   : "Exits 3 while the miss is there.\n") +
                         "# Set LIGHTCULL to the binary when lightcull is not on PATH.\n"
                         "cd \"$(dirname \"$0\")\" || exit 1\n# " +
                         command + "\nexec \"${LIGHTCULL:-lightcull}\"" + command.substr(9) + "\n");
+    // The studio reads a shader's layout and lists from its first line only.
+    std::string studioNote;
+    if (options.shader) {
+        std::string headerLayout, headerLists;
+        try {
+            const CustomShaderOptions h = shaderOptionsFromFile(options.shader->path);
+            headerLayout = toString(h.layout);
+            headerLists = toString(h.lists);
+        } catch (const Error&) {
+        }
+        const std::string used = toString(options.shader->layout), usedLists = toString(options.shader->lists);
+        studioNote = headerLayout == used && headerLists == usedLists
+                         ? "# The shader's layout and lists come from its first line, as in the hunt.\n"
+                         : "# NOTE: the studio takes the shader's layout and lists from its first line (" +
+                               (headerLayout.empty() ? std::string("none") : headerLayout + ", " + headerLists) +
+                               "); this hunt used --layout " + used + " --lists " + usedLists +
+                               ": put `// lightcull: --layout " + used + " --lists " + usedLists +
+                               "` first in the shader to see the same lists there.\n";
+    }
     writeFileSynced((out / "studio.sh").string(),
                     "#!/bin/sh\n# The repro in LightCull Studio: the scene opens, culls and selects the miss "
                     "(Explain shows why).\n# Set LIGHTCULL_STUDIO to the binary when lightcull-studio is not on "
                     "PATH.\n" +
-                        std::string(options.shader ? "# The shader's layout and lists come from its first line.\n"
-                                                   : "") +
+                        studioNote +
                         "cd \"$(dirname \"$0\")\" || exit 1\nexec \"${LIGHTCULL_STUDIO:-lightcull-studio}\"" +
                         studio.substr(16) + " \"$@\"\n");
     for (const char* script : {"repro.sh", "studio.sh"})
