@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <csignal>
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
@@ -36,6 +37,28 @@ CLI::Validator wholeNumber(unsigned long long lo, unsigned long long hi) {
         },
         "N");
 }
+
+// Ctrl+C (SIGINT) or SIGTERM during a hunt: the hunt stops at the next
+// trial (the shrinking keeps what it has) and writes what it covered or
+// found, instead of dying with nothing written. A second signal ends it
+// at once.
+lc::CancelToken gInterrupted;
+extern "C" void onInterrupt(int sig) {
+    if (gInterrupted.cancelled.exchange(true)) {
+        std::signal(sig, SIG_DFL);
+        std::raise(sig);
+    }
+}
+struct InterruptScope {
+    InterruptScope() {
+        std::signal(SIGINT, onInterrupt);
+        std::signal(SIGTERM, onInterrupt);
+    }
+    ~InterruptScope() {
+        std::signal(SIGINT, SIG_DFL);
+        std::signal(SIGTERM, SIG_DFL);
+    }
+};
 
 int usage(const std::string& message) {
     std::cerr << "lightcull: error: " << message << "\n";
@@ -191,7 +214,12 @@ int HuntCommand::run() {
                      static_cast<unsigned long long>(c.trials), seconds, seconds > 0 ? double(c.trials) / seconds : 0.0,
                      c.text().c_str());
     };
+    options.cancel = &gInterrupted;
+    const InterruptScope interrupts;
     const lc::HuntResult result = lc::hunt(options, *backend);
+    if (result.cancelled || gInterrupted.cancelled)
+        std::cerr << "lightcull: interrupted: writing what the hunt covered" << (result.failure ? " and found" : "")
+                  << "\n";
 
     if (result.firstOverCapacityTrial)
         std::cout << "over capacity (not a failure without --overflow): " << result.coverage.overCapacity
@@ -199,7 +227,7 @@ int HuntCommand::run() {
     const std::string command = lc::writeHuntRepro(result, options, *backend, outDir_, device_);
     if (!result.failure) {
         std::cout << lc::huntNoMissText(result, options);
-        return 0;
+        return gInterrupted.cancelled ? 130 : 0; // interrupted: not the clean pass a CI job may read 0 as
     }
     const lc::HuntFailure& f = *result.failure;
     const fs::path out(outDir_);
@@ -222,6 +250,8 @@ int HuntCommand::runPath(lc::HuntOptions& options, const lc::Scene& scene, lc::C
                      static_cast<unsigned long long>(c.trials), n, seconds,
                      seconds > 0 ? double(c.trials) / seconds : 0.0);
     };
+    options.cancel = &gInterrupted;
+    const InterruptScope interrupts;
     const lc::HuntPathResult result = lc::huntPath(options, scene, path, backend);
     const std::string command = lc::writeHuntRepro(lc::huntResultOf(result), options, backend, outDir_, device_);
     lc::writeHuntPathReport(result, path, outDir_);
@@ -230,7 +260,7 @@ int HuntCommand::runPath(lc::HuntOptions& options, const lc::Scene& scene, lc::C
               << (out / "path.csv").string() << ", plot: " << (out / "path.svg").string() << "\n";
     if (!result.failure) {
         std::cout << lc::huntNoMissText(lc::huntResultOf(result), options);
-        return 0;
+        return gInterrupted.cancelled ? 130 : 0;
     }
     const std::string verdict = lc::huntVerdictText(*result.failure, options);
     std::cout << "COUNTEREXAMPLE at frame " << *result.worst << " (the worst):\n"

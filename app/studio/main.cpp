@@ -19,6 +19,7 @@
 #include "shading_probe.hpp"
 
 #include "culling/core/backend.hpp"
+#include "culling/core/params.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <QAction>
@@ -194,6 +195,17 @@ int main(int argc, char** argv) {
     for (const QString& nv : parser.values(paramOpt)) {
         const int eq = nv.indexOf('=');
         const QString name = nv.left(eq), value = nv.mid(eq + 1);
+        // The parameter table's own message names the value and what it takes.
+        if (eq > 0 && name != "tile" && name != "width" && name != "height") {
+            try {
+                lc::CullSettings scratch;
+                lc::Camera camera;
+                lc::setParam(scratch, camera, name.toStdString(), value.toStdString());
+            } catch (const std::exception& e) {
+                std::fprintf(stderr, "lightcull-studio: --param %s: %s\n", qPrintable(nv), e.what());
+                return 2;
+            }
+        }
         if (eq <= 0 || name == "tile" || name == "width" || name == "height" ||
             !window.setParamFromUi(name, value)) {
             std::fprintf(stderr,

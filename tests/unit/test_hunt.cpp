@@ -241,3 +241,19 @@ TEST(HuntCli, CameraPathRefusesTheSearchFlagsAndNeedsAScene) {
     const CliResult fps = runCli({"hunt", "--fps", "10", "--out", (s.path / "c").string()}, s.path);
     EXPECT_EQ(fps.code, 2) << "--fps needs --path";
 }
+
+// Ctrl+C during a hunt writes what it covered and exits 130, not 0: an
+// interrupted hunt is no clean pass for a CI job.
+TEST(HuntCli, AnInterruptedHuntWritesWhatItCoveredAndExits130) {
+    ScratchDir s;
+    const auto out = s.path / "int";
+    const std::string cmd = "timeout --preserve-status -s INT 3 '" + std::string(LC_CLI_PATH) +
+                            "' hunt --backend cpu --budget 120 --out '" + out.string() + "' >'" +
+                            (s.path / "log").string() + "' 2>&1";
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status)) << lc_test::slurp(s.path / "log");
+    EXPECT_EQ(WEXITSTATUS(status), 130) << lc_test::slurp(s.path / "log");
+    const std::string verdict = lc_test::slurp(out / "verdict.txt");
+    EXPECT_EQ(verdict.rfind("cancelled: no miss in ", 0), 0u) << verdict;
+    EXPECT_NE(lc_test::slurp(s.path / "log").find("interrupted"), std::string::npos);
+}
