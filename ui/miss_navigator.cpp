@@ -67,7 +67,7 @@ bool MissNavigator::step(int delta) {
     doc_->setExplainedList(int(m.list));
     const auto& lights = doc_->scene().lights;
     const QString name = m.light < lights.size() ? QString::fromStdString(lights[m.light].name) : QString();
-    emit message(tr("miss %1 of %2: light %3 '%4' in tile %5,%6 (list %7), %8 pixels need it; cause: %9")
+    emit message(tr("miss %1 of %2: light %3 '%4' in tile %5,%6 (list %7), %8 %9; cause: %10")
                      .arg(current_ + 1)
                      .arg(n)
                      .arg(m.light)
@@ -76,6 +76,7 @@ bool MissNavigator::step(int delta) {
                      .arg(m.tile / g.tilesX)
                      .arg(m.list)
                      .arg(m.pixels)
+                     .arg(m.pixels == 1 ? tr("pixel needs it") : tr("pixels need it"))
                      .arg(QString::fromLatin1(lc::toString(m.cause))));
     emit missSelected();
     return true;

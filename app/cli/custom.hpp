@@ -93,7 +93,7 @@ inline void printCustomReport(const lc::RunOutput& run, const lc::Scene& scene, 
             std::cout << "  MISSING light " << m.light
                       << (m.light < scene.lights.size() ? " '" + scene.lights[m.light].name + "'" : std::string())
                       << " in tile " << m.tile % run.result.grid.tilesX << "," << m.tile / run.result.grid.tilesX
-                      << " (list " << m.list << "): " << m.pixels << " pixels need it; cause: " << lc::toString(cause)
+                      << " (list " << m.list << "): " << m.pixels << (m.pixels == 1 ? " pixel needs it; cause: " : " pixels need it; cause: ") << lc::toString(cause)
                       << "\n";
         }
         if (total > shown)

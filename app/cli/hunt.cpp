@@ -232,7 +232,9 @@ int HuntCommand::run() {
     const lc::HuntFailure& f = *result.failure;
     const fs::path out(outDir_);
     const std::string verdict = lc::huntVerdictText(f, options);
-    std::cout << "COUNTEREXAMPLE after " << f.trial + 1 << " trials (" << result.seconds << " s):\n"
+    char took[32];
+    std::snprintf(took, sizeof took, "%.1f", result.seconds);
+    std::cout << "COUNTEREXAMPLE after " << f.trial + 1 << (f.trial ? " trials (" : " trial (") << took << " s):\n"
               << verdict << "repro: " << (out / "repro.sh").string() << "  (" << command << ")\n"
               << "wrote " << outDir_ << "/scene.json, scene.glb, repro.sh, summary.json, verdict.txt, run/\n";
     std::cerr << "lightcull: the culling fails the hunt: " << f.verdict.property << " (exit 3)\n";

@@ -23,6 +23,7 @@ namespace fs = std::filesystem;
 using lc_test::CliResult;
 using lc_test::runCli;
 using lc_test::ScratchDir;
+using lc_test::runReproScript;
 using lc_test::slurp;
 
 namespace {
@@ -54,11 +55,8 @@ TEST(HuntCustom, FindsTheFlawedTileEdgesAndItsReproReproduces) {
 
     // repro.sh: `lightcull run` of the shrunk scene shows the same miss.
     fs::remove_all(out / "run");
-    const std::string cmd = "LIGHTCULL='" + std::string(LC_CLI_PATH) + "' sh '" + (out / "repro.sh").string() +
-                            "' >'" + (s.path / "repro.log").string() + "' 2>&1";
-    const int status = std::system(cmd.c_str());
-    ASSERT_TRUE(WIFEXITED(status));
-    EXPECT_EQ(WEXITSTATUS(status), 3) << slurp(s.path / "repro.log");
+    std::string reproLog;
+    EXPECT_EQ(runReproScript(out, &reproLog), 3) << reproLog;
     const auto again = nlohmann::json::parse(slurp(out / "run" / "summary.json"));
     EXPECT_EQ(again["metrics"]["false_negatives"], summary["metrics"]["false_negatives"]);
 
@@ -89,11 +87,8 @@ TEST(HuntCustom, OverCapacityIsCountedApartUnlessOverflowIsHunted) {
     ASSERT_EQ(r.code, 3) << r.out << r.err;
     EXPECT_NE(slurp(out / "verdict.txt").find("(overflow)"), std::string::npos);
     EXPECT_LE(nlohmann::json::parse(slurp(out / "scene.json"))["lights"].size(), 5u);
-    const std::string cmd = "LIGHTCULL='" + std::string(LC_CLI_PATH) + "' sh '" + (out / "repro.sh").string() +
-                            "' >/dev/null 2>&1";
-    const int status = std::system(cmd.c_str());
-    ASSERT_TRUE(WIFEXITED(status));
-    EXPECT_EQ(WEXITSTATUS(status), 3);
+    std::string reproLog;
+    EXPECT_EQ(runReproScript(out, &reproLog), 3) << reproLog;
 }
 
 // The flawed examples of the classes issue 35 names, each hunted with the
@@ -147,11 +142,8 @@ TEST_P(HuntFlawedExample, IsFoundWithoutBeingToldWhatToVaryAndItsReproReproduces
     EXPECT_EQ(summary["custom"]["overflow_lists"], 0) << "the miss is the shader's own, not a full list";
 
     fs::remove_all(out / "run");
-    const std::string cmd = "LIGHTCULL='" + std::string(LC_CLI_PATH) + "' sh '" + (out / "repro.sh").string() +
-                            "' >'" + (s.path / "repro.log").string() + "' 2>&1";
-    const int status = std::system(cmd.c_str());
-    ASSERT_TRUE(WIFEXITED(status));
-    EXPECT_EQ(WEXITSTATUS(status), 3) << slurp(s.path / "repro.log");
+    std::string reproLog;
+    EXPECT_EQ(runReproScript(out, &reproLog), 3) << reproLog;
 }
 
 INSTANTIATE_TEST_SUITE_P(Issue35, HuntFlawedExample, ::testing::ValuesIn(kFlawedExamples),

@@ -165,12 +165,9 @@ TEST(HuntCustomProperties, ADuplicateIndexIsAFailureAndRunSaysSoToo) {
     EXPECT_EQ(glb.camera.height, json.camera.height);
     EXPECT_EQ(glb.camera.projection, json.camera.projection);
     EXPECT_EQ(glb.triangleCount(), json.triangleCount());
-    const std::string cmd = "LIGHTCULL='" + std::string(LC_CLI_PATH) + "' sh '" + (out / "repro.sh").string() +
-                            "' >'" + (s.path / "repro.log").string() + "' 2>&1";
-    const int status = std::system(cmd.c_str());
-    ASSERT_TRUE(WIFEXITED(status));
-    EXPECT_EQ(WEXITSTATUS(status), 3) << lc_test::slurp(s.path / "repro.log");
-    EXPECT_NE(lc_test::slurp(s.path / "repro.log").find("duplicate indices"), std::string::npos);
+    std::string reproLog;
+    EXPECT_EQ(lc_test::runReproScript(out, &reproLog), 3) << reproLog;
+    EXPECT_NE(reproLog.find("duplicate indices"), std::string::npos);
 }
 
 // --path on the flawed tile-edge shader: the atrium panned past at 650 x 370
@@ -210,9 +207,6 @@ TEST(HuntCustomProperties, ACameraPathFindsTheFramesWhereTheFlawedShaderMisses) 
     EXPECT_NE(verdict.find("at frame "), std::string::npos) << verdict;
     EXPECT_NE(verdict.find("of 8 (8 cameras"), std::string::npos) << verdict;
     EXPECT_NE(lc_test::slurp(out / "path.svg").find("worst frame"), std::string::npos);
-    const std::string cmd = "LIGHTCULL='" + std::string(LC_CLI_PATH) + "' sh '" + (out / "repro.sh").string() +
-                            "' >/dev/null 2>&1";
-    const int status = std::system(cmd.c_str());
-    ASSERT_TRUE(WIFEXITED(status));
-    EXPECT_EQ(WEXITSTATUS(status), 3);
+    std::string reproLog;
+    EXPECT_EQ(lc_test::runReproScript(out, &reproLog), 3) << reproLog;
 }

@@ -53,6 +53,18 @@ inline CliResult runCli(const std::vector<std::string>& args, const std::filesys
     return r;
 }
 
+// Runs a hunt's repro.sh (LIGHTCULL set to the CLI under test) the way a
+// user would: its exit code (-1 when it did not exit) and, in *log, what
+// it printed.
+inline int runReproScript(const std::filesystem::path& dir, std::string* log = nullptr) {
+    const std::filesystem::path logFile = dir.parent_path() / (dir.filename().string() + ".repro.log");
+    const std::string cmd = "LIGHTCULL='" + std::string(LC_CLI_PATH) + "' sh '" + (dir / "repro.sh").string() +
+                            "' >'" + logFile.string() + "' 2>&1";
+    const int status = std::system(cmd.c_str());
+    if (log) *log = slurp(logFile);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
 inline std::size_t lineCount(const std::string& s) {
     std::size_t n = 0;
     for (char c : s) n += c == '\n';

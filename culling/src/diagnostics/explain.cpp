@@ -245,7 +245,7 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
         if (!st.passed && failed.empty()) failed = st.test;
     if (e.listed && e.pixelsNeeding > 0) {
         e.verdict = "needed: listed, and " + std::to_string(e.pixelsNeeding) + " of the list's " +
-                    std::to_string(e.listPixels) + " pixels need it";
+                    std::to_string(e.listPixels) + (e.listPixels == 1 ? " pixel needs it" : " pixels need it");
     } else if (e.listed) {
         e.verdict = e.listPixels == 0 ? "listed, but no pixel uses this list"
                                       : "false positive: listed, but none of the list's " + std::to_string(e.listPixels) +
@@ -276,7 +276,7 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
             cause = " (the reference's tests keep it: this pass dropped it)";
         else
             cause = " (the first test to reject it: '" + failed + "')";
-        e.verdict = "MISSING: not listed, but " + std::to_string(e.pixelsNeeding) + " of the list's pixels need it" +
+        e.verdict = "MISSING: not listed, but " + std::to_string(e.pixelsNeeding) + (e.pixelsNeeding == 1 ? " of the list's pixels needs it" : " of the list's pixels need it") +
                     cause;
     } else {
         e.verdict = "not listed, rightly: no pixel of the list needs it" +

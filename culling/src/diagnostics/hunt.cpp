@@ -433,7 +433,15 @@ double roundSig(double x, int digits) {
     const double scale = std::pow(10.0, digits - 1 - std::floor(std::log10(std::abs(x))));
     return std::round(x * scale) / scale;
 }
-glm::dvec3 roundTo(glm::dvec3 v, double step) { return glm::round(v / step) * step; }
+// Rounds to a multiple of `step`; a step below 1 divides by its inverse, so
+// that 0.1 steps print as 12.7, not 12.700000000000001.
+glm::dvec3 roundTo(glm::dvec3 v, double step) {
+    if (step < 1) {
+        const double inv = std::round(1.0 / step);
+        return glm::round(v * inv) / inv;
+    }
+    return glm::round(v / step) * step;
+}
 
 } // namespace
 
@@ -699,7 +707,7 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
         o << " Light " << v.miss->light << " ('" << l.name << "', a " << toString(l.kind) << " light at " << pos
           << (l.isSpot() ? ", outer angle " + g(l.outerAngleDeg) + " degrees" : std::string()) << ")"
           << " is missing from the list of tile " << tx << "," << ty << " (list " << v.miss->list << ", cause "
-          << toString(v.miss->cause) << ") where " << v.miss->pixels << " geometry pixels need it; "
+          << toString(v.miss->cause) << ") where " << v.miss->pixels << (v.miss->pixels == 1 ? " geometry pixel needs it; " : " geometry pixels need it; ")
           << v.falseNegatives << " false negatives in all";
         if (v.overflowLists || v.invalidIndices)
             o << ", " << v.overflowLists << " lists over the layout's capacity, " << v.invalidIndices
