@@ -466,52 +466,55 @@ Scene shrinkHuntFailure(const Scene& failing, const HuntOptions& options, CullBa
         alone.lights = {best.lights[first.miss->light]};
         if (stillFails(alone)) best = alone;
     }
-    // Then runs of lights (halves, quarters, ... single ones: a crowd of 300
-    // shrinks in few runs), bounded like the triangles below.
-    constexpr std::size_t kLightRuns = 200;
-    const std::size_t lightRunsBefore = count;
-    for (std::size_t chunk = std::max<std::size_t>(1, best.lights.size() / 2); chunk >= 1; chunk /= 2) {
-        for (std::size_t start = 0; start < best.lights.size() && best.lights.size() > 1 &&
-                                    count - lightRunsBefore < kLightRuns;) {
-            const std::size_t end = std::min(best.lights.size(), start + chunk);
-            if (end - start == best.lights.size()) break; // never all of them
-            Scene fewer = best;
-            fewer.lights.erase(fewer.lights.begin() + std::ptrdiff_t(start), fewer.lights.begin() + std::ptrdiff_t(end));
-            if (stillFails(fewer)) best = std::move(fewer);
-            else start = end;
-        }
-        if (count - lightRunsBefore >= kLightRuns) break;
-    }
-    // Triangles: whole meshes, then runs of triangles (halves, quarters, ...
-    // down to single ones), each dropped where the miss stays; bounded, so a
-    // level of 100k triangles shrinks as far as the runs allow.
+    // Drops runs of items from `best` (halves of what is left, then quarters,
+    // ... single ones) while it still fails, never all of them, until the
+    // runs since `since` reach `maxRuns`. `size` counts a scene's items,
+    // `drop(scene, begin, end)` removes [begin, end). True when any went.
+    auto dropRuns = [&](auto size, auto drop, std::size_t since, std::size_t maxRuns) {
+        bool dropped = false;
+        for (std::size_t chunk = std::max<std::size_t>(1, size(best) / 2); chunk >= 1 && count - since < maxRuns;
+             chunk /= 2)
+            for (std::size_t start = 0; start < size(best) && size(best) > 1 && count - since < maxRuns;) {
+                const std::size_t end = std::min(size(best), start + chunk);
+                if (end - start == size(best)) break; // never all of them
+                Scene fewer = best;
+                drop(fewer, start, end);
+                if (stillFails(fewer)) {
+                    best = std::move(fewer); // the next run starts where this one was
+                    dropped = true;
+                } else {
+                    start = end;
+                }
+            }
+        return dropped;
+    };
+    // Then runs of lights: a crowd of 300 shrinks in few runs.
+    dropRuns([](const Scene& sc) { return sc.lights.size(); },
+             [](Scene& sc, std::size_t b, std::size_t e) {
+                 sc.lights.erase(sc.lights.begin() + std::ptrdiff_t(b), sc.lights.begin() + std::ptrdiff_t(e));
+             },
+             count, 200);
+    // Triangles: whole meshes, then runs of each mesh's triangles, within
+    // one bound, so a level of 100k triangles shrinks as far as the runs
+    // allow.
     for (std::size_t i = best.meshes.size(); i-- > 0 && best.meshes.size() > 1;) {
         Scene fewer = best;
         fewer.meshes.erase(fewer.meshes.begin() + std::ptrdiff_t(i));
         if (stillFails(fewer)) best = fewer;
     }
-    constexpr std::size_t kTriangleRuns = 160;
-    const std::size_t runsBefore = count;
+    const std::size_t triangleRunsSince = count;
     for (std::size_t mi = 0; mi < best.meshes.size(); ++mi) {
-        for (std::size_t chunk = best.meshes[mi].triangleCount() / 2; chunk >= 1; chunk /= 2) {
-            for (std::size_t start = 0; start < best.meshes[mi].triangleCount() && count - runsBefore < kTriangleRuns;) {
-                const std::size_t n = best.meshes[mi].triangleCount();
-                if (n <= 1) break;
-                const std::size_t end = std::min(n, start + chunk);
-                Scene fewer = best;
-                std::vector<std::uint32_t>& idx = fewer.meshes[mi].indices;
-                idx.erase(idx.begin() + std::ptrdiff_t(3 * start), idx.begin() + std::ptrdiff_t(3 * end));
-                if (stillFails(fewer)) best = std::move(fewer); // the next run starts where this one was
-                else start = end;
-            }
-            if (count - runsBefore >= kTriangleRuns) break;
-        }
-    }
-    // A mesh that lost triangles is written inline, without the vertices
-    // nothing uses any more (not as its source file's path).
-    for (std::size_t mi = 0; mi < best.meshes.size(); ++mi) {
+        const bool trimmed = dropRuns([mi](const Scene& sc) { return sc.meshes[mi].triangleCount(); },
+                                      [mi](Scene& sc, std::size_t b, std::size_t e) {
+                                          std::vector<std::uint32_t>& idx = sc.meshes[mi].indices;
+                                          idx.erase(idx.begin() + std::ptrdiff_t(3 * b),
+                                                    idx.begin() + std::ptrdiff_t(3 * e));
+                                      },
+                                      triangleRunsSince, 160);
+        if (!trimmed) continue;
+        // A mesh that lost triangles is written inline, without the vertices
+        // nothing uses any more (not as its source file's path).
         Mesh& m = best.meshes[mi];
-        if (mi < failing.meshes.size() && m.indices.size() == failing.meshes[mi].indices.size()) continue;
         std::vector<std::uint32_t> remap(m.vertexCount(), ~0u);
         std::vector<float> positions;
         for (std::uint32_t& v : m.indices) {
@@ -739,15 +742,6 @@ std::string oneLine(std::string s) {
     for (char& c : s)
         if (c == '\n' || c == '\r') c = ' ';
     return s;
-}
-
-std::string shellQuote(const std::string& a) {
-    if (!a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_./:=,+@%") ==
-                          std::string::npos)
-        return a;
-    std::string q = "'";
-    for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
 }
 
 // What a repro folder holds; a folder holding anything else is refused.
