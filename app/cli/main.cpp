@@ -95,18 +95,8 @@ std::string ms(double v) { return v < 0 ? std::string("n/a") : fmt("%.2f ms", v)
 // The command line as a shell would take it back (summary.json records it).
 std::string commandLine(int argc, char** argv) {
     std::string out;
-    for (int i = 0; i < argc; ++i) {
-        const std::string a = i == 0 ? std::string("lightcull") : std::string(argv[i]);
-        const bool plain = !a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                                                             "0123456789-_./:=,+@%") == std::string::npos;
-        std::string q = a;
-        if (!plain) {
-            q = "'";
-            for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-            q += "'";
-        }
-        out += (i ? " " : "") + q;
-    }
+    for (int i = 0; i < argc; ++i)
+        out += (i ? " " : "") + lc::shellQuote(i == 0 ? std::string("lightcull") : std::string(argv[i]));
     return out;
 }
 

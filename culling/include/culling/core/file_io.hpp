@@ -44,4 +44,9 @@ void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outp
 void checkFolderTarget(const std::string& dir, const std::set<std::string>& outputs, const std::string& action,
                        const std::string& outputKind);
 
+// An argument as a POSIX shell takes it back: unchanged when it holds only
+// letters, digits and -_./:=,+@%; else in single quotes (a quote as '\'').
+// For the commands the tool writes down (summary.json, a hunt's scripts).
+std::string shellQuote(const std::string& arg);
+
 } // namespace lc
