@@ -243,11 +243,13 @@ TEST(HuntCli, CameraPathRefusesTheSearchFlagsAndNeedsAScene) {
 }
 
 // Ctrl+C during a hunt writes what it covered and exits 130, not 0: an
-// interrupted hunt is no clean pass for a CI job.
+// interrupted hunt is no clean pass for a CI job. One SIGINT, as a terminal
+// sends it: without --foreground, timeout signals the child and then its own
+// process group, and a second SIGINT rightly ends the hunt at once.
 TEST(HuntCli, AnInterruptedHuntWritesWhatItCoveredAndExits130) {
     ScratchDir s;
     const auto out = s.path / "int";
-    const std::string cmd = "timeout --preserve-status -s INT 3 '" + std::string(LC_CLI_PATH) +
+    const std::string cmd = "timeout --foreground --preserve-status -s INT 3 '" + std::string(LC_CLI_PATH) +
                             "' hunt --backend cpu --budget 120 --out '" + out.string() + "' >'" +
                             (s.path / "log").string() + "' 2>&1";
     const int status = std::system(cmd.c_str());
