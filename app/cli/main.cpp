@@ -21,6 +21,7 @@
 #include "culling/core/file_io.hpp"
 #include "culling/core/params.hpp"
 #include "culling/core/pipeline.hpp"
+#include "culling/core/presets.hpp"
 #include "culling/scene/scene_io.hpp"
 #include "custom.hpp"
 #include "hunt.hpp"
@@ -112,6 +113,15 @@ int verdictExit(const lc::RunOutput& run) {
     const std::uint64_t duplicate = run.custom ? run.custom->duplicateIndices : 0;
     const std::size_t validation = run.custom ? run.custom->validationMessages.size() : 0;
     if (fn == 0 && overflow == 0 && invalid == 0 && duplicate == 0 && validation == 0) return 0;
+    if (!run.custom) {
+        // A built-in algorithm: its misses by cause (the engine limits' drops are losses too).
+        const lc::Metrics& m = run.truth.metrics;
+        std::cerr << "lightcull: the culling fails: " << fn << " false negatives (culling test "
+                  << m.falseNegativesCullingTest() << ", list full " << m.falseNegativesListFull << ", light limit "
+                  << m.falseNegativesLightLimit << "), " << run.result.limits.overflowLists.size()
+                  << " over-full lists (exit " << kExitMisses << ")\n";
+        return kExitMisses;
+    }
     std::cerr << "lightcull: the culling fails: " << fn << " false negatives, " << overflow << " overflowed lists, "
               << invalid << " invalid indices";
     if (duplicate) std::cerr << ", " << duplicate << " duplicate indices";
@@ -153,6 +163,18 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
                   << " / shading work " << m.shadingWork << ")\n"
                   << "optimum of this grid: " << fmt("%.1f", 100.0 * m.efficiencyVsOptimal) << "% (optimal work "
                   << m.optimalWork << " / shading work " << m.shadingWork << ")\n";
+    if (!run.custom && settings.hasLimits()) {
+        // The engine limits: what they were and what they took.
+        const lc::ListLimits& lim = r.limits;
+        std::cout << "limits: cap " << settings.cap << ", max-lights " << settings.maxLights << " ("
+                  << lc::toString(settings.limitKeep) << "), max-entries " << settings.maxEntries
+                  << ", overflow-policy " << lc::toString(settings.overflow) << ": " << lim.overflowLists.size()
+                  << " over-full lists, " << lim.droppedLights.size() << " entries dropped, " << lim.lightsOverLimit
+                  << " lights past the limit; the longest list before the cap " << lim.longestUncapped << "\n";
+        if (m.falseNegatives)
+            std::cout << "misses by cause: culling test " << m.falseNegativesCullingTest() << ", list full "
+                      << m.falseNegativesListFull << ", light limit " << m.falseNegativesLightLimit << "\n";
+    }
     std::cout << "lists " << r.listCountTotal() << ", entries " << r.entries() << ", mean list "
               << fmt("%.2f", m.meanList) << ", max list " << m.maxList << ", " << m.resultBytes
               << " bytes\n";
@@ -174,6 +196,14 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
 }
 
 
+// --preset's help: every engine preset by name.
+std::string presetHelp() {
+    std::string names;
+    for (const lc::EnginePreset& p : lc::enginePresets()) names += (names.empty() ? "" : ", ") + p.name;
+    return "Cull as a shipped engine does (docs/ENGINES.md): its algorithm, grid and limits; flags given beside it "
+           "override it. NAME: " + names;
+}
+
 // Flags shared by `run` and `bench`: the scene, the culling parameters (from
 // the one table), generated lights and the backend.
 struct SceneFlags {
@@ -185,6 +215,8 @@ struct SceneFlags {
     std::map<std::string, std::string> paramValues;
     std::vector<std::pair<std::string, CLI::Option*>> paramOptions;
     CLI::Option* optLights = nullptr;
+    std::string presetName;
+    CLI::Option* optPreset = nullptr;
 
     // `tileSizeFlag`: the tile-size parameter's flag (explain's --tile names a tile).
     void addTo(CLI::App* cmd, const std::string& tileSizeFlag = "tile") {
@@ -196,6 +228,7 @@ struct SceneFlags {
             o->type_name(p.type == lc::ParamType::Int ? "INT" : p.type == lc::ParamType::Bool ? "BOOL" : "CHOICE");
             paramOptions.emplace_back(p.name, o);
         }
+        optPreset = cmd->add_option("--preset", presetName, presetHelp())->type_name("NAME");
         optLights = cmd->add_option(
             "--lights", lightCount,
             "Replace the scene's lights with N generated ones (deterministic, placed in the scene's bounds)");
@@ -237,14 +270,24 @@ struct SceneFlags {
     // camera's (tile, width, height): with lists from a shader or a dump it
     // would have no effect. Empty when none.
     std::string givenCullingFlag() const {
+        if (optPreset && optPreset->count()) return "--preset";
         for (const auto& [name, opt] : paramOptions)
             if (opt->count() && name != "tile" && name != "width" && name != "height") return opt->get_name();
         return {};
     }
 
-    void applyParams(lc::CullSettings& settings, lc::Camera& camera) const {
+    // The culling flags onto `settings` and the scene's camera: the camera's
+    // size first, then --preset (its derived settings see that size and the
+    // scene's lights), then every other flag, which overrides the preset.
+    void applyParams(lc::CullSettings& settings, lc::Scene& scene) const {
         for (const auto& [name, opt] : paramOptions)
-            if (opt->count()) lc::setParam(settings, camera, name, paramValues.at(name));
+            if (opt->count() && (name == "width" || name == "height"))
+                lc::setParam(settings, scene.camera, name, paramValues.at(name));
+        if (optPreset && optPreset->count())
+            lc::applyPreset(lc::enginePreset(presetName), settings, scene.camera, scene.lights.size());
+        for (const auto& [name, opt] : paramOptions)
+            if (opt->count() && name != "width" && name != "height")
+                lc::setParam(settings, scene.camera, name, paramValues.at(name));
     }
 
     std::unique_ptr<lc::CullBackend> openBackend() const {
@@ -362,7 +405,7 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
     const lc::Scene base = flags.loadScene();
     lc::CullSettings baseSettings;
     lc::Scene baseWithParams = base;
-    flags.applyParams(baseSettings, baseWithParams.camera);
+    flags.applyParams(baseSettings, baseWithParams);
     // Every sweep value and the JSON's folder are checked before the first
     // run: a long sweep must not end in an error its first second could tell.
     for (const Sweep& sw : sweeps)
@@ -625,7 +668,7 @@ int main(int argc, char** argv) {
             if (!explainFlags.hasScene()) return fail(2, "explain: give --scene FILE or --builtin NAME");
             lc::Scene scene = explainFlags.loadScene();
             lc::CullSettings settings;
-            explainFlags.applyParams(settings, scene.camera);
+            explainFlags.applyParams(settings, scene);
             unsigned tx = 0, ty = 0;
             char tail = 0;
             if (std::sscanf(explainTile.c_str(), "%u,%u%c", &tx, &ty, &tail) != 2)
@@ -685,7 +728,7 @@ int main(int argc, char** argv) {
             if (const std::string f = checkFlags.givenCullingFlag(); !f.empty())
                 return fail(2, f + ": has no effect on check: the dump's lists are judged as they are (--rule says "
                                    "whose pixels read each list)");
-            checkFlags.applyParams(settings, scene.camera);
+            checkFlags.applyParams(settings, scene);
             const lc::Projection proj(scene.camera);
             lc::DepthImage depth;
             std::unique_ptr<lc::CullBackend> backend;
@@ -730,7 +773,7 @@ int main(int argc, char** argv) {
         lc::Scene scene = runFlags.loadScene();
         scene.origin.command = commandLine(argc, argv);
         lc::CullSettings settings;
-        runFlags.applyParams(settings, scene.camera);
+        runFlags.applyParams(settings, scene);
         std::unique_ptr<lc::CullBackend> backend = runFlags.openBackend();
 
         lc::RunOptions options;

@@ -5,6 +5,7 @@
 #include "custom.hpp"
 
 #include "culling/core/errors.hpp"
+#include "culling/core/presets.hpp"
 #include "culling/diagnostics/report.hpp"
 #include "culling/scene/scene_io.hpp"
 
@@ -49,6 +50,14 @@ void ReportCommand::add(CLI::App& app) {
     for (const std::string& b : lc::availableBackends()) backendHelp += " " + b;
     cmd_->add_option("--backend", backends_, backendHelp + ")")->type_name("NAME");
     cmd_->add_option("--device", device_, "Vulkan device: index or name substring")->type_name("D");
+    std::string presetNames;
+    for (const lc::EnginePreset& p : lc::enginePresets()) presetNames += (presetNames.empty() ? "" : ", ") + p.name;
+    cmd_->add_option("--preset", presets_,
+                     "Run these engine presets side by side instead of the sweep (repeatable or comma-separated; "
+                     "docs/ENGINES.md): misses by cause and the first setting change that keeps every light. NAME: " +
+                         presetNames)
+        ->type_name("NAME[,NAME...]");
+    cmd_->add_flag("--presets", allPresets_, "Run every engine preset side by side instead of the sweep");
     cmd_->add_option("--shader", shaders_,
                      "A custom culling shader as one more row (repeatable; its first-line settings give layout and "
                      "lists; docs/CUSTOM_CULLING.md)")
@@ -121,6 +130,18 @@ int ReportCommand::run() {
         } else {
             options.fixed[name] = value;
         }
+    }
+
+    for (const std::string& p : presets_)
+        for (const std::string& name : splitCommas(p)) options.presets.push_back(lc::enginePreset(name).name);
+    if (allPresets_)
+        for (const lc::EnginePreset& p : lc::enginePresets()) options.presets.push_back(p.name);
+    if (!options.presets.empty()) {
+        for (const auto& [name, opt] : paramOptions_)
+            if (opt->count() && name != "width" && name != "height")
+                return usage("--" + name + ": has no effect with --preset/--presets: each preset sets the culling "
+                             "(run --preset NAME --" + name + " to change one)");
+        if (!shaders_.empty()) return usage("--shader: a custom shader is not a preset; run the two reports apart");
     }
 
     const bool tty = ::isatty(STDERR_FILENO);

@@ -24,7 +24,8 @@ private:
     CLI::App* cmd_ = nullptr;
     SceneSource source_;
     std::string outDir_, device_;
-    std::vector<std::string> backends_, shaders_;
+    std::vector<std::string> backends_, shaders_, presets_;
+    bool allPresets_ = false;
     long long lights_ = -1;
     unsigned long long seed_ = 1;
     int repeat_ = 3, warmup_ = 1;

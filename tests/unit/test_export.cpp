@@ -191,16 +191,20 @@ TEST(Export, TilesCsvHasOneRowPerListMatchingTheResult) {
         std::vector<std::string> lines = split(csv, '\n');
         ASSERT_EQ(lines.back(), ""); // ends with a newline
         lines.pop_back();
-        ASSERT_EQ(lines[0], "tile_x,tile_y,cell,view_depth_min,view_depth_max,cell_mask,count,lights");
+        ASSERT_EQ(lines[0], "tile_x,tile_y,cell,view_depth_min,view_depth_max,cell_mask,count,false_negatives,"
+                            "fn_list_full,fn_light_limit,overflow,dropped,lights");
         ASSERT_EQ(lines.size() - 1, res.listCount.size()) << toString(alg);
         std::size_t emptyDepthRows = 0;
         for (std::size_t l = 0; l < res.listCount.size(); ++l) {
             const auto f = split(lines[l + 1], ',');
-            ASSERT_EQ(f.size(), 8u) << lines[l + 1];
+            ASSERT_EQ(f.size(), 13u) << lines[l + 1];
             EXPECT_EQ(std::stoul(f[6]), res.listCount[l]);
+            EXPECT_EQ(std::stoull(f[7]), r.out.truth.listFalseNegatives[l]);
+            EXPECT_EQ(f[10], "0"); // no limits: never over-full
+            EXPECT_EQ(f[11], "0");
             std::vector<std::uint32_t> listed;
-            if (!f[7].empty())
-                for (const auto& tok : split(f[7], ' ')) listed.push_back(std::uint32_t(std::stoul(tok)));
+            if (!f[12].empty())
+                for (const auto& tok : split(f[12], ' ')) listed.push_back(std::uint32_t(std::stoul(tok)));
             EXPECT_EQ(listed, std::vector<std::uint32_t>(res.lightIndices.begin() + res.listOffset[l],
                                                          res.lightIndices.begin() + res.listOffset[l] + res.listCount[l]));
             if (alg == Algorithm::All) {

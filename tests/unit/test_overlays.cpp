@@ -297,8 +297,8 @@ TEST(Overlays, ReverseLookupMatchesTilesCsv) {
             std::stringstream ls(line);
             for (std::string s; std::getline(ls, s, ',');) f.push_back(s);
             if (line.back() == ',') f.push_back("");
-            ASSERT_EQ(f.size(), 8u) << line;
-            std::istringstream ids(f[7]);
+            ASSERT_EQ(f.size(), 13u) << line;
+            std::istringstream ids(f[12]);
             for (std::uint32_t id; ids >> id;) {
                 listsOfLight[id].insert(row);
                 if (alg != Algorithm::All) tilesOfLight[id].insert(std::stoul(f[1]) * r.grid.tilesX + std::stoul(f[0]));

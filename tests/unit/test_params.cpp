@@ -11,7 +11,8 @@ TEST(Params, TableOrderAndDefaultsMatchTheStructs) {
     std::vector<std::string> names;
     for (const auto& p : t) names.push_back(p.name);
     EXPECT_EQ(names, (std::vector<std::string>{"algorithm", "test", "cells", "slicing", "skip-empty", "spot-test", "bins",
-                                               "tile", "width", "height"}));
+                                               "tile", "width", "height", "cap", "max-lights", "max-entries",
+                                               "overflow-policy", "limit-keep"}));
     // The table's defaults are the structs' defaults.
     const CullSettings s;
     const Camera cam;
@@ -31,6 +32,22 @@ TEST(Params, TableOrderAndDefaultsMatchTheStructs) {
     EXPECT_EQ(cullParam("bins").minValue, 1);
     EXPECT_EQ(cullParam("bins").maxValue, 16384);
     EXPECT_THROW(cullParam("colour"), SettingsError);
+    // The engine limits: off by default, on their own toolbar row.
+    for (const char* n : {"cap", "max-lights", "max-entries", "overflow-policy", "limit-keep"})
+        EXPECT_EQ(cullParam(n).group, "limits") << n;
+    EXPECT_EQ(cullParam("algorithm").group, "");
+    EXPECT_FALSE(s.hasLimits());
+    EXPECT_EQ(cullParam("overflow-policy").choices, (std::vector<std::string>{"index", "nearest", "all-lights"}));
+    EXPECT_EQ(cullParam("limit-keep").choices, (std::vector<std::string>{"index", "nearest"}));
+    CullSettings capped;
+    Camera c;
+    setParam(capped, c, "cap", "63");
+    setParam(capped, c, "overflow-policy", "all-lights");
+    EXPECT_EQ(capped.cap, 63u);
+    EXPECT_EQ(capped.overflow, OverflowPolicy::AllLights);
+    EXPECT_TRUE(capped.hasLimits());
+    EXPECT_THROW(setParam(capped, c, "cap", "-1"), SettingsError);
+    EXPECT_THROW(setParam(capped, c, "limit-keep", "all-lights"), SettingsError);
 }
 
 TEST(Params, SetAndGetRoundTripEveryValue) {

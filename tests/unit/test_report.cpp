@@ -103,8 +103,7 @@ TEST(Report, DefaultSweepFollowsTheParameterTableAndSkipsWhatDoesNotApply) {
             const bool camera = p.name == "width" || p.name == "height";
             EXPECT_EQ(c.params.count(p.name), camera ? 0u : 1u) << p.name;
             if (!camera && c.params.count(p.name))
-                EXPECT_EQ(c.params.at(p.name).empty(),
-                          !paramAppliesTo(p.name, c.settings.algorithm, c.settings.cells, false))
+                EXPECT_EQ(c.params.at(p.name).empty(), !paramAppliesTo(p.name, c.settings, false))
                     << c.label() << " " << p.name;
         }
         if (c.settings.algorithm == Algorithm::All) EXPECT_EQ(c.label(), "all");

@@ -1,5 +1,6 @@
 // View-space lights and the backend registry.
 #include "culling/core/backend.hpp"
+#include "culling/core/limits.hpp"
 
 #include "culling/core/errors.hpp"
 #include "culling/truth/shade.hpp"
@@ -100,6 +101,8 @@ CullResult CullBackend::cull(const DepthImage& depth, const Projection& proj, co
         r.clusterNear = frame.clusterNear;
         r.clusterFar = frame.clusterFar;
     }
+    // The engine limits: one rule for every backend, on the lists its test made.
+    applyListLimits(r, lights, settings);
     return r;
 }
 

@@ -15,11 +15,31 @@ namespace lc {
 // See cull_result.hpp: the lists as a renderer stores them. halfz's far list
 // starts where its near list ends (both backends lay lists out in list
 // order), so its offset is implied and the 4 bytes go to the split.
+long ListLimits::overflowIndex(std::uint32_t list) const {
+    const auto it = std::lower_bound(overflowLists.begin(), overflowLists.end(), list);
+    return it != overflowLists.end() && *it == list ? long(it - overflowLists.begin()) : -1;
+}
+
+std::pair<const std::uint32_t*, const std::uint32_t*> ListLimits::droppedFrom(std::uint32_t list) const {
+    const long k = overflowIndex(list);
+    if (k < 0) return {nullptr, nullptr};
+    const std::uint32_t* base = droppedLights.data();
+    return {base + droppedOffset[std::size_t(k)], base + droppedOffset[std::size_t(k) + 1]};
+}
+
+bool ListLimits::dropped(std::uint32_t list, std::uint32_t light) const {
+    const auto [a, b] = droppedFrom(list);
+    return a != b && std::binary_search(a, b, light);
+}
+
 std::uint64_t CullResult::bytes() const {
     if (algorithm == Algorithm::ZBin)
         return 4 * std::uint64_t(zbinLo.size()) +
                4 * std::uint64_t(grid.tileCount()) * ((std::uint64_t(zbinRank.size()) + 31) / 32);
-    std::uint64_t b = 4 * entries() + 8 * std::uint64_t(listCount.size());
+    const std::uint64_t lists = listCount.size();
+    std::uint64_t b = 4 * entries() + 8 * lists;
+    if (settings.maxEntries) b = 4 * std::uint64_t(settings.maxEntries) + 8 * lists;
+    else if (settings.cap) b = 4 * (std::uint64_t(settings.cap) + 1) * lists;
     if (algorithm == Algorithm::Clustered) b += 8; // clusterNear, clusterFar as float
     return b;
 }
@@ -129,6 +149,20 @@ std::string CullResult::validate(std::size_t lightCount) const {
         }
     }
     if (total != lightIndices.size()) return "index array is not compact";
+    const ListLimits& lim = limits;
+    if (!lim.overLightLimit.empty() && lim.overLightLimit.size() != lightCount)
+        return "limits: the light-limit flags hold " + std::to_string(lim.overLightLimit.size()) + " lights, expected " +
+               std::to_string(lightCount);
+    if (!lim.overflowLists.empty() && lim.droppedOffset.size() != lim.overflowLists.size() + 1)
+        return "limits: dropped offsets do not match the over-full lists";
+    for (std::size_t k = 0; k < lim.overflowLists.size(); ++k) {
+        if (lim.overflowLists[k] >= listCount.size() || (k && lim.overflowLists[k] <= lim.overflowLists[k - 1]))
+            return "limits: over-full list ids are out of range or not ascending";
+        if (lim.droppedOffset[k] > lim.droppedOffset[k + 1] || lim.droppedOffset[k + 1] > lim.droppedLights.size())
+            return "limits: dropped offsets run past the dropped lights";
+    }
+    for (std::uint32_t light : lim.droppedLights)
+        if (light >= lightCount) return "limits: a dropped light is out of range";
     return {};
 }
 
@@ -185,9 +219,21 @@ CullResult zbinPixelLists(const CullResult& z, const DepthImage& depth, const Pr
                     }
                 }
                 m.listCount.push_back(count);
+                // What the limits dropped from the tile's mask, in this bin.
+                if (const auto [a, e] = z.limits.droppedFrom(t); z.limits.overflowIndex(t) >= 0) {
+                    m.limits.overflowLists.push_back(list);
+                    m.limits.droppedOffset.push_back(std::uint32_t(m.limits.droppedLights.size()));
+                    for (const std::uint32_t* d = a; d != e; ++d)
+                        if (lo <= z.zbinRank[*d] && z.zbinRank[*d] <= hi) m.limits.droppedLights.push_back(*d);
+                }
             }
             m.pixelList[std::size_t(y) * depth.width + x] = list;
         }
+    if (!m.limits.overflowLists.empty()) m.limits.droppedOffset.push_back(std::uint32_t(m.limits.droppedLights.size()));
+    m.limits.overLightLimit = z.limits.overLightLimit;
+    m.limits.lightsOverLimit = z.limits.lightsOverLimit;
+    m.limits.longestUncapped = z.limits.longestUncapped;
+    m.limits.entriesUncapped = z.limits.entriesUncapped;
     return m;
 }
 

@@ -16,6 +16,10 @@ constexpr std::pair<Algorithm, const char*> kAlgorithms[] = {
     {Algorithm::Fptl, "fptl"},        {Algorithm::ZBin, "zbin"}};
 constexpr SphereTest kTests[] = {SphereTest::Planes, SphereTest::PlanesAabb, SphereTest::Exact};
 constexpr Slicing kSlicings[] = {Slicing::Log, Slicing::Linear};
+constexpr std::pair<OverflowPolicy, const char*> kOverflow[] = {
+    {OverflowPolicy::Index, "index"}, {OverflowPolicy::Nearest, "nearest"}, {OverflowPolicy::AllLights, "all-lights"}};
+constexpr std::pair<LimitKeep, const char*> kLimitKeep[] = {{LimitKeep::Index, "index"},
+                                                             {LimitKeep::Nearest, "nearest"}};
 constexpr SpotTest kSpotTests[] = {SpotTest::ApexSphere, SpotTest::TightSphere, SpotTest::ConeSphere,
                                    SpotTest::ConePlanes};
 
@@ -40,30 +44,55 @@ std::vector<ParamSpec> buildTable() {
                  "(depth-cell occupancy mask), clustered (3D froxel grid), fptl (fine-pruned tiles: "
                  "minmax, then each light tested against the tile's pixels), zbin (Z-binning: a "
                  "screen-space light mask per tile and linear view-depth bins of the depth-sorted lights)",
-                 "Algorithm"});
+                 "Algorithm", ""});
     t.push_back({"test", ParamType::Choice, "planes", tests, 0, 0,
                  "sphere-vs-volume test: planes (6 planes), planes+aabb (planes and the chunk's "
                  "bounding box), exact (Euclidean distance to the frustum chunk)",
-                 "Sphere test"});
+                 "Sphere test", ""});
     t.push_back({"cells", ParamType::Int, "32", {}, 1, 32,
-                 "2.5d occupancy cells per tile / clustered depth slices", "Cells"});
+                 "2.5d occupancy cells per tile / clustered depth slices", "Cells", ""});
     t.push_back({"slicing", ParamType::Choice, "log", slicings, 0, 0,
-                 "depth slicing of 2.5d cells and clustered slices: log or linear", "Slicing"});
+                 "depth slicing of 2.5d cells and clustered slices: log or linear", "Slicing", ""});
     t.push_back({"skip-empty", ParamType::Bool, "true", {}, 0, 1,
-                 "clustered: clusters holding no geometry get empty lists", "Skip empty"});
+                 "clustered: clusters holding no geometry get empty lists", "Skip empty", ""});
     std::vector<std::string> spotTests;
     for (auto x : kSpotTests) spotTests.push_back(toString(x));
     t.push_back({"spot-test", ParamType::Choice, "apex-sphere", spotTests, 0, 0,
                  "spot-light test: apex-sphere (range sphere at the apex), tight-sphere (smallest "
                  "sphere around the cone), cone-sphere (tight sphere, then cone vs the cell's "
                  "bounding sphere), cone-planes (tight sphere, then cone vs each cell plane)",
-                 "Spot test"});
+                 "Spot test", ""});
     t.push_back({"bins", ParamType::Int, "1024", {}, 1, 16384,
                  "zbin: view-depth bins, linear from the near plane to the far plane (or the farthest "
-                 "light)", "Bins"});
-    t.push_back({"tile", ParamType::Int, "16", {}, 1, 256, "tile size in pixels", "Tile"});
-    t.push_back({"width", ParamType::Int, "1280", {}, 1, 16384, "render width in pixels", "Width"});
-    t.push_back({"height", ParamType::Int, "720", {}, 1, 16384, "render height in pixels", "Height"});
+                 "light)", "Bins", ""});
+    t.push_back({"tile", ParamType::Int, "16", {}, 1, 256, "tile size in pixels", "Tile", ""});
+    t.push_back({"width", ParamType::Int, "1280", {}, 1, 16384, "render width in pixels", "Width", ""});
+    t.push_back({"height", ParamType::Int, "720", {}, 1, 16384, "render height in pixels", "Height", ""});
+    // Engine limits (docs/ALGORITHMS.md, "Caps and limits"): what a shipped
+    // engine's fixed buffers do to the lists the test made.
+    t.push_back({"cap", ParamType::Int, "0", {}, 0, 65536,
+                 "per-list cap: a list keeps at most this many lights (the others are dropped by "
+                 "--overflow-policy); 0 = no cap",
+                 "Cap", "limits"});
+    t.push_back({"max-lights", ParamType::Int, "0", {}, 0, 1000000,
+                 "per-view light limit: only this many lights take part in culling (chosen by "
+                 "--limit-keep), the others are in no list; 0 = no limit",
+                 "Max lights", "limits"});
+    t.push_back({"max-entries", ParamType::Int, "0", {}, 0, 100000000,
+                 "record-buffer limit: all lists together keep at most this many entries, filled in list "
+                 "order (what an over-full list keeps follows --overflow-policy); 0 = no limit",
+                 "Max entries", "limits"});
+    std::vector<std::string> overflows, keeps;
+    for (const auto& x : kOverflow) overflows.push_back(x.second);
+    for (const auto& x : kLimitKeep) keeps.push_back(x.second);
+    t.push_back({"overflow-policy", ParamType::Choice, "index", overflows, 0, 0,
+                 "what an over-full list keeps: index (the lowest light indices, as a shader appending in "
+                 "index order), nearest (the lights nearest the camera, as an engine that sorts them), "
+                 "all-lights (every light: the fallback some engines use)",
+                 "Overflow", "limits"});
+    t.push_back({"limit-keep", ParamType::Choice, "index", keeps, 0, 0,
+                 "which lights --max-lights keeps: index (the lowest indices) or nearest (nearest the camera)",
+                 "Keep", "limits"});
     return t;
 }
 
@@ -92,6 +121,18 @@ std::size_t parseChoice(const ParamSpec& p, const std::string& v) {
 
 } // namespace
 
+const char* toString(OverflowPolicy p) {
+    for (const auto& x : kOverflow)
+        if (x.first == p) return x.second;
+    return "?";
+}
+
+const char* toString(LimitKeep k) {
+    for (const auto& x : kLimitKeep)
+        if (x.first == k) return x.second;
+    return "?";
+}
+
 const char* toString(Algorithm a) {
     for (const auto& x : kAlgorithms)
         if (x.first == a) return x.second;
@@ -117,6 +158,15 @@ std::string CullSettings::validate() const {
     bool knownSpot = false;
     for (auto x : kSpotTests) knownSpot |= x == spotTest;
     if (!knownSpot) return "spot-test: unknown value";
+    if (cap > 65536) return "cap: must be an integer in 0..65536, got " + std::to_string(cap);
+    if (maxLights > 1000000) return "max-lights: must be an integer in 0..1000000, got " + std::to_string(maxLights);
+    if (maxEntries > 100000000)
+        return "max-entries: must be an integer in 0..100000000, got " + std::to_string(maxEntries);
+    bool knownOverflow = false, knownKeep = false;
+    for (const auto& x : kOverflow) knownOverflow |= x.first == overflow;
+    for (const auto& x : kLimitKeep) knownKeep |= x.first == limitKeep;
+    if (!knownOverflow) return "overflow-policy: unknown value";
+    if (!knownKeep) return "limit-keep: unknown value";
     return {};
 }
 
@@ -145,6 +195,11 @@ void setParam(CullSettings& s, Camera& camera, const std::string& name, const st
     else if (name == "tile") camera.tileSize = std::uint32_t(parseInt(p, value));
     else if (name == "width") camera.width = std::uint32_t(parseInt(p, value));
     else if (name == "height") camera.height = std::uint32_t(parseInt(p, value));
+    else if (name == "cap") s.cap = std::uint32_t(parseInt(p, value));
+    else if (name == "max-lights") s.maxLights = std::uint32_t(parseInt(p, value));
+    else if (name == "max-entries") s.maxEntries = std::uint32_t(parseInt(p, value));
+    else if (name == "overflow-policy") s.overflow = kOverflow[parseChoice(p, value)].first;
+    else if (name == "limit-keep") s.limitKeep = kLimitKeep[parseChoice(p, value)].first;
 }
 
 std::string getParam(const CullSettings& s, const Camera& camera, const std::string& name) {
@@ -158,7 +213,12 @@ std::string getParam(const CullSettings& s, const Camera& camera, const std::str
     if (name == "bins") return std::to_string(s.bins);
     if (name == "tile") return std::to_string(camera.tileSize);
     if (name == "width") return std::to_string(camera.width);
-    return std::to_string(camera.height);
+    if (name == "height") return std::to_string(camera.height);
+    if (name == "cap") return std::to_string(s.cap);
+    if (name == "max-lights") return std::to_string(s.maxLights);
+    if (name == "max-entries") return std::to_string(s.maxEntries);
+    if (name == "overflow-policy") return toString(s.overflow);
+    return toString(s.limitKeep);
 }
 
 } // namespace lc

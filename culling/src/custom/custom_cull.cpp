@@ -366,6 +366,7 @@ const char* toString(MissCause c) {
     switch (c) {
     case MissCause::CullingTest: return "culling test";
     case MissCause::ListFull: return "list full";
+    case MissCause::LightLimit: return "light limit";
     case MissCause::InvalidIndex: return "invalid index";
     }
     return "?";
@@ -375,6 +376,7 @@ const char* jsonName(MissCause c) {
     switch (c) {
     case MissCause::CullingTest: return "culling_test";
     case MissCause::ListFull: return "list_full";
+    case MissCause::LightLimit: return "light_limit";
     case MissCause::InvalidIndex: return "invalid_index";
     }
     return "?";
@@ -382,7 +384,10 @@ const char* jsonName(MissCause c) {
 
 std::vector<MissedLight> locateFalseNegatives(const RunOutput& run, const Projection& proj) {
     std::vector<MissedLight> out;
-    auto causeOf = [&](std::uint32_t list) {
+    const ListLimits& limits = run.result.limits;
+    auto causeOf = [&](std::uint32_t list, std::uint32_t light) {
+        if (limits.isOverLimit(light)) return MissCause::LightLimit;
+        if (limits.dropped(list, light)) return MissCause::ListFull;
         if (!run.custom) return MissCause::CullingTest;
         const auto& full = run.custom->overflowedListIds;
         const auto& bad = run.custom->invalidIndexListIds;
@@ -410,7 +415,7 @@ std::vector<MissedLight> locateFalseNegatives(const RunOutput& run, const Projec
                 for (std::uint32_t i = 0; i < run.lights.size(); ++i)
                     if (detail::lightNeeds(run.lights, i, p) && !std::binary_search(first, last, i)) ++missed[{list, i}];
             }
-        for (const auto& [key, pixels] : missed) out.push_back({t, key.first, key.second, pixels, causeOf(key.first)});
+        for (const auto& [key, pixels] : missed) out.push_back({t, key.first, key.second, pixels, causeOf(key.first, key.second)});
     }
     std::stable_sort(out.begin(), out.end(), [](const MissedLight& a, const MissedLight& b) {
         return a.cause != b.cause ? a.cause < b.cause : a.pixels > b.pixels;

@@ -246,6 +246,11 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
     if (e.listed && e.pixelsNeeding > 0) {
         e.verdict = "needed: listed, and " + std::to_string(e.pixelsNeeding) + " of the list's " +
                     std::to_string(e.listPixels) + (e.listPixels == 1 ? " pixel needs it" : " pixels need it");
+    } else if (e.listed && r.settings.overflow == OverflowPolicy::AllLights && r.limits.overflowIndex(list) >= 0) {
+        e.verdict = "listed by the all-lights fallback: the list was over-full (cap " + std::to_string(r.settings.cap) +
+                    ") and lists every light instead" +
+                    (e.pixelsNeeding > 0 ? "; " + std::to_string(e.pixelsNeeding) + " of its pixels need it"
+                                         : std::string("; none of its pixels needs it"));
     } else if (e.listed) {
         e.verdict = e.listPixels == 0 ? "listed, but no pixel uses this list"
                                       : "false positive: listed, but none of the list's " + std::to_string(e.listPixels) +
@@ -267,7 +272,18 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
             return std::binary_search(ids.begin(), ids.end(), list);
         };
         std::string cause;
-        if (c && among(c->overflowedListIds))
+        const ListLimits& limits = run.result.limits;
+        const CullSettings& set = run.result.settings;
+        if (limits.isOverLimit(light))
+            cause = " (dropped: past the light limit, max-lights " + std::to_string(set.maxLights) + " keeping " +
+                    toString(set.limitKeep) + "; the culling never saw it)";
+        else if (limits.dropped(list, light))
+            cause = " (dropped: list full (" +
+                    (set.cap ? "cap " + std::to_string(set.cap) : std::string()) +
+                    (set.cap && set.maxEntries ? ", " : "") +
+                    (set.maxEntries ? "record buffer of " + std::to_string(set.maxEntries) + " entries" : std::string()) +
+                    "); the test kept it, overflow-policy " + toString(set.overflow) + " dropped it)";
+        else if (c && among(c->overflowedListIds))
             cause = " (dropped: list full, layout " + c->layout + "; the shader wrote more entries than fit)";
         else if (c && among(c->invalidIndexListIds))
             cause = " (the list held an index past the light count: an invalid index, perhaps where this light's "

@@ -199,6 +199,12 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
         j["depth_triangles"] = {{"scene", r.depthTriangles}, {"drawn", r.depthTrianglesDrawn}};
     nlohmann::ordered_json mj;
     mj["false_negatives"] = m.falseNegatives;
+    // By cause (docs/ALGORITHMS.md, "Caps and limits"): the engine limits'
+    // drops apart from the culling test's own misses. A custom culling's
+    // over-full lists are counted by pairs in custom.missed_pairs_by_cause.
+    mj["false_negatives_by_cause"] = {{"culling_test", m.falseNegativesCullingTest()},
+                                      {"list_full", m.falseNegativesListFull},
+                                      {"light_limit", m.falseNegativesLightLimit}};
     mj["shading_work"] = m.shadingWork;
     mj["exact_work"] = m.exactWork;
     mj["efficiency"] = m.efficiency;
@@ -214,6 +220,35 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     mj["image_max_error"] =
         m.imageErrorComputed ? nlohmann::ordered_json(m.imageMaxError) : nlohmann::ordered_json(nullptr);
     j["metrics"] = mj;
+    // The engine limits this run culled under, and what they took.
+    if (!run.custom) {
+        const ListLimits& lim = r.limits;
+        nlohmann::ordered_json lj;
+        lj["cap"] = settings.cap;
+        lj["max_lights"] = settings.maxLights;
+        lj["max_entries"] = settings.maxEntries;
+        lj["overflow_policy"] = toString(settings.overflow);
+        lj["limit_keep"] = toString(settings.limitKeep);
+        lj["overflow_lists"] = lim.overflowLists.size();
+        lj["dropped_entries"] = lim.droppedLights.size();
+        lj["lights_over_limit"] = lim.lightsOverLimit;
+        // The longest list the test made: the smallest cap that never overflows.
+        lj["longest_list_uncapped"] = settings.hasLimits() ? lim.longestUncapped : m.maxList;
+        lj["entries_uncapped"] = settings.hasLimits() ? lim.entriesUncapped : r.entries();
+        nlohmann::ordered_json over = nlohmann::ordered_json::array();
+        for (std::size_t k = 0; k < lim.overflowLists.size() && k < 1000; ++k) {
+            const std::uint32_t l = lim.overflowLists[k];
+            const std::uint32_t t = r.tileOfList(l);
+            nlohmann::ordered_json e;
+            e["list"] = l;
+            e["tile"] = {t % std::max(r.grid.tilesX, 1u), t / std::max(r.grid.tilesX, 1u)};
+            e["kept"] = r.listCount[l];
+            e["dropped"] = lim.droppedOffset[k + 1] - lim.droppedOffset[k];
+            over.push_back(std::move(e));
+        }
+        lj["overflowed"] = std::move(over);
+        j["limits"] = std::move(lj);
+    }
     if (run.custom) {
         // docs/CUSTOM_CULLING.md: what the user's culling did beside its lists.
         const CustomCullReport& c = *run.custom;
@@ -261,7 +296,10 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
 
 std::string tilesCsv(const RunOutput& run) {
     const CullResult& r = run.result;
-    std::string out = "tile_x,tile_y,cell,view_depth_min,view_depth_max,cell_mask,count,lights\n";
+    std::string out = "tile_x,tile_y,cell,view_depth_min,view_depth_max,cell_mask,count,false_negatives,"
+                      "fn_list_full,fn_light_limit,overflow,dropped,lights\n";
+    const GroundTruth& gt = run.truth;
+    const bool truth = run.truthComputed && gt.listFalseNegatives.size() == r.listCount.size();
     const std::size_t lists = r.listCount.size();
     const std::uint32_t per = std::max(r.listsPerTile, 1u);
     for (std::size_t l = 0; l < lists; ++l) {
@@ -293,6 +331,15 @@ std::string tilesCsv(const RunOutput& run) {
         }
         const std::uint32_t off = r.listOffset[l], cnt = r.listCount[l];
         row += std::to_string(cnt) + ",";
+        // Misses by cause (empty without ground truth), then the engine
+        // limits: whether the list was over-full and how many lights it lost.
+        if (truth)
+            row += std::to_string(gt.listFalseNegatives[l]) + "," + std::to_string(gt.listFalseNegativesListFull[l]) +
+                   "," + std::to_string(gt.listFalseNegativesLightLimit[l]) + ",";
+        else
+            row += ",,,";
+        const auto [d0, d1] = r.limits.droppedFrom(std::uint32_t(l));
+        row += std::string(r.limits.overflowIndex(std::uint32_t(l)) >= 0 ? "1," : "0,") + std::to_string(d1 - d0) + ",";
         for (std::uint32_t k = 0; k < cnt; ++k) {
             if (k) row += ' ';
             row += std::to_string(r.lightIndices[off + k]);
@@ -355,6 +402,35 @@ RgbImage tintedTiles(const RunOutput& run, int legendH, Shade shade) {
     return img;
 }
 
+// Per tile: 1 when one of its lists was over-full under the engine limits.
+std::vector<char> tilesOverflowing(const CullResult& r) {
+    std::vector<char> over(std::max<std::size_t>(r.grid.tileCount(), 1), 0);
+    for (std::uint32_t l : r.limits.overflowLists) {
+        const std::uint32_t t = r.tileOfList(l);
+        if (r.algorithm == Algorithm::All) std::fill(over.begin(), over.end(), 1);
+        else if (t < over.size()) over[t] = 1;
+    }
+    return over;
+}
+
+// The colour that marks over-full lists (the heat map's frames, the misses a
+// cap or record buffer caused) and the light limit's misses, everywhere.
+const glm::dvec3 kOverflowColour(1.0, 0.55, 0.0);
+const glm::dvec3 kLightLimitColour(0.75, 0.3, 1.0);
+
+// A frame `width` pixels wide inside each flagged tile.
+void frameTiles(Canvas& cv, const TileGrid& g, const std::vector<char>& flagged, int width, glm::dvec3 c) {
+    for (std::uint32_t t = 0; t < g.tileCount() && t < flagged.size(); ++t) {
+        if (!flagged[t]) continue;
+        const TileGrid::Rect rc = g.tileRect(t % g.tilesX, t / g.tilesX);
+        const int x0 = int(rc.x0), y0 = int(rc.y0), x1 = int(rc.x1), y1 = int(rc.y1);
+        cv.fill(x0, y0, x1, std::min(y1, y0 + width), c);
+        cv.fill(x0, std::max(y0, y1 - width), x1, y1, c);
+        cv.fill(x0, y0, std::min(x1, x0 + width), y1, c);
+        cv.fill(std::max(x0, x1 - width), y0, x1, y1, c);
+    }
+}
+
 } // namespace
 
 RgbImage heatmapImage(const RunOutput& run) {
@@ -362,7 +438,8 @@ RgbImage heatmapImage(const RunOutput& run) {
     const CullResult& r = run.result;
     const std::uint32_t W = depth.width, H = depth.height;
     const int scale = std::max(1, int(W) / 480);
-    const int legendH = scale * 29;
+    const bool overflow = !r.limits.overflowLists.empty();
+    const int legendH = scale * (overflow ? 39 : 29);
 
     // List-length range over all lists, for the colour scale.
     std::uint32_t minList = std::numeric_limits<std::uint32_t>::max(), maxList = 0;
@@ -435,13 +512,25 @@ RgbImage heatmapImage(const RunOutput& run) {
     if (cx > bx0 + cv.textWidth(left, scale) + 2 * scale &&
         cx + cw < bx1 - cv.textWidth(right, scale) - 2 * scale)
         cv.text(cx, ty, centre, scale, glm::dvec3(1.0));
+    if (overflow) {
+        // Over-full lists (engine limits): an orange frame in their tiles.
+        frameTiles(cv, r.grid, tilesOverflowing(r), std::max(1, scale), kOverflowColour);
+        std::uint64_t tilesOver = 0;
+        for (char f : tilesOverflowing(r)) tilesOver += f;
+        cv.text(bx0, ty + 10 * scale,
+                "OVER-FULL LISTS " + std::to_string(r.limits.overflowLists.size()) + " IN " +
+                    std::to_string(tilesOver) + " TILES, " + std::to_string(r.limits.droppedLights.size()) +
+                    " ENTRIES DROPPED",
+                scale, kOverflowColour);
+    }
     return img;
 }
 
 RgbImage missHeatmapImage(const RunOutput& run) {
     const std::uint32_t W = run.depth.width, H = run.depth.height;
     const int scale = std::max(1, int(W) / 480);
-    const int legendH = scale * 16;
+    const Metrics& split = run.truth.metrics;
+    const int legendH = scale * (split.falseNegativesListFull || split.falseNegativesLightLimit ? 26 : 16);
     const std::vector<double> fn = tileHeat(run, HeatMode::FalseNegatives);
     double most = 0;
     std::size_t tilesMissing = 0;
@@ -449,11 +538,29 @@ RgbImage missHeatmapImage(const RunOutput& run) {
         if (v > 0) most = std::max(most, v), ++tilesMissing;
     // Grey depth; a tile with misses red, brighter with more (log scale, so
     // that a tile missing one light at a few pixels still stands out).
+    // The cause of most of a tile's misses picks its hue: red for the
+    // culling test, orange for a list the engine limits left full, violet
+    // for lights past the light limit.
+    const CullResult& r = run.result;
+    const GroundTruth& gt = run.truth;
+    const bool byCause = gt.listFalseNegativesListFull.size() == r.listCount.size() && r.algorithm != Algorithm::All;
+    auto hueOf = [&](std::size_t t) {
+        if (!byCause) return glm::dvec3(1.0, 0.08, 0.08);
+        std::uint64_t all = 0, full = 0, limit = 0;
+        const auto [first, count] = r.tileLists(std::uint32_t(t));
+        for (std::uint32_t l = first; l < first + count; ++l)
+            all += gt.listFalseNegatives[l], full += gt.listFalseNegativesListFull[l],
+                limit += gt.listFalseNegativesLightLimit[l];
+        const std::uint64_t test = all - full - limit;
+        if (full > test && full >= limit) return kOverflowColour;
+        if (limit > test && limit > full) return kLightLimitColour;
+        return glm::dvec3(1.0, 0.08, 0.08);
+    };
     RgbImage img = tintedTiles(run, legendH, [&](std::size_t t, double g) {
         const double v = t < fn.size() && fn[t] > 0 ? fn[t] : 0.0;
         if (!(v > 0)) return glm::dvec3(g * 0.6);
         const double k = most > 1 ? 0.45 + 0.55 * std::log(v) / std::log(most) : 1.0;
-        return glm::dvec3(0.35 + 0.65 * k, 0.08, 0.08) * (0.55 + 0.45 * g);
+        return hueOf(t) * (0.35 + 0.65 * k) * (0.55 + 0.45 * g);
     });
     Canvas cv{img};
     const int y0 = int(H), m = 4 * scale;
@@ -464,6 +571,18 @@ RgbImage missHeatmapImage(const RunOutput& run) {
             : "FALSE NEGATIVES " + std::to_string(run.truth.metrics.falseNegatives) + " IN " +
                   std::to_string(tilesMissing) + " TILES, MOST " + std::to_string(std::uint64_t(most)) + " IN ONE";
     cv.text(m, y0 + m, text, scale, tilesMissing ? glm::dvec3(1.0, 0.45, 0.45) : glm::dvec3(1.0));
+    const Metrics& mt = run.truth.metrics;
+    if (tilesMissing && (mt.falseNegativesListFull || mt.falseNegativesLightLimit)) {
+        // The split, each in its own colour, on a second line.
+        int x = m;
+        const auto part = [&](const std::string& s, glm::dvec3 c) {
+            cv.text(x, y0 + m + 10 * scale, s, scale, c);
+            x += cv.textWidth(s, scale) + 3 * scale;
+        };
+        part("TEST " + std::to_string(mt.falseNegativesCullingTest()), glm::dvec3(1.0, 0.45, 0.45));
+        part("LIST FULL " + std::to_string(mt.falseNegativesListFull), kOverflowColour);
+        part("LIGHT LIMIT " + std::to_string(mt.falseNegativesLightLimit), kLightLimitColour);
+    }
     return img;
 }
 

@@ -367,8 +367,11 @@ HuntVerdict judgeHuntTrial(const Scene& scene, const HuntOptions& options, CullB
     v.falseNegatives = run.truthComputed ? run.truth.metrics.falseNegatives : 0;
     v.geometryPixels = run.truthComputed ? run.truth.metrics.geometryPixels : 0;
     v.invalidIndices = run.custom ? run.custom->invalidIndices : 0;
-    v.overflowLists = run.custom ? run.custom->overflowLists : 0;
-    v.overCapacity = v.overflowLists > 0;
+    // A custom shader's lists past its layout's capacity, or a built-in
+    // algorithm's engine limits (--cap, --max-entries, --max-lights): their
+    // drops are what the limits model, counted apart unless --overflow.
+    v.overflowLists = run.custom ? run.custom->overflowLists : run.result.limits.overflowLists.size();
+    v.overCapacity = v.overflowLists > 0 || (!run.custom && run.result.limits.lightsOverLimit > 0);
     std::vector<MissedLight> missed;
     if (v.falseNegatives) missed = locateFalseNegatives(run, Projection(scene.camera));
     const bool testMiss = !missed.empty() && missed.front().cause == MissCause::CullingTest;
@@ -395,10 +398,16 @@ HuntVerdict judgeHuntTrial(const Scene& scene, const HuntOptions& options, CullB
     // reference's over the same depth (a superset: float rounding may add).
     if (!options.shader && backend.name() != "cpu" && !v.fails) {
         const Projection proj(scene.camera);
-        const CullResult ref = makeCpuBackend()->cull(
-            run.depth, proj, TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize),
-            run.lights, options.settings);
-        const CullResult& got = run.result;
+        const TileGrid grid = TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
+        // Under engine limits the backends' rounding may fill a list's last
+        // slots differently: the test's own lists, before the limits, are
+        // compared (the limits are one host rule, tested on their own).
+        CullSettings open = options.settings;
+        open.cap = open.maxLights = open.maxEntries = 0;
+        const CullResult ref = makeCpuBackend()->cull(run.depth, proj, grid, run.lights, open);
+        CullResult unlimited;
+        if (options.settings.hasLimits()) unlimited = backend.cull(run.depth, proj, grid, run.lights, open);
+        const CullResult& got = options.settings.hasLimits() ? unlimited : run.result;
         if (ref.listCount.size() != got.listCount.size()) {
             v.fails = true;
             v.property = "lists differ from the CPU reference (" + std::to_string(got.listCount.size()) +

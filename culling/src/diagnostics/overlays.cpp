@@ -320,6 +320,7 @@ const char* toString(HeatMode m) {
     case HeatMode::FalsePositives: return "false-positives";
     case HeatMode::Efficiency: return "efficiency";
     case HeatMode::FalseNegatives: return "false-negatives";
+    case HeatMode::Overflow: return "overflow";
     }
     return "?";
 }
@@ -337,6 +338,17 @@ std::vector<double> tileHeat(const RunOutput& run, HeatMode mode) {
             for (std::uint32_t l = first; l < first + count && l < r.listCount.size(); ++l)
                 m = std::max(m, r.listCount[l]);
             heat[t] = m;
+            continue;
+        }
+        if (mode == HeatMode::Overflow) {
+            bool over = false;
+            std::uint64_t dropped = 0;
+            for (std::uint32_t l = first; l < first + count; ++l) {
+                const auto [a, b] = r.limits.droppedFrom(l);
+                over = over || r.limits.overflowIndex(l) >= 0;
+                dropped += std::uint64_t(b - a);
+            }
+            if (over) heat[t] = double(dropped);
             continue;
         }
         if (mode == HeatMode::FalseNegatives) {

@@ -4,6 +4,7 @@
 #include "culling/diagnostics/report.hpp"
 
 #include "culling/core/backend.hpp"
+#include "culling/core/presets.hpp"
 #include "culling/core/errors.hpp"
 #include "culling/core/file_io.hpp"
 #include "culling/truth/ground_truth.hpp"
@@ -17,6 +18,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <set>
 
 #include <fcntl.h>
@@ -81,6 +83,15 @@ std::vector<std::string> sweepValues(const ParamSpec& p, const ReportOptions& o)
 
 } // namespace
 
+bool paramAppliesTo(const std::string& name, const CullSettings& s, bool sceneHasSpotLights) {
+    // The engine limits apply to every algorithm; their policies only where
+    // their limit is set.
+    if (name == "overflow-policy") return s.cap || s.maxEntries;
+    if (name == "limit-keep") return s.maxLights;
+    if (name == "cap" || name == "max-lights" || name == "max-entries") return true;
+    return paramAppliesTo(name, s.algorithm, s.cells, sceneHasSpotLights);
+}
+
 bool paramAppliesTo(const std::string& name, Algorithm a, std::uint32_t cells, bool sceneHasSpotLights) {
     if (name == "algorithm") return true;
     if (name == "width" || name == "height") return false;
@@ -95,10 +106,13 @@ bool paramAppliesTo(const std::string& name, Algorithm a, std::uint32_t cells, b
 
 std::string ReportConfig::label() const {
     if (!customLabel.empty()) return customLabel;
+    if (!preset.empty()) return "preset:" + preset;
     std::string s = toString(settings.algorithm);
     for (const ParamSpec& p : cullParams()) {
         if (p.name == "algorithm") continue;
         auto it = params.find(p.name);
+        // A limit that is off says nothing.
+        if (p.group == "limits" && it != params.end() && it->second == "0") continue;
         if (it != params.end() && !it->second.empty()) s += " " + p.name + "=" + it->second;
     }
     return s;
@@ -134,13 +148,16 @@ std::vector<ReportConfig> reportConfigs(const ReportOptions& options, const std:
             ReportConfig cfg;
             cfg.backend = backend;
             Camera cam;
-            std::uint32_t cells = 0;
+            // What decides where the others apply: the cells and the limits.
+            CullSettings probe;
+            probe.algorithm = algo;
             for (std::size_t k = 0; k < specs.size(); ++k)
-                if (specs[k]->name == "cells") cells = std::uint32_t(std::stoul(values[k][idx[k]]));
-            if (cells == 0) cells = cfg.settings.cells;
+                if (const std::string& n = specs[k]->name;
+                    n == "cells" || n == "cap" || n == "max-lights" || n == "max-entries")
+                    setParam(probe, cam, n, values[k][idx[k]]);
             for (std::size_t k = 0; k < specs.size(); ++k) {
                 const ParamSpec& p = *specs[k];
-                const bool applies = paramAppliesTo(p.name, algo, cells, sceneHasSpotLights);
+                const bool applies = paramAppliesTo(p.name, probe, sceneHasSpotLights);
                 const std::string v = applies ? values[k][idx[k]] : std::string();
                 if (applies) setParam(cfg.settings, cam, p.name, v);
                 cfg.params[p.name] = v;
@@ -198,11 +215,110 @@ void judgeRow(ReportRow& row, const std::vector<double>& cullMs, const CullResul
     row.optimalWork = m.optimalWork;
     row.efficiencyVsOptimal = m.efficiencyVsOptimal;
     row.falseNegatives = m.falseNegatives;
+    row.falseNegativesListFull = m.falseNegativesListFull;
+    row.falseNegativesLightLimit = m.falseNegativesLightLimit;
+    row.overflowLists = result.limits.overflowLists.size();
+    row.longestUncapped = result.settings.hasLimits() ? result.limits.longestUncapped : m.maxList;
     row.meanList = m.meanList;
     row.maxList = m.maxList;
     row.resultBytes = m.resultBytes;
     row.imageRmse = err.rmse;
     row.imageMaxError = err.maxAbs;
+}
+
+} // namespace
+
+namespace {
+
+// One row per preset: its settings and grid for this scene and camera.
+std::vector<ReportConfig> presetConfigs(const ReportOptions& options, const std::string& backend, const Scene& scene) {
+    std::vector<ReportConfig> out;
+    for (const std::string& name : options.presets) {
+        const EnginePreset& preset = enginePreset(name); // throws for unknown names
+        ReportConfig cfg;
+        cfg.backend = backend;
+        cfg.preset = preset.name;
+        Camera cam = scene.camera;
+        applyPreset(preset, cfg.settings, cam, scene.lights.size());
+        cfg.tileSize = cam.tileSize;
+        for (const ParamSpec& p : cullParams())
+            if (sweptByTable(p)) cfg.params[p.name] = getParam(cfg.settings, cam, p.name);
+        out.push_back(std::move(cfg));
+    }
+    return out;
+}
+
+// The smallest value of `param` in [from, to] at which misses(value) is 0,
+// by bisection (the limits only keep more lights as they grow); `to` when
+// misses(to) is not 0 either.
+std::uint64_t smallestLossless(std::uint64_t from, std::uint64_t to,
+                               const std::function<std::uint64_t(std::uint64_t)>& misses) {
+    if (from >= to) return to;
+    std::uint64_t lo = from, hi = to; // misses(hi) == 0 assumed
+    while (lo < hi) {
+        const std::uint64_t mid = lo + (hi - lo) / 2;
+        if (misses(mid) == 0) hi = mid;
+        else lo = mid + 1;
+    }
+    return hi;
+}
+
+// A preset row's misses from its limits: the first setting change that
+// removes them, each limit raised to the smallest value that loses nothing
+// (the light limit first, then the record buffer, then the cap).
+std::string findFix(const ReportRow& row, CullBackend& backend, const DepthImage& depth, const Projection& proj,
+                    const ViewLights& lights, const TileGrid& grid, const CancelToken* cancel) {
+    if (row.falseNegativesListFull == 0 && row.falseNegativesLightLimit == 0)
+        return row.falseNegatives ? "none: the misses are the culling test's, not a limit's" : "";
+    CullSettings s = row.config.settings;
+    GroundTruthOptions gto;
+    gto.imageError = false;
+    auto judge = [&](const CullSettings& t) {
+        if (cancel && cancel->cancelled.load()) throw Cancelled();
+        return computeGroundTruth(depth, proj, lights, backend.cull(depth, proj, grid, lights, t), gto, cancel).metrics;
+    };
+    std::string fix;
+    const auto add = [&](const std::string& part) { fix += (fix.empty() ? "" : ", ") + part; };
+    if (row.falseNegativesLightLimit && s.maxLights) {
+        const std::uint64_t v = smallestLossless(s.maxLights + 1, lights.size(), [&](std::uint64_t m) {
+            CullSettings t = s;
+            t.maxLights = std::uint32_t(m);
+            return judge(t).falseNegativesLightLimit;
+        });
+        s.maxLights = v >= lights.size() ? 0 : std::uint32_t(v);
+        add(s.maxLights ? "max-lights " + std::to_string(v) : "max-lights 0 (no limit)");
+    }
+    Metrics m = judge(s);
+    if (m.falseNegativesListFull && s.maxEntries) {
+        CullSettings open = s;
+        open.maxEntries = 0;
+        const std::uint64_t need = backend.cull(depth, proj, grid, lights, open).entries();
+        const std::uint64_t v = smallestLossless(s.maxEntries + 1, std::max<std::uint64_t>(need, s.maxEntries + 1),
+                                                 [&](std::uint64_t e) {
+                                                     CullSettings t = s;
+                                                     t.maxEntries = std::uint32_t(e);
+                                                     return judge(t).falseNegativesListFull;
+                                                 });
+        s.maxEntries = std::uint32_t(v);
+        add("max-entries " + std::to_string(v));
+        m = judge(s);
+    }
+    if (m.falseNegativesListFull && s.cap) {
+        CullSettings open = s;
+        open.cap = 0;
+        std::uint32_t longest = 0;
+        for (std::uint32_t c : backend.cull(depth, proj, grid, lights, open).listCount) longest = std::max(longest, c);
+        const std::uint64_t v = smallestLossless(s.cap + 1, std::max<std::uint32_t>(longest, s.cap + 1), [&](std::uint64_t c) {
+            CullSettings t = s;
+            t.cap = std::uint32_t(c);
+            return judge(t).falseNegativesListFull;
+        });
+        s.cap = std::uint32_t(v);
+        add("cap " + std::to_string(v));
+        m = judge(s);
+    }
+    if (m.falseNegativesListFull || m.falseNegativesLightLimit) add("(still " + std::to_string(m.falseNegatives) + " misses)");
+    return fix;
 }
 
 } // namespace
@@ -242,7 +358,8 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             rep.notes.push_back(name + ": not run (" + e.what() + ")");
             continue;
         }
-        std::vector<ReportConfig> cfgs = reportConfigs(options, b->name(), hasSpots);
+        std::vector<ReportConfig> cfgs = options.presets.empty() ? reportConfigs(options, b->name(), hasSpots)
+                                                                 : presetConfigs(options, b->name(), sceneIn);
         total += cfgs.size();
         work.emplace_back(std::move(b), std::move(cfgs));
     }
@@ -289,6 +406,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
                     throw Error("backend '" + backend->name() + "' produced an inconsistent result for " +
                                 cfg.label() + ": " + bad);
                 judgeRow(row, cullMs, result, depth, proj, lights, *backend, allImage, options, cancel);
+                if (!cfg.preset.empty()) row.fix = findFix(row, *backend, depth, proj, lights, grid, cancel);
                 rep.rows.push_back(std::move(row));
                 ++done;
                 if (progress) progress(done, total, cfg.backend + " " + cfg.label());
@@ -353,7 +471,8 @@ std::string reportCsv(const Report& rep) {
         out += "," + col;
     }
     out += ",cull_ms,shade_ms,total_ms,efficiency,false_negatives,mean_list,max_list,result_bytes,"
-           "image_rmse,image_max_error,pareto_efficiency,pareto_error,optimal_work,efficiency_vs_optimal\n";
+           "image_rmse,image_max_error,pareto_efficiency,pareto_error,optimal_work,efficiency_vs_optimal,"
+           "fn_list_full,fn_light_limit,overflow_lists,longest_list_uncapped,preset,fix\n";
     auto quoted = [](const std::string& s) {
         if (s.find_first_of(",\"\n") == std::string::npos) return s;
         std::string q = "\"";
@@ -371,7 +490,9 @@ std::string reportCsv(const Report& rep) {
                std::to_string(r.maxList) + "," + std::to_string(r.resultBytes) + "," + roundTrip(r.imageRmse) + "," +
                roundTrip(r.imageMaxError) + "," + (r.paretoEfficiency ? "1" : "0") + "," +
                (r.paretoError ? "1" : "0") + "," + std::to_string(r.optimalWork) + "," +
-               roundTrip(r.efficiencyVsOptimal) + "\n";
+               roundTrip(r.efficiencyVsOptimal) + "," + std::to_string(r.falseNegativesListFull) + "," +
+               std::to_string(r.falseNegativesLightLimit) + "," + std::to_string(r.overflowLists) + "," +
+               std::to_string(r.longestUncapped) + "," + quoted(r.config.preset) + "," + quoted(r.fix) + "\n";
     }
     return out;
 }
@@ -384,6 +505,80 @@ std::string describe(const ReportRow& r) {
     return "`" + r.config.label() + "` (" + r.config.backend + ": cull " + fmt("%.3f", r.cullMs) + " ms + shade " +
            fmt("%.3f", r.shadeMs) + " ms = " + fmt("%.3f", r.totalMs) + " ms, efficiency " +
            fmt("%.3f", r.efficiency) + ", image RMSE " + fmt("%.3g", r.imageRmse) + ")";
+}
+
+// Per configuration swept over caps: the smallest cap that loses no light
+// and what it costs, beside the longest list (the cap that never overflows).
+std::string capsSection(const Report& rep) {
+    std::map<std::string, std::vector<const ReportRow*>> groups;
+    bool anyCap = false;
+    for (const ReportRow& r : rep.rows) {
+        if (!r.config.customLabel.empty()) continue;
+        anyCap = anyCap || r.config.settings.cap > 0;
+        ReportConfig uncapped = r.config;
+        uncapped.params["cap"] = "0";
+        uncapped.params.erase("overflow-policy");
+        if (r.config.settings.cap)
+            uncapped.params["overflow-policy"] = toString(r.config.settings.overflow);
+        groups[r.config.backend + " `" + uncapped.label() + "`"].push_back(&r);
+    }
+    if (!anyCap) return {};
+    std::string md = "\n## Caps\n\nPer configuration, the smallest swept per-list cap that loses no light "
+                     "(no false negative from a full list), the bytes an engine allocates for it (a count and `cap` "
+                     "indices per list), and the longest list the test made (a cap that never overflows).\n\n";
+    for (auto& [key, rows] : groups) {
+        std::sort(rows.begin(), rows.end(),
+                  [](auto* a, auto* b) { return a->config.settings.cap < b->config.settings.cap; });
+        const ReportRow* lossless = nullptr;
+        std::uint32_t longest = 0;
+        for (const ReportRow* r : rows) {
+            longest = std::max(longest, r->longestUncapped);
+            if (!lossless && r->config.settings.cap > 0 && r->falseNegativesListFull == 0) lossless = r;
+        }
+        md += "- " + key + ": ";
+        md += lossless ? "cap " + std::to_string(lossless->config.settings.cap) + " loses nothing (" +
+                             std::to_string(lossless->resultBytes) + " bytes, " +
+                             std::to_string(lossless->overflowLists) + " over-full lists)"
+                       : std::string("every swept cap loses lights");
+        for (const ReportRow* r : rows)
+            if (r->config.settings.cap > 0 && r->falseNegativesListFull > 0)
+                md += "; cap " + std::to_string(r->config.settings.cap) + " misses " +
+                      std::to_string(r->falseNegativesListFull) + " light-pixels in " +
+                      std::to_string(r->overflowLists) + " over-full lists";
+        md += "; the longest list is " + std::to_string(longest) + ".\n";
+    }
+    return md;
+}
+
+// The engine presets side by side: misses by cause, what they cost, and the
+// first setting change that keeps every light.
+std::string presetsSection(const Report& rep) {
+    std::string md;
+    for (const ReportRow& r : rep.rows) {
+        if (r.config.preset.empty()) continue;
+        if (md.empty())
+            md = "\n## Engine presets\n\nEach preset culls as the engine does (docs/ENGINES.md: the source of "
+                 "every number and what the model leaves out). FN = false negatives (light-pixels missed): by the "
+                 "culling test, by a full list (cap or record buffer), by the light limit.\n\n"
+                 "| backend | preset | engine | settings | FN test / list full / light limit | over-full lists | "
+                 "efficiency | bytes | cull ms | to lose nothing |\n|---|---|---|---|---|---:|---:|---:|---:|---|\n";
+        const CullSettings& s = r.config.settings;
+        std::string set = std::string(toString(s.algorithm)) + " tile " + std::to_string(r.config.tileSize);
+        if (s.algorithm == Algorithm::Clustered || s.algorithm == Algorithm::TwoPointFiveD)
+            set += " cells " + std::to_string(s.cells) + " " + toString(s.slicing);
+        if (s.algorithm == Algorithm::ZBin) set += " bins " + std::to_string(s.bins);
+        if (s.cap) set += " cap " + std::to_string(s.cap);
+        if (s.maxEntries) set += " max-entries " + std::to_string(s.maxEntries);
+        if (s.cap || s.maxEntries) set += " overflow-policy " + std::string(toString(s.overflow));
+        if (s.maxLights) set += " max-lights " + std::to_string(s.maxLights) + " keep " + toString(s.limitKeep);
+        md += "| " + r.config.backend + " | " + r.config.preset + " | " + enginePreset(r.config.preset).engine + " | " +
+              set + " | " + std::to_string(r.falseNegatives - r.falseNegativesListFull - r.falseNegativesLightLimit) +
+              " / " + std::to_string(r.falseNegativesListFull) + " / " + std::to_string(r.falseNegativesLightLimit) +
+              " | " + std::to_string(r.overflowLists) + " | " + fmt("%.4f", r.efficiency) + " | " +
+              std::to_string(r.resultBytes) + " | " + fmt("%.3f", r.cullMs) + " | " +
+              (r.fix.empty() ? std::string("loses nothing") : r.fix) + " |\n";
+    }
+    return md;
 }
 
 } // namespace
@@ -488,6 +683,8 @@ std::string reportMarkdown(const Report& rep) {
             md += ".\n";
         }
     }
+    md += capsSection(rep);
+    md += presetsSection(rep);
     md += "\n## Table\n\n| backend | configuration | cull ms | shade ms | total ms | efficiency | of optimum | FN | "
           "mean list | max list | bytes | image RMSE | image max | Pareto |\n|---|---|---:|---:|---:|---:|---:|---:|---:|"
           "---:|---:|---:|---:|---|\n";

@@ -139,10 +139,14 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
         gt.listShadingWork.assign(lists, 0);
         gt.listExactWork.assign(lists, 0);
         gt.listFalseNegatives.assign(lists, 0);
+        gt.listFalseNegativesListFull.assign(lists, 0);
+        gt.listFalseNegativesLightLimit.assign(lists, 0);
         for (std::size_t l = 0; l < tileOf.size(); ++l) {
             gt.listShadingWork[tileOf[l]] += sub.listShadingWork[l];
             gt.listExactWork[tileOf[l]] += sub.listExactWork[l];
             gt.listFalseNegatives[tileOf[l]] += sub.listFalseNegatives[l];
+            gt.listFalseNegativesListFull[tileOf[l]] += sub.listFalseNegativesListFull[l];
+            gt.listFalseNegativesLightLimit[tileOf[l]] += sub.listFalseNegativesLightLimit[l];
         }
         // The masks are the lists the renderer keeps: their lengths and bytes.
         Metrics& m = gt.metrics;
@@ -161,14 +165,19 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
     gt.listShadingWork.assign(lists, 0);
     gt.listExactWork.assign(lists, 0);
     gt.listFalseNegatives.assign(lists, 0);
+    gt.listFalseNegativesListFull.assign(lists, 0);
+    gt.listFalseNegativesLightLimit.assign(lists, 0);
     gt.tileGeometryPixels.assign(tiles, 0);
+    // The engine limits: a missed light they dropped is counted by cause.
+    const ListLimits& limits = result.limits;
+    const bool limited = !limits.empty();
     Metrics& m = gt.metrics;
 
     glm::dvec3 bmin, bmax;
     if (geometryBounds(depth, proj, workers, cancel, bmin, bmax)) {
         const detail::LightGrid grid(lights, bmin, bmax);
         struct Acc {
-            std::vector<std::uint64_t> w, e, fn;
+            std::vector<std::uint64_t> w, e, fn, fnFull, fnLimit;
             std::vector<std::uint32_t> tilePixels;
             // The optimum: per list its pixels and the lights they need
             // together; `all`'s one list spans every band, so it keeps a flag
@@ -186,6 +195,7 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
         const std::uint32_t per = std::max(result.listsPerTile, 1u); // <= 32: one bit per sub-list
         for (auto& a : acc) {
             a.w.assign(lists, 0), a.e.assign(lists, 0), a.fn.assign(lists, 0);
+            if (limited) a.fnFull.assign(lists, 0), a.fnLimit.assign(lists, 0);
             a.tilePixels.assign(tiles, 0);
             if (oneList) {
                 a.neededAnywhere.assign(lights.size(), 0);
@@ -201,6 +211,9 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
         // per needed light.
         std::vector<std::vector<std::uint32_t>> stamps(workers, std::vector<std::uint32_t>(lights.size(), 0));
         std::vector<std::uint32_t> stampNow(workers, 0);
+        // dropStamps[w][i] == the current stamp when the limits dropped light i from the list.
+        std::vector<std::vector<std::uint32_t>> dropStamps(limited ? workers : 0,
+                                                           std::vector<std::uint32_t>(lights.size(), 0));
         const std::uint32_t ts = result.grid.tileSize;
         // Bands of one tile row, walked tile by tile: a tile's pixels come one
         // after another, so the lights its lists need together are counted
@@ -223,19 +236,26 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
                         if (l != stampedList) {
                             if (++now == 0) { // wrapped: clear old stamps
                                 std::fill(stamp.begin(), stamp.end(), 0);
+                                if (limited) std::fill(dropStamps[w].begin(), dropStamps[w].end(), 0);
                                 now = 1;
                             }
                             const std::uint32_t* first = result.lightIndices.data() + result.listOffset[l];
                             for (std::uint32_t k = 0; k < result.listCount[l]; ++k) stamp[first[k]] = now;
+                            if (limited)
+                                for (auto [d, e] = limits.droppedFrom(l); d != e; ++d) dropStamps[w][*d] = now;
                             stampedList = l;
                         }
                         a.w[l] += result.listCount[l];
                         const std::uint32_t subBit = oneList || perTileUnion ? 1u : 1u << (l - t * per);
                         const std::uint32_t u = perTileUnion ? t : l; // where the union counts
-                        std::uint64_t needed = 0, missed = 0;
+                        std::uint64_t needed = 0, missed = 0, missedFull = 0, missedLimit = 0;
                         grid.forEachContaining(p, [&](std::uint32_t i) {
                             ++needed;
                             missed += stamp[i] != now;
+                            if (limited && stamp[i] != now) {
+                                if (limits.isOverLimit(i)) ++missedLimit;
+                                else if (dropStamps[w][i] == now) ++missedFull;
+                            }
                             if (oneList) {
                                 a.neededAnywhere[i] = 1;
                                 return;
@@ -248,6 +268,7 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
                         });
                         a.e[l] += needed;
                         a.fn[l] += missed;
+                        if (limited) a.fnFull[l] += missedFull, a.fnLimit[l] += missedLimit;
                         if (!oneList) ++a.listPixels[u];
                     }
         });
@@ -272,6 +293,10 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
                 gt.listShadingWork[l] += a.w[l];
                 gt.listExactWork[l] += a.e[l];
                 gt.listFalseNegatives[l] += a.fn[l];
+                if (limited) {
+                    gt.listFalseNegativesListFull[l] += a.fnFull[l];
+                    gt.listFalseNegativesLightLimit[l] += a.fnLimit[l];
+                }
             }
             for (std::size_t t = 0; t < tiles; ++t) gt.tileGeometryPixels[t] += a.tilePixels[t];
         }
@@ -281,6 +306,8 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
         m.shadingWork += gt.listShadingWork[l];
         m.exactWork += gt.listExactWork[l];
         m.falseNegatives += gt.listFalseNegatives[l];
+        m.falseNegativesListFull += gt.listFalseNegativesListFull[l];
+        m.falseNegativesLightLimit += gt.listFalseNegativesLightLimit[l];
         m.maxList = std::max(m.maxList, result.listCount[l]);
     }
     for (std::uint32_t c : gt.tileGeometryPixels) m.geometryPixels += c;

@@ -18,6 +18,34 @@ struct Timings {
     double depthMs = -1, cullMs = -1, groundTruthMs = -1, shadeMs = -1;
 };
 
+// What the engine limits (CullSettings::cap, maxLights, maxEntries) took from
+// the lists the culling test made (applyListLimits, core/limits.hpp). Empty
+// when no limit applies. List ids are the result's own numbering.
+struct ListLimits {
+    // Per light: 1 when the light is past the per-view light limit (so in
+    // no list); empty when maxLights is 0 or not reached.
+    std::vector<std::uint8_t> overLightLimit;
+    std::uint64_t lightsOverLimit = 0;
+    // Lists that held more lights than the cap (or than the record buffer
+    // had left), ascending; per such list k the lights the limit dropped are
+    // droppedLights[droppedOffset[k] .. droppedOffset[k+1]), ascending (none
+    // under the all-lights fallback, which lists every light instead).
+    std::vector<std::uint32_t> overflowLists, droppedOffset, droppedLights;
+    // The longest list the test made, before any cap: the smallest cap that
+    // never overflows.
+    std::uint32_t longestUncapped = 0;
+    // Entries before the limits; the lists' entries after them are entries().
+    std::uint64_t entriesUncapped = 0;
+
+    bool empty() const { return overLightLimit.empty() && overflowLists.empty(); }
+    bool isOverLimit(std::uint32_t light) const { return light < overLightLimit.size() && overLightLimit[light]; }
+    // Index into overflowLists of `list`, or -1 when it did not overflow.
+    long overflowIndex(std::uint32_t list) const;
+    // The lights the limits dropped from `list` (empty when it did not overflow).
+    std::pair<const std::uint32_t*, const std::uint32_t*> droppedFrom(std::uint32_t list) const;
+    bool dropped(std::uint32_t list, std::uint32_t light) const;
+};
+
 // Lists stored compactly: list l covers lightIndices[listOffset[l] ..
 // listOffset[l] + listCount[l]), indices ascending. Memory grows with the
 // entries the scene produces: 4 bytes per entry + 8 per list + per-tile depth
@@ -67,6 +95,8 @@ struct CullResult {
     bool cellLists = false;
 
     std::vector<std::uint32_t> listOffset, listCount, lightIndices;
+    // What the engine limits dropped (settings.cap, maxLights, maxEntries).
+    ListLimits limits;
 
     // Light-versus-volume tests one pass over the lists performed (Vulkan: the
     // candidates left by the light bins; cpu: the lights whose screen bounds
@@ -102,6 +132,11 @@ struct CullResult {
     // masks the culling computes on the way are in diagnosticBytes().
     // zbin: the renderer's form instead, a 32-bit range per bin and a bit per
     // light per tile: 4 x bins + 4 x tiles x ceil(lights / 32).
+    // With a per-list cap (settings.cap), what an engine with that cap
+    // allocates instead: per list a count and `cap` indices, 4 x (cap + 1)
+    // bytes, whatever the lists hold (zbin's masks keep their size); with a
+    // record buffer (settings.maxEntries) 4 bytes per record it can hold and
+    // 8 per list (offset + count).
     std::uint64_t bytes() const;
     // Bytes of the per-tile intermediates kept for diagnostics and overlays,
     // at the GPU's float precision: depth min/max (8 per tile) and cell/slice

@@ -17,6 +17,18 @@ enum class Algorithm { All, Naive, MinMax, HalfZ, TwoPointFiveD, Clustered, Fptl
 const char* toString(Algorithm a);
 Algorithm algorithmFromString(const std::string& s); // throws SettingsError("algorithm", ...)
 
+// Engine limits (docs/ALGORITHMS.md, "Caps and limits"). Which lights an
+// over-full list keeps: the lowest indices (a shader appending lights in
+// index order), the ones nearest the camera (an engine that sorts its lights
+// first), or every light (the fallback of an engine whose over-full record
+// means "shade with all lights").
+enum class OverflowPolicy { Index, Nearest, AllLights };
+const char* toString(OverflowPolicy p); // "index", "nearest", "all-lights"
+// Which lights a per-view light limit keeps: the lowest indices, or the ones
+// nearest the camera.
+enum class LimitKeep { Index, Nearest };
+const char* toString(LimitKeep k); // "index", "nearest"
+
 // Settings of one culling run. Resolution and tile size live on the Camera
 // (they are part of what the culling camera sees) but are also parameters.
 struct CullSettings {
@@ -27,6 +39,14 @@ struct CullSettings {
     bool skipEmpty = true;           // clustered: empty clusters (no geometry) get empty lists
     SpotTest spotTest = SpotTest::ApexSphere; // how spot lights are culled (point lights ignore it)
     std::uint32_t bins = 1024;       // zbin: linear view-depth bins (1..16384)
+    // Engine limits, applied to the lists the culling test made (both
+    // backends, one rule: applyListLimits in core/limits.hpp); 0 = none.
+    std::uint32_t cap = 0;           // entries one list keeps at most
+    std::uint32_t maxLights = 0;     // lights the view culls at most (the others are in no list)
+    std::uint32_t maxEntries = 0;    // entries all lists together keep at most (a record buffer)
+    OverflowPolicy overflow = OverflowPolicy::Index; // what an over-full list or buffer keeps
+    LimitKeep limitKeep = LimitKeep::Index;          // which lights maxLights keeps
+    bool hasLimits() const { return cap || maxLights || maxEntries; }
 
     // Empty when valid, else names the field.
     std::string validate() const;
@@ -45,10 +65,14 @@ struct ParamSpec {
     long long minValue = 0, maxValue = 0; // Int only
     std::string help;
     std::string label;               // short UI label
+    // "limits" for the engine limits (the studio shows them on their own
+    // toolbar row, beside the engine preset); empty for the culling proper.
+    std::string group;
 };
 
 // Every culling parameter, in display order: algorithm, test, cells, slicing,
-// skip-empty, spot-test, bins, tile, width, height.
+// skip-empty, spot-test, bins, tile, width, height, then the limits: cap,
+// max-lights, max-entries, overflow, limit-keep.
 const std::vector<ParamSpec>& cullParams();
 const ParamSpec& cullParam(const std::string& name); // throws SettingsError
 

@@ -100,9 +100,11 @@ struct CustomCullReport {
 // layout's capacity, or that held an index past the light count, is labelled
 // by that (the tool cannot tell whether the culling's test would have listed
 // the light had there been room); any other miss is the culling's own test.
-enum class MissCause { CullingTest, ListFull, InvalidIndex };
-const char* toString(MissCause c); // "culling test", "list full", "invalid index"
-const char* jsonName(MissCause c); // "culling_test", "list_full", "invalid_index"
+// A built-in algorithm's engine limits (CullSettings::cap, maxEntries,
+// maxLights) label a light they dropped "list full" or "light limit".
+enum class MissCause { CullingTest, ListFull, LightLimit, InvalidIndex };
+const char* toString(MissCause c); // "culling test", "list full", "light limit", "invalid index"
+const char* jsonName(MissCause c); // "culling_test", "list_full", "light_limit", "invalid_index"
 
 // One false negative, located: in `tile`, `pixels` geometry pixels need
 // `light` but their list (`list`) does not hold it.

@@ -89,8 +89,8 @@ std::vector<TileLightRow> tileLightRows(const RunOutput& run, const Projection& 
                                         int cell = -1);
 
 // Per-tile heat values for the camera view and the export.
-enum class HeatMode { ListLength, FalsePositives, Efficiency, FalseNegatives };
-// "list-length", "false-positives", "efficiency", "false-negatives"
+enum class HeatMode { ListLength, FalsePositives, Efficiency, FalseNegatives, Overflow };
+// "list-length", "false-positives", "efficiency", "false-negatives", "overflow"
 const char* toString(HeatMode m);
 // NaN where the tile holds no geometry. With W_t and E_t the shading and
 // exact work of the tile's pixels (sums of GroundTruth::listShadingWork and
@@ -99,7 +99,10 @@ const char* toString(HeatMode m);
 // - FalsePositives: W_t - E_t, light evaluations no pixel needed;
 // - Efficiency: E_t / W_t (1 when W_t = 0);
 // - FalseNegatives: the tile's false negatives, sum over its pixels of the
-//   lights they need and their list lacks (0 for `all`).
+//   lights they need and their list lacks (0 for `all`);
+// - Overflow: the entries the engine limits (CullSettings::cap, maxEntries)
+//   dropped from the tile's lists, NaN for a tile none of whose lists was
+//   over-full (so only over-full tiles are drawn: a filter).
 // For `all` the ground truth keeps no per-tile work (its one list spans every
 // tile), so FalsePositives and Efficiency are NaN there.
 std::vector<double> tileHeat(const RunOutput& run, HeatMode mode);

@@ -36,6 +36,9 @@ struct ReportConfig {
     std::map<std::string, std::string> params;
     // A custom shader's row: "custom:my_cull.comp fixed:64 tile" (then label() is this).
     std::string customLabel;
+    // An engine preset's row (ReportOptions::presets): its name; label() is
+    // then "preset:NAME".
+    std::string preset;
     // "2.5d tile=16 test=planes cells=32 slicing=log" (applicable ones only).
     std::string label() const;
 };
@@ -49,6 +52,16 @@ struct ReportRow {
     std::uint64_t optimalWork = 0;
     double efficiencyVsOptimal = 1.0;
     std::uint64_t falseNegatives = 0;
+    // Of those, the engine limits' (list full: a cap or record buffer; light
+    // limit), and the lists they left over-full.
+    std::uint64_t falseNegativesListFull = 0, falseNegativesLightLimit = 0, overflowLists = 0;
+    // The longest list the culling test made before any cap: the smallest cap
+    // that never overflows.
+    std::uint32_t longestUncapped = 0;
+    // A preset's row with misses from its limits: the first setting change
+    // that removes them, found by culling again ("max-lights 300, cap 41"),
+    // or why none of the limits is to blame. Empty otherwise.
+    std::string fix;
     double meanList = 0;
     std::uint32_t maxList = 0;
     std::uint64_t resultBytes = 0;
@@ -74,6 +87,9 @@ struct ReportOptions {
     // scene camera's tile size, beside the vulkan rows: on the vulkan
     // backend's depth when it ran, else the first backend's.
     std::vector<CustomShaderOptions> shaders;
+    // Engine presets (core/presets.hpp) to run side by side instead of the
+    // sweep: one row each per backend, at the preset's own grid and limits.
+    std::vector<std::string> presets;
     // A cancel returns the rows finished so far (Report::cancelled set)
     // instead of throwing Cancelled: the studio shows what a long sweep made.
     bool partialOnCancel = false;
@@ -101,6 +117,10 @@ struct Report {
 // but `all`.
 bool paramAppliesTo(const std::string& name, Algorithm algorithm, std::uint32_t cells,
                     bool sceneHasSpotLights = false);
+// The same for full settings: the engine limits (cap, max-lights,
+// max-entries) apply to every algorithm, `all` included; overflow only with a
+// cap or record buffer set, limit-keep only with a light limit.
+bool paramAppliesTo(const std::string& name, const CullSettings& settings, bool sceneHasSpotLights = false);
 
 // The configurations of one backend, in sweep order. Throws SettingsError for
 // an unknown or invalid fixed parameter.

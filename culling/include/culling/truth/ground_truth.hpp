@@ -14,6 +14,13 @@ namespace lc {
 
 struct Metrics {
     std::uint64_t falseNegatives = 0; // sum_p |needed(p) \ listed(p)|
+    // The false negatives by cause (the rest are the culling test's own): a
+    // light the engine limits dropped from p's list (a cap or a full record
+    // buffer: "list full"), and a light past the per-view light limit.
+    std::uint64_t falseNegativesListFull = 0, falseNegativesLightLimit = 0;
+    std::uint64_t falseNegativesCullingTest() const {
+        return falseNegatives - falseNegativesListFull - falseNegativesLightLimit;
+    }
     std::uint64_t shadingWork = 0;    // W = sum_p |listed(p)|
     std::uint64_t exactWork = 0;      // E = sum_p |needed(p)|
     double efficiency = 1.0;          // E / W (1 when W == 0)
@@ -34,6 +41,9 @@ struct GroundTruth {
     Metrics metrics;
     // Per list (CullResult numbering): sums over the pixels that use it.
     std::vector<std::uint64_t> listShadingWork, listExactWork, listFalseNegatives;
+    // Per list, the part of listFalseNegatives from the engine limits
+    // (Metrics::falseNegativesListFull, falseNegativesLightLimit).
+    std::vector<std::uint64_t> listFalseNegativesListFull, listFalseNegativesLightLimit;
     // Per tile: pixels with geometry.
     std::vector<std::uint32_t> tileGeometryPixels;
 };

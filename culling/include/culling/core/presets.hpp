@@ -1,0 +1,41 @@
+#pragma once
+// Engine presets (docs/ENGINES.md): the culling settings and limits of a
+// shipped engine's light culling, modelled with this tool's algorithms. Every
+// number comes from the engine's public source, cited in docs/ENGINES.md; a
+// preset says what its model leaves out.
+
+#include "culling/core/params.hpp"
+#include "culling/scene/scene.hpp"
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace lc {
+
+struct EnginePreset {
+    std::string name;   // "urp", "hdrp-fptl", ... (--preset NAME)
+    std::string engine; // "Unity URP Forward+ (desktop)"
+    // Parameter -> value, set in this order (the parameter table's names).
+    std::vector<std::pair<std::string, std::string>> params;
+    // Settings an engine derives from the screen and the light count (URP's
+    // tile width from its word budget, Filament's froxel size from its
+    // buffer, Unreal's light pool from its grid): applied after `params`.
+    std::function<void(CullSettings&, Camera&, std::size_t lightCount)> derive;
+    // How the derived settings are worked out, in one line (docs, --help).
+    std::string derivedRule;
+    // What the model leaves out, in one line.
+    std::string leftOut;
+};
+
+// Every preset, in docs/ENGINES.md's order.
+const std::vector<EnginePreset>& enginePresets();
+// Throws SettingsError("preset", ...) naming the known presets.
+const EnginePreset& enginePreset(const std::string& name);
+// Sets `settings` and the camera's tile size as the preset says for a scene
+// of `lightCount` lights seen through `camera` (its resolution as it is).
+void applyPreset(const EnginePreset& preset, CullSettings& settings, Camera& camera, std::size_t lightCount);
+
+} // namespace lc
