@@ -600,13 +600,27 @@ void CameraView::updateOverlay() {
     heatData_->SetPoints(pts);
     heatData_->SetPolys(quads);
     heatData_->GetCellData()->SetScalars(values);
-    if (mode == lc::HeatMode::Efficiency) {
+    if (mode == lc::HeatMode::Overflow) {
+        // One hue, the orange that marks over-full lists everywhere (the
+        // heat map PNGs' frames): only over-full tiles are drawn at all.
+        lut_->SetHueRange(0.08, 0.08);
+        lut_->SetSaturationRange(0.6, 1.0);
+        lut_->SetValueRange(1.0, 1.0);
+        lut_->SetTableRange(0, std::max(1.0, maxHeat));
+        legendTitle_ = "dropped\nentries";
+        legend_->SetLabelFormat("%.0f");
+        legend_->SetNumberOfLabels(maxHeat < 5 ? int(std::max(1.0, maxHeat)) + 1 : 5);
+    } else if (mode == lc::HeatMode::Efficiency) {
+        lut_->SetSaturationRange(0.9, 0.9);
+        lut_->SetValueRange(1.0, 1.0);
         lut_->SetHueRange(0.0, 0.667);
         lut_->SetTableRange(0, 1);
         legendTitle_ = "efficiency\nper tile";
         legend_->SetLabelFormat("%.2f");
         legend_->SetNumberOfLabels(5);
     } else {
+        lut_->SetSaturationRange(0.9, 0.9);
+        lut_->SetValueRange(1.0, 1.0);
         lut_->SetHueRange(0.667, 0.0);
         const double top = std::max(1.0, maxHeat);
         lut_->SetTableRange(0, top);
@@ -639,6 +653,10 @@ void CameraView::updateOverlay() {
                                          : std::string(lc::toString(run->result.algorithm));
     heatCaption_ = what + "  " + std::to_string(g.tilesX) + "x" +
                    std::to_string(g.tilesY) + " tiles of " + std::to_string(g.tileSize) + " px";
+    // The engine limits, when they took something: over-full lists and lights past the limit.
+    if (const lc::ListLimits& lim = run->result.limits; !run->custom && !lim.empty())
+        heatCaption_ += "  |  " + std::to_string(lim.overflowLists.size()) + " over-full" +
+                        (lim.lightsOverLimit ? ", " + std::to_string(lim.lightsOverLimit) + " past limit" : std::string());
     updateImage();
     updateLegendAndCaption();
     updateSelectedTile();

@@ -17,6 +17,7 @@
 #include "vtk_adapters.hpp"
 
 #include "culling/core/errors.hpp"
+#include "culling/core/presets.hpp"
 #include "culling/scene/gltf_io.hpp"
 #include "culling/scene/scene_io.hpp"
 
@@ -496,9 +497,35 @@ void MainWindow::buildToolbar() {
 
     // Culling controls, generated from the one parameter table (lc::cullParams)
     // that also defines CullSettings and the CLI's flags.
-    QToolBar* bar = addToolBar(tr("Culling"));
-    bar->setObjectName("cullToolbar");
+    QToolBar* cullBar = addToolBar(tr("Culling"));
+    cullBar->setObjectName("cullToolbar");
+    // The engine limits on a row of their own, after the engine preset that
+    // sets them (docs/ENGINES.md).
+    addToolBarBreak();
+    QToolBar* limitsBar = addToolBar(tr("Limits"));
+    limitsBar->setObjectName("limitsToolbar");
+    auto* presetLabel = new QLabel(tr("Engine preset "));
+    limitsBar->addWidget(presetLabel);
+    presetCombo_ = new QComboBox;
+    presetCombo_->setObjectName("presetCombo");
+    presetCombo_->addItem(tr("(none)"), QString());
+    for (const lc::EnginePreset& p : lc::enginePresets())
+        presetCombo_->addItem(QString::fromStdString(p.name), QString::fromStdString(p.name));
+    presetCombo_->setToolTip(tr("Cull as a shipped engine does: its algorithm, grid and limits (docs/ENGINES.md). "
+                                "Shows the preset the settings equal, (none) once one is changed."));
+    for (int i = 1; i < presetCombo_->count(); ++i) {
+        const lc::EnginePreset& p = lc::enginePreset(presetCombo_->itemData(i).toString().toStdString());
+        presetCombo_->setItemData(i, QString::fromStdString(p.engine + ". Left out: " + p.leftOut), Qt::ToolTipRole);
+    }
+    connect(presetCombo_, qOverload<int>(&QComboBox::activated), this, [this](int i) {
+        const std::string name = presetCombo_->itemData(i).toString().toStdString();
+        if (!name.empty()) applyPreset(name);
+    });
+    limitsBar->addWidget(presetCombo_);
+    limitsBar->addSeparator();
+    QToolBar* bar = cullBar;
     for (const lc::ParamSpec& p : lc::cullParams()) {
+        bar = p.group == "limits" ? limitsBar : cullBar;
         const std::string name = p.name;
         const QString tip = QString::fromStdString(p.help);
         if (p.type == lc::ParamType::Bool) {
@@ -537,7 +564,8 @@ void MainWindow::buildToolbar() {
     for (auto& [name, w] : paramWidgets_) w->setObjectName(QString::fromStdString("param_" + name));
     // Ctrl+Z in a culling field undoes the scene's last edit (tile, width and
     // height are camera edits), as in the properties panel.
-    (new UndoKeysToWindow(bar))->watch(bar);
+    (new UndoKeysToWindow(cullBar))->watch(cullBar);
+    bar = cullBar;
 
     // What runs the culling (custom shader, backend, device) sits on the
     // first row beside the file actions: with it on the parameter row, a
@@ -602,7 +630,49 @@ void MainWindow::syncParamWidgets() {
         else if (auto* combo = qobject_cast<QComboBox*>(w)) combo->setCurrentText(v);
         else if (auto* spin = qobject_cast<QSpinBox*>(w)) spin->setValue(v.toInt());
     }
+    // The preset whose settings these are, for this scene, else "(none)".
+    if (presetCombo_) {
+        int shown = 0;
+        const lc::Camera& cam = doc_->scene().camera;
+        for (int i = 1; i < presetCombo_->count() && !shown; ++i) {
+            lc::CullSettings s;
+            lc::Camera c = cam;
+            lc::applyPreset(lc::enginePreset(presetCombo_->itemData(i).toString().toStdString()), s, c,
+                            doc_->scene().lights.size());
+            bool same = c.tileSize == cam.tileSize;
+            for (const lc::ParamSpec& p : lc::cullParams())
+                same = same && lc::getParam(s, c, p.name) == lc::getParam(doc_->settings(), cam, p.name);
+            if (same) shown = i;
+        }
+        presetCombo_->setCurrentIndex(shown);
+    }
     syncingParams_ = false;
+}
+
+void MainWindow::applyPreset(const std::string& name) {
+    lc::CullSettings s;
+    lc::Camera cam = doc_->scene().camera;
+    try {
+        lc::applyPreset(lc::enginePreset(name), s, cam, doc_->scene().lights.size());
+    } catch (const lc::Error& e) {
+        log(describe(e), true);
+        syncParamWidgets();
+        return;
+    }
+    const lc::EnginePreset& p = lc::enginePreset(name);
+    log(tr("preset %1: %2 (left out: %3)")
+            .arg(QString::fromStdString(name), QString::fromStdString(p.engine), QString::fromStdString(p.leftOut)));
+    doc_->setSettings(s);
+    if (cam.tileSize != doc_->scene().camera.tileSize) doc_->setCamera(cam, tr("Preset %1").arg(QString::fromStdString(name)));
+    syncParamWidgets();
+}
+
+bool MainWindow::setPresetFromUi(const QString& name) {
+    const int i = presetCombo_->findData(name);
+    if (i < 1) return false;
+    presetCombo_->setCurrentIndex(i);
+    emit presetCombo_->activated(i); // what a user's pick emits
+    return presetCombo_->currentIndex() == i;
 }
 
 void MainWindow::onParamEdited(const std::string& name, const QString& value) {

@@ -117,6 +117,9 @@ public:
     void setBackend(const QString& backend, const QString& device = {});
     // Sets one culling parameter through its toolbar control (as a user would).
     bool setParamFromUi(const QString& name, const QString& value);
+    // Picks an engine preset in the Limits toolbar's combo (as a user would):
+    // its algorithm, grid and limits for this scene. False for an unknown name.
+    bool setPresetFromUi(const QString& name);
 
     // --- editing ----------------------------------------------------------------
     // Adds a light under the inspector-view position `pos` (logical px) when a
@@ -206,6 +209,8 @@ private:
     QPlainTextEdit* log_;
     QMenu* recentMenu_ = nullptr;
     QComboBox* backendCombo_ = nullptr;
+    QComboBox* presetCombo_ = nullptr; // "(none)" or the preset the settings equal
+    void applyPreset(const std::string& name);
     QLineEdit* deviceEdit_ = nullptr;
     std::map<std::string, QWidget*> paramWidgets_;
     bool syncingParams_ = false;

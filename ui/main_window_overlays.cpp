@@ -94,7 +94,8 @@ void MainWindow::buildOverlayMenus(QMenu* file, QMenu* view) {
     const std::pair<QString, lc::HeatMode> modes[] = {{tr("List length"), lc::HeatMode::ListLength},
                                                       {tr("False positives"), lc::HeatMode::FalsePositives},
                                                       {tr("Efficiency"), lc::HeatMode::Efficiency},
-                                                      {tr("False negatives (misses)"), lc::HeatMode::FalseNegatives}};
+                                                      {tr("False negatives (misses)"), lc::HeatMode::FalseNegatives},
+                                                      {tr("Over-full lists (engine limits)"), lc::HeatMode::Overflow}};
     for (const auto& [text, mode] : modes) {
         QAction* a = heat->addAction(text);
         a->setObjectName(QString("actionHeat_%1").arg(lc::toString(mode)));

@@ -245,13 +245,13 @@ private slots:
         std::vector<int> bestLights;
         while (!csv.atEnd()) {
             const QStringList f = QString::fromUtf8(csv.readLine()).trimmed().split(',');
-            QCOMPARE(f.size(), 8);
+            QCOMPARE(f.size(), 13);
             if (f[6].toInt() > bestCount) {
                 bestCount = f[6].toInt();
                 bestX = f[0].toInt();
                 bestY = f[1].toInt();
                 bestLights.clear();
-                for (const QString& s : f[7].split(' ', Qt::SkipEmptyParts)) bestLights.push_back(s.toInt());
+                for (const QString& s : f[12].split(' ', Qt::SkipEmptyParts)) bestLights.push_back(s.toInt());
             }
         }
         QVERIFY(bestCount > 0);
