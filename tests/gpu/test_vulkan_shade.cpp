@@ -240,3 +240,25 @@ TEST_F(VulkanShade, BadListsAreTypedErrorsAndZeroLightsShadeBlack) {
     const ShadeInputs allIn = makeShadeInputs(depth, proj, nullptr);
     for (float v : gpu.shade(allIn, none, nullptr)) ASSERT_EQ(v, 0.0f);
 }
+
+// An image whose G-buffer is past one storage buffer's range (lavapipe:
+// 128 MiB, 2048x2048 pixels of 32 bytes) is shaded in bands of rows: the same
+// image as the CPU reference, every band's pixels with their own lists. Found
+// by the 3840x2160 hard case, which failed on "G-buffer exceeds this device's
+// storage buffer range".
+TEST_F(VulkanShade, AnImagePastOneStorageBufferIsShadedInBands) {
+    CullBackend& gpu = gputest::vulkan();
+    auto cpu = makeCpuBackend();
+    Scene scene = smallScene("atrium", 4096, 1100, 24);
+    const Projection proj(scene.camera);
+    const TileGrid grid = TileGrid::make(4096, 1100, 16);
+    const ViewLights lights = makeViewLights(scene);
+    const DepthImage depth = cpu->renderDepth(scene, proj);
+    CullSettings settings;
+    settings.algorithm = Algorithm::MinMax;
+    const CullResult result = cpu->cull(depth, proj, grid, lights, settings);
+    const ShadeInputs in = makeShadeInputs(depth, proj, &result);
+    ASSERT_GT(std::size_t(4096) * 1100 * 32, std::size_t(1) << 27); // past lavapipe's range: bands
+    expectSameImage(gpu.shade(in, lights, &result), shadeCpu(in, lights, &result), in, "banded");
+    EXPECT_GT(gpu.lastShadeMs(), 0.0);
+}

@@ -511,6 +511,89 @@ inline const std::vector<HardCase>& hardCases() {
                  return s;
              },
              SphereTest::PlanesAabb, 16, Slicing::Log, "", 0, checkHasGeometry});
+        // ---- The shapes of engines' own limit bugs (issue 37; docs/ENGINES.md
+        // says which presets lose lights on each and why). The built-in
+        // algorithms have no limits and must miss nothing on them.
+        add({"lights_past_scene_limit",
+             "600 lights in the room: past Godot's 512, HDRP's 512 on screen, URP's and Filament's 256, "
+             "WebGL2 Bevy's 204 (Godot #56591, #61747; Filament #7493)",
+             [] {
+                 Scene s = room(128, 72);
+                 s.lights = lightsIn({-9, 0.2, -29}, {9, 7.5, 1}, 600, 37);
+                 return s;
+             }});
+        add({"dense_cluster_4k",
+             "3840x2160, 160 small lights packed round one box: tile and cluster lists past a cap (Bevy #3915; "
+             "HDRP's 23, later 63)",
+             [] {
+                 Scene s = room(3840, 2160);
+                 s.lights.clear();
+                 for (int i = 0; i < 160; ++i) {
+                     const double a = 0.61 * i, r = 0.3 + 0.01 * (i % 40);
+                     s.lights.push_back(light("c" + std::to_string(i),
+                                              {3.5 + r * std::cos(a), 2.5 + 0.02 * (i % 50), -12.5 + r * std::sin(a)},
+                                              1.5 + 0.01 * (i % 30)));
+                 }
+                 return s;
+             },
+             SphereTest::Planes, 16, Slicing::Log, "", 0, checkHasGeometry});
+        add({"wide_spots_short_far",
+             "spot lights at the widest the model holds (90 degree half-angle: a hemisphere) under a far "
+             "plane of 12, cones cut by it",
+             [] {
+                 Scene s = room(96, 64);
+                 s.camera.farPlane = 12;
+                 s.lights.clear();
+                 for (int i = 0; i < 24; ++i) {
+                     PointLight l = light("spot" + std::to_string(i), {-8 + 0.7 * i, 6, -2 - 0.9 * i}, 6 + 0.2 * (i % 7));
+                     l.kind = LightKind::Spot;
+                     l.direction = {std::sin(0.5 * i), -1, std::cos(0.7 * i)};
+                     l.outerAngleDeg = 90 - (i % 3) * 10;
+                     s.lights.push_back(l);
+                 }
+                 return s;
+             },
+             SphereTest::PlanesAabb, 16, Slicing::Log, "", 0, checkHasGeometry});
+        add({"lights_seen_from_far",
+             "the room seen from 2,000 units away through a 2 degree lens: every light a few pixels wide, "
+             "log slices stretched over a far plane of 5,000",
+             [] {
+                 Scene s = room(128, 72);
+                 s.camera.position = {0, 800, 1900};
+                 s.camera.target = {0, 3, -14};
+                 s.camera.fovYDeg = 2;
+                 s.camera.nearPlane = 1;
+                 s.camera.farPlane = 5000;
+                 return s;
+             },
+             SphereTest::Planes, 16, Slicing::Log, "", 0, checkHasGeometry});
+        add({"orthographic_far_cut",
+             "an orthographic camera whose far plane (18) cuts the room: lights and walls beyond it",
+             [] {
+                 Scene s = room(96, 64);
+                 s.camera.projection = ProjectionKind::Orthographic;
+                 s.camera.orthoHeight = 12;
+                 s.camera.farPlane = 18;
+                 return s;
+             },
+             SphereTest::Planes, 16, Slicing::Log, "", 0, checkHasGeometry});
+        add({"near_gap_first_slice",
+             "geometry and lights from 0.2 to 4 in front of a near plane of 0.05: all of it inside the "
+             "first slice of engines whose first slice ends at 5 (Filament, Bevy), many log slices here",
+             [] {
+                 Scene s = room(96, 64);
+                 s.camera.position = {0, 1, 1.5};
+                 s.camera.target = {0, 1, -3};
+                 s.camera.nearPlane = 0.05;
+                 Mesh& m = s.meshes[0];
+                 addBox(m, {-0.4, 0.8, 0.8}, {-0.1, 1.1, 1.1}); // 0.4..0.7 in front of the eye
+                 addBox(m, {0.2, 0.6, -1.5}, {0.8, 1.4, -0.9});
+                 for (int i = 0; i < 24; ++i)
+                     s.lights.push_back(light("near" + std::to_string(i),
+                                              {-0.6 + 0.05 * i, 0.7 + 0.03 * (i % 9), 1.3 - 0.18 * i}, 0.15 + 0.02 * (i % 6)));
+                 return s;
+             },
+             SphereTest::Planes, 32, Slicing::Log, "", 0, checkHasGeometry});
         add({"nan_light_position", "a NaN in a light's position: LightError naming the light",
              [] {
                  Scene s = room(32, 16);

@@ -16,6 +16,7 @@
 #include "hardcase_scenes.hpp"
 
 #include "culling/core/depth.hpp"
+#include "culling/core/presets.hpp"
 #include "culling/truth/ground_truth.hpp"
 
 #include <algorithm>
@@ -227,6 +228,47 @@ INSTANTIATE_TEST_SUITE_P(HardCases, HardCaseTest,
                              return std::get<0>(info.param) + "__" + algorithmId(std::get<1>(info.param)) + "__" +
                                     std::get<2>(info.param);
                          });
+
+// The cases shaped after engines' limit bugs, through every engine preset
+// (CPU reference): the misses each preset's limits cause, by cause, are the
+// table docs/ENGINES.md shows ("On the hard cases"). A change of a preset, a
+// case or the limits' rule shows here as the table to put in the docs.
+TEST(HardCasePresets, LossesMatchTheDocumentedTable) {
+    const char* engineCases[] = {"lights_past_scene_limit", "dense_cluster_4k",     "wide_spots_short_far",
+                                 "lights_seen_from_far",    "orthographic_far_cut", "near_gap_first_slice"};
+    auto cpu = makeCpuBackend();
+    std::string table;
+    for (const char* name : engineCases) {
+        const HardCase& c = caseNamed(name);
+        const Scene base = c.make();
+        for (const EnginePreset& p : enginePresets()) {
+            Scene scene = base;
+            CullSettings s;
+            applyPreset(p, s, scene.camera, scene.lights.size());
+            RunOptions o;
+            o.truthOptions.imageError = false;
+            const RunOutput run = runPipeline(scene, s, *cpu, o);
+            const Metrics& m = run.truth.metrics;
+            EXPECT_EQ(m.falseNegativesCullingTest(), 0u) << name << " " << p.name;
+            table += "| " + std::string(name) + " | " + p.name + " | " + std::to_string(m.falseNegativesListFull) +
+                     " | " + std::to_string(m.falseNegativesLightLimit) + " | " +
+                     std::to_string(run.result.limits.overflowLists.size()) + " | " +
+                     std::to_string(run.result.limits.lightsOverLimit) + " |\n";
+        }
+    }
+    std::ifstream in(std::string(LC_SOURCE_DIR) + "/docs/ENGINES.md");
+    ASSERT_TRUE(in);
+    std::string doc, line;
+    bool inside = false;
+    while (std::getline(in, line)) {
+        if (line.find("<!-- hardcase-presets: end -->") != std::string::npos) inside = false;
+        if (inside && line.rfind("| ", 0) == 0 && line.find(" | ---") == std::string::npos &&
+            line.find("| case |") == std::string::npos)
+            doc += line + "\n";
+        if (line.find("<!-- hardcase-presets: begin -->") != std::string::npos) inside = true;
+    }
+    EXPECT_EQ(doc, table) << "docs/ENGINES.md's table should read:\n" << table;
+}
 
 // tests/hardcase/cases.txt names the cases for CTest (one process per case):
 // it must list exactly the cases above, in order.
