@@ -458,11 +458,13 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
         const auto msSince = [](Clock::time_point t0) {
             return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         };
+        lc::DepthPass pass;
         for (int i = 0; i < opt.warmup + opt.repeat; ++i) {
             const Clock::time_point d0 = Clock::now();
-            const lc::DepthImage depth = backend->renderDepth(scene, proj);
+            pass = backend->depthPass(scene, proj);
             const double dc = msSince(d0);
-            const double d = backend->lastDepthMs(), dw = backend->lastDepthWallMs();
+            const lc::DepthImage& depth = pass.image;
+            const double d = pass.ms, dw = pass.wallMs;
             // Peak device memory of the culling pass alone: what it allocates
             // beyond what is alive before it (its buffers, the staging copies
             // included; the depth image is the input, on the device already
@@ -487,8 +489,8 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
                     cs = stats(cullMs), ws = stats(cullWallMs), ccs = stats(cullCallMs);
         std::cout << label << ": depth " << fmt("%.3f", ds.median) << " [" << fmt("%.3f", ds.min) << ".."
                   << fmt("%.3f", ds.max) << "] (wall " << fmt("%.3f", dws.median) << ", call "
-                  << fmt("%.3f", dcs.median) << ", " << backend->lastDepthTrianglesDrawn() << " of "
-                  << backend->lastDepthTriangles() << " triangles), cull " << fmt("%.3f", cs.median) << " ["
+                  << fmt("%.3f", dcs.median) << ", " << pass.trianglesDrawn << " of "
+                  << pass.triangles << " triangles), cull " << fmt("%.3f", cs.median) << " ["
                   << fmt("%.3f", cs.min) << ".." << fmt("%.3f", cs.max) << "] (wall "
                   << fmt("%.3f", ws.median) << ", call " << fmt("%.3f", ccs.median) << "), " << last.entries()
                   << " entries, " << last.listCountTotal() << " lists, " << last.bytes() << " bytes (+"
@@ -516,8 +518,8 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
                            {"diagnostic_bytes", last.diagnosticBytes()},
                            {"volume_tests", last.volumeTests},
                            {"depth_bytes", std::uint64_t(scene.camera.width) * scene.camera.height * 4},
-                           {"depth_triangles", backend->lastDepthTriangles()},
-                           {"depth_triangles_drawn", backend->lastDepthTrianglesDrawn()},
+                           {"depth_triangles", pass.triangles},
+                           {"depth_triangles_drawn", pass.trianglesDrawn},
                            {"peak_device_bytes", peakDeviceBytes}});
 
         std::size_t k = 0;
@@ -730,14 +732,15 @@ int main(int argc, char** argv) {
                                    "whose pixels read each list)");
             checkFlags.applyParams(settings, scene);
             const lc::Projection proj(scene.camera);
-            lc::DepthImage depth;
+            lc::DepthPass pass;
+            lc::DepthImage& depth = pass.image;
             std::unique_ptr<lc::CullBackend> backend;
             if (!checkDepth.depthFile.empty()) {
                 depth = lc::loadDepthFile(checkDepth.depthFile, proj);
             } else {
                 scene.validate();
                 backend = checkFlags.openBackend();
-                depth = backend->renderDepth(scene, proj);
+                pass = backend->depthPass(scene, proj);
             }
             lc::CustomCullReport report;
             lc::RunOptions options;
@@ -749,9 +752,9 @@ int main(int argc, char** argv) {
             if (backend) {
                 result.depthReused = false;
                 result.depthFrom = "pre-pass on " + backend->name() + " (" + backend->deviceName() + ")";
-                result.result.timings.depthMs = backend->lastDepthMs();
-                result.result.depthTriangles = backend->lastDepthTriangles();
-                result.result.depthTrianglesDrawn = backend->lastDepthTrianglesDrawn();
+                result.result.timings.depthMs = pass.ms;
+                result.result.depthTriangles = pass.triangles;
+                result.result.depthTrianglesDrawn = pass.trianglesDrawn;
             } else {
                 result.depthFrom = "depth file " + checkDepth.depthFile;
             }

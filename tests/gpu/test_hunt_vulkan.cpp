@@ -42,13 +42,11 @@ public:
     std::string name() const override { return inner_.name(); }
     std::string deviceName() const override { return inner_.deviceName(); }
     std::string timingMethod() const override { return inner_.timingMethod(); }
-    DepthImage renderDepth(const Scene& scene, const Projection& proj) override {
-        DepthImage d = inner_.renderDepth(scene, proj);
-        lastDepthMs_ = inner_.lastDepthMs();
-        return d;
+protected:
+    DepthPass renderDepthPass(const Scene& scene, const Projection& proj) override {
+        return inner_.depthPass(scene, proj);
     }
 
-protected:
     CullResult cullFrame(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
                          const ViewLights& lights, const CullSettings& settings) override {
         CullResult r = inner_.cull(depth, proj, frame.grid, lights, settings);

@@ -385,8 +385,9 @@ TEST_F(GpuTest, GpuWorkLayoutEmulatedOnLavapipe) {
         const Projection proj(scene.camera);
         const TileGrid grid = TileGrid::make(width, 187, 16);
         const ViewLights lights = makeViewLights(scene);
-        const DepthImage depth = emulated->renderDepth(scene, proj);
-        EXPECT_GE(emulated->lastDepthMs(), 0.0);
+        const DepthPass pass = emulated->depthPass(scene, proj);
+        const DepthImage& depth = pass.image;
+        EXPECT_GE(pass.ms, 0.0);
         const DepthImage cpuLayoutDepth = gputest::vulkan().renderDepth(scene, proj);
         EXPECT_EQ(depth.depth, cpuLayoutDepth.depth) << "staged vertex upload changed the depth";
         for (Algorithm a : kAlgorithms) {

@@ -70,13 +70,16 @@ class VulkanDepth : public GpuTest, public ::testing::WithParamInterface<DepthCa
 
 // The Vulkan pre-pass of `scene` against the CPU rasteriser's: the same
 // surface wins every pixel but on triangle edges.
-void expectAgreesWithCpuRasteriser(const Scene& scene, const Projection& proj, const std::string& label) {
+// `out`: the Vulkan pass (its figures), when given.
+void expectAgreesWithCpuRasteriser(const Scene& scene, const Projection& proj, const std::string& label,
+                                   DepthPass* out = nullptr) {
     const DepthImage cpu = rasterizeDepthCpu(scene, proj);
-    const DepthImage gpu = gputest::vulkan().renderDepth(scene, proj);
+    DepthPass pass = gputest::vulkan().depthPass(scene, proj);
+    const DepthImage& gpu = pass.image;
     ASSERT_EQ(gpu.width, cpu.width);
     ASSERT_EQ(gpu.height, cpu.height);
     EXPECT_EQ(gpu.clearDepth, cpu.clearDepth);
-    EXPECT_GE(gputest::vulkan().lastDepthMs(), 0.0);
+    EXPECT_GE(pass.ms, 0.0);
 
     // Pixels whose centre lies within this distance of a triangle edge may be
     // covered by one rasteriser and not the other: lavapipe snaps vertices to
@@ -139,6 +142,7 @@ void expectAgreesWithCpuRasteriser(const Scene& scene, const Projection& proj, c
     EXPECT_GT(both, 0u);
     EXPECT_EQ(notOnEdge, 0u);
     EXPECT_LE(coverageDiffers + depthWinnerDiffers, both / 100) << "edge differences should be rare";
+    if (out) *out = std::move(pass);
 }
 
 
@@ -218,15 +222,12 @@ TEST_F(GpuTest, ClosedSolidsFollowTheMeshContent) {
     const Projection proj(scene.camera);
     std::unique_ptr<CullBackend> vk = makeVulkanBackend("");
     const Mesh closed = scene.meshes[0];
-    vk->renderDepth(scene, proj);
-    EXPECT_EQ(vk->lastDepthTrianglesDrawn(), 6u) << "three faces of a box seen from a corner's direction";
+    EXPECT_EQ(vk->depthPass(scene, proj).trianglesDrawn, 6u) << "three faces of a box seen from a corner's direction";
     scene.meshes[0].indices[0] = scene.meshes[0].indices[1]; // a triangle that repeats a corner: not closed
-    vk->renderDepth(scene, proj);
-    EXPECT_EQ(vk->lastDepthTrianglesDrawn(), 12u);
+    EXPECT_EQ(vk->depthPass(scene, proj).trianglesDrawn, 12u);
     scene.meshes[0] = closed;
     scene.meshes[0].positions[0] += 0.5f; // moved corner: still closed, other planes
-    vk->renderDepth(scene, proj);
-    EXPECT_LT(vk->lastDepthTrianglesDrawn(), 12u);
+    EXPECT_LT(vk->depthPass(scene, proj).trianglesDrawn, 12u);
     expectAgreesWithCpuRasteriser(scene, proj, "closed solids, edited box");
 }
 
@@ -282,12 +283,13 @@ TEST_F(GpuTest, ClosedSolidsLoseOnlyFacesNoRayMeetsFirst) {
              {ProjectionKind::Perspective, ProjectionKind::ReversedZ, ProjectionKind::Orthographic}) {
             scene->camera.projection = kind;
             const Projection proj(scene->camera);
-            expectAgreesWithCpuRasteriser(*scene, proj, isRoom ? "closed solids, room" : "closed solids, cut");
-            EXPECT_EQ(gputest::vulkan().lastDepthTriangles(), total);
+            DepthPass pass;
+            expectAgreesWithCpuRasteriser(*scene, proj, isRoom ? "closed solids, room" : "closed solids, cut", &pass);
+            EXPECT_EQ(pass.triangles, total);
             if (isRoom) // the three boxes in the room show at most three faces each
-                EXPECT_LE(gputest::vulkan().lastDepthTrianglesDrawn(), total - 3 * 6) << toString(kind);
+                EXPECT_LE(pass.trianglesDrawn, total - 3 * 6) << toString(kind);
             else
-                EXPECT_EQ(gputest::vulkan().lastDepthTrianglesDrawn(), total) << toString(kind);
+                EXPECT_EQ(pass.trianglesDrawn, total) << toString(kind);
         }
     }
 }

@@ -87,6 +87,21 @@ CullFrame makeCullFrame(const DepthImage& depth, const Projection& proj, const T
     return f;
 }
 
+DepthPass CullBackend::depthPass(const Scene& scene, const Projection& proj) {
+    const auto t0 = std::chrono::steady_clock::now();
+    DepthPass d = renderDepthPass(scene, proj);
+    const double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (d.wallMs < 0) d.wallMs = wall;
+    if (d.ms < 0) d.ms = d.wallMs;
+    const DepthImage& img = d.image;
+    if (img.width != proj.width() || img.height != proj.height() ||
+        img.depth.size() != std::size_t(img.width) * img.height)
+        throw Error("backend '" + name() + "' returned a " + std::to_string(img.width) + "x" +
+                    std::to_string(img.height) + " depth image for a " + std::to_string(proj.width()) + "x" +
+                    std::to_string(proj.height()) + " camera");
+    return d;
+}
+
 CullResult CullBackend::cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
                              const ViewLights& lights, const CullSettings& settings) {
     const CullFrame frame = makeCullFrame(depth, proj, grid, lights, settings);

@@ -312,21 +312,18 @@ RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBack
     out.lights = makeViewLights(scene);
     throwIfCancelled(cancel);
 
-    const auto t0 = Clock::now();
+    DepthPass pass;
     if (options.reuseDepth) {
         out.depth = *options.reuseDepth;
         out.depthReused = true;
+        if (out.depth.width != grid.width || out.depth.height != grid.height ||
+            out.depth.depth.size() != std::size_t(grid.width) * grid.height)
+            throw Error("the reused depth image is " + std::to_string(out.depth.width) + "x" +
+                        std::to_string(out.depth.height) + " but the camera is " + std::to_string(grid.width) + "x" +
+                        std::to_string(grid.height));
     } else {
-        out.depth = backend.renderDepth(scene, proj);
-    }
-    const double depthWallMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-    if (out.depth.width != grid.width || out.depth.height != grid.height ||
-        out.depth.depth.size() != std::size_t(grid.width) * grid.height) {
-        const std::string size = std::to_string(out.depth.width) + "x" + std::to_string(out.depth.height);
-        const std::string cam = std::to_string(grid.width) + "x" + std::to_string(grid.height);
-        if (out.depthReused) throw Error("the reused depth image is " + size + " but the camera is " + cam);
-        throw Error("backend '" + backend.name() + "' returned a " + size + " depth image for a " + cam +
-                    " camera");
+        pass = backend.depthPass(scene, proj); // checks the image against the camera
+        out.depth = std::move(pass.image);
     }
     throwIfCancelled(cancel);
 
@@ -335,15 +332,12 @@ RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBack
     const double cullWallMs = std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
     if (const std::string bad = out.result.validate(out.lights.size()); !bad.empty())
         throw Error("backend '" + backend.name() + "' produced an inconsistent result: " + bad);
-    // A backend that did not time a phase gets the wall time around the call.
-    out.result.timings.depthMs = out.depthReused              ? 0.0
-                                 : backend.lastDepthMs() >= 0 ? backend.lastDepthMs()
-                                                              : depthWallMs;
+    // The depth pass's own figures; a backend that did not time its cull
+    // gets the wall time around the call.
+    out.result.timings.depthMs = out.depthReused ? 0.0 : pass.ms;
     if (out.result.timings.cullMs < 0) out.result.timings.cullMs = cullWallMs;
-    if (!out.depthReused) {
-        out.result.depthTriangles = backend.lastDepthTriangles();
-        out.result.depthTrianglesDrawn = backend.lastDepthTrianglesDrawn();
-    }
+    out.result.depthTriangles = pass.triangles;
+    out.result.depthTrianglesDrawn = pass.trianglesDrawn;
     if (out.result.backend.empty()) out.result.backend = backend.name();
     if (out.result.device.empty()) out.result.device = backend.deviceName();
     if (out.result.timingMethod.empty()) out.result.timingMethod = backend.timingMethod();

@@ -359,22 +359,22 @@ public:
     std::string deviceName() const override { return device_; }
     std::string timingMethod() const override { return "cpu-wall-clock (steady_clock)"; }
 
-    DepthImage renderDepth(const Scene& scene, const Projection& proj) override {
+protected:
+    DepthPass renderDepthPass(const Scene& scene, const Projection& proj) override {
+        DepthPass d;
         const auto t0 = std::chrono::steady_clock::now();
-        DepthImage img = rasterizeDepthCpu(scene, proj);
-        lastDepthMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-        lastDepthTriangles_ = lastDepthTrianglesDrawn_ = scene.triangleCount();
-        return img;
+        d.image = rasterizeDepthCpu(scene, proj);
+        d.ms = d.wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        d.triangles = d.trianglesDrawn = scene.triangleCount();
+        return d;
     }
 
-protected:
     CullResult cullFrame(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
                          const ViewLights& lights, const CullSettings& settings) override {
         const auto t0 = std::chrono::steady_clock::now();
         CullResult r = cullCpu(frame, depth, proj, lights, settings);
         r.timings.cullMs =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-        r.timings.depthMs = lastDepthMs_;
         lastCullWallMs_ = r.timings.cullMs;
         r.backend = name();
         r.device = device_;

@@ -447,20 +447,20 @@ RunOutput runCustomPipeline(const Scene& scene, const CustomShaderOptions& optio
     const TileGrid grid = TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
     RunOutput out;
     out.lights = makeViewLights(scene);
+    DepthPass pass;
     if (depthOverride) {
         out.depth = *depthOverride;
         out.depthReused = true;
     } else {
-        out.depth = depthBackend.renderDepth(scene, proj);
+        pass = depthBackend.depthPass(scene, proj);
+        out.depth = std::move(pass.image);
         // The rasteriser that drew the depth, not the lists' source ("custom").
         out.depthFrom = "pre-pass on " + depthBackend.name() + " (" + depthBackend.deviceName() + ")";
     }
     out.result = runCustomShader(options, out.depth, proj, grid, out.lights, report);
-    out.result.timings.depthMs = depthOverride ? 0.0 : depthBackend.lastDepthMs();
-    if (!depthOverride) {
-        out.result.depthTriangles = depthBackend.lastDepthTriangles();
-        out.result.depthTrianglesDrawn = depthBackend.lastDepthTrianglesDrawn();
-    }
+    out.result.timings.depthMs = depthOverride ? 0.0 : pass.ms;
+    out.result.depthTriangles = pass.triangles;
+    out.result.depthTrianglesDrawn = pass.trianglesDrawn;
     judge(out, proj, &depthBackend, runOptions);
     out.custom = std::make_shared<CustomCullReport>(report);
     return out;

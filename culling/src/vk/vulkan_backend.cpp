@@ -290,7 +290,6 @@ public:
     void resetPeakDeviceBytes() override { ctx_.resetPeakMemory(); }
     std::uint64_t deviceAllocations() const override { return ctx_.memoryStats().allocations; }
 
-    DepthImage renderDepth(const Scene& scene, const Projection& proj) override;
     // The Lambert shading pass (vk/shade_pass.cpp), created on first use.
     std::vector<float> shade(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled) override {
         if (!shadePass_) shadePass_ = std::make_unique<ShadePass>(ctx_);
@@ -298,6 +297,7 @@ public:
     }
 
 protected:
+    DepthPass renderDepthPass(const Scene& scene, const Projection& proj) override;
     CullResult cullFrame(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
                          const ViewLights& lights, const CullSettings& settings) override;
 
@@ -529,7 +529,8 @@ VkPipeline VulkanBackend::depthPipeline(bool reversed) {
     return pipe;
 }
 
-DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj) {
+DepthPass VulkanBackend::renderDepthPass(const Scene& scene, const Projection& proj) {
+    DepthPass pass;
     const std::uint32_t W = proj.width(), H = proj.height();
     if (W == 0 || H == 0) throw SettingsError("camera.width", "resolution must be at least 1x1");
     const auto& lim = ctx_.properties().limits;
@@ -591,8 +592,8 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
         vertexFloats += m.vertexCount() * 3;
     }
     solids_ = std::move(solidsInUse); // the analyses of meshes no longer drawn go
-    lastDepthTriangles_ = sceneIndices / 3;
-    lastDepthTrianglesDrawn_ = ix.size() / 3;
+    pass.triangles = sceneIndices / 3;
+    pass.trianglesDrawn = ix.size() / 3;
     // Device-local vertex and index buffers (staged on a discrete GPU), the
     // index buffer sized for every triangle so that turning the camera does
     // not resize it.
@@ -700,10 +701,10 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
         "depth.commands");
     // GPU: the render pass alone; CPU device: the whole submission (the
     // readback copy included).
-    lastDepthMs_ = gpuClock ? stamps.milliseconds(0) : wallMs;
-    lastDepthWallMs_ = wallMs;
+    pass.ms = gpuClock ? stamps.milliseconds(0) : wallMs;
+    pass.wallMs = wallMs;
 
-    DepthImage out;
+    DepthImage& out = pass.image;
     out.width = W;
     out.height = H;
     out.clearDepth = clearDepth;
@@ -711,7 +712,7 @@ DepthImage VulkanBackend::renderDepth(const Scene& scene, const Projection& proj
     out.depth.assign(px, px + std::size_t(W) * H);
     residentId_ = out.deviceCopy = nextDepthId();
     residentSample_ = depthSample(out);
-    return out;
+    return pass;
 }
 
 CullResult VulkanBackend::cullFrame(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
@@ -1394,7 +1395,6 @@ CullResult VulkanBackend::cullFrame(const CullFrame& frame, const DepthImage& de
     res.device = deviceName();
     res.timingMethod = timingMethod();
     res.timings.cullMs = gpuClock ? gpuMs : wallMs;
-    res.timings.depthMs = lastDepthMs_;
     lastCullWallMs_ = wallMs;
     lastLongestList_ = longest;
     lastPoolsFitted_ = poolsFitted;

@@ -84,29 +84,35 @@ std::uint32_t listsPerTileOf(Algorithm algorithm, std::uint32_t cells, bool cell
 CullFrame makeCullFrame(const DepthImage& depth, const Projection& proj, const TileGrid& grid,
                         const ViewLights& lights, const CullSettings& settings);
 
+// One depth pre-pass, as CullBackend::depthPass returns it: the image and
+// what it cost. Whoever ran it owns these figures (no later result is stamped
+// with them behind its back).
+struct DepthPass {
+    DepthImage image;
+    double ms = -1;     // as the backend times it (timingMethod())
+    double wallMs = -1; // CPU wall clock around its submission, the readback included
+    // The scene's triangles and those rasterised (the Vulkan backend leaves
+    // out the faces of closed solids turned away from the camera; the CPU
+    // rasteriser draws every triangle).
+    std::size_t triangles = 0, trianglesDrawn = 0;
+};
+
 class CullBackend {
 public:
     virtual ~CullBackend() = default;
     virtual std::string name() const = 0;       // "cpu", "vulkan"
     virtual std::string deviceName() const = 0;
-    // Depth pre-pass of the scene through the camera. Sets lastDepthMs().
-    virtual DepthImage renderDepth(const Scene& scene, const Projection& proj) = 0;
+    // Depth pre-pass of the scene through the camera: the image, its time
+    // and triangles. Checks that the image fits the camera.
+    DepthPass depthPass(const Scene& scene, const Projection& proj);
+    // The image alone, for callers that time nothing.
+    DepthImage renderDepth(const Scene& scene, const Projection& proj) { return depthPass(scene, proj).image; }
     // Culling pass over a depth image (any backend's). Fills result timings.
     // Validates and builds the frame once (makeCullFrame), then the backend's
     // cullFrame culls it; the result carries the frame's grid, lists per tile
     // and depth ranges, which diagnostics read instead of working them out.
     CullResult cull(const DepthImage& depth, const Projection& proj, const TileGrid& grid, const ViewLights& lights,
                     const CullSettings& settings);
-    double lastDepthMs() const { return lastDepthMs_; }
-    // CPU wall-clock milliseconds of the last renderDepth() around its
-    // submission (its readback included); where the depth time is a wall
-    // clock already, that.
-    double lastDepthWallMs() const { return lastDepthWallMs_ >= 0 ? lastDepthWallMs_ : lastDepthMs_; }
-    // Triangles of the scene and those the last renderDepth() rasterised (the
-    // Vulkan backend leaves out the faces of closed solids turned away from
-    // the camera; the CPU rasteriser draws every triangle).
-    std::size_t lastDepthTriangles() const { return lastDepthTriangles_; }
-    std::size_t lastDepthTrianglesDrawn() const { return lastDepthTrianglesDrawn_; }
     virtual std::string timingMethod() const = 0;
     // CPU wall-clock milliseconds of the last cull() around its submissions
     // (equal to its cullMs where that is the timing method; -1: not run).
@@ -130,13 +136,12 @@ public:
     double lastShadeMs() const { return lastShadeMs_; }
 
 protected:
+    // The backend's depth pre-pass (depthPass checks what it returns).
+    virtual DepthPass renderDepthPass(const Scene& scene, const Projection& proj) = 0;
     // The culling pass of a frame makeCullFrame built from these inputs.
     virtual CullResult cullFrame(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
                                  const ViewLights& lights, const CullSettings& settings) = 0;
 
-    double lastDepthMs_ = -1;
-    double lastDepthWallMs_ = -1; // -1: the same as lastDepthMs_
-    std::size_t lastDepthTriangles_ = 0, lastDepthTrianglesDrawn_ = 0;
     double lastCullWallMs_ = -1;
     unsigned lastIndexBits_ = 32;
     double lastShadeMs_ = -1;
