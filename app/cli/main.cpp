@@ -283,11 +283,15 @@ struct SceneFlags {
         for (const auto& [name, opt] : paramOptions)
             if (opt->count() && (name == "width" || name == "height"))
                 lc::setParam(settings, scene.camera, name, paramValues.at(name));
-        if (optPreset && optPreset->count())
-            lc::applyPreset(lc::enginePreset(presetName), settings, scene.camera, scene.lights.size());
+        std::vector<std::pair<std::string, std::string>> given;
         for (const auto& [name, opt] : paramOptions)
-            if (opt->count() && name != "width" && name != "height")
-                lc::setParam(settings, scene.camera, name, paramValues.at(name));
+            if (opt->count() && name != "width" && name != "height") given.emplace_back(name, paramValues.at(name));
+        // With a preset the flags go in before its derived settings, which
+        // follow them (a light limit raised re-derives URP's tile width).
+        if (optPreset && optPreset->count())
+            lc::applyPreset(lc::enginePreset(presetName), settings, scene.camera, scene.lights.size(), given);
+        else
+            for (const auto& [name, value] : given) lc::setParam(settings, scene.camera, name, value);
     }
 
     std::unique_ptr<lc::CullBackend> openBackend() const {

@@ -132,10 +132,15 @@ int ReportCommand::run() {
         }
     }
 
-    for (const std::string& p : presets_)
-        for (const std::string& name : splitCommas(p)) options.presets.push_back(lc::enginePreset(name).name);
+    // Each preset once, in the order named (--presets: all of them).
+    const auto addPreset = [&](const std::string& name) {
+        if (std::find(options.presets.begin(), options.presets.end(), name) == options.presets.end())
+            options.presets.push_back(name);
+    };
     if (allPresets_)
-        for (const lc::EnginePreset& p : lc::enginePresets()) options.presets.push_back(p.name);
+        for (const lc::EnginePreset& p : lc::enginePresets()) addPreset(p.name);
+    for (const std::string& p : presets_)
+        for (const std::string& name : splitCommas(p)) addPreset(lc::enginePreset(name).name);
     if (!options.presets.empty()) {
         for (const auto& [name, opt] : paramOptions_)
             if (opt->count() && name != "width" && name != "height")

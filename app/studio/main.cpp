@@ -20,6 +20,7 @@
 
 #include "culling/core/backend.hpp"
 #include "culling/core/params.hpp"
+#include "culling/core/presets.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <QAction>
@@ -118,7 +119,11 @@ int main(int argc, char** argv) {
                                     "Once the run has its ground truth, select its first miss and explain it "
                                     "(as Culling > Next miss; a hunt's studio.sh uses it).");
     QCommandLineOption backendOpt("backend", "Culling backend (as the toolbar's; remembered): cpu or vulkan.", "NAME");
-    parser.addOptions({sceneOpt, builtinOpt, lightsOpt, seedOpt, shaderOpt, paramOpt, backendOpt, firstMissOpt, runOpt,
+    QCommandLineOption presetOpt("preset",
+                                 "Cull as an engine does (as the Limits toolbar's Engine preset; docs/ENGINES.md), "
+                                 "for the scene once it is open; --param values override it.",
+                                 "NAME");
+    parser.addOptions({sceneOpt, builtinOpt, lightsOpt, seedOpt, shaderOpt, paramOpt, presetOpt, backendOpt, firstMissOpt, runOpt,
                        shotOpt, quitOpt, dragOpt, shadingOpt, imageModeOpt});
     parser.process(app);
     if (parser.isSet(sceneOpt) && parser.isSet(builtinOpt)) {
@@ -216,6 +221,15 @@ int main(int argc, char** argv) {
         }
     }
 
+    if (parser.isSet(presetOpt)) {
+        try {
+            lc::enginePreset(parser.value(presetOpt).toStdString());
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "lightcull-studio: --preset: %s\n", e.what());
+            return 2;
+        }
+    }
+
     // Opening a scene runs culling once (so does the default start).
     bool ok = true;
     if (parser.isSet(sceneOpt)) ok = window.openSceneFile(parser.value(sceneOpt));
@@ -232,6 +246,14 @@ int main(int argc, char** argv) {
             return 2;
         }
         window.document()->resetScene(std::move(scene), window.document()->filePath());
+        window.runCulling();
+    }
+    if (ok && parser.isSet(presetOpt)) {
+        // The preset's grid and limits depend on the scene's camera and
+        // lights: set once it is open; --param values given beside it win.
+        window.setPresetFromUi(parser.value(presetOpt));
+        for (const QString& nv : parser.values(paramOpt))
+            window.setParamFromUi(nv.left(nv.indexOf('=')), nv.mid(nv.indexOf('=') + 1));
         window.runCulling();
     }
     if (ok && parser.isSet(shaderOpt) && !window.setCustomShader(parser.value(shaderOpt)) && scripted) return 1;

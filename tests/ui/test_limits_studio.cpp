@@ -18,6 +18,8 @@
 
 #include <QAction>
 #include <QComboBox>
+#include <QFileInfo>
+#include <QProcess>
 #include <QLabel>
 #include <QSpinBox>
 #include <QToolBar>
@@ -133,6 +135,24 @@ private slots:
         QVERIFY(panel->explanation());
         auto* verdict = panel->findChild<QLabel*>("explainVerdict");
         QVERIFY2(verdict->text().contains("dropped: list full (cap 3)"), qPrintable(verdict->text()));
+    }
+
+    // lightcull-studio --preset NAME: set once the scene is open, --param
+    // beside it winning; an unknown name is one line and exit 2.
+    void presetOnTheCommandLine() {
+        QTemporaryDir dir;
+        const QString shot = dir.path() + "/preset.png";
+        QProcess p;
+        p.start(LC_STUDIO_PATH, {"--builtin", "atrium", "--backend",
+                                 "cpu", "--preset", "threejs", "--param", "cap=4", "--screenshot", shot, "--quit"});
+        QVERIFY(p.waitForFinished(120000));
+        QCOMPARE(p.exitCode(), 0);
+        QVERIFY(QFileInfo(shot).size() > 0);
+        p.start(LC_STUDIO_PATH, {"--builtin", "atrium", "--preset", "unity", "--quit"});
+        QVERIFY(p.waitForFinished(60000));
+        QCOMPARE(p.exitCode(), 2);
+        const QString err = QString::fromUtf8(p.readAllStandardError());
+        QVERIFY2(err.contains("--preset") && err.contains("unknown preset 'unity'"), qPrintable(err));
     }
 };
 

@@ -169,7 +169,7 @@ TEST(Limits, AHugeFallbackIsASettingsErrorNotGigabytes) {
     CullSettings s;
     s.cap = 1;
     s.overflow = OverflowPolicy::AllLights;
-    EXPECT_THROW(applyListLimits(r, lightsAtDepths(20000), s), SettingsError);
+    EXPECT_THROW(applyListLimits(r, lightsAtDepths(20000), s), Error); // found while running: exit 1, not 2
 }
 
 namespace {
@@ -351,6 +351,15 @@ TEST(Presets, DerivedSettingsFollowTheEnginesRules) {
     EXPECT_EQ(c.tileSize % 8, 0u);
     EXPECT_LE(((1920 + c.tileSize - 1) / c.tileSize) * ((1080 + c.tileSize - 1) / c.tileSize), 256u);
     EXPECT_GT(((1920 + c.tileSize - 9) / (c.tileSize - 8)) * ((1080 + c.tileSize - 9) / (c.tileSize - 8)), 256u);
+    // A light limit given beside the preset re-derives its grid from it:
+    // URP mobile raised to 256 lights takes the desktop's budget and tiles.
+    applyPreset(enginePreset("urp-mobile"), s, c, 300, {{"max-lights", "256"}});
+    EXPECT_EQ(s.maxLights, 256u);
+    EXPECT_EQ(c.tileSize, 32u);
+    EXPECT_EQ(s.bins, 4096u / (2 + 8));
+    // ... and a value given beside it wins over a derived one.
+    applyPreset(enginePreset("unreal-5"), s, c, 10, {{"max-entries", "1000"}});
+    EXPECT_EQ(s.maxEntries, 1000u);
     // A preset replaces what was set before it.
     CullSettings t;
     t.cap = 5;
@@ -411,13 +420,17 @@ TEST(Presets, TheReportFindsTheSmallestLimitThatLosesNothing) {
     // three.js: cap 8 with 40 lights in every list: a cap of 40 keeps them all.
     EXPECT_EQ(rep.rows[0].config.preset, "threejs");
     EXPECT_GT(rep.rows[0].falseNegativesListFull, 0u);
-    EXPECT_EQ(rep.rows[0].fix, "cap 40");
+    EXPECT_EQ(rep.rows[0].fix, "cap 40 (TiledLightsNode's tileLightCount)");
     // URP mobile: 32 lights kept of 40, all needed everywhere.
-    EXPECT_EQ(rep.rows[1].fix, "max-lights 0 (no limit)");
+    // 40 lights all needed everywhere: URP keeps 32, a constant of its mobile path.
+    EXPECT_EQ(rep.rows[1].fix, "max-lights 40: no setting reaches it (URP's k_MaxVisibleLightCountMobile is fixed "
+                               "at 32): keep fewer lights in view");
     EXPECT_EQ(rep.rows[1].falseNegativesLightLimit, rep.rows[1].falseNegatives);
     EXPECT_EQ(rep.rows[2].fix, "");
     EXPECT_EQ(rep.rows[2].falseNegatives, 0u);
     const std::string md = reportMarkdown(rep);
     EXPECT_NE(md.find("## Engine presets"), std::string::npos);
-    EXPECT_NE(md.find("| cap 40 |"), std::string::npos) << md;
+    EXPECT_NE(md.find("| cap 40 (TiledLightsNode's tileLightCount) |"), std::string::npos) << md;
+    // No cap was swept: no Caps section (a preset's cap is not a sweep).
+    EXPECT_EQ(md.find("## Caps"), std::string::npos) << md;
 }

@@ -12,8 +12,8 @@ namespace lc {
 
 namespace {
 
-// Entries the all-lights fallback may store in all (1 GiB of indices).
-constexpr std::uint64_t kMaxFallbackEntries = std::uint64_t(1) << 28;
+// Entries the all-lights fallback may store in all (256 MiB of indices).
+constexpr std::uint64_t kMaxFallbackEntries = std::uint64_t(1) << 26;
 
 // Light order by distance of its position from the camera (view space), ties
 // by index: the order an engine that sorts its lights keeps them in.
@@ -89,7 +89,7 @@ void applyListLimits(CullResult& r, const ViewLights& lights, const CullSettings
             // used. Stored here as every light: bounded, so a fallback on
             // every list of a huge scene is an error, not gigabytes.
             if (indices.size() + kept.size() > kMaxFallbackEntries)
-                throw SettingsError("overflow-policy", "all-lights on " + std::to_string(lim.overflowLists.size()) +
+                throw Error("overflow-policy all-lights: on " + std::to_string(lim.overflowLists.size()) +
                                                     "+ over-full lists of " + std::to_string(kept.size()) +
                                                     " lights would list more than " +
                                                     std::to_string(kMaxFallbackEntries) +

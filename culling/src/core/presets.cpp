@@ -16,8 +16,10 @@ std::uint32_t ceilDiv(std::uint64_t a, std::uint64_t b) { return std::uint32_t((
 // Unity URP Forward+ (ForwardLights.cs): words per tile from the visible
 // lights, the tile width doubled from 8 until the tile masks fit the word
 // budget, the Z bins from the bin budget (4096 words) over (2 + words) per bin.
-void deriveUrp(CullSettings& s, Camera& c, std::size_t lights, std::uint32_t maxLights, std::uint64_t maxTileWords) {
-    const std::uint64_t visible = std::min<std::uint64_t>(lights, maxLights);
+void deriveUrp(CullSettings& s, Camera& c, std::size_t lights) {
+    const std::uint64_t visible = s.maxLights ? std::min<std::uint64_t>(lights, s.maxLights) : lights;
+    // UniversalRenderPipeline.maxTileWords: 1024 vec4s with at most 32 lights, else 4096.
+    const std::uint64_t maxTileWords = s.maxLights && s.maxLights <= 32 ? 4096 : 16384;
     const std::uint64_t words = std::max<std::uint64_t>(1, (visible + 31) / 32);
     std::uint32_t tile = 8;
     while (std::uint64_t(ceilDiv(c.width, tile)) * ceilDiv(c.height, tile) * words > maxTileWords && tile < 256)
@@ -50,7 +52,7 @@ void deriveBevy(CullSettings&, Camera& c, std::size_t) {
 // Unreal (LightGridInjection.cpp): with linked-list culling, a pool of
 // cells x MaxCulledLightsPerCell (32) entries shared by every cell.
 void deriveUnreal(CullSettings& s, Camera& c, std::size_t) {
-    const std::uint64_t cells = std::uint64_t(ceilDiv(c.width, 64)) * ceilDiv(c.height, 64) * 32;
+    const std::uint64_t cells = std::uint64_t(ceilDiv(c.width, c.tileSize)) * ceilDiv(c.height, c.tileSize) * s.cells;
     s.maxEntries = std::uint32_t(std::min<std::uint64_t>(cells * 32, 100000000));
 }
 
@@ -59,14 +61,14 @@ std::vector<EnginePreset> buildPresets() {
     p.push_back({"urp",
                  "Unity URP Forward+ (desktop)",
                  {{"algorithm", "zbin"}, {"max-lights", "256"}, {"limit-keep", "nearest"}},
-                 [](CullSettings& s, Camera& c, std::size_t n) { deriveUrp(s, c, n, 256, 16384); },
+                 deriveUrp,
                  "tile: 8 px doubled until tiles x ceil(lights/32) words <= 16384; bins: 4096 / (2 + words per tile)",
                  "URP's Z bins are log2 in perspective (ours linear); reflection probes share the tile masks; "
                  "directional lights are not binned"});
     p.push_back({"urp-mobile",
                  "Unity URP Forward+ (mobile, OpenGL, WebGPU)",
                  {{"algorithm", "zbin"}, {"max-lights", "32"}, {"limit-keep", "nearest"}},
-                 [](CullSettings& s, Camera& c, std::size_t n) { deriveUrp(s, c, n, 32, 4096); },
+                 deriveUrp,
                  "tile: 8 px doubled until tiles x ceil(lights/32) words <= 4096; bins: 4096 / (2 + words per tile)",
                  "as urp; GLES 3.0 and older keep 16 lights"});
     p.push_back({"hdrp-fptl",
@@ -140,10 +142,36 @@ std::vector<EnginePreset> buildPresets() {
                  "",
                  "three.js tiles have no depth at all and test a screen-space circle against the tile (ours: the "
                  "tile's side planes with the camera's near and far); spot lights are not tiled there"});
+    // How far each engine lets its limits go (docs/ENGINES.md cites each).
+    const auto setRoom = [&](const std::string& name, std::vector<EnginePreset::Room> r) {
+        for (EnginePreset& e : p)
+            if (e.name == name) e.room = std::move(r);
+    };
+    setRoom("urp", {{"max-lights", 256, "URP's k_MaxVisibleLightCountDesktop"}});
+    setRoom("urp-mobile", {{"max-lights", 32, "URP's k_MaxVisibleLightCountMobile"}});
+    setRoom("hdrp-fptl", {{"cap", 63, "ShaderConfig FPTLMaxLightCount"},
+                          {"max-lights", 2048, "the HDRP asset's maximum punctual lights on screen"}});
+    setRoom("hdrp-cluster", {{"cap", 63, "the cluster count's 6 bits"},
+                             {"max-lights", 2048, "the HDRP asset's maximum punctual lights on screen"}});
+    setRoom("unreal-5", {{"max-entries", 0, "r.Forward.MaxCulledLightsPerCell (the pool is cells x it)"}});
+    setRoom("unreal-5-fixed", {{"cap", 0, "r.Forward.MaxCulledLightsPerCell"}});
+    setRoom("godot-4", {{"max-lights", 8192, "rendering/limits/cluster_builder/max_clustered_elements"}});
+    setRoom("filament", {{"max-lights", 256, "CONFIG_MAX_LIGHT_COUNT"},
+                         {"max-entries", 65535, "the record buffer (16-bit offsets)"}});
+    setRoom("bevy-webgl2", {{"max-lights", 204, "MAX_UNIFORM_BUFFER_CLUSTERABLE_OBJECTS"},
+                            {"max-entries", 16384, "ViewClusterBindings::MAX_INDICES"}});
+    setRoom("threejs", {{"cap", 0, "TiledLightsNode's tileLightCount"},
+                        {"max-lights", 0, "TiledLightsNode's maxLights (its constructor's first argument)"}});
     return p;
 }
 
 } // namespace
+
+const EnginePreset::Room* EnginePreset::roomFor(const std::string& param) const {
+    for (const Room& r : room)
+        if (r.param == param) return &r;
+    return nullptr;
+}
 
 const std::vector<EnginePreset>& enginePresets() {
     static const std::vector<EnginePreset> presets = buildPresets();
@@ -159,13 +187,16 @@ const EnginePreset& enginePreset(const std::string& name) {
     throw SettingsError("preset", "unknown preset '" + name + "' (known: " + known + ")");
 }
 
-void applyPreset(const EnginePreset& preset, CullSettings& settings, Camera& camera, std::size_t lightCount) {
+void applyPreset(const EnginePreset& preset, CullSettings& settings, Camera& camera, std::size_t lightCount,
+                 const std::vector<std::pair<std::string, std::string>>& overrides) {
     // From the defaults, so that nothing of an earlier choice stays.
     CullSettings s;
     Camera c = camera;
     c.tileSize = 16;
     for (const auto& [name, value] : preset.params) setParam(s, c, name, value);
+    for (const auto& [name, value] : overrides) setParam(s, c, name, value);
     if (preset.derive) preset.derive(s, c, lightCount);
+    for (const auto& [name, value] : overrides) setParam(s, c, name, value);
     settings = s;
     camera.tileSize = c.tileSize;
 }

@@ -295,8 +295,16 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
         e.verdict = "MISSING: not listed, but " + std::to_string(e.pixelsNeeding) + (e.pixelsNeeding == 1 ? " of the list's pixels needs it" : " of the list's pixels need it") +
                     cause;
     } else {
+        // A light the limits took out loses nothing here, but the list would
+        // have held it: say so, so that a limit's reach is visible.
+        const ListLimits& limits = run.result.limits;
+        std::string limit;
+        if (limits.isOverLimit(light))
+            limit = "; past the light limit too (max-lights " + std::to_string(r.settings.maxLights) + ")";
+        else if (limits.dropped(list, light))
+            limit = "; the list was full too: the test kept it and the limits dropped it";
         e.verdict = "not listed, rightly: no pixel of the list needs it" +
-                    (failed.empty() ? std::string() : " (the first test to reject it: '" + failed + "')");
+                    (failed.empty() ? std::string() : " (the first test to reject it: '" + failed + "')") + limit;
     }
     return e;
 }

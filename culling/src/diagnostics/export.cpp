@@ -513,15 +513,24 @@ RgbImage heatmapImage(const RunOutput& run) {
         cx + cw < bx1 - cv.textWidth(right, scale) - 2 * scale)
         cv.text(cx, ty, centre, scale, glm::dvec3(1.0));
     if (overflow) {
-        // Over-full lists (engine limits): an orange frame in their tiles.
-        frameTiles(cv, r.grid, tilesOverflowing(r), std::max(1, scale), kOverflowColour);
+        // Over-full lists (engine limits): an orange frame in their tiles,
+        // lined in black inside so that it reads on viridis's yellow too.
+        const std::vector<char> over = tilesOverflowing(r);
+        frameTiles(cv, r.grid, over, 2 * scale, glm::dvec3(0.0));
+        frameTiles(cv, r.grid, over, scale, kOverflowColour);
         std::uint64_t tilesOver = 0;
-        for (char f : tilesOverflowing(r)) tilesOver += f;
-        cv.text(bx0, ty + 10 * scale,
-                "OVER-FULL LISTS " + std::to_string(r.limits.overflowLists.size()) + " IN " +
-                    std::to_string(tilesOver) + " TILES, " + std::to_string(r.limits.droppedLights.size()) +
-                    " ENTRIES DROPPED",
-                scale, kOverflowColour);
+        for (char f : over) tilesOver += f;
+        const std::string lists = std::to_string(r.limits.overflowLists.size()),
+                          dropped = std::to_string(r.limits.droppedLights.size());
+        // The longest wording that fits the image's width.
+        for (const std::string& t : {"OVER-FULL LISTS " + lists + " IN " + std::to_string(tilesOver) + " TILES, " +
+                                         dropped + " ENTRIES DROPPED",
+                                     "OVER-FULL " + lists + ", DROPPED " + dropped, "OVER-FULL " + lists,
+                                     "FULL " + lists})
+            if (cv.textWidth(t, scale) <= bx1 - bx0 || t.rfind("FULL ", 0) == 0) {
+                cv.text(bx0, ty + 10 * scale, t, scale, kOverflowColour);
+                break;
+            }
     }
     return img;
 }
@@ -570,18 +579,26 @@ RgbImage missHeatmapImage(const RunOutput& run) {
             ? "NO FALSE NEGATIVES"
             : "FALSE NEGATIVES " + std::to_string(run.truth.metrics.falseNegatives) + " IN " +
                   std::to_string(tilesMissing) + " TILES, MOST " + std::to_string(std::uint64_t(most)) + " IN ONE";
-    cv.text(m, y0 + m, text, scale, tilesMissing ? glm::dvec3(1.0, 0.45, 0.45) : glm::dvec3(1.0));
+    // A narrow image (a hunt's shrunk repro) gets the short form.
+    const std::string shortText = "FN " + std::to_string(run.truth.metrics.falseNegatives) + " IN " +
+                                  std::to_string(tilesMissing) + " TILES";
+    cv.text(m, y0 + m, tilesMissing && cv.textWidth(text, scale) > int(W) - 2 * m ? shortText : text, scale,
+            tilesMissing ? glm::dvec3(1.0, 0.45, 0.45) : glm::dvec3(1.0));
     const Metrics& mt = run.truth.metrics;
     if (tilesMissing && (mt.falseNegativesListFull || mt.falseNegativesLightLimit)) {
-        // The split, each in its own colour, on a second line.
+        // The split, each in its own colour, on a second line: long labels
+        // where they fit, else short ones.
+        const std::string t = std::to_string(mt.falseNegativesCullingTest()),
+                          f = std::to_string(mt.falseNegativesListFull), l = std::to_string(mt.falseNegativesLightLimit);
+        const bool roomy = cv.textWidth("TEST " + t + "   LIST FULL " + f + "   LIGHT LIMIT " + l, scale) <= int(W) - 2 * m;
         int x = m;
         const auto part = [&](const std::string& s, glm::dvec3 c) {
             cv.text(x, y0 + m + 10 * scale, s, scale, c);
-            x += cv.textWidth(s, scale) + 3 * scale;
+            x += cv.textWidth(s + "   ", scale) + scale; // three spaces between the parts
         };
-        part("TEST " + std::to_string(mt.falseNegativesCullingTest()), glm::dvec3(1.0, 0.45, 0.45));
-        part("LIST FULL " + std::to_string(mt.falseNegativesListFull), kOverflowColour);
-        part("LIGHT LIMIT " + std::to_string(mt.falseNegativesLightLimit), kLightLimitColour);
+        part((roomy ? "TEST " : "T ") + t, glm::dvec3(1.0, 0.45, 0.45));
+        part((roomy ? "LIST FULL " : "F ") + f, kOverflowColour);
+        part((roomy ? "LIGHT LIMIT " : "L ") + l, kLightLimitColour);
     }
     return img;
 }

@@ -265,59 +265,74 @@ std::uint64_t smallestLossless(std::uint64_t from, std::uint64_t to,
 
 // A preset row's misses from its limits: the first setting change that
 // removes them, each limit raised to the smallest value that loses nothing
-// (the light limit first, then the record buffer, then the cap).
-std::string findFix(const ReportRow& row, CullBackend& backend, const DepthImage& depth, const Projection& proj,
-                    const ViewLights& lights, const TileGrid& grid, const CancelToken* cancel) {
+// (the light limit first, then the record buffer, then the cap), with the
+// preset's derived settings worked out again for it as the engine would; and
+// where the engine does not let that limit go so far, what it does allow.
+std::string findFix(const ReportRow& row, const EnginePreset& preset, const Scene& scene, CullBackend& backend,
+                    const DepthImage& depth, const Projection& proj, const ViewLights& lights,
+                    const CancelToken* cancel) {
     if (row.falseNegativesListFull == 0 && row.falseNegativesLightLimit == 0)
         return row.falseNegatives ? "none: the misses are the culling test's, not a limit's" : "";
-    CullSettings s = row.config.settings;
     GroundTruthOptions gto;
     gto.imageError = false;
-    auto judge = [&](const CullSettings& t) {
+    std::vector<std::pair<std::string, std::string>> over;
+    auto cullWith = [&](const std::vector<std::pair<std::string, std::string>>& o) {
         if (cancel && cancel->cancelled.load()) throw Cancelled();
-        return computeGroundTruth(depth, proj, lights, backend.cull(depth, proj, grid, lights, t), gto, cancel).metrics;
+        CullSettings s;
+        Camera cam = scene.camera;
+        applyPreset(preset, s, cam, scene.lights.size(), o);
+        const TileGrid grid = TileGrid::make(cam.width, cam.height, cam.tileSize);
+        return backend.cull(depth, proj, grid, lights, s);
+    };
+    auto metricsWith = [&](const std::vector<std::pair<std::string, std::string>>& o) {
+        return computeGroundTruth(depth, proj, lights, cullWith(o), gto, cancel).metrics;
+    };
+    auto with = [&](const std::string& param, std::uint64_t v) {
+        auto o = over;
+        o.emplace_back(param, std::to_string(v));
+        return o;
     };
     std::string fix;
-    const auto add = [&](const std::string& part) { fix += (fix.empty() ? "" : ", ") + part; };
+    const auto add = [&](const std::string& param, std::uint64_t v, std::uint64_t current) {
+        const EnginePreset::Room* room = preset.roomFor(param);
+        std::string part = param + " " + std::to_string(v);
+        if (room && room->most && v > room->most)
+            part += room->most <= current
+                        ? ": no setting reaches it (" + room->setting + " is fixed at " + std::to_string(room->most) +
+                              "): " + (param == "max-lights" ? "keep fewer lights in view" : "keep lists shorter")
+                        : ": past what the engine allows (" + room->setting + ": at most " +
+                              std::to_string(room->most) + ")";
+        else if (room)
+            part += " (" + room->setting + ")";
+        fix += (fix.empty() ? "" : ", ") + part;
+        over.emplace_back(param, std::to_string(v));
+    };
+    CullSettings s = row.config.settings;
     if (row.falseNegativesLightLimit && s.maxLights) {
         const std::uint64_t v = smallestLossless(s.maxLights + 1, lights.size(), [&](std::uint64_t m) {
-            CullSettings t = s;
-            t.maxLights = std::uint32_t(m);
-            return judge(t).falseNegativesLightLimit;
+            return metricsWith(with("max-lights", m)).falseNegativesLightLimit;
         });
-        s.maxLights = v >= lights.size() ? 0 : std::uint32_t(v);
-        add(s.maxLights ? "max-lights " + std::to_string(v) : "max-lights 0 (no limit)");
+        add("max-lights", v, s.maxLights);
     }
-    Metrics m = judge(s);
+    Metrics m = metricsWith(over);
     if (m.falseNegativesListFull && s.maxEntries) {
-        CullSettings open = s;
-        open.maxEntries = 0;
-        const std::uint64_t need = backend.cull(depth, proj, grid, lights, open).entries();
-        const std::uint64_t v = smallestLossless(s.maxEntries + 1, std::max<std::uint64_t>(need, s.maxEntries + 1),
-                                                 [&](std::uint64_t e) {
-                                                     CullSettings t = s;
-                                                     t.maxEntries = std::uint32_t(e);
-                                                     return judge(t).falseNegativesListFull;
-                                                 });
-        s.maxEntries = std::uint32_t(v);
-        add("max-entries " + std::to_string(v));
-        m = judge(s);
+        const std::uint64_t need = std::max<std::uint64_t>(cullWith(with("max-entries", 0)).entries(), s.maxEntries + 1);
+        const std::uint64_t v = smallestLossless(s.maxEntries + 1, need, [&](std::uint64_t e) {
+            return metricsWith(with("max-entries", e)).falseNegativesListFull;
+        });
+        add("max-entries", v, s.maxEntries);
+        m = metricsWith(over);
     }
     if (m.falseNegativesListFull && s.cap) {
-        CullSettings open = s;
-        open.cap = 0;
         std::uint32_t longest = 0;
-        for (std::uint32_t c : backend.cull(depth, proj, grid, lights, open).listCount) longest = std::max(longest, c);
-        const std::uint64_t v = smallestLossless(s.cap + 1, std::max<std::uint32_t>(longest, s.cap + 1), [&](std::uint64_t c) {
-            CullSettings t = s;
-            t.cap = std::uint32_t(c);
-            return judge(t).falseNegativesListFull;
+        for (std::uint32_t c : cullWith(with("cap", 0)).listCount) longest = std::max(longest, c);
+        const std::uint64_t v = smallestLossless(s.cap + 1, std::max<std::uint64_t>(longest, s.cap + 1), [&](std::uint64_t c) {
+            return metricsWith(with("cap", c)).falseNegativesListFull;
         });
-        s.cap = std::uint32_t(v);
-        add("cap " + std::to_string(v));
-        m = judge(s);
+        add("cap", v, s.cap);
+        m = metricsWith(over);
     }
-    if (m.falseNegativesListFull || m.falseNegativesLightLimit) add("(still " + std::to_string(m.falseNegatives) + " misses)");
+    if (m.falseNegativesListFull || m.falseNegativesLightLimit) fix += " (still " + std::to_string(m.falseNegatives) + " misses)";
     return fix;
 }
 
@@ -406,7 +421,8 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
                     throw Error("backend '" + backend->name() + "' produced an inconsistent result for " +
                                 cfg.label() + ": " + bad);
                 judgeRow(row, cullMs, result, depth, proj, lights, *backend, allImage, options, cancel);
-                if (!cfg.preset.empty()) row.fix = findFix(row, *backend, depth, proj, lights, grid, cancel);
+                if (!cfg.preset.empty())
+                    row.fix = findFix(row, enginePreset(cfg.preset), sceneIn, *backend, depth, proj, lights, cancel);
                 rep.rows.push_back(std::move(row));
                 ++done;
                 if (progress) progress(done, total, cfg.backend + " " + cfg.label());
@@ -513,7 +529,9 @@ std::string capsSection(const Report& rep) {
     std::map<std::string, std::vector<const ReportRow*>> groups;
     bool anyCap = false;
     for (const ReportRow& r : rep.rows) {
-        if (!r.config.customLabel.empty()) continue;
+        // A custom shader has no cap to sweep; a preset's cap is the engine's
+        // (its row's fix says how far to raise it).
+        if (!r.config.customLabel.empty() || !r.config.preset.empty()) continue;
         anyCap = anyCap || r.config.settings.cap > 0;
         ReportConfig uncapped = r.config;
         uncapped.params["cap"] = "0";
@@ -574,7 +592,9 @@ std::string presetsSection(const Report& rep) {
         md += "| " + r.config.backend + " | " + r.config.preset + " | " + enginePreset(r.config.preset).engine + " | " +
               set + " | " + std::to_string(r.falseNegatives - r.falseNegativesListFull - r.falseNegativesLightLimit) +
               " / " + std::to_string(r.falseNegativesListFull) + " / " + std::to_string(r.falseNegativesLightLimit) +
-              " | " + std::to_string(r.overflowLists) + " | " + fmt("%.4f", r.efficiency) + " | " +
+              " | " + std::to_string(r.overflowLists) + " | " +
+              (r.falseNegatives ? fmt("(%.4f: not a score with misses)", r.efficiency) : fmt("%.4f", r.efficiency)) +
+              " | " +
               std::to_string(r.resultBytes) + " | " + fmt("%.3f", r.cullMs) + " | " +
               (r.fix.empty() ? std::string("loses nothing") : r.fix) + " |\n";
     }

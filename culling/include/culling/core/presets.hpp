@@ -8,6 +8,7 @@
 #include "culling/scene/scene.hpp"
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <utility>
@@ -28,6 +29,17 @@ struct EnginePreset {
     std::string derivedRule;
     // What the model leaves out, in one line.
     std::string leftOut;
+    // How far the engine lets each limit be raised, for the fixes the report
+    // suggests: the parameter, the most the engine allows (0: no bound; the
+    // preset's own value: a constant), and the engine's name for it.
+    struct Room {
+        std::string param;
+        std::uint32_t most = 0;
+        std::string setting;
+    };
+    std::vector<Room> room;
+    // The room for `param`, or null when the preset does not name one.
+    const Room* roomFor(const std::string& param) const;
 };
 
 // Every preset, in docs/ENGINES.md's order.
@@ -36,6 +48,10 @@ const std::vector<EnginePreset>& enginePresets();
 const EnginePreset& enginePreset(const std::string& name);
 // Sets `settings` and the camera's tile size as the preset says for a scene
 // of `lightCount` lights seen through `camera` (its resolution as it is).
-void applyPreset(const EnginePreset& preset, CullSettings& settings, Camera& camera, std::size_t lightCount);
+// `overrides` (parameter, value) are set over the preset's own before its
+// settings are derived (a light limit raised re-derives URP's tile width from
+// it, as the engine would) and again after (so that they win).
+void applyPreset(const EnginePreset& preset, CullSettings& settings, Camera& camera, std::size_t lightCount,
+                 const std::vector<std::pair<std::string, std::string>>& overrides = {});
 
 } // namespace lc
