@@ -299,12 +299,10 @@ bool sameAllLightsImage(const RunOutput& a, const Camera& ca, const RunOutput& b
     return samePixels(a, ca, b, cb) && sameLights(a.lights, b.lights);
 }
 
-RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBackend& backend,
-                      const RunOptions& options, const CancelToken* cancel) {
+RunOutput runPipeline(const Scene& scene, ListSource& source, CullBackend* backend, const RunOptions& options,
+                      const CancelToken* cancel) {
     using Clock = std::chrono::steady_clock;
     scene.validate();
-    if (const std::string bad = settings.validate(); !bad.empty()) throwSettings(bad);
-
     const Projection proj(scene.camera);
     const TileGrid grid = TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
 
@@ -322,28 +320,49 @@ RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBack
                         std::to_string(out.depth.height) + " but the camera is " + std::to_string(grid.width) + "x" +
                         std::to_string(grid.height));
     } else {
-        pass = backend.depthPass(scene, proj); // checks the image against the camera
+        if (!backend) throw Error("a run without a backend needs a depth image");
+        pass = backend->depthPass(scene, proj); // checks the image against the camera
         out.depth = std::move(pass.image);
     }
     throwIfCancelled(cancel);
 
     const auto t1 = Clock::now();
-    out.result = backend.cull(out.depth, proj, grid, out.lights, settings);
+    out.result = source.makeLists(scene, out.depth, proj, grid, out.lights);
     const double cullWallMs = std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
+    out.custom = source.report();
     if (const std::string bad = out.result.validate(out.lights.size()); !bad.empty())
-        throw Error("backend '" + backend.name() + "' produced an inconsistent result: " + bad);
-    // The depth pass's own figures; a backend that did not time its cull
-    // gets the wall time around the call.
+        throw Error("'" + (out.result.backend.empty() && backend ? backend->name() : out.result.backend) +
+                    "' produced inconsistent lists: " + bad);
+    // The depth pass's own figures; a source that did not time its lists
+    // gets the wall time around the call (a dump's are not timed: -1 stays).
     out.result.timings.depthMs = out.depthReused ? 0.0 : pass.ms;
-    if (out.result.timings.cullMs < 0) out.result.timings.cullMs = cullWallMs;
+    if (out.result.timings.cullMs < 0 && !out.custom) out.result.timings.cullMs = cullWallMs;
     out.result.depthTriangles = pass.triangles;
     out.result.depthTrianglesDrawn = pass.trianglesDrawn;
-    if (out.result.backend.empty()) out.result.backend = backend.name();
-    if (out.result.device.empty()) out.result.device = backend.deviceName();
-    if (out.result.timingMethod.empty()) out.result.timingMethod = backend.timingMethod();
+    if (backend) {
+        if (out.result.backend.empty()) out.result.backend = backend->name();
+        if (out.result.device.empty()) out.result.device = backend->deviceName();
+        if (out.result.timingMethod.empty()) out.result.timingMethod = backend->timingMethod();
+        // Lists from elsewhere than the backend that drew the depth: name
+        // the rasteriser (backends differ at a few edge pixels).
+        if (!out.depthReused && out.result.backend != backend->name())
+            out.depthFrom = "pre-pass on " + backend->name() + " (" + backend->deviceName() + ")";
+    }
     throwIfCancelled(cancel);
-    judgeRun(out, proj, backend, options, cancel);
+    if (backend) {
+        judgeRun(out, proj, *backend, options, cancel);
+    } else {
+        const std::unique_ptr<CullBackend> cpu = makeCpuBackend();
+        judgeRun(out, proj, *cpu, options, cancel);
+    }
     return out;
+}
+
+RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBackend& backend,
+                      const RunOptions& options, const CancelToken* cancel) {
+    if (const std::string bad = settings.validate(); !bad.empty()) throwSettings(bad);
+    BackendLists lists(backend, settings);
+    return runPipeline(scene, lists, &backend, options, cancel);
 }
 
 void judgeRun(RunOutput& out, const Projection& proj, CullBackend& shadeBackend, const RunOptions& options,

@@ -423,67 +423,26 @@ std::vector<MissedLight> locateFalseNegatives(const RunOutput& run, const Projec
     return out;
 }
 
-namespace {
 
-// Ground truth and the image error over decoded custom lists: runPipeline's
-// own last phases. Lists read from a dump are shaded on the CPU reference.
-void judge(RunOutput& out, const Projection& proj, CullBackend* shadeBackend, const RunOptions& runOptions) {
-    if (const std::string bad = out.result.validate(out.lights.size()); !bad.empty())
-        throw Error("custom lists are inconsistent after decoding: " + bad);
-    std::unique_ptr<CullBackend> cpu;
-    if (!shadeBackend) {
-        cpu = makeCpuBackend();
-        shadeBackend = cpu.get();
-    }
-    judgeRun(out, proj, *shadeBackend, runOptions);
+CullResult ShaderLists::makeLists(const Scene&, const DepthImage& depth, const Projection& proj, const TileGrid& grid,
+                                  const ViewLights& lights) {
+    return runCustomShader(options_, depth, proj, grid, lights, report_);
 }
 
-} // namespace
-
-RunOutput runCustomPipeline(const Scene& scene, const CustomShaderOptions& options, CullBackend& depthBackend,
-                            const RunOptions& runOptions, CustomCullReport& report, const DepthImage* depthOverride) {
-    scene.validate();
-    const Projection proj(scene.camera);
-    const TileGrid grid = TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
-    RunOutput out;
-    out.lights = makeViewLights(scene);
-    DepthPass pass;
-    if (depthOverride) {
-        out.depth = *depthOverride;
-        out.depthReused = true;
-    } else {
-        pass = depthBackend.depthPass(scene, proj);
-        out.depth = std::move(pass.image);
-        // The rasteriser that drew the depth, not the lists' source ("custom").
-        out.depthFrom = "pre-pass on " + depthBackend.name() + " (" + depthBackend.deviceName() + ")";
-    }
-    out.result = runCustomShader(options, out.depth, proj, grid, out.lights, report);
-    out.result.timings.depthMs = depthOverride ? 0.0 : pass.ms;
-    out.result.depthTriangles = pass.triangles;
-    out.result.depthTrianglesDrawn = pass.trianglesDrawn;
-    judge(out, proj, &depthBackend, runOptions);
-    out.custom = std::make_shared<CustomCullReport>(report);
-    return out;
+std::shared_ptr<const CustomCullReport> ShaderLists::report() const {
+    return std::make_shared<CustomCullReport>(report_);
 }
 
-RunOutput checkListDump(const Scene& scene, const std::string& listsPath, const LayoutSpec& layout,
-                        const ListSpec& lists, const DepthImage& depth, const RunOptions& runOptions,
-                        CustomCullReport& report) {
-    scene.validate();
-    const Projection proj(scene.camera);
-    const TileGrid grid = TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
-    RunOutput out;
-    out.lights = makeViewLights(scene);
-    out.depth = depth;
-    out.depthReused = true;
-    const CullResult skeleton = ruleSkeleton(depth, proj, grid, out.lights, lists);
+CullResult DumpLists::makeLists(const Scene&, const DepthImage& depth, const Projection& proj, const TileGrid& grid,
+                                const ViewLights& lights) {
+    const CullResult skeleton = ruleSkeleton(depth, proj, grid, lights, lists_);
     CullResult r = skeleton;
-    report.source = listsPath;
-    report.layout = toString(layout);
-    report.lists = toString(lists);
-    const auto lightCount = std::uint32_t(out.lights.size());
-    const std::string ext = fs::path(listsPath).extension().string();
-    const std::string bytes = detail::readWholeFile(listsPath);
+    report_.source = path_;
+    report_.layout = toString(layout_);
+    report_.lists = toString(lists_);
+    const auto lightCount = std::uint32_t(lights.size());
+    const std::string ext = fs::path(path_).extension().string();
+    const std::string bytes = detail::readWholeFile(path_);
     if (ext == ".csv") {
         // One line per list: "list,light,light,...". Lists not named are empty.
         std::vector<std::vector<std::uint32_t>> perList(r.listOffset.size());
@@ -491,7 +450,7 @@ RunOutput checkListDump(const Scene& scene, const std::string& listsPath, const 
         std::string line;
         int lineNo = 0;
         if (bytes.find_first_not_of(" \t\r\n") == std::string::npos)
-            throw InputError(listsPath, "", 0, "empty: not a list dump (a CSV holds a line per list: list,light,light,...)");
+            throw InputError(path_, "", 0, "empty: not a list dump (a CSV holds a line per list: list,light,light,...)");
         while (std::getline(in, line)) {
             ++lineNo;
             if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -503,31 +462,31 @@ RunOutput checkListDump(const Scene& scene, const std::string& listsPath, const 
             const auto fields = splitOn(line, ',');
             std::uint64_t list = 0;
             if (!parseUint(fields[0], list))
-                throw InputError(listsPath, "", lineNo, "'" + fields[0] + "' is not a list index");
+                throw InputError(path_, "", lineNo, "'" + fields[0] + "' is not a list index");
             if (list >= perList.size())
-                throw InputError(listsPath, "", lineNo, "list " + std::to_string(list) + " is outside 0.." +
-                                                            std::to_string(perList.size() - 1) + " (" + toString(lists) + ")");
+                throw InputError(path_, "", lineNo, "list " + std::to_string(list) + " is outside 0.." +
+                                                            std::to_string(perList.size() - 1) + " (" + toString(lists_) + ")");
             for (std::size_t k = 1; k < fields.size(); ++k) {
                 std::uint64_t v = 0;
                 if (fields[k].empty()) continue;
                 if (!parseUint(fields[k], v) || v > 0xFFFFFFFFull)
-                    throw InputError(listsPath, "", lineNo, "'" + fields[k] + "' is not a light index");
+                    throw InputError(path_, "", lineNo, "'" + fields[k] + "' is not a light index");
                 perList[list].push_back(std::uint32_t(v));
             }
         }
-        assignLists(perList, lightCount, r, report);
+        assignLists(perList, lightCount, r, report_);
     } else {
         if (bytes.size() % 4 != 0)
-            throw InputError(listsPath, "", 0, std::to_string(bytes.size()) + " bytes is not a whole number of 32-bit words");
-        const std::uint64_t need = layoutWords(layout, r.listOffset.size(), lightCount);
+            throw InputError(path_, "", 0, std::to_string(bytes.size()) + " bytes is not a whole number of 32-bit words");
+        const std::uint64_t need = layoutWords(layout_, r.listOffset.size(), lightCount);
         if (bytes.size() / 4 < need)
-            throw InputError(listsPath, "", 0, std::to_string(bytes.size() / 4) + " words, but " + toString(layout) +
-                                                   " with " + std::to_string(r.listOffset.size()) + " lists (" + toString(lists) +
+            throw InputError(path_, "", 0, std::to_string(bytes.size() / 4) + " words, but " + toString(layout_) +
+                                                   " with " + std::to_string(r.listOffset.size()) + " lists (" + toString(lists_) +
                                                    ") and " + std::to_string(lightCount) + " lights needs " + std::to_string(need));
         if (bytes.size() / 4 > need)
-            report.warnings.push_back(
-                fs::path(listsPath).filename().string() + ": " + std::to_string(bytes.size() / 4) + " words, of which " +
-                toString(layout) + " with " + std::to_string(r.listOffset.size()) + " lists (" + toString(lists) +
+            report_.warnings.push_back(
+                fs::path(path_).filename().string() + ": " + std::to_string(bytes.size() / 4) + " words, of which " +
+                toString(layout_) + " with " + std::to_string(r.listOffset.size()) + " lists (" + toString(lists_) +
                 ") reads the first " + std::to_string(need) +
                 ": a padded buffer is fine, but check the layout, --tile and the resolution");
         std::vector<std::uint32_t> words(bytes.size() / 4);
@@ -535,18 +494,36 @@ RunOutput checkListDump(const Scene& scene, const std::string& listsPath, const 
             const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + 4 * i);
             words[i] = std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 | std::uint32_t(b[3]) << 24;
         }
-        decodeLists(words, layout, lightCount, r, report);
+        decodeLists(words, layout_, lightCount, r, report_);
     }
     r.backend = "dump";
-    r.device = "engine lists from " + fs::path(listsPath).filename().string();
+    r.device = "engine lists from " + fs::path(path_).filename().string();
     r.timingMethod = "not timed (lists read from a file)";
     r.timings.cullMs = -1;
     r.volumeTests = 0;
-    compareWithBuiltin(r, skeleton, report);
-    out.result = std::move(r);
-    judge(out, proj, nullptr, runOptions);
-    out.custom = std::make_shared<CustomCullReport>(report);
-    return out;
+    compareWithBuiltin(r, skeleton, report_);
+    return r;
+}
+
+std::shared_ptr<const CustomCullReport> DumpLists::report() const {
+    return std::make_shared<CustomCullReport>(report_);
+}
+
+RunOutput runCustomPipeline(const Scene& scene, const CustomShaderOptions& options, CullBackend& depthBackend,
+                            const RunOptions& runOptions, CustomCullReport& report, const DepthImage* depthOverride) {
+    ShaderLists lists(options, report);
+    RunOptions o = runOptions;
+    if (depthOverride) o.reuseDepth = depthOverride;
+    return runPipeline(scene, lists, &depthBackend, o);
+}
+
+RunOutput checkListDump(const Scene& scene, const std::string& listsPath, const LayoutSpec& layout,
+                        const ListSpec& lists, const DepthImage& depth, const RunOptions& runOptions,
+                        CustomCullReport& report) {
+    DumpLists dump(listsPath, layout, lists, report);
+    RunOptions o = runOptions;
+    o.reuseDepth = &depth;
+    return runPipeline(scene, dump, nullptr, o);
 }
 
 DepthImage loadDepthFile(const std::string& path, const Projection& proj) {

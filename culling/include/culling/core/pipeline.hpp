@@ -68,8 +68,51 @@ struct RunOptions {
     const DepthImage* reuseDepth = nullptr;
 };
 
-// Validates the scene and settings (typed errors), runs every phase on
-// `backend`, and fills result.timings (depth, cull, ground truth, shade).
+// Where a run's light lists come from: a built-in algorithm on a backend
+// (BackendLists), a user's culling shader or an engine's list dump
+// (culling/custom/custom_cull.hpp); a capture will be one more. The pipeline
+// owns the rest of the chain for every source alike: the scene's check, the
+// view lights, the depth (a pre-pass or an image it is given), the lists'
+// check, ground truth, shading and every timing but the lists' own.
+class ListSource {
+public:
+    virtual ~ListSource() = default;
+    // The frame's lists over `depth`: valid for `lights`; timings.cullMs,
+    // backend, device and timingMethod set where the source knows them (the
+    // pipeline fills the rest: its wall clock, the depth backend's names).
+    virtual CullResult makeLists(const Scene& scene, const DepthImage& depth, const Projection& proj,
+                                 const TileGrid& grid, const ViewLights& lights) = 0;
+    // What the source did beside its lists (a shader's or a dump's report,
+    // RunOutput::custom); null for a built-in algorithm.
+    virtual std::shared_ptr<const CustomCullReport> report() const { return nullptr; }
+};
+
+// A built-in algorithm: `settings` culled on `backend` (CullBackend::cull).
+class BackendLists final : public ListSource {
+public:
+    BackendLists(CullBackend& backend, const CullSettings& settings) : backend_(backend), settings_(settings) {}
+    CullResult makeLists(const Scene&, const DepthImage& depth, const Projection& proj, const TileGrid& grid,
+                         const ViewLights& lights) override {
+        return backend_.cull(depth, proj, grid, lights, settings_);
+    }
+
+private:
+    CullBackend& backend_;
+    CullSettings settings_;
+};
+
+// The one pipeline: validates the scene (typed errors), takes the depth from
+// options.reuseDepth or a pre-pass on `backend`, the lists from `source`,
+// then ground truth and shading as `options` say (shading on `backend`, or
+// the CPU reference when it is null; then options.reuseDepth is required).
+// Fills result.timings (depth, cull, ground truth, shade), the depth's
+// triangles and, when another rasteriser than the lists' drew the depth,
+// RunOutput::depthFrom.
+RunOutput runPipeline(const Scene& scene, ListSource& source, CullBackend* backend, const RunOptions& options = {},
+                      const CancelToken* cancel = nullptr);
+
+// A built-in algorithm through the one pipeline: BackendLists(backend,
+// settings) with depth and shading on `backend`. Settings are checked first.
 RunOutput runPipeline(const Scene& scene, const CullSettings& settings, CullBackend& backend,
                       const RunOptions& options = {}, const CancelToken* cancel = nullptr);
 

@@ -132,8 +132,39 @@ void decodeLists(const std::vector<std::uint32_t>& words, const LayoutSpec& layo
 CullResult runCustomShader(const CustomShaderOptions& options, const DepthImage& depth, const Projection& proj,
                            const TileGrid& grid, const ViewLights& lights, CustomCullReport& report);
 
+// A user's culling shader as a list source of the one pipeline
+// (core/pipeline.hpp): runCustomShader over the depth it is handed; what the
+// shader did beside its lists goes to `report` and RunOutput::custom.
+class ShaderLists final : public ListSource {
+public:
+    ShaderLists(const CustomShaderOptions& options, CustomCullReport& report) : options_(options), report_(report) {}
+    CullResult makeLists(const Scene& scene, const DepthImage& depth, const Projection& proj, const TileGrid& grid,
+                         const ViewLights& lights) override;
+    std::shared_ptr<const CustomCullReport> report() const override;
+
+private:
+    CustomShaderOptions options_;
+    CustomCullReport& report_;
+};
+
+// An engine's dumped lists as a list source (checkListDump's reader).
+class DumpLists final : public ListSource {
+public:
+    DumpLists(std::string path, const LayoutSpec& layout, const ListSpec& lists, CustomCullReport& report)
+        : path_(std::move(path)), layout_(layout), lists_(lists), report_(report) {}
+    CullResult makeLists(const Scene& scene, const DepthImage& depth, const Projection& proj, const TileGrid& grid,
+                         const ViewLights& lights) override;
+    std::shared_ptr<const CustomCullReport> report() const override;
+
+private:
+    std::string path_;
+    LayoutSpec layout_;
+    ListSpec lists_;
+    CustomCullReport& report_;
+};
+
 // The depth pre-pass, the custom shader, ground truth and (unless off) the
-// image error, as runPipeline does for a built-in algorithm; `depthOverride`
+// image error: the one pipeline with ShaderLists; `depthOverride`
 // (non-null) replaces the pre-pass with an engine's own depth buffer.
 RunOutput runCustomPipeline(const Scene& scene, const CustomShaderOptions& options, CullBackend& depthBackend,
                             const RunOptions& runOptions, CustomCullReport& report,
@@ -142,7 +173,8 @@ RunOutput runCustomPipeline(const Scene& scene, const CustomShaderOptions& optio
 // An engine's own lists from a file: raw little-endian 32-bit words in
 // `layout` (as a GPU debugger's buffer export writes them), or CSV with one
 // line per list "list,light,light,..." (a header line is allowed). Judged on
-// `depth` like a shader's output.
+// `depth` like a shader's output: the one pipeline with DumpLists, shaded
+// (when asked) on the CPU reference.
 RunOutput checkListDump(const Scene& scene, const std::string& listsPath, const LayoutSpec& layout,
                         const ListSpec& lists, const DepthImage& depth, const RunOptions& runOptions,
                         CustomCullReport& report);
