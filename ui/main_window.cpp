@@ -794,6 +794,26 @@ void MainWindow::onRunFinished(quint64 generation, std::shared_ptr<const lc::Run
                                  .arg(depthTriangles);
         if (m.falseNegatives > 0) warn(line); // a finding about the culling, not a failure of the run
         else log(line);
+        // The engine limits: what they took, by cause, and what would keep it.
+        const lc::ListLimits& lim = out->result.limits;
+        if (!out->custom && out->result.settings.hasLimits() && (!lim.empty() || m.falseNegatives)) {
+            QString keep;
+            if (m.falseNegativesListFull)
+                keep += tr("; a cap of %1 (the longest list) never overflows").arg(lim.longestUncapped);
+            if (m.falseNegativesLightLimit)
+                keep += tr("; %1 lights past max-lights %2").arg(qulonglong(lim.lightsOverLimit))
+                            .arg(out->result.settings.maxLights);
+            log(tr("run %1 limits: %2 over-full lists, %3 entries dropped; misses by cause: culling test %4, list "
+                   "full %5, light limit %6%7 (lightcull report --presets finds the smallest values that keep every "
+                   "light)")
+                    .arg(generation)
+                    .arg(qulonglong(lim.overflowLists.size()))
+                    .arg(qulonglong(lim.droppedLights.size()))
+                    .arg(qulonglong(m.falseNegativesCullingTest()))
+                    .arg(qulonglong(m.falseNegativesListFull))
+                    .arg(qulonglong(m.falseNegativesLightLimit))
+                    .arg(keep));
+        }
     }
     statusBar()->showMessage(tr("culling done (run %1)").arg(generation), 4000);
     emit runFinished(generation);
@@ -872,6 +892,12 @@ void MainWindow::updateStatus() {
     }
     statusFn_->setText(m.falseNegatives > 0 ? tr("MISSES LIGHTS: FN %1").arg(m.falseNegatives)
                                             : tr("FN %1").arg(m.falseNegatives));
+    // By cause, where the engine limits took some of them.
+    if (m.falseNegativesListFull || m.falseNegativesLightLimit)
+        statusFn_->setText(statusFn_->text() + tr(" (test %1, list full %2, light limit %3)")
+                                                   .arg(qulonglong(m.falseNegativesCullingTest()))
+                                                   .arg(qulonglong(m.falseNegativesListFull))
+                                                   .arg(qulonglong(m.falseNegativesLightLimit)));
     statusFn_->setStyleSheet(m.falseNegatives > 0 ? "color: white; background: #c0392b; padding: 0 4px"
                                                   : "color: #2e7d32");
     // With misses efficiency is no score: lists that drop needed lights look
