@@ -24,7 +24,7 @@ layout(constant_id = 2) const uint CELLS = 32u;
 layout(constant_id = 3) const uint SLICING = 0u;      // LC_SLICING_*
 layout(constant_id = 4) const uint ALGORITHM = 0u;    // LC_ALG_*
 layout(constant_id = 5) const uint SPHERE_TEST = 0u;  // LC_TEST_*
-layout(constant_id = 6) const uint WRITE_PASS = 0u;   // cull_lists: 0 count, 1 write, 2 both (GPUs), 3 write by atomic ranges
+layout(constant_id = 6) const uint WRITE_PASS = 0u;   // LC_PASS_* (cull_lists), LC_PRUNE_*, LC_ZBIN_*
 // Lanes sharing one tile (tile_bounds) or one list (cull_lists): 1 (an
 // invocation each: CPU devices), or the subgroup size (a subgroup each: GPUs).
 layout(constant_id = 7) const uint LANES = 1u;
@@ -83,7 +83,7 @@ layout(std430, binding = 6) buffer IndexBuf { uint16_t lightIndices[]; };
 layout(std430, binding = 6) buffer IndexBuf { uint lightIndices[]; };
 #define LC_INDEX(l) (l)
 #endif
-// status: STATUS_* bits; candidateTests: light-versus-volume tests the count
+// status: LC_STATUS_* bits (gpu_shared.h); candidateTests: light-versus-volume tests the count
 // pass performed (the write pass repeats them), for the benchmarks, in
 // LC_TEST_COUNTERS counters (countTests in cull_lists.comp).
 layout(std430, binding = 7) buffer StatusBuf { uint status; uint candidateTests[]; };
@@ -105,13 +105,7 @@ layout(std430, binding = 9) readonly buffer SpotBuf { GpuSpotCone spots[]; };
 // list the host reads the entries from here and skips the write pass.
 layout(std430, binding = 10) buffer StashBuf { uint stash[]; };
 
-const uint STATUS_SPLIT_WORKGROUP = 1u; // more than one subgroup per workgroup
-const uint STATUS_COUNT_MISMATCH = 2u;  // write pass found a different count
-const uint STATUS_TESTS_OVERFLOW = 4u;  // candidateTests wrapped around 2^32
-// A loop ended before its condition did: lavapipe (gallivm) stops every loop
-// of a shader invocation after 65,535 iterations in all, silently. The host
-// sizes the work per invocation below that and turns this bit into an error.
-const uint STATUS_LOOP_LIMIT = 8u;
+// Status bits: LC_STATUS_* in gpu_shared.h.
 
 bool isOrtho() { return ORTHO != 0u; }
 

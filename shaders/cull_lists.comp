@@ -9,15 +9,15 @@
 // barriers. With DEPTH_BINS a word is also ANDed with the words of the
 // depth bins that hold the list's depth range (light_bins.comp), so lights
 // in front of or behind the tile's geometry are not tested at all.
-// WRITE_PASS == 0 stores the count and stashes the list's first
-// P.bins.z entries (cull_common.glsl, binding 10); WRITE_PASS == 1 copies a
+// WRITE_PASS == LC_PASS_COUNT stores the count and stashes the list's first
+// P.bins.z entries (cull_common.glsl, binding 10); WRITE_PASS == LC_PASS_WRITE copies a
 // list the stash holds whole, else tests again and writes the indices at the
 // scanned offset and checks that the count matches; a list that would end
 // beyond the index array is left out (the host sees the total and reruns).
-// WRITE_PASS == 3 (clustered's tile walk, CPU devices) is the write pass
+// WRITE_PASS == LC_PASS_WRITE_AT_RANGES (clustered's tile walk, CPU devices) is the write pass
 // without a scan before it: a tile walk's lists take their ranges with one
 // atomic add on the total, as below.
-// WRITE_PASS == 2 (GPUs, a subgroup per list) does both in one dispatch: the
+// WRITE_PASS == LC_PASS_FUSED (GPUs, a subgroup per list) does both in one dispatch: the
 // count pass, then the list takes its range of the index array with one
 // atomic add on the total (listOffset[lists]) and is written there at once,
 // from the walk's masks kept in registers, the stash or a second walk; the
@@ -42,7 +42,7 @@ void countTests(uint item, uint tested) {
     if (TESTS_WRAP == 0u) {
         atomicAdd(candidateTests[at], tested);
     } else if (atomicAdd(candidateTests[at], tested) + tested < tested) {
-        atomicOr(status, STATUS_TESTS_OVERFLOW);
+        atomicOr(status, LC_STATUS_TESTS_OVERFLOW);
     }
 }
 
@@ -279,10 +279,10 @@ void clusteredTileWalk(uint id) {
     for (uint k = 0u; k < TILE_WALK; ++k) n[k] = 0u;
     uint poolBase = (firstList + firstCell) * stashSlots, poolSlots = (endCell - firstCell) * stashSlots;
     uint pooled = 0u; // entries the count pass met (and pooled while they fit)
-    if (WRITE_PASS != 0u) {
+    if (WRITE_PASS != LC_PASS_COUNT) {
         uint sum = 0u;
         for (uint c = firstCell; c < endCell; ++c) sum += listCount[firstList + c];
-        if (WRITE_PASS == 3u) {
+        if (WRITE_PASS == LC_PASS_WRITE_AT_RANGES) {
             // No scan before: the invocation's lists take their ranges, in
             // slice order, with one atomic add on the total (listOffset[lists]).
             uint at = sum != 0u ? atomicAdd(listOffset[P.counts.z], sum) : 0u;
@@ -316,7 +316,7 @@ void clusteredTileWalk(uint id) {
                 uint list = firstList + c;
                 if (listOffset[list] + listCount[list] <= uint(lightIndices.length()) &&
                     n[c - firstCell] != listCount[list])
-                    atomicOr(status, STATUS_COUNT_MISMATCH);
+                    atomicOr(status, LC_STATUS_COUNT_MISMATCH);
             }
         }
     }
@@ -365,7 +365,7 @@ void clusteredTileWalk(uint id) {
                 if (SPOT_TEST == LC_SPOT_CONE_SPHERE) chunkSphere(ch, cellCentre, cellRadius);
                 if (lightKept(l, ch, cellCentre, cellRadius, false, 0.0, 0.0, 0.0, 0.0, 0u)) {
                     uint list = firstList + c, k = n[c - firstCell];
-                    if (WRITE_PASS != 0u) lightIndices[listOffset[list] + k] = LC_INDEX(l);
+                    if (WRITE_PASS != LC_PASS_COUNT) lightIndices[listOffset[list] + k] = LC_INDEX(l);
                     else if (pooled < poolSlots) stash[poolBase + pooled] = (c << 24u) | l;
                     pooled += 1u;
                     n[c - firstCell] = k + 1u;
@@ -374,8 +374,8 @@ void clusteredTileWalk(uint id) {
         }
         cut = q < quads || any(notEqual(quad, uvec4(0u))); // a loop ended by the driver's cap, not by the candidates
     }
-    if (cut) atomicOr(status, STATUS_LOOP_LIMIT);
-    if (WRITE_PASS == 0u) {
+    if (cut) atomicOr(status, LC_STATUS_LOOP_LIMIT);
+    if (WRITE_PASS == LC_PASS_COUNT) {
         for (uint c = firstCell; c < endCell; ++c) listCount[firstList + c] = n[c - firstCell];
         countTests(id, tested);
     } else {
@@ -383,7 +383,7 @@ void clusteredTileWalk(uint id) {
         while (lists != 0u) {
             uint c = uint(findLSB(lists));
             lists &= lists - 1u;
-            if (n[c - firstCell] != listCount[firstList + c]) atomicOr(status, STATUS_COUNT_MISMATCH);
+            if (n[c - firstCell] != listCount[firstList + c]) atomicOr(status, LC_STATUS_COUNT_MISMATCH);
         }
     }
 }
@@ -394,7 +394,7 @@ void main() {
               gl_LocalInvocationIndex;
     uint lightCount = P.counts.x;
     if (ALGORITHM == LC_ALG_ALL) {
-        if (WRITE_PASS == 0u) {
+        if (WRITE_PASS == LC_PASS_COUNT) {
             if (id == 0u) listCount[0] = lightCount;
         } else if (id < lightCount && id < uint(lightIndices.length())) {
             lightIndices[id] = LC_INDEX(id);
@@ -408,13 +408,13 @@ void main() {
     uint stashSlots = P.bins.z;
     uint list = id, lane = 0u;
     if (LANES != 1u) {
-        if (gl_SubgroupSize != LANES) atomicOr(status, STATUS_SPLIT_WORKGROUP);
+        if (gl_SubgroupSize != LANES) atomicOr(status, LC_STATUS_SPLIT_WORKGROUP);
         list = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_NumSubgroups + gl_SubgroupID;
         lane = gl_SubgroupInvocationID;
     }
     // Uniform per list (so per subgroup): the early exits keep subgroups whole.
     if (list >= P.counts.z) return;
-    if (WRITE_PASS == 1u) {
+    if (WRITE_PASS == LC_PASS_WRITE) {
         uint count = listCount[list];
         // The index array may be smaller than the lists (a first submission
         // sized from the previous cull): then the host writes them again.
@@ -477,7 +477,7 @@ void main() {
         bool cellLog = SLICING == LC_SLICING_LOG && (CELL_LOG != 0u || (maskLo > 0.0 && maskHi > maskLo));
         float cellLog0 = cellLog ? log2(maskLo) : 0.0;
         float cellScale = cellLog && maskLo > 0.0 && maskHi > maskLo ? float(CELLS) / log2(maskHi / maskLo) : 0.0;
-        if (WRITE_PASS == 1u) base = listOffset[list];
+        if (WRITE_PASS == LC_PASS_WRITE) base = listOffset[list];
         uint tilesX = P.size.z, words = P.bins.x;
         uint tx = tile % tilesX, ty = tile / tilesX;
         uint columnBase = tx * words, rowBase = P.bins.y + ty * words;
@@ -506,7 +506,7 @@ void main() {
                 ++tested;
                 if (lightKept(l, ch, cellCentre, cellRadius, cellLog, cellLog0, cellScale, maskLo, maskHi,
                               geomMask)) {
-                    if (WRITE_PASS != 0u) lightIndices[base + n] = LC_INDEX(l);
+                    if (WRITE_PASS != LC_PASS_COUNT) lightIndices[base + n] = LC_INDEX(l);
                     else if (n < stashSlots) stash[list * stashSlots + n] = l;
                     ++n;
                 }
@@ -517,8 +517,8 @@ void main() {
             ListWalk wk = ListWalk(ch, cellCentre, cellRadius, cellLog, cellLog0, cellScale, maskLo, maskHi,
                                    geomMask, words, columnBase, rowBase, depthBins, nearBase, farBase);
             uint kept[KEPT_WORDS];
-            n = subgroupListWalk(wk, list, lane, WRITE_PASS == 1u, base, kept, tested, cut);
-            if (WRITE_PASS == 2u && n != 0u) {
+            n = subgroupListWalk(wk, list, lane, WRITE_PASS == LC_PASS_WRITE, base, kept, tested, cut);
+            if (WRITE_PASS == LC_PASS_FUSED && n != 0u) {
                 // The list's range: one atomic add on the total, by one lane.
                 uint at = lane == 0u ? atomicAdd(listOffset[P.counts.z], n) : 0u;
                 base = subgroupMax(at);
@@ -535,21 +535,21 @@ void main() {
                     } else {
                         uint testedAgain = 0u;
                         if (subgroupListWalk(wk, list, lane, true, base, kept, testedAgain, cut) != n)
-                            atomicOr(status, STATUS_COUNT_MISMATCH);
+                            atomicOr(status, LC_STATUS_COUNT_MISMATCH);
                     }
                 }
             }
         }
-        if (cut) atomicOr(status, STATUS_LOOP_LIMIT);
+        if (cut) atomicOr(status, LC_STATUS_LOOP_LIMIT);
     }
-    if (WRITE_PASS == 0u || WRITE_PASS == 2u) {
+    if (WRITE_PASS == LC_PASS_COUNT || WRITE_PASS == LC_PASS_FUSED) {
         if (LANES != 1u) tested = subgroupAdd(tested);
         if (lane == 0u) {
             listCount[list] = n;
-            if (WRITE_PASS == 2u) listOffset[list] = base;
+            if (WRITE_PASS == LC_PASS_FUSED) listOffset[list] = base;
             countTests(list, tested);
         }
     } else if (n != listCount[list]) {
-        atomicOr(status, STATUS_COUNT_MISMATCH);
+        atomicOr(status, LC_STATUS_COUNT_MISMATCH);
     }
 }

@@ -1,14 +1,14 @@
 #version 450
 // fptl's fine prune (culling/cpu/fine_prune.hpp), run after cull_lists wrote the
 // coarse (minmax) lists into the index array:
-//   WRITE_PASS 0: an invocation per entry of the index array. It finds its
+//   WRITE_PASS LC_PRUNE_MARK: an invocation per entry of the index array. It finds its
 //     list (a binary search of the offsets), walks the geometry pixels of
 //     that list's tile and overwrites the entry with PRUNED when no pixel lies
 //     inside the light's volume: its range sphere and, for a spot light, its
 //     cone (binding 9 holds every spot's cone for fptl), both widened by the
 //     backend's float margin (cull_common.glsl) so that every light the
 //     double-precision reference keeps stays.
-//   WRITE_PASS 1: an invocation per list moves its kept entries, in order, to
+//   WRITE_PASS LC_PRUNE_PACK: an invocation per list moves its kept entries, in order, to
 //     the front of its range and writes the new count. Offsets stay: a list
 //     keeps its slot, its tail unused (the host packs them on read-back).
 // Loops per invocation: at most a tile's pixels plus the search (pass 0),
@@ -45,7 +45,7 @@ void main() {
     uint id = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
               gl_LocalInvocationIndex;
     uint lists = P.counts.z;
-    if (WRITE_PASS == 0u) {
+    if (WRITE_PASS == LC_PRUNE_MARK) {
         if (id >= listOffset[lists]) return;
         // offset[lo] <= id < offset[hi]: ends on the one non-empty list holding id.
         uint lo = 0u, hi = lists;

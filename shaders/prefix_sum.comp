@@ -9,7 +9,7 @@
 //   up to 128 subgroups; invocation 0 scans the subgroup totals in shared
 //   memory between two barriers (cheap once per dispatch), and each
 //   invocation's run is short (lavapipe caps an invocation at 65,535 loop
-//   iterations: see STATUS_LOOP_LIMIT).
+//   iterations: see LC_STATUS_LOOP_LIMIT).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
@@ -28,11 +28,11 @@ void main() {
     bool cut = i < e;
     uint run, total;
     if (LANES == 1u) {
-        if (gl_NumSubgroups != 1u) atomicOr(status, STATUS_SPLIT_WORKGROUP);
+        if (gl_NumSubgroups != 1u) atomicOr(status, LC_STATUS_SPLIT_WORKGROUP);
         run = subgroupExclusiveAdd(sum);
         total = subgroupAdd(sum);
     } else {
-        if (gl_NumSubgroups > 128u) atomicOr(status, STATUS_SPLIT_WORKGROUP);
+        if (gl_NumSubgroups > 128u) atomicOr(status, LC_STATUS_SPLIT_WORKGROUP);
         uint inclusive = subgroupInclusiveAdd(sum);
         if (gl_SubgroupInvocationID == gl_SubgroupSize - 1u) subgroupBase[gl_SubgroupID] = inclusive;
         // Invocation 0 reads every subgroup's total written above.
@@ -54,7 +54,7 @@ void main() {
         listOffset[i] = run;
         run += listCount[i];
     }
-    if (cut || i < e) atomicOr(status, STATUS_LOOP_LIMIT);
+    if (cut || i < e) atomicOr(status, LC_STATUS_LOOP_LIMIT);
     if (LANES == 1u) {
         if (subgroupElect()) listOffset[N] = total;
     } else if (tid == stride - 1u) {

@@ -169,7 +169,7 @@ void main() {
         if (tx >= P.size.z) return;
     } else {
         // A subgroup per tile, gl_NumSubgroups tiles per workgroup along x.
-        if (gl_SubgroupSize != LANES) atomicOr(status, STATUS_SPLIT_WORKGROUP);
+        if (gl_SubgroupSize != LANES) atomicOr(status, LC_STATUS_SPLIT_WORKGROUP);
         tx = gl_WorkGroupID.x * gl_NumSubgroups + gl_SubgroupID;
         ty = gl_WorkGroupID.y;
         lane = gl_SubgroupInvocationID; // of LANES, the subgroup size

@@ -6,8 +6,8 @@
 // P.depthBins.y bins per unit of view depth) keeps the lowest and highest
 // position whose widened depth extent reaches it, at binMask[base + 2b] and
 // binMask[base + 2b + 1] (base = P.bins.w, the words after the plane bins).
-//   WRITE_PASS 0: an invocation per bin sets the empty range (lo > hi).
-//   WRITE_PASS 1: an invocation per light takes the bins its extent spans
+//   WRITE_PASS LC_ZBIN_INIT: an invocation per bin sets the empty range (lo > hi).
+//   WRITE_PASS LC_ZBIN_BIN: an invocation per light takes the bins its extent spans
 //     (at most 16,384: under lavapipe's loop cap).
 #extension GL_GOOGLE_include_directive : require
 #include "cull_common.glsl"
@@ -23,7 +23,7 @@ void main() {
               gl_LocalInvocationIndex;
     uint bins = uint(P.depthBins.z);
     uint base = P.bins.w;
-    if (WRITE_PASS == 0u) {
+    if (WRITE_PASS == LC_ZBIN_INIT) {
         if (id >= bins) return;
         binMask[base + 2u * id] = 0xffffffffu;
         binMask[base + 2u * id + 1u] = 0u;

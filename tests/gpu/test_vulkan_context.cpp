@@ -135,3 +135,29 @@ TEST_F(GpuTest, NoDriverIsAClearDeviceError) {
 }
 
 } // namespace
+
+// A role asked for twice in one frame would hand back a reference to a buffer
+// the second ask may have replaced: the cache refuses instead, and refuses
+// any ask outside a frame. A new frame may ask for the role again, and the
+// buffer it kept (large enough) is the same one.
+TEST_F(GpuTest, BufferCacheRolesAreAskedForOncePerFrame) {
+    vk::Context ctx(vk::ContextOptions{"", "lc.test"});
+    vk::BufferCache cache(ctx);
+    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    EXPECT_THROW(cache.get("a", 64, usage, vk::BufferCache::Kind::Host), std::logic_error);
+    VkBuffer first = VK_NULL_HANDLE;
+    {
+        vk::BufferCache::Frame frame(cache);
+        first = cache.get("a", 64, usage, vk::BufferCache::Kind::Host).buffer;
+        EXPECT_NO_THROW(cache.get("b", 64, usage, vk::BufferCache::Kind::Host));
+        try {
+            cache.get("a", 4096, usage, vk::BufferCache::Kind::Host);
+            FAIL() << "a role asked for twice in one frame";
+        } catch (const std::logic_error& e) {
+            EXPECT_NE(std::string(e.what()).find("'a' asked for twice"), std::string::npos) << e.what();
+        }
+        EXPECT_THROW(vk::BufferCache::Frame nested(cache), std::logic_error);
+    }
+    vk::BufferCache::Frame next(cache);
+    EXPECT_EQ(cache.get("a", 60, usage, vk::BufferCache::Kind::Host).buffer, first) << "kept between frames";
+}

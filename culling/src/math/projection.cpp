@@ -104,6 +104,8 @@ Projection::Projection(const Camera& cam)
         vec4(float(ab.x), float(ab.y), orthographic() ? 1.0f : 0.0f, float(clearDepth()));
 }
 
+glm::dvec2 Projection::windowDepthAB() const { return depthAB(kind_, near_, far_); }
+
 double Projection::viewDepthFromWindowDepth(double d) const {
     const glm::dvec2 ab = depthAB(kind_, near_, far_);
     return lcViewDepthFromWindowDepthD(d, ab.x, ab.y, orthographic());

@@ -399,42 +399,16 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
                                             "): check the entry point '" + entry + "' and the bindings" + firstMessage());
     st->pipeline = vk::PipelineHandle(dev, pipe);
 
-    VkDescriptorPoolSize sizes[3] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-                                     {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
-                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3}};
-    VkDescriptorPoolCreateInfo dpci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    dpci.maxSets = 1;
-    dpci.poolSizeCount = 3;
-    dpci.pPoolSizes = sizes;
-    VkDescriptorPool pool;
-    LC_VK(vkCreateDescriptorPool(dev, &dpci, nullptr, &pool));
-    st->pool = vk::DescriptorPoolHandle(dev, pool);
-    VkDescriptorSetAllocateInfo dsai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    dsai.descriptorPool = pool;
-    dsai.descriptorSetCount = 1;
-    VkDescriptorSetLayout sl = st->setLayout;
-    dsai.pSetLayouts = &sl;
-    VkDescriptorSet set;
-    LC_VK(vkAllocateDescriptorSets(dev, &dsai, &set));
-    VkDescriptorBufferInfo bi[4] = {{st->params.buffer, 0, VK_WHOLE_SIZE},
-                                    {st->depthBuf.buffer, 0, VK_WHOLE_SIZE},
-                                    {st->lightBuf.buffer, 0, VK_WHOLE_SIZE},
-                                    {st->out.buffer, 0, VK_WHOLE_SIZE}};
-    VkDescriptorImageInfo ii{sampler, st->depthImage.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    VkWriteDescriptorSet w[5]{};
+    std::vector<vk::Context::DescriptorWrite> bindings(5);
+    const VkBuffer buffers[5] = {st->params.buffer, VK_NULL_HANDLE, st->depthBuf.buffer, st->lightBuf.buffer,
+                                 st->out.buffer};
     for (std::uint32_t i = 0; i < 5; ++i) {
-        w[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-        w[i].dstSet = set;
-        w[i].dstBinding = i;
-        w[i].descriptorCount = 1;
-        w[i].descriptorType = types[i];
+        bindings[i].type = types[i];
+        bindings[i].buffer = buffers[i];
     }
-    w[0].pBufferInfo = &bi[0];
-    w[1].pImageInfo = &ii;
-    w[2].pBufferInfo = &bi[1];
-    w[3].pBufferInfo = &bi[2];
-    w[4].pBufferInfo = &bi[3];
-    vkUpdateDescriptorSets(dev, 5, w, 0, nullptr);
+    bindings[1].image = {sampler, st->depthImage.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    st->pool = st->ctx->createDescriptorPool(bindings, 1, "custom.descriptorPool");
+    VkDescriptorSet set = st->ctx->writeDescriptorSet(st->pool, st->setLayout, bindings, "custom.set");
 
     double wallMs = 0;
     const bool finished = st->ctx->submitAndWaitFor(

@@ -128,15 +128,27 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     if (gx > lim.maxComputeWorkGroupCount[0] || gy > lim.maxComputeWorkGroupCount[1])
         throw DeviceError("shading: too many workgroups for one dispatch on this device");
 
-    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    Buffer params = ctx_.createBuffer(sizeof(GpuShadeParams), usage, "shade.params");
-    Buffer pixelBuf = ctx_.createBuffer(pixels * sizeof(GpuShadePixel), usage, "shade.pixels");
-    Buffer listBuf = ctx_.createBuffer(pixels * 4, usage, "shade.pixelLists");
-    Buffer lightBuf = ctx_.createBuffer(lightCount * sizeof(GpuShadeLight), usage, "shade.lights");
-    Buffer offsetBuf = ctx_.createBuffer(culled ? listTotal * 4 : 4, usage, "shade.listOffsets");
-    Buffer countBuf = ctx_.createBuffer(culled ? listTotal * 4 : 4, usage, "shade.listCounts");
-    Buffer indexBuf = ctx_.createBuffer(culled ? culled->lightIndices.size() * 4 : 4, usage, "shade.lightIndices");
-    Buffer outBuf = ctx_.createReadbackBuffer(pixels * 3 * 4, usage, "shade.rgb");
+    // Host-visible buffers kept between calls (fresh ones cost a page fault
+    // per 4 KiB touched), each bound at the bytes this call asked for.
+    BufferCache::Frame cacheFrame(cache_);
+    std::vector<Context::DescriptorWrite> bindings(kBindings);
+    auto buffer = [&](std::uint32_t binding, const char* role, std::size_t bytes,
+                      BufferCache::Kind kind = BufferCache::Kind::Host) -> const Buffer& {
+        const VkBufferUsageFlags usage =
+            binding == 8 ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+        const Buffer& b = cache_.get(role, bytes, usage, kind);
+        bindings[binding].buffer = b.buffer;
+        bindings[binding].range = std::max<std::size_t>(bytes, 4);
+        return b;
+    };
+    const Buffer& params = buffer(0, "shade.params", sizeof(GpuShadeParams));
+    const Buffer& pixelBuf = buffer(1, "shade.pixels", pixels * sizeof(GpuShadePixel));
+    const Buffer& listBuf = buffer(2, "shade.pixelLists", pixels * 4);
+    const Buffer& lightBuf = buffer(3, "shade.lights", lightCount * sizeof(GpuShadeLight));
+    const Buffer& offsetBuf = buffer(4, "shade.listOffsets", culled ? listTotal * 4 : 4);
+    const Buffer& countBuf = buffer(5, "shade.listCounts", culled ? listTotal * 4 : 4);
+    const Buffer& indexBuf = buffer(6, "shade.lightIndices", culled ? culled->lightIndices.size() * 4 : 4);
+    const Buffer& outBuf = buffer(7, "shade.rgb", pixels * 3 * 4, BufferCache::Kind::HostRead);
     // The lights again as uniform blocks of blockLights_ each (the last one
     // padded): every chunk of the all-lights image, and a list image's lights
     // when one block holds them all.
@@ -147,8 +159,9 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
     const bool inBlock = allLights || lightCount <= blockLights_ || ascending;
     const std::size_t chunks = inBlock ? std::max<std::size_t>((lightCount + blockLights_ - 1) / blockLights_, 1) : 1;
     const std::size_t blockBytes = std::size_t(blockLights_) * sizeof(GpuShadeLight);
-    Buffer blockBuf = ctx_.createBuffer(inBlock ? chunks * blockBytes : 4, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
-                                        "shade.lightBlocks");
+    const Buffer& blockBuf = buffer(8, "shade.lightBlocks", inBlock ? chunks * blockBytes : 4);
+    bindings[8].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC;
+    bindings[8].range = inBlock ? blockBytes : 4;
 
     params.as<GpuShadeParams>()->size =
         glm::uvec4(in.width, in.height, std::uint32_t(lightCount), std::uint32_t(listTotal));
@@ -173,39 +186,8 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
             std::memcpy(indexBuf.mapped, culled->lightIndices.data(), culled->lightIndices.size() * 4);
     }
 
-    VkDevice dev = ctx_.device();
-    const VkDescriptorPoolSize ps[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings - 1},
-                                        {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, 1}};
-    VkDescriptorPoolCreateInfo dpci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    dpci.maxSets = 1;
-    dpci.poolSizeCount = 2;
-    dpci.pPoolSizes = ps;
-    VkDescriptorPool poolRaw;
-    LC_VK(vkCreateDescriptorPool(dev, &dpci, nullptr, &poolRaw));
-    DescriptorPoolHandle pool(dev, poolRaw);
-    ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_POOL, poolRaw, "shade.descriptorPool");
-    VkDescriptorSetLayout sl = setLayout_;
-    VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    ai.descriptorPool = pool;
-    ai.descriptorSetCount = 1;
-    ai.pSetLayouts = &sl;
-    VkDescriptorSet set;
-    LC_VK(vkAllocateDescriptorSets(dev, &ai, &set));
-    ctx_.name(VK_OBJECT_TYPE_DESCRIPTOR_SET, set, "shade.set");
-    const Buffer* bufs[kBindings] = {&params,   &pixelBuf, &listBuf, &lightBuf, &offsetBuf,
-                                     &countBuf, &indexBuf, &outBuf,  &blockBuf};
-    std::array<VkDescriptorBufferInfo, kBindings> infos{};
-    std::array<VkWriteDescriptorSet, kBindings> writes{};
-    for (std::uint32_t i = 0; i < kBindings; ++i) {
-        infos[i] = {bufs[i]->buffer, 0, i == 8 ? (inBlock ? blockBytes : 4) : VK_WHOLE_SIZE};
-        writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-        writes[i].dstSet = set;
-        writes[i].dstBinding = i;
-        writes[i].descriptorCount = 1;
-        writes[i].descriptorType = i == 8 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        writes[i].pBufferInfo = &infos[i];
-    }
-    vkUpdateDescriptorSets(dev, kBindings, writes.data(), 0, nullptr);
+    DescriptorPoolHandle pool = ctx_.createDescriptorPool(bindings, 1, "shade.descriptorPool");
+    VkDescriptorSet set = ctx_.writeDescriptorSet(pool, setLayout_, bindings, "shade.set");
 
     VkPipeline pipe = pipeline(allLights, inBlock);
     ms = ctx_.submitAndWait(

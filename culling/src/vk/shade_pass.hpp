@@ -21,6 +21,9 @@ private:
     VkPipeline pipeline(bool allLights, bool lightsInBlock);
 
     Context& ctx_;
+    // The shading's buffers, kept between calls while they fit (after ctx_:
+    // freed before the device).
+    BufferCache cache_{ctx_};
     DescriptorSetLayoutHandle setLayout_;
     PipelineLayoutHandle layout_;
     ShaderModuleHandle shader_;

@@ -469,8 +469,22 @@ Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const 
     return b;
 }
 
+BufferCache::Frame::Frame(BufferCache& cache) : cache_(cache) {
+    if (cache_.inFrame_) throw std::logic_error("BufferCache: a frame opened inside another");
+    cache_.inFrame_ = true;
+}
+
+BufferCache::Frame::~Frame() {
+    cache_.inFrame_ = false;
+    cache_.taken_.clear();
+}
+
 const Buffer& BufferCache::get(const std::string& role, VkDeviceSize bytes, VkBufferUsageFlags usage,
                                Kind kind) {
+    if (!inFrame_) throw std::logic_error("BufferCache: buffer role '" + role + "' asked for outside a frame");
+    if (!taken_.insert(role).second)
+        throw std::logic_error("BufferCache: buffer role '" + role +
+                               "' asked for twice in one frame (the first reference would dangle)");
     bytes = std::max<VkDeviceSize>(bytes, 4);
     auto it = entries_.find(role);
     if (it != entries_.end()) {
@@ -606,6 +620,53 @@ Context::PassLayouts Context::createPassLayouts(const std::vector<VkDescriptorTy
     out.pipeline = PipelineLayoutHandle(device_, pl);
     name(VK_OBJECT_TYPE_PIPELINE_LAYOUT, pl, n + ".pipelineLayout");
     return out;
+}
+
+DescriptorPoolHandle Context::createDescriptorPool(const std::vector<DescriptorWrite>& bindings,
+                                                  std::uint32_t sets, const std::string& n) const {
+    std::map<VkDescriptorType, std::uint32_t> perType;
+    for (const DescriptorWrite& b : bindings) perType[b.type] += sets;
+    std::vector<VkDescriptorPoolSize> sizes;
+    for (const auto& [type, count] : perType) sizes.push_back({type, count});
+    VkDescriptorPoolCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    ci.maxSets = sets;
+    ci.poolSizeCount = std::uint32_t(sizes.size());
+    ci.pPoolSizes = sizes.data();
+    VkDescriptorPool pool;
+    LC_VK(vkCreateDescriptorPool(device_, &ci, nullptr, &pool));
+    name(VK_OBJECT_TYPE_DESCRIPTOR_POOL, pool, n);
+    return DescriptorPoolHandle(device_, pool);
+}
+
+VkDescriptorSet Context::writeDescriptorSet(VkDescriptorPool pool, VkDescriptorSetLayout layout,
+                                            const std::vector<DescriptorWrite>& bindings,
+                                            const std::string& n) const {
+    VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    ai.descriptorPool = pool;
+    ai.descriptorSetCount = 1;
+    ai.pSetLayouts = &layout;
+    VkDescriptorSet set;
+    LC_VK(vkAllocateDescriptorSets(device_, &ai, &set));
+    name(VK_OBJECT_TYPE_DESCRIPTOR_SET, set, n);
+    std::vector<VkDescriptorBufferInfo> infos(bindings.size());
+    std::vector<VkWriteDescriptorSet> writes(bindings.size());
+    for (std::uint32_t i = 0; i < bindings.size(); ++i) {
+        const DescriptorWrite& b = bindings[i];
+        writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+        writes[i].dstSet = set;
+        writes[i].dstBinding = i;
+        writes[i].descriptorCount = 1;
+        writes[i].descriptorType = b.type;
+        if (b.type == VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER || b.type == VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE ||
+            b.type == VK_DESCRIPTOR_TYPE_STORAGE_IMAGE) {
+            writes[i].pImageInfo = &b.image;
+        } else {
+            infos[i] = {b.buffer, 0, b.range};
+            writes[i].pBufferInfo = &infos[i];
+        }
+    }
+    vkUpdateDescriptorSets(device_, std::uint32_t(writes.size()), writes.data(), 0, nullptr);
+    return set;
 }
 
 namespace {

@@ -10,6 +10,8 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <set>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -235,6 +237,20 @@ public:
     };
     PassLayouts createPassLayouts(const std::vector<VkDescriptorType>& types, const std::string& name,
                                   std::uint32_t pushConstantBytes = 0) const;
+    // One binding of a descriptor set: a buffer's first `range` bytes, or
+    // (image types) a sampled image.
+    struct DescriptorWrite {
+        VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        VkBuffer buffer = VK_NULL_HANDLE;
+        VkDeviceSize range = VK_WHOLE_SIZE;
+        VkDescriptorImageInfo image{};
+    };
+    // A descriptor pool with room for `sets` sets of `bindings`' types,
+    // named "<name>", and a set of it written with binding i = bindings[i].
+    DescriptorPoolHandle createDescriptorPool(const std::vector<DescriptorWrite>& bindings, std::uint32_t sets,
+                                              const std::string& name) const;
+    VkDescriptorSet writeDescriptorSet(VkDescriptorPool pool, VkDescriptorSetLayout layout,
+                                       const std::vector<DescriptorWrite>& bindings, const std::string& name) const;
 
     // Records a one-time command buffer, submits it, waits. Returns the CPU
     // wall-clock milliseconds from submit to the fence signalling.
@@ -293,6 +309,23 @@ class BufferCache {
     explicit BufferCache(const Context& ctx) : ctx_(ctx) {}
     BufferCache(const BufferCache&) = delete;
     BufferCache& operator=(const BufferCache&) = delete;
+
+    // One pass's use of the cache (a depth pre-pass, a cull, a shading):
+    // buffers are asked for only while a frame is open, and each role once
+    // in it, because asking again may replace the buffer an earlier
+    // reference names. Either is a std::logic_error, not a dangling
+    // reference.
+    class Frame {
+      public:
+        explicit Frame(BufferCache& cache);
+        ~Frame();
+        Frame(const Frame&) = delete;
+        Frame& operator=(const Frame&) = delete;
+
+      private:
+        BufferCache& cache_;
+    };
+
     // Made by Context::createBuffer(..., kind). The buffer lives until the role asks again with a
     // size or kind it does not fit, or the cache goes.
     const Buffer& get(const std::string& role, VkDeviceSize bytes, VkBufferUsageFlags usage, Kind kind);
@@ -305,6 +338,8 @@ class BufferCache {
     };
     const Context& ctx_;
     std::map<std::string, Entry> entries_;
+    bool inFrame_ = false;
+    std::set<std::string> taken_; // the roles the open frame asked for
 };
 
 } // namespace lc::vk

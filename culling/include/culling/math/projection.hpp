@@ -38,6 +38,9 @@ public:
 
     // The linearisation constants shared with GLSL (gpu_shared.h).
     DepthParams depthParams() const { return params_; }
+    // (A, B) of window depth d = A + B / viewDepth (perspective kinds) or
+    // A + B * viewDepth (orthographic kinds), in double.
+    glm::dvec2 windowDepthAB() const;
 
     // Window depth d in [0,1] -> view depth (positive in front of the camera).
     double viewDepthFromWindowDepth(double d) const;

@@ -71,6 +71,29 @@ const uint LC_SPOT_NONE = 0u;
 const uint LC_SPOT_CONE_SPHERE = 1u;
 const uint LC_SPOT_CONE_PLANES = 2u;
 
+// The stages one shader runs as (specialisation constant WRITE_PASS).
+// cull_lists: count (and stash), write, both in one dispatch at ranges taken
+// by atomic adds (GPUs), write at such ranges (clustered's tile walk).
+const uint LC_PASS_COUNT = 0u;
+const uint LC_PASS_WRITE = 1u;
+const uint LC_PASS_FUSED = 2u;
+const uint LC_PASS_WRITE_AT_RANGES = 3u;
+// fine_prune: mark the pruned entries, then pack each list's kept ones.
+const uint LC_PRUNE_MARK = 0u;
+const uint LC_PRUNE_PACK = 1u;
+// zbin: empty every bin, then bin the lights.
+const uint LC_ZBIN_INIT = 0u;
+const uint LC_ZBIN_BIN = 1u;
+// Bits of the status word (binding 7) the passes OR in; the host turns each
+// into an error (or, for the counters, into "not counted").
+const uint LC_STATUS_SPLIT_WORKGROUP = 1u; // a device split a one-subgroup workgroup
+const uint LC_STATUS_COUNT_MISMATCH = 2u;  // the write pass found a different count
+const uint LC_STATUS_TESTS_OVERFLOW = 4u;  // a test counter wrapped around 2^32
+// A loop ended before its condition did: lavapipe (gallivm) stops every loop
+// of a shader invocation after 65,535 iterations in all, silently. The host
+// sizes the work per invocation below that and turns this bit into an error.
+const uint LC_STATUS_LOOP_LIMIT = 8u;
+
 // Per-dispatch parameters of the culling passes (one read-only storage buffer,
 // std430). Sizes and modes that shape the code (tile size, cells, slicing,
 // sphere test, algorithm) are specialisation constants instead.
