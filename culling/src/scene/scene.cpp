@@ -13,10 +13,6 @@
 
 namespace lc {
 
-void CancelToken::throwIfCancelled() const {
-    if (cancelled.load(std::memory_order_relaxed)) throw Cancelled();
-}
-
 namespace {
 bool finite3(const glm::dvec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);

@@ -121,6 +121,18 @@ VkPhysicalDevice chooseDevice(const std::vector<VkPhysicalDevice>& devs, std::st
 
 // Creates an instance (with validation when requested). Returns the instance
 // and whether VK_EXT_debug_utils is enabled.
+// The messenger of every validation message (warnings and errors, general,
+// validation and performance) into debugCallback: chained into instance
+// creation for its own messages, then created for the instance's life.
+VkDebugUtilsMessengerCreateInfoEXT messengerInfo() {
+    VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    mci.pfnUserCallback = debugCallback;
+    return mci;
+}
+
 VkInstance createInstance(bool& debugUtils, bool& validation, bool forceValidation) {
     std::uint32_t n = 0;
     LC_VK(vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr));
@@ -173,11 +185,7 @@ VkInstance createInstance(bool& debugUtils, bool& validation, bool forceValidati
     VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
     features.enabledValidationFeatureCount = 1;
     features.pEnabledValidationFeatures = &syncEnable;
-    VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-    mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-    mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-    mci.pfnUserCallback = debugCallback;
+    VkDebugUtilsMessengerCreateInfoEXT mci = messengerInfo();
     if (validation && validationFeatures) mci.pNext = &features;
 
     VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
@@ -235,13 +243,7 @@ Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
     instance_ = createInstance(debugUtils_, validation, opt.validation);
     try {
         if (validation) {
-            VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-            mci.messageSeverity =
-                VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-            mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                              VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                              VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-            mci.pfnUserCallback = debugCallback;
+            const VkDebugUtilsMessengerCreateInfoEXT mci = messengerInfo();
             auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
                 vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
             if (!create) throw DeviceError("vkCreateDebugUtilsMessengerEXT unavailable");

@@ -1,10 +1,10 @@
 #pragma once
 // Depth buffers and the CPU reference rasteriser.
 
+#include "culling/core/cancel.hpp"
 #include "culling/math/projection.hpp"
 #include "culling/scene/scene.hpp"
 
-#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -25,12 +25,6 @@ struct DepthImage {
     float at(std::uint32_t x, std::uint32_t y) const { return depth[std::size_t(y) * width + x]; }
     bool hasGeometry(std::uint32_t x, std::uint32_t y) const { return at(x, y) != clearDepth; }
     std::size_t geometryPixelCount() const;
-};
-
-// Cooperative cancellation for long operations; checked between chunks.
-struct CancelToken {
-    std::atomic<bool> cancelled{false};
-    void throwIfCancelled() const;
 };
 
 // Rasterises every mesh triangle into a depth image: pixel-centre sampling,
