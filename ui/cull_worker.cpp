@@ -129,17 +129,15 @@ std::shared_ptr<const lc::RunOutput> CullWorker::addDeferredTruth(const CullRequ
         truthCancel_ = truthCancel;
     }
     try {
+        // The pipeline's own truth phase (lc::judgeRun: truth, its time),
+        // run later; the image error stays with the shading phase.
         auto full = std::make_shared<lc::RunOutput>(partial);
-        lc::GroundTruthOptions truthOptions;
-        truthOptions.imageError = false;
-        const auto t0 = std::chrono::steady_clock::now();
+        lc::RunOptions truthOnly;
+        truthOnly.groundTruth = true;
+        truthOnly.truthOptions.imageError = false;
         runAtLowPriority([&] {
-            full->truth = lc::computeGroundTruth(full->depth, lc::Projection(req.scene->camera), full->lights,
-                                                 full->result, truthOptions, truthCancel.get());
+            lc::judgeRun(*full, lc::Projection(req.scene->camera), *backend_, truthOnly, truthCancel.get());
         });
-        full->result.timings.groundTruthMs =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-        full->truthComputed = true;
         done = std::move(full);
         emit finished(req.generation, done);
     } catch (const lc::Cancelled&) {

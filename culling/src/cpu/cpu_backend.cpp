@@ -113,31 +113,32 @@ template <class Fn> void parallelRows(std::uint32_t rows, Fn fn) {
 
 } // namespace
 
-// The culling pass itself (the CPU backend's cullFrame() without the timing).
-static CullResult cullCpu(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
-                          const ViewLights& lights, const CullSettings& settings) {
-    const TileGrid& grid = frame.grid;
-    const Algorithm algo = settings.algorithm;
-    const std::uint32_t tiles = grid.tileCount();
-    const std::uint32_t cells = settings.cells;
-    const std::size_t n = lights.size();
+namespace {
 
-    CullResult res;
-    res.algorithm = algo;
-    res.settings = settings;
-    res.grid = grid;
-    res.listsPerTile = frame.listsPerTile;
-    res.tileDepthMin.assign(tiles, kInf);
-    res.tileDepthMax.assign(tiles, -kInf);
+// The inputs every part of a CPU cull reads: the frame, the depth as view
+// depth per pixel (NaN: no geometry), each light's culling sphere.
+struct CpuCull {
+    const CullFrame& frame;
+    const DepthImage& depth;
+    const Projection& proj;
+    const ViewLights& lights;
+    const CullSettings& settings;
+    std::vector<double> viewDepth;
+    std::vector<glm::dvec3> sphereCenter;
+    std::vector<double> sphereRadius;
+};
 
-    // Per pixel view depth (NaN = no geometry) and per tile bounds, in double
-    // from the float depth.
-    std::vector<double> viewDepth(depth.depth.size(), std::nan(""));
+// Per pixel view depth and per tile bounds, in double from the float depth.
+void tileBounds(CpuCull& c, CullResult& res) {
+    const DepthImage& depth = c.depth;
+    const TileGrid& grid = c.frame.grid;
+    std::vector<double>& viewDepth = c.viewDepth;
+    viewDepth.assign(depth.depth.size(), std::nan(""));
     for (std::uint32_t y = 0; y < depth.height; ++y) {
         for (std::uint32_t x = 0; x < depth.width; ++x) {
             const std::size_t i = std::size_t(y) * depth.width + x;
             if (depth.depth[i] == depth.clearDepth) continue;
-            const double v = proj.viewDepthFromWindowDepth(double(depth.depth[i]));
+            const double v = c.proj.viewDepthFromWindowDepth(double(depth.depth[i]));
             if (!std::isfinite(v)) continue;
             viewDepth[i] = v;
             const std::uint32_t t = grid.tileOfPixel(x, y);
@@ -145,195 +146,192 @@ static CullResult cullCpu(const CullFrame& frame, const DepthImage& depth, const
             res.tileDepthMax[t] = std::max(res.tileDepthMax[t], v);
         }
     }
-    auto tileEmpty = [&](std::uint32_t t) { return !(res.tileDepthMin[t] <= res.tileDepthMax[t]); };
+}
 
-    // Each light's culling sphere (the frame's: its range sphere, or for a
-    // spot light the sphere its spot test uses); spot tests may refine it per
-    // chunk below. The camera's and the clusters' depth ranges are the
-    // frame's too (an infinite far plane replaced by the farthest depth any
-    // light reaches).
-    std::vector<glm::dvec3> sphereCenter(n);
-    std::vector<double> sphereRadius(n);
-    for (std::size_t l = 0; l < n; ++l) {
-        sphereCenter[l] = frame.cullSpheres[l].center;
-        sphereRadius[l] = frame.cullSpheres[l].radius;
+// 2.5d's occupied cells and clustered's occupied slices per tile.
+void cellMasks(const CpuCull& c, CullResult& res) {
+    const DepthImage& depth = c.depth;
+    const TileGrid& grid = c.frame.grid;
+    const Algorithm algo = c.settings.algorithm;
+    const std::uint32_t cells = c.settings.cells;
+    res.cellMask.assign(grid.tileCount(), 0);
+    for (std::uint32_t y = 0; y < depth.height; ++y) {
+        for (std::uint32_t x = 0; x < depth.width; ++x) {
+            const double v = c.viewDepth[std::size_t(y) * depth.width + x];
+            if (std::isnan(v)) continue;
+            const std::uint32_t t = grid.tileOfPixel(x, y);
+            const std::uint32_t k =
+                algo == Algorithm::Clustered
+                    ? sliceOfDepth(c.settings.slicing, res.clusterNear, res.clusterFar, cells, v)
+                    : sliceOfDepth(c.settings.slicing, res.tileDepthMin[t], res.tileDepthMax[t], cells, v);
+            res.cellMask[t] |= 1u << k;
+        }
     }
+}
+
+// Every algorithm but `all`: each light against each tile's (or cell's)
+// volume in its screen range, tile rows on several threads; the lists in
+// `lists`, the tests counted into res.volumeTests.
+void cullTiles(const CpuCull& cc, CullResult& res, std::vector<std::vector<std::uint32_t>>& lists) {
+    const CullFrame& frame = cc.frame;
+    const DepthImage& depth = cc.depth;
+    const Projection& proj = cc.proj;
+    const ViewLights& lights = cc.lights;
+    const CullSettings& settings = cc.settings;
+    const TileGrid& grid = frame.grid;
+    const Algorithm algo = settings.algorithm;
+    const std::uint32_t cells = settings.cells;
+    const std::size_t n = lights.size();
+    const std::vector<double>& viewDepth = cc.viewDepth;
+    const std::vector<glm::dvec3>& sphereCenter = cc.sphereCenter;
+    const std::vector<double>& sphereRadius = cc.sphereRadius;
     const bool coneRefines =
         settings.spotTest == SpotTest::ConeSphere || settings.spotTest == SpotTest::ConePlanes;
-    const double camNear = frame.cameraNear;
-    const double naiveFar = frame.cameraFar;
-    if (algo == Algorithm::Clustered) {
-        res.clusterNear = frame.clusterNear;
-        res.clusterFar = frame.clusterFar;
+    const double camNear = frame.cameraNear, naiveFar = frame.cameraFar;
+    auto tileEmpty = [&](std::uint32_t t) { return !(res.tileDepthMin[t] <= res.tileDepthMax[t]); };
+    std::vector<TileRange> ranges(n);
+    std::vector<std::uint32_t> clusterMask(algo == Algorithm::Clustered ? n : 0);
+    for (std::size_t l = 0; l < n; ++l) {
+        ranges[l] = lightTileRange(proj, grid, sphereCenter[l], sphereRadius[l]);
+        if (algo == Algorithm::Clustered) {
+            const double cd = -sphereCenter[l].z, r = sphereRadius[l];
+            clusterMask[l] = sliceRangeMask(settings.slicing, res.clusterNear, res.clusterFar,
+                                            cells, cd - r, cd + r);
+        }
     }
-    if (algo == Algorithm::HalfZ) {
-        res.halfzSplit.assign(tiles, kInf);
-        for (std::uint32_t t = 0; t < tiles; ++t)
-            if (!tileEmpty(t)) res.halfzSplit[t] = 0.5 * (res.tileDepthMin[t] + res.tileDepthMax[t]);
-    }
-    if (algo == Algorithm::TwoPointFiveD || algo == Algorithm::Clustered) {
-        res.cellMask.assign(tiles, 0);
-        for (std::uint32_t y = 0; y < depth.height; ++y) {
-            for (std::uint32_t x = 0; x < depth.width; ++x) {
+    const SphereTest test = settings.test;
+    // fptl's fine test: any geometry pixel of the tile inside the light's
+    // volume (fine_prune.hpp), from the same per-pixel positions.
+    auto tilePixelKeeps = [&](const TileGrid::Rect& rect, std::uint32_t l) {
+        for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
+            for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
                 const double v = viewDepth[std::size_t(y) * depth.width + x];
                 if (std::isnan(v)) continue;
-                const std::uint32_t t = grid.tileOfPixel(x, y);
-                const std::uint32_t k =
-                    algo == Algorithm::Clustered
-                        ? sliceOfDepth(settings.slicing, res.clusterNear, res.clusterFar, cells, v)
-                        : sliceOfDepth(settings.slicing, res.tileDepthMin[t], res.tileDepthMax[t], cells, v);
-                res.cellMask[t] |= 1u << k;
+                if (fptlPixelKeeps(lights, l, proj.viewPositionFromDepth(x, y, double(depth.at(x, y)))))
+                    return true;
             }
-        }
-    }
-
-    const std::size_t listTotal = algo == Algorithm::All ? 1 : std::size_t(tiles) * res.listsPerTile;
-    std::vector<std::vector<std::uint32_t>> lists(listTotal);
-
-    if (algo == Algorithm::All) {
-        lists[0].resize(n);
-        for (std::size_t l = 0; l < n; ++l) lists[0][l] = std::uint32_t(l);
-    } else if (tiles > 0) {
-        std::vector<TileRange> ranges(n);
-        std::vector<std::uint32_t> clusterMask(algo == Algorithm::Clustered ? n : 0);
-        for (std::size_t l = 0; l < n; ++l) {
-            ranges[l] = lightTileRange(proj, grid, sphereCenter[l], sphereRadius[l]);
-            if (algo == Algorithm::Clustered) {
-                const double cd = -sphereCenter[l].z, r = sphereRadius[l];
-                clusterMask[l] = sliceRangeMask(settings.slicing, res.clusterNear, res.clusterFar,
-                                                cells, cd - r, cd + r);
+        return false;
+    };
+    // The one per-chunk test: the culling sphere, then for a spot light
+    // under a cone test the cone refinement (spot_tests.hpp).
+    // Counted into the tile row's counter (the rows run on several
+    // threads), summed below.
+    std::vector<std::uint64_t> rowTests(grid.tilesY, 0);
+    auto intersects = [&](const FrustumChunk& chunk, std::uint32_t l, std::uint64_t& tests) {
+        ++tests;
+        if (!sphereIntersectsChunk(test, chunk, sphereCenter[l], sphereRadius[l])) return false;
+        if (!coneRefines || !lights.isSpot(l)) return true;
+        return spotIntersectsChunk(settings.spotTest, test, lights.spotCone(l), chunk);
+    };
+    parallelRows(grid.tilesY, [&](std::uint32_t ty) {
+        std::uint64_t& tests = rowTests[ty];
+        std::vector<std::uint32_t> candidates;
+        for (std::size_t l = 0; l < n; ++l)
+            if (!ranges[l].empty() && ranges[l].ty0 <= ty && ty <= ranges[l].ty1)
+                candidates.push_back(std::uint32_t(l));
+        std::vector<FrustumChunk> sliceChunk(cells);
+        std::vector<char> sliceBuilt(cells);
+        for (std::uint32_t tx = 0; tx < grid.tilesX; ++tx) {
+            const std::uint32_t t = grid.tileIndex(tx, ty);
+            const TileGrid::Rect rect = grid.tileRect(tx, ty);
+            const bool empty = tileEmpty(t);
+            // naive's and zbin's screen-space volumes do not depend on the depth.
+            if (empty && algo != Algorithm::Naive && algo != Algorithm::ZBin &&
+                !(algo == Algorithm::Clustered && !settings.skipEmpty))
+                continue;
+            const double tmin = res.tileDepthMin[t], tmax = res.tileDepthMax[t];
+            FrustumChunk chunkA, chunkB;
+            switch (algo) {
+            case Algorithm::ZBin:
+            case Algorithm::Naive: chunkA = makeFrustumChunk(proj, rect, camNear, naiveFar); break;
+            case Algorithm::Fptl:
+            case Algorithm::MinMax:
+            case Algorithm::TwoPointFiveD: chunkA = makeFrustumChunk(proj, rect, tmin, tmax); break;
+            case Algorithm::HalfZ:
+                chunkA = makeFrustumChunk(proj, rect, tmin, res.halfzSplit[t]);
+                chunkB = makeFrustumChunk(proj, rect, res.halfzSplit[t], tmax);
+                break;
+            default: std::fill(sliceBuilt.begin(), sliceBuilt.end(), 0); break;
             }
-        }
-        const SphereTest test = settings.test;
-        // fptl's fine test: any geometry pixel of the tile inside the light's
-        // volume (fine_prune.hpp), from the same per-pixel positions.
-        auto tilePixelKeeps = [&](const TileGrid::Rect& rect, std::uint32_t l) {
-            for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
-                for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
-                    const double v = viewDepth[std::size_t(y) * depth.width + x];
-                    if (std::isnan(v)) continue;
-                    if (fptlPixelKeeps(lights, l, proj.viewPositionFromDepth(x, y, double(depth.at(x, y)))))
-                        return true;
-                }
-            return false;
-        };
-        // The one per-chunk test: the culling sphere, then for a spot light
-        // under a cone test the cone refinement (spot_tests.hpp).
-        // Counted into the tile row's counter (the rows run on several
-        // threads), summed below.
-        std::vector<std::uint64_t> rowTests(grid.tilesY, 0);
-        auto intersects = [&](const FrustumChunk& chunk, std::uint32_t l, std::uint64_t& tests) {
-            ++tests;
-            if (!sphereIntersectsChunk(test, chunk, sphereCenter[l], sphereRadius[l])) return false;
-            if (!coneRefines || !lights.isSpot(l)) return true;
-            return spotIntersectsChunk(settings.spotTest, test, lights.spotCone(l), chunk);
-        };
-        parallelRows(grid.tilesY, [&](std::uint32_t ty) {
-            std::uint64_t& tests = rowTests[ty];
-            std::vector<std::uint32_t> candidates;
-            for (std::size_t l = 0; l < n; ++l)
-                if (!ranges[l].empty() && ranges[l].ty0 <= ty && ty <= ranges[l].ty1)
-                    candidates.push_back(std::uint32_t(l));
-            std::vector<FrustumChunk> sliceChunk(cells);
-            std::vector<char> sliceBuilt(cells);
-            for (std::uint32_t tx = 0; tx < grid.tilesX; ++tx) {
-                const std::uint32_t t = grid.tileIndex(tx, ty);
-                const TileGrid::Rect rect = grid.tileRect(tx, ty);
-                const bool empty = tileEmpty(t);
-                // naive's and zbin's screen-space volumes do not depend on the depth.
-                if (empty && algo != Algorithm::Naive && algo != Algorithm::ZBin &&
-                    !(algo == Algorithm::Clustered && !settings.skipEmpty))
-                    continue;
-                const double tmin = res.tileDepthMin[t], tmax = res.tileDepthMax[t];
-                FrustumChunk chunkA, chunkB;
+            for (std::uint32_t l : candidates) {
+                const TileRange& rg = ranges[l];
+                if (tx < rg.tx0 || tx > rg.tx1) continue;
+                const glm::dvec3& c = sphereCenter[l];
+                const double r = sphereRadius[l];
                 switch (algo) {
-                case Algorithm::ZBin:
-                case Algorithm::Naive: chunkA = makeFrustumChunk(proj, rect, camNear, naiveFar); break;
-                case Algorithm::Fptl:
+                case Algorithm::Naive:
+                case Algorithm::ZBin: // the tile's mask: the screen-space test
                 case Algorithm::MinMax:
-                case Algorithm::TwoPointFiveD: chunkA = makeFrustumChunk(proj, rect, tmin, tmax); break;
-                case Algorithm::HalfZ:
-                    chunkA = makeFrustumChunk(proj, rect, tmin, res.halfzSplit[t]);
-                    chunkB = makeFrustumChunk(proj, rect, res.halfzSplit[t], tmax);
+                    if (intersects(chunkA, l, tests)) lists[t].push_back(l);
                     break;
-                default: std::fill(sliceBuilt.begin(), sliceBuilt.end(), 0); break;
+                case Algorithm::Fptl:
+                    // Coarse: minmax's test; fine: a pixel of the tile the light could reach.
+                    if (intersects(chunkA, l, tests) && tilePixelKeeps(rect, l)) lists[t].push_back(l);
+                    break;
+                case Algorithm::HalfZ:
+                    if (intersects(chunkA, l, tests)) lists[2 * t].push_back(l);
+                    if (intersects(chunkB, l, tests)) lists[2 * t + 1].push_back(l);
+                    break;
+                case Algorithm::TwoPointFiveD: {
+                    const double cd = -c.z;
+                    const std::uint32_t m =
+                        sliceRangeMask(settings.slicing, tmin, tmax, cells, cd - r, cd + r);
+                    if ((m & res.cellMask[t]) && intersects(chunkA, l, tests))
+                        lists[t].push_back(l);
+                    break;
                 }
-                for (std::uint32_t l : candidates) {
-                    const TileRange& rg = ranges[l];
-                    if (tx < rg.tx0 || tx > rg.tx1) continue;
-                    const glm::dvec3& c = sphereCenter[l];
-                    const double r = sphereRadius[l];
-                    switch (algo) {
-                    case Algorithm::Naive:
-                    case Algorithm::ZBin: // the tile's mask: the screen-space test
-                    case Algorithm::MinMax:
-                        if (intersects(chunkA, l, tests)) lists[t].push_back(l);
-                        break;
-                    case Algorithm::Fptl:
-                        // Coarse: minmax's test; fine: a pixel of the tile the light could reach.
-                        if (intersects(chunkA, l, tests) && tilePixelKeeps(rect, l)) lists[t].push_back(l);
-                        break;
-                    case Algorithm::HalfZ:
-                        if (intersects(chunkA, l, tests)) lists[2 * t].push_back(l);
-                        if (intersects(chunkB, l, tests)) lists[2 * t + 1].push_back(l);
-                        break;
-                    case Algorithm::TwoPointFiveD: {
-                        const double cd = -c.z;
-                        const std::uint32_t m =
-                            sliceRangeMask(settings.slicing, tmin, tmax, cells, cd - r, cd + r);
-                        if ((m & res.cellMask[t]) && intersects(chunkA, l, tests))
-                            lists[t].push_back(l);
-                        break;
-                    }
-                    case Algorithm::Clustered: {
-                        std::uint32_t m = clusterMask[l];
-                        if (settings.skipEmpty) m &= res.cellMask[t];
-                        for (; m; m &= m - 1) {
-                            const std::uint32_t k = std::uint32_t(std::countr_zero(m));
-                            if (!sliceBuilt[k]) {
-                                sliceChunk[k] = makeFrustumChunk(
-                                    proj, rect,
-                                    sliceBoundary(settings.slicing, res.clusterNear, res.clusterFar, cells, k),
-                                    sliceBoundary(settings.slicing, res.clusterNear, res.clusterFar, cells, k + 1));
-                                sliceBuilt[k] = 1;
-                            }
-                            if (intersects(sliceChunk[k], l, tests))
-                                lists[std::size_t(t) * cells + k].push_back(l);
+                case Algorithm::Clustered: {
+                    std::uint32_t m = clusterMask[l];
+                    if (settings.skipEmpty) m &= res.cellMask[t];
+                    for (; m; m &= m - 1) {
+                        const std::uint32_t k = std::uint32_t(std::countr_zero(m));
+                        if (!sliceBuilt[k]) {
+                            sliceChunk[k] = makeFrustumChunk(
+                                proj, rect,
+                                sliceBoundary(settings.slicing, res.clusterNear, res.clusterFar, cells, k),
+                                sliceBoundary(settings.slicing, res.clusterNear, res.clusterFar, cells, k + 1));
+                            sliceBuilt[k] = 1;
                         }
-                        break;
+                        if (intersects(sliceChunk[k], l, tests))
+                            lists[std::size_t(t) * cells + k].push_back(l);
                     }
-                    default: break;
-                    }
+                    break;
                 }
-            }
-        });
-        for (std::uint64_t t : rowTests) res.volumeTests += t;
-    }
-
-    if (algo == Algorithm::ZBin) {
-        // The lights sorted by the view depth of their culling sphere's
-        // centre; per linear bin of [near, far] the range of sorted positions
-        // whose depth extent (with the tests' slack) reaches it.
-        res.zbinNear = camNear;
-        res.zbinFar = naiveFar;
-        std::vector<double> centreDepth(n);
-        for (std::size_t l = 0; l < n; ++l) centreDepth[l] = -sphereCenter[l].z;
-        zbinSortLights(centreDepth, res.zbinOrder, res.zbinRank);
-        res.zbinLo.assign(settings.bins, std::numeric_limits<std::uint32_t>::max());
-        res.zbinHi.assign(settings.bins, 0);
-        for (std::uint32_t k = 0; k < n; ++k) {
-            const std::uint32_t l = res.zbinOrder[k];
-            const double slack = sphereTestSlack(sphereCenter[l], sphereRadius[l]);
-            const double a = centreDepth[l] - sphereRadius[l] - slack, b = centreDepth[l] + sphereRadius[l] + slack;
-            if (b < res.zbinNear || a > res.zbinFar) continue;
-            for (std::uint32_t bin = res.zbinOf(a), last = res.zbinOf(b); bin <= last; ++bin) {
-                res.zbinLo[bin] = std::min(res.zbinLo[bin], k);
-                res.zbinHi[bin] = std::max(res.zbinHi[bin], k);
+                default: break;
+                }
             }
         }
-    }
+    });
+    for (std::uint64_t t : rowTests) res.volumeTests += t;
+}
 
-    // Compact: offsets, counts and one index array.
+// zbin: the lights sorted by the view depth of their culling sphere's
+// centre; per linear bin of [near, far] the range of sorted positions whose
+// depth extent (with the tests' slack) reaches it.
+void zbinBins(const CpuCull& c, CullResult& res) {
+    const std::size_t n = c.lights.size();
+    res.zbinNear = c.frame.cameraNear;
+    res.zbinFar = c.frame.cameraFar;
+    std::vector<double> centreDepth(n);
+    for (std::size_t l = 0; l < n; ++l) centreDepth[l] = -c.sphereCenter[l].z;
+    zbinSortLights(centreDepth, res.zbinOrder, res.zbinRank);
+    res.zbinLo.assign(c.settings.bins, std::numeric_limits<std::uint32_t>::max());
+    res.zbinHi.assign(c.settings.bins, 0);
+    for (std::uint32_t k = 0; k < n; ++k) {
+        const std::uint32_t l = res.zbinOrder[k];
+        const double slack = sphereTestSlack(c.sphereCenter[l], c.sphereRadius[l]);
+        const double a = centreDepth[l] - c.sphereRadius[l] - slack, b = centreDepth[l] + c.sphereRadius[l] + slack;
+        if (b < res.zbinNear || a > res.zbinFar) continue;
+        for (std::uint32_t bin = res.zbinOf(a), last = res.zbinOf(b); bin <= last; ++bin) {
+            res.zbinLo[bin] = std::min(res.zbinLo[bin], k);
+            res.zbinHi[bin] = std::max(res.zbinHi[bin], k);
+        }
+    }
+}
+
+// The lists compacted: offsets, counts and one index array.
+void compactLists(const std::vector<std::vector<std::uint32_t>>& lists, CullResult& res) {
+    const std::size_t listTotal = lists.size();
     res.listOffset.resize(listTotal);
     res.listCount.resize(listTotal);
     std::size_t total = 0;
@@ -347,6 +345,59 @@ static CullResult cullCpu(const CullFrame& frame, const DepthImage& depth, const
     res.lightIndices.resize(total);
     for (std::size_t i = 0; i < listTotal; ++i)
         std::copy(lists[i].begin(), lists[i].end(), res.lightIndices.begin() + res.listOffset[i]);
+}
+
+} // namespace
+
+// The culling pass itself (the CPU backend's cullFrame() without the timing).
+static CullResult cullCpu(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
+                          const ViewLights& lights, const CullSettings& settings) {
+    const TileGrid& grid = frame.grid;
+    const Algorithm algo = settings.algorithm;
+    const std::uint32_t tiles = grid.tileCount();
+    const std::size_t n = lights.size();
+
+    CullResult res;
+    res.algorithm = algo;
+    res.settings = settings;
+    res.grid = grid;
+    res.listsPerTile = frame.listsPerTile;
+    res.tileDepthMin.assign(tiles, kInf);
+    res.tileDepthMax.assign(tiles, -kInf);
+    CpuCull c{frame, depth, proj, lights, settings, {}, {}, {}};
+    tileBounds(c, res);
+    // Each light's culling sphere (the frame's: its range sphere, or for a
+    // spot light the sphere its spot test uses); spot tests may refine it per
+    // chunk. The camera's and the clusters' depth ranges are the frame's too
+    // (an infinite far plane replaced by the farthest depth any light reaches).
+    c.sphereCenter.resize(n);
+    c.sphereRadius.resize(n);
+    for (std::size_t l = 0; l < n; ++l) {
+        c.sphereCenter[l] = frame.cullSpheres[l].center;
+        c.sphereRadius[l] = frame.cullSpheres[l].radius;
+    }
+    if (algo == Algorithm::Clustered) {
+        res.clusterNear = frame.clusterNear;
+        res.clusterFar = frame.clusterFar;
+    }
+    if (algo == Algorithm::HalfZ) {
+        res.halfzSplit.assign(tiles, kInf);
+        for (std::uint32_t t = 0; t < tiles; ++t)
+            if (res.tileDepthMin[t] <= res.tileDepthMax[t])
+                res.halfzSplit[t] = 0.5 * (res.tileDepthMin[t] + res.tileDepthMax[t]);
+    }
+    if (algo == Algorithm::TwoPointFiveD || algo == Algorithm::Clustered) cellMasks(c, res);
+
+    const std::size_t listTotal = algo == Algorithm::All ? 1 : std::size_t(tiles) * res.listsPerTile;
+    std::vector<std::vector<std::uint32_t>> lists(listTotal);
+    if (algo == Algorithm::All) {
+        lists[0].resize(n);
+        for (std::size_t l = 0; l < n; ++l) lists[0][l] = std::uint32_t(l);
+    } else if (tiles > 0) {
+        cullTiles(c, res, lists);
+    }
+    if (algo == Algorithm::ZBin) zbinBins(c, res);
+    compactLists(lists, res);
     return res;
 }
 
