@@ -47,167 +47,156 @@ std::array<glm::dvec3, 4> chunkFace(const std::array<glm::dvec3, 8>& c, int plan
             c[std::size_t(kFace[p][3])]};
 }
 
-Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint32_t list, std::uint32_t light) {
+namespace {
+
+// The algorithm's tests of the light against the list's volume, as steps
+// with their numbers; whether all passed.
+bool explainTests(const RunOutput& run, const Projection& proj, const BoundingSphere& sphere, Explanation& e) {
     const CullResult& r = run.result;
     const ViewLights& lights = run.lights;
-    if (list >= r.listCount.size())
-        throw SettingsError("list", std::to_string(list) + " is outside 0.." + std::to_string(r.listCount.size() - 1));
-    if (light >= lights.size())
-        throw SettingsError("light", std::to_string(light) + " is outside 0.." + std::to_string(lights.size() - 1));
     const CullSettings& s = r.settings;
-    Explanation e;
-    e.list = list;
-    e.light = light;
-    e.algorithm = run.custom ? "custom (" + std::string(toString(r.algorithm)) + " lists)" : toString(r.algorithm);
-    const std::uint32_t per = std::max(r.listsPerTile, 1u);
-    e.tile = r.tileOfList(list);
-    e.sub = per > 1 ? int(list % per) : -1;
-    const auto first = r.lightIndices.begin() + r.listOffset[list];
-    e.listed = std::binary_search(first, first + r.listCount[list], light);
-
-    const BoundingSphere sphere = lights.cullSphere(light, s.spotTest);
-    e.sphereCenter = sphere.center;
-    e.sphereRadius = sphere.radius;
+    const std::uint32_t light = e.light, per = std::max(r.listsPerTile, 1u);
     const double rr = sphere.radius + sphereTestSlack(sphere.center, sphere.radius);
     auto step = [&](std::string test, std::string numbers, bool passed) {
         e.steps.push_back({std::move(test), std::move(numbers), passed});
         return passed;
     };
-
-    if (r.algorithm == Algorithm::All) {
-        step("all", "one list holds every light: nothing is tested", true);
+    const std::uint32_t t = e.tile;
+    const TileGrid::Rect rect = r.grid.tileRect(t % r.grid.tilesX, t / r.grid.tilesX);
+    const double tmin = r.tileDepthMin[t], tmax = r.tileDepthMax[t];
+    const double cd = -sphere.center.z;
+    const bool empty = tileEmpty(r, t);
+    bool ok = true;
+    double lo = 0, hi = 0;
+    const bool emptyListed = r.algorithm == Algorithm::Naive || r.algorithm == Algorithm::ZBin ||
+                             (r.algorithm == Algorithm::Clustered && !s.skipEmpty);
+    if (empty && !emptyListed) {
+        ok = step("tile holds geometry", "no geometry pixel: the tile gets an empty list", false);
     } else {
-        const std::uint32_t t = e.tile;
-        const TileGrid::Rect rect = r.grid.tileRect(t % r.grid.tilesX, t / r.grid.tilesX);
-        const double tmin = r.tileDepthMin[t], tmax = r.tileDepthMax[t];
-        const double cd = -sphere.center.z;
-        const bool empty = tileEmpty(r, t);
-        bool ok = true;
-        double lo = 0, hi = 0;
-        const bool emptyListed = r.algorithm == Algorithm::Naive || r.algorithm == Algorithm::ZBin ||
-                                 (r.algorithm == Algorithm::Clustered && !s.skipEmpty);
-        if (empty && !emptyListed) {
-            ok = step("tile holds geometry", "no geometry pixel: the tile gets an empty list", false);
-        } else {
-            switch (r.algorithm) {
-            case Algorithm::ZBin: // the tile's mask: naive's screen-space volume
-            case Algorithm::Naive: {
-                // The range the pass culled over: the camera's near and far,
-                // an infinite far replaced by the farthest reach of a light.
-                lo = r.cameraNear;
-                hi = r.cameraFar;
-                break;
+        switch (r.algorithm) {
+        case Algorithm::ZBin: // the tile's mask: naive's screen-space volume
+        case Algorithm::Naive: {
+            // The range the pass culled over: the camera's near and far,
+            // an infinite far replaced by the farthest reach of a light.
+            lo = r.cameraNear;
+            hi = r.cameraFar;
+            break;
+        }
+        case Algorithm::Fptl:
+        case Algorithm::MinMax: lo = tmin, hi = tmax; break;
+        case Algorithm::TwoPointFiveD:
+            if (r.cellLists && e.sub >= 0) {
+                lo = sliceBoundary(s.slicing, tmin, tmax, per, std::uint32_t(e.sub));
+                hi = sliceBoundary(s.slicing, tmin, tmax, per, std::uint32_t(e.sub) + 1);
+            } else {
+                lo = tmin, hi = tmax;
             }
-            case Algorithm::Fptl:
-            case Algorithm::MinMax: lo = tmin, hi = tmax; break;
-            case Algorithm::TwoPointFiveD:
-                if (r.cellLists && e.sub >= 0) {
-                    lo = sliceBoundary(s.slicing, tmin, tmax, per, std::uint32_t(e.sub));
-                    hi = sliceBoundary(s.slicing, tmin, tmax, per, std::uint32_t(e.sub) + 1);
-                } else {
-                    lo = tmin, hi = tmax;
-                }
-                break;
-            case Algorithm::HalfZ:
-                lo = e.sub == 1 ? r.halfzSplit[t] : tmin;
-                hi = e.sub == 1 ? tmax : r.halfzSplit[t];
-                break;
-            case Algorithm::Clustered:
-                lo = sliceBoundary(s.slicing, r.clusterNear, r.clusterFar, per, std::uint32_t(e.sub));
-                hi = sliceBoundary(s.slicing, r.clusterNear, r.clusterFar, per, std::uint32_t(e.sub) + 1);
-                break;
-            default: break;
-            }
-            e.chunkDepthMin = lo;
-            e.chunkDepthMax = hi;
-            if (r.algorithm == Algorithm::TwoPointFiveD && !r.cellLists) {
-                const std::uint32_t m = sliceRangeMask(s.slicing, tmin, tmax, s.cells, cd - sphere.radius, cd + sphere.radius);
-                char bits[80];
-                std::snprintf(bits, sizeof bits, "light's cells 0x%08x & tile's occupied cells 0x%08x", m, r.cellMask[t]);
-                ok = step("cell mask (" + std::to_string(s.cells) + " " + toString(s.slicing) + " cells of " + num(tmin) +
-                              ".." + num(tmax) + ")",
-                          bits, (m & r.cellMask[t]) != 0) && ok;
-            }
-            if (r.algorithm == Algorithm::Clustered) {
-                const std::uint32_t m = sliceRangeMask(s.slicing, r.clusterNear, r.clusterFar, per, cd - sphere.radius,
-                                                       cd + sphere.radius);
-                const bool inRange = (m >> e.sub) & 1u;
-                ok = step("slice range", "the light's depth " + num(cd - sphere.radius) + ".." + num(cd + sphere.radius) +
-                                             (inRange ? " reaches" : " misses") + " slice " + std::to_string(e.sub),
-                          inRange) && ok;
-                if (s.skipEmpty) {
-                    const bool occ = (r.cellMask[t] >> e.sub) & 1u;
-                    ok = step("slice holds geometry (skip-empty)", occ ? "occupied" : "empty: skipped", occ) && ok;
-                }
-            }
-            const FrustumChunk chunk = makeFrustumChunk(proj, rect, lo, hi);
-            e.hasChunk = true;
-            e.chunkCorners = chunk.corners;
-            for (int k = 0; k < 6; ++k) {
-                const double d = signedDistance(chunk.planes[std::size_t(k)], sphere.center);
-                ok = step(chunkPlaneName(k), "signed distance " + num(d) + (d >= -rr ? " >= " : " < ") + "-r = " + num(-rr),
-                          d >= -rr) && ok;
-                if (e.decisivePlane < 0 || d + rr < e.decisiveMargin) e.decisivePlane = k, e.decisiveMargin = d + rr;
-            }
-            if (s.test != SphereTest::Planes) {
-                glm::dvec3 blo = chunk.corners[0], bhi = chunk.corners[0];
-                for (const auto& c : chunk.corners) blo = glm::min(blo, c), bhi = glm::max(bhi, c);
-                const double d = glm::length(sphere.center - glm::clamp(sphere.center, blo, bhi));
-                ok = step("box around the chunk (planes+aabb)", "distance " + num(d) + (d <= rr ? " <= " : " > ") + "r = " + num(rr),
-                          d <= rr) && ok;
-            }
-            if (s.test == SphereTest::Exact) {
-                const double d = distanceToChunk(chunk, sphere.center);
-                ok = step("exact distance to the chunk", "distance " + num(d) + (d <= rr ? " <= " : " > ") + "r = " + num(rr),
-                          d <= rr) && ok;
-            }
-            const bool coneRefines = s.spotTest == SpotTest::ConeSphere || s.spotTest == SpotTest::ConePlanes;
-            if (coneRefines && lights.isSpot(light)) {
-                const bool pass = spotIntersectsChunk(s.spotTest, s.test, lights.spotCone(light), chunk);
-                ok = step(std::string("spot cone (") + toString(s.spotTest) + ")",
-                          pass ? "the cone meets the chunk" : "the cone misses the chunk", pass) && ok;
-            }
-            if (r.algorithm == Algorithm::ZBin && light < r.zbinRank.size()) {
-                // After the mask, each pixel's bin: the light is looped over
-                // where its rank lies in the bin's range. Reported, not a test
-                // of the list (the mask is the list).
-                const std::uint32_t k = r.zbinRank[light];
-                std::uint32_t inRange = 0, pixels = 0;
-                for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
-                    for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
-                        if (!run.depth.hasGeometry(x, y)) continue;
-                        ++pixels;
-                        const std::uint32_t b = r.zbinOf(proj.viewDepthFromWindowDepth(run.depth.at(x, y)));
-                        inRange += r.zbinLo[b] <= k && k <= r.zbinHi[b];
-                    }
-                step("Z-bins (per pixel, after the mask)",
-                     "sorted position " + std::to_string(k) + " of " + std::to_string(lights.size()) + "; bins " +
-                         std::to_string(r.zbinOf(cd - sphere.radius)) + ".." + std::to_string(r.zbinOf(cd + sphere.radius)) +
-                         " of " + std::to_string(r.zbinLo.size()) + "; the pixels of " + std::to_string(inRange) + " of the tile's " +
-                         std::to_string(pixels) + " geometry pixels loop over it",
-                     inRange > 0);
-            }
-            if (r.algorithm == Algorithm::Fptl) {
-                // The fine prune, as the reference runs it (fine_prune.hpp):
-                // the tile's geometry pixels inside the light's volume.
-                std::uint32_t inside = 0, pixels = 0;
-                for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
-                    for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
-                        if (!run.depth.hasGeometry(x, y)) continue;
-                        ++pixels;
-                        inside += fptlPixelKeeps(lights, light, proj.viewPositionFromDepth(x, y, run.depth.at(x, y)));
-                    }
-                ok = step("fine prune (the tile's pixels)",
-                          std::to_string(inside) + " of the tile's " + std::to_string(pixels) +
-                              " geometry pixels lie inside the light's volume (+slack)",
-                          inside > 0) && ok;
+            break;
+        case Algorithm::HalfZ:
+            lo = e.sub == 1 ? r.halfzSplit[t] : tmin;
+            hi = e.sub == 1 ? tmax : r.halfzSplit[t];
+            break;
+        case Algorithm::Clustered:
+            lo = sliceBoundary(s.slicing, r.clusterNear, r.clusterFar, per, std::uint32_t(e.sub));
+            hi = sliceBoundary(s.slicing, r.clusterNear, r.clusterFar, per, std::uint32_t(e.sub) + 1);
+            break;
+        default: break;
+        }
+        e.chunkDepthMin = lo;
+        e.chunkDepthMax = hi;
+        if (r.algorithm == Algorithm::TwoPointFiveD && !r.cellLists) {
+            const std::uint32_t m = sliceRangeMask(s.slicing, tmin, tmax, s.cells, cd - sphere.radius, cd + sphere.radius);
+            char bits[80];
+            std::snprintf(bits, sizeof bits, "light's cells 0x%08x & tile's occupied cells 0x%08x", m, r.cellMask[t]);
+            ok = step("cell mask (" + std::to_string(s.cells) + " " + toString(s.slicing) + " cells of " + num(tmin) +
+                          ".." + num(tmax) + ")",
+                      bits, (m & r.cellMask[t]) != 0) && ok;
+        }
+        if (r.algorithm == Algorithm::Clustered) {
+            const std::uint32_t m = sliceRangeMask(s.slicing, r.clusterNear, r.clusterFar, per, cd - sphere.radius,
+                                                   cd + sphere.radius);
+            const bool inRange = (m >> e.sub) & 1u;
+            ok = step("slice range", "the light's depth " + num(cd - sphere.radius) + ".." + num(cd + sphere.radius) +
+                                         (inRange ? " reaches" : " misses") + " slice " + std::to_string(e.sub),
+                      inRange) && ok;
+            if (s.skipEmpty) {
+                const bool occ = (r.cellMask[t] >> e.sub) & 1u;
+                ok = step("slice holds geometry (skip-empty)", occ ? "occupied" : "empty: skipped", occ) && ok;
             }
         }
-        e.testsPass = ok;
+        const FrustumChunk chunk = makeFrustumChunk(proj, rect, lo, hi);
+        e.hasChunk = true;
+        e.chunkCorners = chunk.corners;
+        for (int k = 0; k < 6; ++k) {
+            const double d = signedDistance(chunk.planes[std::size_t(k)], sphere.center);
+            ok = step(chunkPlaneName(k), "signed distance " + num(d) + (d >= -rr ? " >= " : " < ") + "-r = " + num(-rr),
+                      d >= -rr) && ok;
+            if (e.decisivePlane < 0 || d + rr < e.decisiveMargin) e.decisivePlane = k, e.decisiveMargin = d + rr;
+        }
+        if (s.test != SphereTest::Planes) {
+            glm::dvec3 blo = chunk.corners[0], bhi = chunk.corners[0];
+            for (const auto& c : chunk.corners) blo = glm::min(blo, c), bhi = glm::max(bhi, c);
+            const double d = glm::length(sphere.center - glm::clamp(sphere.center, blo, bhi));
+            ok = step("box around the chunk (planes+aabb)", "distance " + num(d) + (d <= rr ? " <= " : " > ") + "r = " + num(rr),
+                      d <= rr) && ok;
+        }
+        if (s.test == SphereTest::Exact) {
+            const double d = distanceToChunk(chunk, sphere.center);
+            ok = step("exact distance to the chunk", "distance " + num(d) + (d <= rr ? " <= " : " > ") + "r = " + num(rr),
+                      d <= rr) && ok;
+        }
+        const bool coneRefines = s.spotTest == SpotTest::ConeSphere || s.spotTest == SpotTest::ConePlanes;
+        if (coneRefines && lights.isSpot(light)) {
+            const bool pass = spotIntersectsChunk(s.spotTest, s.test, lights.spotCone(light), chunk);
+            ok = step(std::string("spot cone (") + toString(s.spotTest) + ")",
+                      pass ? "the cone meets the chunk" : "the cone misses the chunk", pass) && ok;
+        }
+        if (r.algorithm == Algorithm::ZBin && light < r.zbinRank.size()) {
+            // After the mask, each pixel's bin: the light is looped over
+            // where its rank lies in the bin's range. Reported, not a test
+            // of the list (the mask is the list).
+            const std::uint32_t k = r.zbinRank[light];
+            std::uint32_t inRange = 0, pixels = 0;
+            for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
+                for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
+                    if (!run.depth.hasGeometry(x, y)) continue;
+                    ++pixels;
+                    const std::uint32_t b = r.zbinOf(proj.viewDepthFromWindowDepth(run.depth.at(x, y)));
+                    inRange += r.zbinLo[b] <= k && k <= r.zbinHi[b];
+                }
+            step("Z-bins (per pixel, after the mask)",
+                 "sorted position " + std::to_string(k) + " of " + std::to_string(lights.size()) + "; bins " +
+                     std::to_string(r.zbinOf(cd - sphere.radius)) + ".." + std::to_string(r.zbinOf(cd + sphere.radius)) +
+                     " of " + std::to_string(r.zbinLo.size()) + "; the pixels of " + std::to_string(inRange) + " of the tile's " +
+                     std::to_string(pixels) + " geometry pixels loop over it",
+                 inRange > 0);
+        }
+        if (r.algorithm == Algorithm::Fptl) {
+            // The fine prune, as the reference runs it (fine_prune.hpp):
+            // the tile's geometry pixels inside the light's volume.
+            std::uint32_t inside = 0, pixels = 0;
+            for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
+                for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
+                    if (!run.depth.hasGeometry(x, y)) continue;
+                    ++pixels;
+                    inside += fptlPixelKeeps(lights, light, proj.viewPositionFromDepth(x, y, run.depth.at(x, y)));
+                }
+            ok = step("fine prune (the tile's pixels)",
+                      std::to_string(inside) + " of the tile's " + std::to_string(pixels) +
+                          " geometry pixels lie inside the light's volume (+slack)",
+                      inside > 0) && ok;
+        }
     }
-    if (r.algorithm == Algorithm::All) e.testsPass = true;
+    return ok;
+}
 
-    // Ground truth over the list's pixels.
+// Ground truth over the list's pixels: how many use the list, how many need
+// the light, the needed pixel nearest its centre or, where none does, the
+// pixel nearest its range.
+void explainPixels(const RunOutput& run, const Projection& proj, Explanation& e) {
+    const CullResult& r = run.result;
+    const ViewLights& lights = run.lights;
+    const std::uint32_t list = e.list, light = e.light;
     e.nearestDistance = kInf;
     double neededToCentre = kInf;
     std::uint32_t x0 = 0, y0 = 0, x1 = r.grid.width, y1 = r.grid.height;
@@ -240,6 +229,13 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
         }
     if (e.pixelsNeeding > 0 || e.listPixels == 0) e.nearestDistance = -1;
 
+}
+
+// The verdict: needed, a false positive, missing (and why) or rightly left out.
+std::string verdictOf(const RunOutput& run, Explanation& e) {
+    const CullResult& r = run.result;
+    const ViewLights& lights = run.lights;
+    const std::uint32_t list = e.list, light = e.light;
     std::string failed;
     for (const ExplainStep& st : e.steps)
         if (!st.passed && failed.empty()) failed = st.test;
@@ -306,6 +302,37 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
         e.verdict = "not listed, rightly: no pixel of the list needs it" +
                     (failed.empty() ? std::string() : " (the first test to reject it: '" + failed + "')") + limit;
     }
+    return e.verdict;
+}
+
+} // namespace
+
+Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint32_t list, std::uint32_t light) {
+    const CullResult& r = run.result;
+    const ViewLights& lights = run.lights;
+    if (list >= r.listCount.size())
+        throw SettingsError("list", std::to_string(list) + " is outside 0.." + std::to_string(r.listCount.size() - 1));
+    if (light >= lights.size())
+        throw SettingsError("light", std::to_string(light) + " is outside 0.." + std::to_string(lights.size() - 1));
+    const CullSettings& s = r.settings;
+    Explanation e;
+    e.list = list;
+    e.light = light;
+    e.algorithm = run.custom ? "custom (" + std::string(toString(r.algorithm)) + " lists)" : toString(r.algorithm);
+    const std::uint32_t per = std::max(r.listsPerTile, 1u);
+    e.tile = r.tileOfList(list);
+    e.sub = per > 1 ? int(list % per) : -1;
+    const auto first = r.lightIndices.begin() + r.listOffset[list];
+    e.listed = std::binary_search(first, first + r.listCount[list], light);
+
+    const BoundingSphere sphere = lights.cullSphere(light, s.spotTest);
+    e.sphereCenter = sphere.center;
+    e.sphereRadius = sphere.radius;
+    if (r.algorithm == Algorithm::All)
+        e.steps.push_back({"all", "one list holds every light: nothing is tested", true});
+    e.testsPass = r.algorithm == Algorithm::All || explainTests(run, proj, sphere, e);
+    explainPixels(run, proj, e);
+    verdictOf(run, e);
     return e;
 }
 

@@ -114,6 +114,204 @@ bool geometryBounds(const DepthImage& depth, const Projection& proj, unsigned wo
 
 } // namespace
 
+namespace {
+
+// zbin: a pixel loops over its tile's mask within its bin's range, so it is
+// judged through the per-(tile, bin) lists, then folded back to the tiles.
+GroundTruth zbinTruth(const DepthImage& depth, const Projection& proj, const ViewLights& lights,
+                      const CullResult& result, const GroundTruthOptions& opt, const CancelToken* cancel) {
+    const CullResult perPixel = zbinPixelLists(result, depth, proj);
+    GroundTruth sub = computeGroundTruth(depth, proj, lights, perPixel, opt, cancel);
+    std::vector<std::uint32_t> tileOf(perPixel.listCount.size(), 0);
+    for (std::uint32_t y = 0; y < depth.height; ++y)
+        for (std::uint32_t x = 0; x < depth.width; ++x)
+            if (const std::uint32_t l = perPixel.pixelList[std::size_t(y) * depth.width + x]; l != 0xffffffffu)
+                tileOf[l] = result.grid.tileOfPixel(x, y);
+    GroundTruth gt;
+    gt.metrics = sub.metrics;
+    gt.tileGeometryPixels = std::move(sub.tileGeometryPixels);
+    const std::size_t lists = result.listCount.size();
+    gt.listShadingWork.assign(lists, 0);
+    gt.listExactWork.assign(lists, 0);
+    gt.listFalseNegatives.assign(lists, 0);
+    gt.listFalseNegativesListFull.assign(lists, 0);
+    gt.listFalseNegativesLightLimit.assign(lists, 0);
+    for (std::size_t l = 0; l < tileOf.size(); ++l) {
+        gt.listShadingWork[tileOf[l]] += sub.listShadingWork[l];
+        gt.listExactWork[tileOf[l]] += sub.listExactWork[l];
+        gt.listFalseNegatives[tileOf[l]] += sub.listFalseNegatives[l];
+        gt.listFalseNegativesListFull[tileOf[l]] += sub.listFalseNegativesListFull[l];
+        gt.listFalseNegativesLightLimit[tileOf[l]] += sub.listFalseNegativesLightLimit[l];
+    }
+    // The masks are the lists the renderer keeps: their lengths and bytes.
+    Metrics& m = gt.metrics;
+    m.maxList = 0;
+    for (std::uint32_t c : result.listCount) m.maxList = std::max(m.maxList, c);
+    m.meanList = lists == 0 ? 0.0 : double(result.entries()) / double(lists);
+    m.resultBytes = result.bytes();
+    return gt;
+}
+
+// Every geometry pixel in bands of tile rows on `workers` threads: per list
+// the shading work, the exact work and the misses (by cause under limits),
+// per tile its geometry pixels, and the optimum's work into gt.metrics.
+void countPixels(const DepthImage& depth, const Projection& proj, const ViewLights& lights,
+                 const CullResult& result, const glm::dvec3& bmin, const glm::dvec3& bmax, unsigned workers,
+                 const CancelToken* cancel, GroundTruth& gt) {
+    const std::size_t lists = result.listCount.size();
+    const std::size_t tiles = result.grid.tileCount();
+    const ListLimits& limits = result.limits;
+    const bool limited = !limits.empty();
+    Metrics& m = gt.metrics;
+    const detail::LightGrid grid(lights, bmin, bmax);
+    struct Acc {
+        std::vector<std::uint64_t> w, e, fn, fnFull, fnLimit;
+        std::vector<std::uint32_t> tilePixels;
+        // The optimum: per list its pixels and the lights they need
+        // together; `all`'s one list spans every band, so it keeps a flag
+        // per light instead.
+        std::vector<std::uint64_t> listPixels, listUnion;
+        std::vector<std::uint32_t> unionTile, unionSubs; // per light: the tile counted, its sub-lists counted
+        std::vector<char> neededAnywhere;
+    };
+    std::vector<Acc> acc(workers);
+    const bool oneList = result.algorithm == Algorithm::All;
+    // Per-pixel lists (zbin's): the optimum is the per-tile one, so the
+    // union is counted per tile (one "sub-list").
+    const bool perTileUnion = !result.pixelList.empty();
+    const std::size_t unions = perTileUnion ? std::max(lists, tiles) : lists;
+    const std::uint32_t per = std::max(result.listsPerTile, 1u); // <= 32: one bit per sub-list
+    for (auto& a : acc) {
+        a.w.assign(lists, 0), a.e.assign(lists, 0), a.fn.assign(lists, 0);
+        if (limited) a.fnFull.assign(lists, 0), a.fnLimit.assign(lists, 0);
+        a.tilePixels.assign(tiles, 0);
+        if (oneList) {
+            a.neededAnywhere.assign(lights.size(), 0);
+        } else {
+            a.listPixels.assign(unions, 0), a.listUnion.assign(unions, 0);
+            a.unionTile.assign(lights.size(), std::numeric_limits<std::uint32_t>::max());
+            a.unionSubs.assign(lights.size(), 0);
+        }
+    }
+    // Membership of a needed light in the pixel's list: stamp[i] == the
+    // current stamp when light i is listed. Neighbouring pixels mostly share
+    // a list, so re-stamping on a change costs less than a binary search
+    // per needed light.
+    std::vector<std::vector<std::uint32_t>> stamps(workers, std::vector<std::uint32_t>(lights.size(), 0));
+    std::vector<std::uint32_t> stampNow(workers, 0);
+    // dropStamps[w][i] == the current stamp when the limits dropped light i from the list.
+    std::vector<std::vector<std::uint32_t>> dropStamps(limited ? workers : 0,
+                                                       std::vector<std::uint32_t>(lights.size(), 0));
+    const std::uint32_t ts = result.grid.tileSize;
+    // Bands of one tile row, walked tile by tile: a tile's pixels come one
+    // after another, so the lights its lists need together are counted
+    // with one tile number and one bit per sub-list per light.
+    forEachRowBand(depth.height, ts, workers, cancel, [&](unsigned w, std::uint32_t y0, std::uint32_t y1) {
+        Acc& a = acc[w];
+        std::vector<std::uint32_t>& stamp = stamps[w];
+        std::uint32_t& now = stampNow[w];
+        std::uint32_t stampedList = std::numeric_limits<std::uint32_t>::max();
+        for (std::uint32_t tx0 = 0; tx0 < depth.width; tx0 += ts)
+            for (std::uint32_t y = y0; y < y1; ++y)
+                for (std::uint32_t x = tx0; x < std::min(depth.width, tx0 + ts); ++x) {
+                    if (!depth.hasGeometry(x, y)) continue;
+                    const double d = depth.at(x, y);
+                    const glm::dvec3 p = proj.viewPositionFromDepth(x, y, d);
+                    const std::uint32_t l = result.listOfPixel(x, y, proj.viewDepthFromWindowDepth(d));
+                    if (l >= lists) throw Error("ground truth: listOfPixel gave list " + std::to_string(l));
+                    const std::uint32_t t = result.grid.tileOfPixel(x, y);
+                    ++a.tilePixels[t];
+                    if (l != stampedList) {
+                        if (++now == 0) { // wrapped: clear old stamps
+                            std::fill(stamp.begin(), stamp.end(), 0);
+                            if (limited) std::fill(dropStamps[w].begin(), dropStamps[w].end(), 0);
+                            now = 1;
+                        }
+                        const std::uint32_t* first = result.lightIndices.data() + result.listOffset[l];
+                        for (std::uint32_t k = 0; k < result.listCount[l]; ++k) stamp[first[k]] = now;
+                        if (limited)
+                            for (auto [d, e] = limits.droppedFrom(l); d != e; ++d) dropStamps[w][*d] = now;
+                        stampedList = l;
+                    }
+                    a.w[l] += result.listCount[l];
+                    const std::uint32_t subBit = oneList || perTileUnion ? 1u : 1u << (l - t * per);
+                    const std::uint32_t u = perTileUnion ? t : l; // where the union counts
+                    std::uint64_t needed = 0, missed = 0, missedFull = 0, missedLimit = 0;
+                    grid.forEachContaining(p, [&](std::uint32_t i) {
+                        ++needed;
+                        missed += stamp[i] != now;
+                        if (limited && stamp[i] != now) {
+                            if (limits.isOverLimit(i)) ++missedLimit;
+                            else if (dropStamps[w][i] == now) ++missedFull;
+                        }
+                        if (oneList) {
+                            a.neededAnywhere[i] = 1;
+                            return;
+                        }
+                        if (a.unionTile[i] != t) a.unionTile[i] = t, a.unionSubs[i] = 0;
+                        if (!(a.unionSubs[i] & subBit)) {
+                            a.unionSubs[i] |= subBit;
+                            ++a.listUnion[u];
+                        }
+                    });
+                    a.e[l] += needed;
+                    a.fn[l] += missed;
+                    if (limited) a.fnFull[l] += missedFull, a.fnLimit[l] += missedLimit;
+                    if (!oneList) ++a.listPixels[u];
+                }
+    });
+    if (oneList) {
+        std::uint64_t anywhere = 0, pixels = 0;
+        for (std::size_t i = 0; i < lights.size(); ++i) {
+            bool any = false;
+            for (const Acc& a : acc) any = any || a.neededAnywhere[i];
+            anywhere += any;
+        }
+        for (const Acc& a : acc)
+            for (std::uint32_t c : a.tilePixels) pixels += c;
+        m.optimalWork = anywhere * pixels;
+    } else {
+        // optimal += pixels of the list x lights its pixels need together
+        // (each list lies in one band: one worker has all of it).
+        for (const Acc& a : acc)
+            for (std::size_t l = 0; l < a.listPixels.size(); ++l) m.optimalWork += a.listPixels[l] * a.listUnion[l];
+    }
+    for (const Acc& a : acc) {
+        for (std::size_t l = 0; l < lists; ++l) {
+            gt.listShadingWork[l] += a.w[l];
+            gt.listExactWork[l] += a.e[l];
+            gt.listFalseNegatives[l] += a.fn[l];
+            if (limited) {
+                gt.listFalseNegativesListFull[l] += a.fnFull[l];
+                gt.listFalseNegativesLightLimit[l] += a.fnLimit[l];
+            }
+        }
+        for (std::size_t t = 0; t < tiles; ++t) gt.tileGeometryPixels[t] += a.tilePixels[t];
+    }
+}
+
+// The image error: the culled lists' Lambert image against every light's.
+void addImageError(const DepthImage& depth, const Projection& proj, const ViewLights& lights,
+                   const CullResult& result, const CancelToken* cancel, Metrics& m) {
+    const std::size_t lists = result.listCount.size();
+    const std::vector<float> ref = shadeLambertCpu(depth, proj, lights, nullptr);
+    if (isCancelled(cancel)) throw Cancelled();
+    // A single list of every light in order (`all`) shades, through the same
+    // kernel in the same order, bitwise like the reference: reuse it.
+    bool identity = lists == 1 && result.listCount[0] == lights.size();
+    for (std::size_t i = 0; identity && i < lights.size(); ++i)
+        identity = result.lightIndices[result.listOffset[0] + i] == i;
+    const std::vector<float> cul =
+        identity ? ref : shadeLambertCpu(depth, proj, lights, &result);
+    if (isCancelled(cancel)) throw Cancelled();
+    const ImageError e = compareShadedImages(depth, cul, ref);
+    m.imageRmse = e.rmse;
+    m.imageMaxError = e.maxAbs;
+    m.imageErrorComputed = true;
+}
+
+} // namespace
+
 GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
                                const ViewLights& lights, const CullResult& result,
                                const GroundTruthOptions& opt, const CancelToken* cancel) {
@@ -122,40 +320,8 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
         throw Error("ground truth: inconsistent cull result: " + bad);
     if (result.grid.width != depth.width || result.grid.height != depth.height)
         throw Error("ground truth: cull result grid does not match the depth image");
-    if (result.algorithm == Algorithm::ZBin && result.pixelList.empty()) {
-        // A pixel loops over its tile's mask within its bin's range: judged
-        // through the per-(tile, bin) lists, then folded back to the tiles.
-        const CullResult perPixel = zbinPixelLists(result, depth, proj);
-        GroundTruth sub = computeGroundTruth(depth, proj, lights, perPixel, opt, cancel);
-        std::vector<std::uint32_t> tileOf(perPixel.listCount.size(), 0);
-        for (std::uint32_t y = 0; y < depth.height; ++y)
-            for (std::uint32_t x = 0; x < depth.width; ++x)
-                if (const std::uint32_t l = perPixel.pixelList[std::size_t(y) * depth.width + x]; l != 0xffffffffu)
-                    tileOf[l] = result.grid.tileOfPixel(x, y);
-        GroundTruth gt;
-        gt.metrics = sub.metrics;
-        gt.tileGeometryPixels = std::move(sub.tileGeometryPixels);
-        const std::size_t lists = result.listCount.size();
-        gt.listShadingWork.assign(lists, 0);
-        gt.listExactWork.assign(lists, 0);
-        gt.listFalseNegatives.assign(lists, 0);
-        gt.listFalseNegativesListFull.assign(lists, 0);
-        gt.listFalseNegativesLightLimit.assign(lists, 0);
-        for (std::size_t l = 0; l < tileOf.size(); ++l) {
-            gt.listShadingWork[tileOf[l]] += sub.listShadingWork[l];
-            gt.listExactWork[tileOf[l]] += sub.listExactWork[l];
-            gt.listFalseNegatives[tileOf[l]] += sub.listFalseNegatives[l];
-            gt.listFalseNegativesListFull[tileOf[l]] += sub.listFalseNegativesListFull[l];
-            gt.listFalseNegativesLightLimit[tileOf[l]] += sub.listFalseNegativesLightLimit[l];
-        }
-        // The masks are the lists the renderer keeps: their lengths and bytes.
-        Metrics& m = gt.metrics;
-        m.maxList = 0;
-        for (std::uint32_t c : result.listCount) m.maxList = std::max(m.maxList, c);
-        m.meanList = lists == 0 ? 0.0 : double(result.entries()) / double(lists);
-        m.resultBytes = result.bytes();
-        return gt;
-    }
+    if (result.algorithm == Algorithm::ZBin && result.pixelList.empty())
+        return zbinTruth(depth, proj, lights, result, opt, cancel);
 
     const std::size_t lists = result.listCount.size();
     const std::size_t tiles = result.grid.tileCount();
@@ -168,139 +334,10 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
     gt.listFalseNegativesListFull.assign(lists, 0);
     gt.listFalseNegativesLightLimit.assign(lists, 0);
     gt.tileGeometryPixels.assign(tiles, 0);
-    // The engine limits: a missed light they dropped is counted by cause.
-    const ListLimits& limits = result.limits;
-    const bool limited = !limits.empty();
     Metrics& m = gt.metrics;
-
     glm::dvec3 bmin, bmax;
-    if (geometryBounds(depth, proj, workers, cancel, bmin, bmax)) {
-        const detail::LightGrid grid(lights, bmin, bmax);
-        struct Acc {
-            std::vector<std::uint64_t> w, e, fn, fnFull, fnLimit;
-            std::vector<std::uint32_t> tilePixels;
-            // The optimum: per list its pixels and the lights they need
-            // together; `all`'s one list spans every band, so it keeps a flag
-            // per light instead.
-            std::vector<std::uint64_t> listPixels, listUnion;
-            std::vector<std::uint32_t> unionTile, unionSubs; // per light: the tile counted, its sub-lists counted
-            std::vector<char> neededAnywhere;
-        };
-        std::vector<Acc> acc(workers);
-        const bool oneList = result.algorithm == Algorithm::All;
-        // Per-pixel lists (zbin's): the optimum is the per-tile one, so the
-        // union is counted per tile (one "sub-list").
-        const bool perTileUnion = !result.pixelList.empty();
-        const std::size_t unions = perTileUnion ? std::max(lists, tiles) : lists;
-        const std::uint32_t per = std::max(result.listsPerTile, 1u); // <= 32: one bit per sub-list
-        for (auto& a : acc) {
-            a.w.assign(lists, 0), a.e.assign(lists, 0), a.fn.assign(lists, 0);
-            if (limited) a.fnFull.assign(lists, 0), a.fnLimit.assign(lists, 0);
-            a.tilePixels.assign(tiles, 0);
-            if (oneList) {
-                a.neededAnywhere.assign(lights.size(), 0);
-            } else {
-                a.listPixels.assign(unions, 0), a.listUnion.assign(unions, 0);
-                a.unionTile.assign(lights.size(), std::numeric_limits<std::uint32_t>::max());
-                a.unionSubs.assign(lights.size(), 0);
-            }
-        }
-        // Membership of a needed light in the pixel's list: stamp[i] == the
-        // current stamp when light i is listed. Neighbouring pixels mostly share
-        // a list, so re-stamping on a change costs less than a binary search
-        // per needed light.
-        std::vector<std::vector<std::uint32_t>> stamps(workers, std::vector<std::uint32_t>(lights.size(), 0));
-        std::vector<std::uint32_t> stampNow(workers, 0);
-        // dropStamps[w][i] == the current stamp when the limits dropped light i from the list.
-        std::vector<std::vector<std::uint32_t>> dropStamps(limited ? workers : 0,
-                                                           std::vector<std::uint32_t>(lights.size(), 0));
-        const std::uint32_t ts = result.grid.tileSize;
-        // Bands of one tile row, walked tile by tile: a tile's pixels come one
-        // after another, so the lights its lists need together are counted
-        // with one tile number and one bit per sub-list per light.
-        forEachRowBand(depth.height, ts, workers, cancel, [&](unsigned w, std::uint32_t y0, std::uint32_t y1) {
-            Acc& a = acc[w];
-            std::vector<std::uint32_t>& stamp = stamps[w];
-            std::uint32_t& now = stampNow[w];
-            std::uint32_t stampedList = std::numeric_limits<std::uint32_t>::max();
-            for (std::uint32_t tx0 = 0; tx0 < depth.width; tx0 += ts)
-                for (std::uint32_t y = y0; y < y1; ++y)
-                    for (std::uint32_t x = tx0; x < std::min(depth.width, tx0 + ts); ++x) {
-                        if (!depth.hasGeometry(x, y)) continue;
-                        const double d = depth.at(x, y);
-                        const glm::dvec3 p = proj.viewPositionFromDepth(x, y, d);
-                        const std::uint32_t l = result.listOfPixel(x, y, proj.viewDepthFromWindowDepth(d));
-                        if (l >= lists) throw Error("ground truth: listOfPixel gave list " + std::to_string(l));
-                        const std::uint32_t t = result.grid.tileOfPixel(x, y);
-                        ++a.tilePixels[t];
-                        if (l != stampedList) {
-                            if (++now == 0) { // wrapped: clear old stamps
-                                std::fill(stamp.begin(), stamp.end(), 0);
-                                if (limited) std::fill(dropStamps[w].begin(), dropStamps[w].end(), 0);
-                                now = 1;
-                            }
-                            const std::uint32_t* first = result.lightIndices.data() + result.listOffset[l];
-                            for (std::uint32_t k = 0; k < result.listCount[l]; ++k) stamp[first[k]] = now;
-                            if (limited)
-                                for (auto [d, e] = limits.droppedFrom(l); d != e; ++d) dropStamps[w][*d] = now;
-                            stampedList = l;
-                        }
-                        a.w[l] += result.listCount[l];
-                        const std::uint32_t subBit = oneList || perTileUnion ? 1u : 1u << (l - t * per);
-                        const std::uint32_t u = perTileUnion ? t : l; // where the union counts
-                        std::uint64_t needed = 0, missed = 0, missedFull = 0, missedLimit = 0;
-                        grid.forEachContaining(p, [&](std::uint32_t i) {
-                            ++needed;
-                            missed += stamp[i] != now;
-                            if (limited && stamp[i] != now) {
-                                if (limits.isOverLimit(i)) ++missedLimit;
-                                else if (dropStamps[w][i] == now) ++missedFull;
-                            }
-                            if (oneList) {
-                                a.neededAnywhere[i] = 1;
-                                return;
-                            }
-                            if (a.unionTile[i] != t) a.unionTile[i] = t, a.unionSubs[i] = 0;
-                            if (!(a.unionSubs[i] & subBit)) {
-                                a.unionSubs[i] |= subBit;
-                                ++a.listUnion[u];
-                            }
-                        });
-                        a.e[l] += needed;
-                        a.fn[l] += missed;
-                        if (limited) a.fnFull[l] += missedFull, a.fnLimit[l] += missedLimit;
-                        if (!oneList) ++a.listPixels[u];
-                    }
-        });
-        if (oneList) {
-            std::uint64_t anywhere = 0, pixels = 0;
-            for (std::size_t i = 0; i < lights.size(); ++i) {
-                bool any = false;
-                for (const Acc& a : acc) any = any || a.neededAnywhere[i];
-                anywhere += any;
-            }
-            for (const Acc& a : acc)
-                for (std::uint32_t c : a.tilePixels) pixels += c;
-            m.optimalWork = anywhere * pixels;
-        } else {
-            // optimal += pixels of the list x lights its pixels need together
-            // (each list lies in one band: one worker has all of it).
-            for (const Acc& a : acc)
-                for (std::size_t l = 0; l < a.listPixels.size(); ++l) m.optimalWork += a.listPixels[l] * a.listUnion[l];
-        }
-        for (const Acc& a : acc) {
-            for (std::size_t l = 0; l < lists; ++l) {
-                gt.listShadingWork[l] += a.w[l];
-                gt.listExactWork[l] += a.e[l];
-                gt.listFalseNegatives[l] += a.fn[l];
-                if (limited) {
-                    gt.listFalseNegativesListFull[l] += a.fnFull[l];
-                    gt.listFalseNegativesLightLimit[l] += a.fnLimit[l];
-                }
-            }
-            for (std::size_t t = 0; t < tiles; ++t) gt.tileGeometryPixels[t] += a.tilePixels[t];
-        }
-    }
+    if (geometryBounds(depth, proj, workers, cancel, bmin, bmax))
+        countPixels(depth, proj, lights, result, bmin, bmax, workers, cancel, gt);
 
     for (std::size_t l = 0; l < lists; ++l) {
         m.shadingWork += gt.listShadingWork[l];
@@ -316,22 +353,7 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
     m.meanList = lists == 0 ? 0.0 : double(result.entries()) / double(lists);
     m.resultBytes = result.bytes();
 
-    if (opt.imageError) {
-        const std::vector<float> ref = shadeLambertCpu(depth, proj, lights, nullptr);
-        if (isCancelled(cancel)) throw Cancelled();
-        // A single list of every light in order (`all`) shades, through the same
-        // kernel in the same order, bitwise like the reference: reuse it.
-        bool identity = lists == 1 && result.listCount[0] == lights.size();
-        for (std::size_t i = 0; identity && i < lights.size(); ++i)
-            identity = result.lightIndices[result.listOffset[0] + i] == i;
-        const std::vector<float> cul =
-            identity ? ref : shadeLambertCpu(depth, proj, lights, &result);
-        if (isCancelled(cancel)) throw Cancelled();
-        const ImageError e = compareShadedImages(depth, cul, ref);
-        m.imageRmse = e.rmse;
-        m.imageMaxError = e.maxAbs;
-        m.imageErrorComputed = true;
-    }
+    if (opt.imageError) addImageError(depth, proj, lights, result, cancel, m);
     return gt;
 }
 
