@@ -135,14 +135,12 @@ const char* writePngRaw(FILE* f, const RgbImage& img, png_bytep* rows, char* err
 
 } // namespace
 
-std::string summaryJson(const Scene& scene, const CullSettings& settings, const RunOutput& run) {
-    const CullResult& r = run.result;
-    const Metrics& m = run.truth.metrics;
-    nlohmann::ordered_json j;
-    j["scene"] = scene.name;
-    // What reproduces this run: the file and its version, the glTF choices
-    // that shaped the scene, the command, and whether it was edited since
-    // (then the edited scene is beside this file as scene.json).
+namespace {
+
+// What reproduces a run: the file and its version, the glTF choices that
+// shaped the scene, the command, and whether it was edited since (then the
+// edited scene is beside summary.json as scene.json).
+nlohmann::ordered_json sceneSourceJson(const Scene& scene) {
     const SceneOrigin& o = scene.origin;
     nlohmann::ordered_json src;
     src["file"] = o.file.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(o.file);
@@ -159,7 +157,93 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     src["command"] = o.command.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(o.command);
     src["edited"] = o.edited;
     src["edited_scene"] = o.edited ? nlohmann::ordered_json("scene.json") : nlohmann::ordered_json(nullptr);
-    j["scene_source"] = std::move(src);
+    return src;
+}
+
+// The engine limits a run culled under, and what they took.
+nlohmann::ordered_json limitsJson(const CullSettings& settings, const RunOutput& run) {
+    const CullResult& r = run.result;
+    const Metrics& m = run.truth.metrics;
+    const ListLimits& lim = r.limits;
+    nlohmann::ordered_json lj;
+    lj["cap"] = settings.cap;
+    lj["max_lights"] = settings.maxLights;
+    lj["max_entries"] = settings.maxEntries;
+    lj["overflow_policy"] = toString(settings.overflow);
+    lj["limit_keep"] = toString(settings.limitKeep);
+    lj["overflow_lists"] = lim.overflowLists.size();
+    lj["dropped_entries"] = lim.droppedLights.size();
+    lj["lights_over_limit"] = lim.lightsOverLimit;
+    // The longest list the test made: the smallest cap that never overflows.
+    lj["longest_list_uncapped"] = settings.hasLimits() ? lim.longestUncapped : m.maxList;
+    lj["entries_uncapped"] = settings.hasLimits() ? lim.entriesUncapped : r.entries();
+    nlohmann::ordered_json over = nlohmann::ordered_json::array();
+    for (std::size_t k = 0; k < lim.overflowLists.size() && k < 1000; ++k) {
+        const std::uint32_t l = lim.overflowLists[k];
+        const std::uint32_t t = r.tileOfList(l);
+        nlohmann::ordered_json e;
+        e["list"] = l;
+        e["tile"] = {t % std::max(r.grid.tilesX, 1u), t / std::max(r.grid.tilesX, 1u)};
+        e["kept"] = r.listCount[l];
+        e["dropped"] = lim.droppedOffset[k + 1] - lim.droppedOffset[k];
+        over.push_back(std::move(e));
+    }
+    lj["overflowed"] = std::move(over);
+    return lj;
+}
+
+// docs/CUSTOM_CULLING.md: what a user's culling did beside its lists.
+nlohmann::ordered_json customJson(const Scene& scene, const RunOutput& run) {
+    const CullResult& r = run.result;
+    const CustomCullReport& c = *run.custom;
+    nlohmann::ordered_json cj;
+    cj["source"] = c.source;
+    cj["layout"] = c.layout;
+    cj["lists"] = c.lists;
+    cj["pass_ms"] = c.passMs >= 0 ? nlohmann::ordered_json(c.passMs) : nlohmann::ordered_json(nullptr);
+    cj["overflow_lists"] = c.overflowLists;
+    cj["overflow_entries"] = c.overflowEntries;
+    cj["invalid_indices"] = c.invalidIndices;
+    cj["duplicate_indices"] = c.duplicateIndices;
+    cj["validation_messages"] = c.validationMessages;
+    cj["warnings"] = c.warnings;
+    cj["builtin_algorithm"] = c.builtinAlgorithm;
+    cj["builtin_entries"] = c.builtinEntries;
+    cj["lists_differing_from_builtin"] = c.listsDifferingFromBuiltin;
+    // Every false negative located: tile, list, light and the pixels that
+    // needed it (the 1,000 with most pixels; the total is in metrics).
+    const Projection proj(scene.camera);
+    nlohmann::ordered_json missed = nlohmann::ordered_json::array();
+    const std::vector<MissedLight> located = locateFalseNegatives(run, proj);
+    nlohmann::ordered_json byCause;
+    for (MissCause c : {MissCause::CullingTest, MissCause::ListFull, MissCause::InvalidIndex})
+        byCause[jsonName(c)] = std::count_if(located.begin(), located.end(),
+                                             [&](const MissedLight& m) { return m.cause == c; });
+    for (std::size_t i = 0; i < located.size() && i < 1000; ++i) {
+        const MissedLight& ml = located[i];
+        nlohmann::ordered_json e;
+        e["tile"] = {ml.tile % r.grid.tilesX, ml.tile / r.grid.tilesX};
+        e["list"] = ml.list;
+        e["light"] = ml.light;
+        e["light_name"] = ml.light < scene.lights.size() ? scene.lights[ml.light].name : std::string();
+        e["pixels"] = ml.pixels;
+        e["cause"] = jsonName(ml.cause);
+        missed.push_back(std::move(e));
+    }
+    cj["missed"] = std::move(missed);
+    cj["missed_pairs"] = located.size();
+    cj["missed_pairs_by_cause"] = std::move(byCause);
+    return cj;
+}
+
+} // namespace
+
+std::string summaryJson(const Scene& scene, const CullSettings& settings, const RunOutput& run) {
+    const CullResult& r = run.result;
+    const Metrics& m = run.truth.metrics;
+    nlohmann::ordered_json j;
+    j["scene"] = scene.name;
+    j["scene_source"] = sceneSourceJson(scene);
     j["algorithm"] = run.custom ? std::string("custom") : std::string(toString(settings.algorithm));
     j["test"] = toString(settings.test);
     j["backend"] = r.backend;
@@ -220,77 +304,8 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     mj["image_max_error"] =
         m.imageErrorComputed ? nlohmann::ordered_json(m.imageMaxError) : nlohmann::ordered_json(nullptr);
     j["metrics"] = mj;
-    // The engine limits this run culled under, and what they took.
-    if (!run.custom) {
-        const ListLimits& lim = r.limits;
-        nlohmann::ordered_json lj;
-        lj["cap"] = settings.cap;
-        lj["max_lights"] = settings.maxLights;
-        lj["max_entries"] = settings.maxEntries;
-        lj["overflow_policy"] = toString(settings.overflow);
-        lj["limit_keep"] = toString(settings.limitKeep);
-        lj["overflow_lists"] = lim.overflowLists.size();
-        lj["dropped_entries"] = lim.droppedLights.size();
-        lj["lights_over_limit"] = lim.lightsOverLimit;
-        // The longest list the test made: the smallest cap that never overflows.
-        lj["longest_list_uncapped"] = settings.hasLimits() ? lim.longestUncapped : m.maxList;
-        lj["entries_uncapped"] = settings.hasLimits() ? lim.entriesUncapped : r.entries();
-        nlohmann::ordered_json over = nlohmann::ordered_json::array();
-        for (std::size_t k = 0; k < lim.overflowLists.size() && k < 1000; ++k) {
-            const std::uint32_t l = lim.overflowLists[k];
-            const std::uint32_t t = r.tileOfList(l);
-            nlohmann::ordered_json e;
-            e["list"] = l;
-            e["tile"] = {t % std::max(r.grid.tilesX, 1u), t / std::max(r.grid.tilesX, 1u)};
-            e["kept"] = r.listCount[l];
-            e["dropped"] = lim.droppedOffset[k + 1] - lim.droppedOffset[k];
-            over.push_back(std::move(e));
-        }
-        lj["overflowed"] = std::move(over);
-        j["limits"] = std::move(lj);
-    }
-    if (run.custom) {
-        // docs/CUSTOM_CULLING.md: what the user's culling did beside its lists.
-        const CustomCullReport& c = *run.custom;
-        nlohmann::ordered_json cj;
-        cj["source"] = c.source;
-        cj["layout"] = c.layout;
-        cj["lists"] = c.lists;
-        cj["pass_ms"] = c.passMs >= 0 ? nlohmann::ordered_json(c.passMs) : nlohmann::ordered_json(nullptr);
-        cj["overflow_lists"] = c.overflowLists;
-        cj["overflow_entries"] = c.overflowEntries;
-        cj["invalid_indices"] = c.invalidIndices;
-        cj["duplicate_indices"] = c.duplicateIndices;
-        cj["validation_messages"] = c.validationMessages;
-        cj["warnings"] = c.warnings;
-        cj["builtin_algorithm"] = c.builtinAlgorithm;
-        cj["builtin_entries"] = c.builtinEntries;
-        cj["lists_differing_from_builtin"] = c.listsDifferingFromBuiltin;
-        // Every false negative located: tile, list, light and the pixels that
-        // needed it (the 1,000 with most pixels; the total is in metrics).
-        const Projection proj(scene.camera);
-        nlohmann::ordered_json missed = nlohmann::ordered_json::array();
-        const std::vector<MissedLight> located = locateFalseNegatives(run, proj);
-        nlohmann::ordered_json byCause;
-        for (MissCause c : {MissCause::CullingTest, MissCause::ListFull, MissCause::InvalidIndex})
-            byCause[jsonName(c)] = std::count_if(located.begin(), located.end(),
-                                                 [&](const MissedLight& m) { return m.cause == c; });
-        for (std::size_t i = 0; i < located.size() && i < 1000; ++i) {
-            const MissedLight& ml = located[i];
-            nlohmann::ordered_json e;
-            e["tile"] = {ml.tile % r.grid.tilesX, ml.tile / r.grid.tilesX};
-            e["list"] = ml.list;
-            e["light"] = ml.light;
-            e["light_name"] = ml.light < scene.lights.size() ? scene.lights[ml.light].name : std::string();
-            e["pixels"] = ml.pixels;
-            e["cause"] = jsonName(ml.cause);
-            missed.push_back(std::move(e));
-        }
-        cj["missed"] = std::move(missed);
-        cj["missed_pairs"] = located.size();
-        cj["missed_pairs_by_cause"] = std::move(byCause);
-        j["custom"] = std::move(cj);
-    }
+    if (!run.custom) j["limits"] = limitsJson(settings, run);
+    if (run.custom) j["custom"] = customJson(scene, run);
     return j.dump(2) + "\n";
 }
 

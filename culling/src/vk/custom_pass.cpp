@@ -245,62 +245,13 @@ struct RunState {
 
 } // namespace
 
-CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth, const Projection& proj,
-                           const TileGrid& grid, const ViewLights& lights, CustomCullReport& report) {
-    report.source = o.path;
-    report.layout = toString(o.layout);
-    report.lists = toString(o.lists);
-    const auto lightCount = std::uint32_t(lights.size());
+namespace {
 
-    // The list rule's CPU reference: grid, tile bounds, halfz splits, froxel
-    // range, and the lists a built-in algorithm of that rule makes.
-    const CullResult skeleton = detail::ruleSkeleton(depth, proj, grid, lights, o.lists);
+// The contract's parameters (docs/CUSTOM_CULLING.md): grid, counts, modes,
+// depth linearisation, planes, lens and matrices.
+CustomParams customParams(const CustomShaderOptions& o, const Projection& proj, const TileGrid& grid,
+                          const CullResult& skeleton, std::uint32_t lightCount, std::uint64_t compactEntries) {
     const auto listCount = std::uint32_t(skeleton.listOffset.size());
-    const std::uint64_t compactEntries =
-        o.layout.kind == ListLayout::Compact ? (o.layout.capacity ? o.layout.capacity : 64ull * listCount) : 0;
-    const std::uint64_t outWords = layoutWords(o.layout, listCount, lightCount);
-    if (outWords * 4 > (std::uint64_t(1) << 30))
-        throw SettingsError("layout", toString(o.layout) + " needs " + std::to_string(outWords * 4 >> 20) +
-                                          " MiB of lists here; more than the 1 GiB allowed");
-
-    // The shader: SPIR-V as given, or compiled with the contract's defines.
-    const std::string ext = fs::path(o.path).extension().string();
-    std::vector<std::uint32_t> spirv;
-    std::string entry = o.entry;
-    if (ext == ".spv") {
-        spirv = loadSpirv(o.path);
-    } else {
-        const bool hlsl = ext == ".hlsl";
-        if (!hlsl) entry = "main";
-        spirv = compileSource(o.path, detail::withoutByteOrderMark(detail::readWholeFile(o.path)), hlsl, o.entry,
-                              definesFor(o, grid, skeleton.listsPerTile, lightCount, compactEntries));
-    }
-
-    checkInterface(o.path, spirv, entry);
-
-    const std::size_t messagesBefore = vk::validationMessages().size();
-    // Whatever the layer says during this run is the shader's report, not a
-    // failure of the built-in passes: taken out of the global list on every path.
-    struct TakeMessages {
-        std::size_t from;
-        ~TakeMessages() { vk::eraseValidationMessagesFrom(from); }
-    } takeMessages{messagesBefore};
-    auto firstMessage = [&]() -> std::string {
-        const auto m = vk::validationMessages();
-        return m.size() > messagesBefore ? "; validation: " + m[messagesBefore] : std::string();
-    };
-    auto st = std::make_unique<RunState>();
-    vk::ContextOptions co;
-    co.device = o.device;
-    co.purpose = "lc.custom";
-    co.validation = o.validation;
-    co.robustAccess = true;
-    st->ctx = std::make_unique<vk::Context>(co);
-    const vk::Context& ctx = *st->ctx;
-    const VkDevice dev = ctx.device();
-    report.device = ctx.deviceName();
-
-    // Inputs.
     CustomParams params{};
     params.size = {grid.width, grid.height, grid.tilesX, grid.tilesY};
     const std::uint32_t capacity = o.layout.kind == ListLayout::Fixed   ? o.layout.capacity
@@ -317,27 +268,26 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
     params.lens = {float(corner.x), float(corner.y), proj.orthographic() ? 1.0f : 0.0f, 0.0f};
     params.proj = glm::mat4(proj.clipFromView());
     params.invProj = glm::mat4(glm::inverse(proj.clipFromView()));
-    st->params = ctx.createBuffer(sizeof params, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "custom.params");
-    std::memcpy(st->params.mapped, &params, sizeof params);
+    return params;
+}
 
-    const std::size_t pixels = std::size_t(depth.width) * depth.height;
-    st->depthBuf = ctx.createBuffer(pixels * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                    "custom.depthBuffer");
-    std::memcpy(st->depthBuf.mapped, depth.depth.data(), pixels * 4);
+// The shader's SPIR-V: as given (.spv), or GLSL / HLSL compiled with the
+// contract's defines. `entry`: the entry point the pipeline takes.
+std::vector<std::uint32_t> shaderWords(const CustomShaderOptions& o, const TileGrid& grid, const CullResult& skeleton,
+                                       std::uint32_t lightCount, std::uint64_t compactEntries, std::string& entry) {
+    const std::string ext = fs::path(o.path).extension().string();
+    if (ext == ".spv") return loadSpirv(o.path);
+    const bool hlsl = ext == ".hlsl";
+    if (!hlsl) entry = "main";
+    return compileSource(o.path, detail::withoutByteOrderMark(detail::readWholeFile(o.path)), hlsl, o.entry,
+                         definesFor(o, grid, skeleton.listsPerTile, lightCount, compactEntries));
+}
 
-    std::vector<CustomLight> gl(lightCount);
-    for (std::uint32_t i = 0; i < lightCount; ++i) {
-        gl[i].positionRadius = glm::vec4(glm::vec3(lights.centers[i]), float(lights.radii[i]));
-        if (lights.isSpot(i))
-            gl[i].spotAxisAngle = glm::vec4(glm::vec3(lights.spotAxes[i]), float(lights.spotAngles[i]));
-    }
-    st->lightBuf = ctx.createBuffer(std::max<std::size_t>(gl.size(), 1) * sizeof(CustomLight),
-                                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "custom.lights");
-    if (!gl.empty()) std::memcpy(st->lightBuf.mapped, gl.data(), gl.size() * sizeof(CustomLight));
-    st->out = ctx.createReadbackBuffer(
-        outWords * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, "custom.lists");
-
-    // The depth texture, from the depth buffer through a copy.
+// The depth texture (binding 1), from the depth buffer through a copy.
+void uploadDepthTexture(RunState& rs, const DepthImage& depth) {
+    RunState* st = &rs;
+    const vk::Context& ctx = *st->ctx;
+    const VkDevice dev = ctx.device();
     st->depthImage = ctx.createImage(depth.width, depth.height, VK_FORMAT_R32_SFLOAT,
                                      VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
                                      VK_IMAGE_ASPECT_COLOR_BIT, "custom.depthTexture");
@@ -377,6 +327,79 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
         },
         "custom.uploadDepth");
 
+}
+
+} // namespace
+
+CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth, const Projection& proj,
+                           const TileGrid& grid, const ViewLights& lights, CustomCullReport& report) {
+    report.source = o.path;
+    report.layout = toString(o.layout);
+    report.lists = toString(o.lists);
+    const auto lightCount = std::uint32_t(lights.size());
+
+    // The list rule's CPU reference: grid, tile bounds, halfz splits, froxel
+    // range, and the lists a built-in algorithm of that rule makes.
+    const CullResult skeleton = detail::ruleSkeleton(depth, proj, grid, lights, o.lists);
+    const auto listCount = std::uint32_t(skeleton.listOffset.size());
+    const std::uint64_t compactEntries =
+        o.layout.kind == ListLayout::Compact ? (o.layout.capacity ? o.layout.capacity : 64ull * listCount) : 0;
+    const std::uint64_t outWords = layoutWords(o.layout, listCount, lightCount);
+    if (outWords * 4 > (std::uint64_t(1) << 30))
+        throw SettingsError("layout", toString(o.layout) + " needs " + std::to_string(outWords * 4 >> 20) +
+                                          " MiB of lists here; more than the 1 GiB allowed");
+
+    // The shader: SPIR-V as given, or compiled with the contract's defines.
+    std::string entry = o.entry;
+    const std::vector<std::uint32_t> spirv = shaderWords(o, grid, skeleton, lightCount, compactEntries, entry);
+    checkInterface(o.path, spirv, entry);
+
+    const std::size_t messagesBefore = vk::validationMessages().size();
+    // Whatever the layer says during this run is the shader's report, not a
+    // failure of the built-in passes: taken out of the global list on every path.
+    struct TakeMessages {
+        std::size_t from;
+        ~TakeMessages() { vk::eraseValidationMessagesFrom(from); }
+    } takeMessages{messagesBefore};
+    auto firstMessage = [&]() -> std::string {
+        const auto m = vk::validationMessages();
+        return m.size() > messagesBefore ? "; validation: " + m[messagesBefore] : std::string();
+    };
+    auto st = std::make_unique<RunState>();
+    vk::ContextOptions co;
+    co.device = o.device;
+    co.purpose = "lc.custom";
+    co.validation = o.validation;
+    co.robustAccess = true;
+    st->ctx = std::make_unique<vk::Context>(co);
+    const vk::Context& ctx = *st->ctx;
+    const VkDevice dev = ctx.device();
+    report.device = ctx.deviceName();
+
+    // Inputs.
+    const CustomParams params = customParams(o, proj, grid, skeleton, lightCount, compactEntries);
+    st->params = ctx.createBuffer(sizeof params, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "custom.params");
+    std::memcpy(st->params.mapped, &params, sizeof params);
+
+    const std::size_t pixels = std::size_t(depth.width) * depth.height;
+    st->depthBuf = ctx.createBuffer(pixels * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                    "custom.depthBuffer");
+    std::memcpy(st->depthBuf.mapped, depth.depth.data(), pixels * 4);
+
+    std::vector<CustomLight> gl(lightCount);
+    for (std::uint32_t i = 0; i < lightCount; ++i) {
+        gl[i].positionRadius = glm::vec4(glm::vec3(lights.centers[i]), float(lights.radii[i]));
+        if (lights.isSpot(i))
+            gl[i].spotAxisAngle = glm::vec4(glm::vec3(lights.spotAxes[i]), float(lights.spotAngles[i]));
+    }
+    st->lightBuf = ctx.createBuffer(std::max<std::size_t>(gl.size(), 1) * sizeof(CustomLight),
+                                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "custom.lights");
+    if (!gl.empty()) std::memcpy(st->lightBuf.mapped, gl.data(), gl.size() * sizeof(CustomLight));
+    st->out = ctx.createReadbackBuffer(
+        outWords * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, "custom.lists");
+
+    uploadDepthTexture(*st, depth);
+
     // Layouts, pipeline, descriptors.
     const std::vector<VkDescriptorType> types = {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                                                  VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -406,7 +429,7 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
         bindings[i].type = types[i];
         bindings[i].buffer = buffers[i];
     }
-    bindings[1].image = {sampler, st->depthImage.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    bindings[1].image = {st->sampler, st->depthImage.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     st->pool = st->ctx->createDescriptorPool(bindings, 1, "custom.descriptorPool");
     VkDescriptorSet set = st->ctx->writeDescriptorSet(st->pool, st->setLayout, bindings, "custom.set");
 

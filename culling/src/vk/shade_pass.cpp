@@ -63,6 +63,40 @@ VkPipeline ShadePass::pipeline(bool allLights, bool lightsInBlock) {
     return pipe;
 }
 
+// A G-buffer past one storage buffer's range (lavapipe's 128 MiB holds
+// 2048x2048 of 32-byte pixels, not 4K): shaded in bands of whole rows, each
+// in range. A pixel's shading reads only its own G-buffer entry and its
+// list, so the bands add up to the same image.
+std::vector<float> ShadePass::runInBands(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled,
+                                         double& ms) {
+    const std::size_t pixels = std::size_t(in.width) * in.height;
+    const auto& lim = ctx_.properties().limits;
+    const std::size_t rowBytes = std::size_t(in.width) * sizeof(GpuShadePixel);
+    const std::uint32_t bandRows = std::uint32_t(lim.maxStorageBufferRange / rowBytes);
+    if (bandRows == 0)
+        throw DeviceError("shading: one " + std::to_string(in.width) +
+                          "-pixel row exceeds this device's storage buffer range");
+    std::vector<float> rgb;
+    rgb.reserve(pixels * 3);
+    ms = 0;
+    for (std::uint32_t y0 = 0; y0 < in.height; y0 += bandRows) {
+        const std::uint32_t rows = std::min(bandRows, in.height - y0);
+        const std::size_t first = std::size_t(y0) * in.width, count = std::size_t(rows) * in.width;
+        ShadeInputs band;
+        band.width = in.width;
+        band.height = rows;
+        band.position.assign(in.position.begin() + 3 * first, in.position.begin() + 3 * (first + count));
+        band.normal.assign(in.normal.begin() + 3 * first, in.normal.begin() + 3 * (first + count));
+        band.list.assign(in.list.begin() + first, in.list.begin() + first + count);
+        band.perPixelLists = in.perPixelLists;
+        double bandMs = 0;
+        const std::vector<float> part = run(band, lights, culled, bandMs);
+        rgb.insert(rgb.end(), part.begin(), part.end());
+        ms += bandMs;
+    }
+    return rgb;
+}
+
 std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled,
                                   double& ms) {
     if (in.perPixelLists && culled) culled = in.perPixelLists.get(); // zbin: the lists `in.list` indexes
@@ -92,36 +126,7 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
             throw Error("shading: pixel " + std::to_string(i) + " uses list " + std::to_string(in.list[i]) + " of " +
                         std::to_string(listTotal));
     const auto& lim = ctx_.properties().limits;
-    if (pixels * sizeof(GpuShadePixel) > lim.maxStorageBufferRange) {
-        // A G-buffer past one storage buffer's range (lavapipe's 128 MiB
-        // holds 2048x2048 of 32-byte pixels, not 4K): shaded in bands of
-        // whole rows, each in range. A pixel's shading reads only its own
-        // G-buffer entry and its list, so the bands add up to the same image.
-        const std::size_t rowBytes = std::size_t(in.width) * sizeof(GpuShadePixel);
-        const std::uint32_t bandRows = std::uint32_t(lim.maxStorageBufferRange / rowBytes);
-        if (bandRows == 0)
-            throw DeviceError("shading: one " + std::to_string(in.width) +
-                              "-pixel row exceeds this device's storage buffer range");
-        std::vector<float> rgb;
-        rgb.reserve(pixels * 3);
-        ms = 0;
-        for (std::uint32_t y0 = 0; y0 < in.height; y0 += bandRows) {
-            const std::uint32_t rows = std::min(bandRows, in.height - y0);
-            const std::size_t first = std::size_t(y0) * in.width, count = std::size_t(rows) * in.width;
-            ShadeInputs band;
-            band.width = in.width;
-            band.height = rows;
-            band.position.assign(in.position.begin() + 3 * first, in.position.begin() + 3 * (first + count));
-            band.normal.assign(in.normal.begin() + 3 * first, in.normal.begin() + 3 * (first + count));
-            band.list.assign(in.list.begin() + first, in.list.begin() + first + count);
-            band.perPixelLists = in.perPixelLists;
-            double bandMs = 0;
-            const std::vector<float> part = run(band, lights, culled, bandMs);
-            rgb.insert(rgb.end(), part.begin(), part.end());
-            ms += bandMs;
-        }
-        return rgb;
-    }
+    if (pixels * sizeof(GpuShadePixel) > lim.maxStorageBufferRange) return runInBands(in, lights, culled, ms);
     // Four pixels of a row an invocation (shade.comp).
     const std::uint32_t columns = (in.width + 3) / 4;
     const std::uint32_t gx = (columns + kGroup - 1) / kGroup, gy = (in.height + kGroup - 1) / kGroup;

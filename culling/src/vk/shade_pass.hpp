@@ -19,6 +19,7 @@ public:
 
 private:
     VkPipeline pipeline(bool allLights, bool lightsInBlock);
+    std::vector<float> runInBands(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled, double& ms);
 
     Context& ctx_;
     // The shading's buffers, kept between calls while they fit (after ctx_:
