@@ -454,6 +454,27 @@ glm::dvec3 roundTo(glm::dvec3 v, double step) {
 
 } // namespace
 
+namespace {
+
+// A mesh without the vertices its triangles no longer use, to be written
+// inline (no longer its source file).
+void keepUsedVertices(Mesh& m) {
+    std::vector<std::uint32_t> remap(m.vertexCount(), ~0u);
+    std::vector<float> positions;
+    for (std::uint32_t& v : m.indices) {
+        if (remap[v] == ~0u) {
+            remap[v] = std::uint32_t(positions.size() / 3);
+            positions.insert(positions.end(), m.positions.begin() + 3 * v, m.positions.begin() + 3 * v + 3);
+        }
+        v = remap[v];
+    }
+    m.positions = std::move(positions);
+    m.sourcePath.clear();
+    m.resolvedPath.clear();
+}
+
+} // namespace
+
 Scene shrinkHuntFailure(const Scene& failing, const HuntOptions& options, CullBackend& backend, std::size_t* runs) {
     std::size_t count = 0;
     const HuntVerdict first = judgeHuntTrial(failing, options, backend);
@@ -523,19 +544,7 @@ Scene shrinkHuntFailure(const Scene& failing, const HuntOptions& options, CullBa
         if (!trimmed) continue;
         // A mesh that lost triangles is written inline, without the vertices
         // nothing uses any more (not as its source file's path).
-        Mesh& m = best.meshes[mi];
-        std::vector<std::uint32_t> remap(m.vertexCount(), ~0u);
-        std::vector<float> positions;
-        for (std::uint32_t& v : m.indices) {
-            if (remap[v] == ~0u) {
-                remap[v] = std::uint32_t(positions.size() / 3);
-                positions.insert(positions.end(), m.positions.begin() + 3 * v, m.positions.begin() + 3 * v + 3);
-            }
-            v = remap[v];
-        }
-        m.positions = std::move(positions);
-        m.sourcePath.clear();
-        m.resolvedPath.clear();
+        keepUsedVertices(best.meshes[mi]);
     }
     // Screen: halve each side while it still fails.
     for (int axis = 0; axis < 2; ++axis)

@@ -329,32 +329,11 @@ private:
     std::uint64_t keyValues_ = 0;
 };
 
-CameraPath readGltfPath(const std::string& path, const Camera& base, double fps, const std::string& animation,
-                        std::size_t maxFrames, const std::string& camera) {
-    GltfReadReport rep; // warnings (unknown extensions...) do not concern the path
-    const tinygltf::Model model = parseGltfModel(path, rep);
-    GltfPathReader r(path, model);
-    const std::vector<GltfPlacedNode> placed = walkGltfScene(path, model);
-    const int chosen = chooseGltfCamera(path, model, placed, camera);
-    if (chosen < 0)
-        r.fail("", "no camera node in the scene: a glTF camera path is the animation of a camera node (" +
-                       r.animationList() + ")");
-    const int camNode = placed[std::size_t(chosen)].node;
-
-    // The camera's chain of nodes, root first. walkGltfScene reached each
-    // node of the scene once, so parents are unique and the chain ends.
-    std::vector<int> parent(model.nodes.size(), -1);
-    for (const GltfPlacedNode& p : placed)
-        for (int c : model.nodes[std::size_t(p.node)].children) parent[std::size_t(c)] = p.node;
-    std::vector<int> chain;
-    for (int n = camNode; n >= 0 && chain.size() <= model.nodes.size(); n = parent[std::size_t(n)]) chain.push_back(n);
-    std::reverse(chain.begin(), chain.end());
-    std::vector<int> chainPos(model.nodes.size(), -1);
-    for (std::size_t i = 0; i < chain.size(); ++i) chainPos[std::size_t(chain[i])] = int(i);
-    const std::string cameraLabel = "camera node " + r.nodeLabel(camNode);
-
-    // The animation: the one asked for, else the first that moves the chain.
-    std::vector<std::size_t> moving;
+// The animation: the one asked for (by name or index), else the first that
+// moves the camera's chain; `moving`: every animation that does.
+std::size_t chooseAnimation(const GltfPathReader& r, const tinygltf::Model& model, const std::string& path,
+                            const std::string& animation, const std::vector<int>& chainPos,
+                            const std::string& cameraLabel, std::vector<std::size_t>& moving) {
     for (std::size_t a = 0; a < model.animations.size(); ++a)
         if (r.moves(a, chainPos)) moving.push_back(a);
     std::size_t anim = 0;
@@ -380,6 +359,63 @@ CameraPath readGltfPath(const std::string& path, const Camera& base, double fps,
             r.fail("animations", "no animation moves the " + cameraLabel + " or its ancestors (" + r.animationList() + ")");
         anim = moving.front();
     }
+    return anim;
+}
+
+// The camera's world matrix at time t (frame f): the chain's steps with the
+// tracks sampled into them.
+glm::dmat4 worldAt(const GltfPathReader& r, std::vector<ChainStep> now, const std::vector<Track>& tracks, double t,
+                   std::size_t f, const std::string& animField) {
+    for (const Track& tr : tracks) {
+        double v[4];
+        tr.sample(t, v);
+        ChainStep& s = now[tr.step];
+        if (tr.what == Trs::Translation) s.translation = {v[0], v[1], v[2]};
+        else if (tr.what == Trs::Scale) s.scale = {v[0], v[1], v[2]};
+        else s.rotation = glm::dquat(v[3], v[0], v[1], v[2]);
+    }
+    glm::dmat4 world(1.0);
+    for (ChainStep& s : now) {
+        if (s.node < 0) {
+            world = world * s.constant;
+            continue;
+        }
+        const double len = glm::length(s.rotation);
+        if (!(len > 1e-12) || !std::isfinite(len))
+            r.fail(animField, "at " + num(t) + " s (frame " + std::to_string(f) + ") the rotation of " +
+                                  idx("nodes", std::size_t(s.node)) + " interpolates to a zero or non-finite quaternion");
+        world = world * glm::translate(glm::dmat4(1.0), s.translation) * glm::mat4_cast(s.rotation / len) *
+                glm::scale(glm::dmat4(1.0), s.scale);
+    }
+    return world;
+}
+
+CameraPath readGltfPath(const std::string& path, const Camera& base, double fps, const std::string& animation,
+                        std::size_t maxFrames, const std::string& camera) {
+    GltfReadReport rep; // warnings (unknown extensions...) do not concern the path
+    const tinygltf::Model model = parseGltfModel(path, rep);
+    GltfPathReader r(path, model);
+    const std::vector<GltfPlacedNode> placed = walkGltfScene(path, model);
+    const int chosen = chooseGltfCamera(path, model, placed, camera);
+    if (chosen < 0)
+        r.fail("", "no camera node in the scene: a glTF camera path is the animation of a camera node (" +
+                       r.animationList() + ")");
+    const int camNode = placed[std::size_t(chosen)].node;
+
+    // The camera's chain of nodes, root first. walkGltfScene reached each
+    // node of the scene once, so parents are unique and the chain ends.
+    std::vector<int> parent(model.nodes.size(), -1);
+    for (const GltfPlacedNode& p : placed)
+        for (int c : model.nodes[std::size_t(p.node)].children) parent[std::size_t(c)] = p.node;
+    std::vector<int> chain;
+    for (int n = camNode; n >= 0 && chain.size() <= model.nodes.size(); n = parent[std::size_t(n)]) chain.push_back(n);
+    std::reverse(chain.begin(), chain.end());
+    std::vector<int> chainPos(model.nodes.size(), -1);
+    for (std::size_t i = 0; i < chain.size(); ++i) chainPos[std::size_t(chain[i])] = int(i);
+    const std::string cameraLabel = "camera node " + r.nodeLabel(camNode);
+
+    std::vector<std::size_t> moving;
+    const std::size_t anim = chooseAnimation(r, model, path, animation, chainPos, cameraLabel, moving);
     const std::string animField = idx("animations", anim);
 
     // Steps of the world matrix: constant runs and animated nodes.
@@ -460,28 +496,7 @@ CameraPath readGltfPath(const std::string& path, const Camera& base, double fps,
     out.frames.reserve(frameCount);
     for (std::size_t f = 0; f < frameCount; ++f) {
         const double t = f + 1 == frameCount ? t1 : std::min(t0 + double(f) / fps, t1);
-        std::vector<ChainStep> now = steps;
-        for (const Track& tr : tracks) {
-            double v[4];
-            tr.sample(t, v);
-            ChainStep& s = now[tr.step];
-            if (tr.what == Trs::Translation) s.translation = {v[0], v[1], v[2]};
-            else if (tr.what == Trs::Scale) s.scale = {v[0], v[1], v[2]};
-            else s.rotation = glm::dquat(v[3], v[0], v[1], v[2]);
-        }
-        glm::dmat4 world(1.0);
-        for (ChainStep& s : now) {
-            if (s.node < 0) {
-                world = world * s.constant;
-                continue;
-            }
-            const double len = glm::length(s.rotation);
-            if (!(len > 1e-12) || !std::isfinite(len))
-                r.fail(animField, "at " + num(t) + " s (frame " + std::to_string(f) + ") the rotation of " +
-                                      idx("nodes", std::size_t(s.node)) + " interpolates to a zero or non-finite quaternion");
-            world = world * glm::translate(glm::dmat4(1.0), s.translation) * glm::mat4_cast(s.rotation / len) *
-                    glm::scale(glm::dmat4(1.0), s.scale);
-        }
+        const glm::dmat4 world = worldAt(r, steps, tracks, t, f, animField);
         GltfCameraPose pose;
         if (!gltfCameraPose(world, pose))
             r.fail(animField, "at " + num(t) + " s (frame " + std::to_string(f) + ") the " + cameraLabel +
