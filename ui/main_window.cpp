@@ -1,5 +1,6 @@
 #include "main_window.hpp"
 #include "miss_navigator.hpp"
+#include "param_toolbars.hpp"
 
 #include "camera_view.hpp"
 #include "cull_worker.hpp"
@@ -146,11 +147,11 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
         if (isLive()) runCulling(/*liveEdit=*/true);
     });
     connect(doc_, &Document::settingsChanged, this, [this] {
-        syncParamWidgets();
+        params_->sync();
         if (isLive()) runCulling();
     });
-    connect(doc_, &Document::cameraChanged, this, &MainWindow::syncParamWidgets);
-    connect(doc_, &Document::sceneReset, this, &MainWindow::syncParamWidgets);
+    connect(doc_, &Document::cameraChanged, params_, &ParamToolbars::sync);
+    connect(doc_, &Document::sceneReset, params_, &ParamToolbars::sync);
     connect(doc_, &Document::dirtyChanged, this, &MainWindow::updateTitle);
     connect(doc_, &Document::filePathChanged, this, &MainWindow::updateTitle);
     connect(doc_, &Document::runOutputChanged, this, &MainWindow::updateStatus);
@@ -169,7 +170,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     resizeDocks({findChild<QDockWidget*>("sceneDock"), findChild<QDockWidget*>("tileDock")}, {260, 330},
                 Qt::Horizontal);
     restoreSettings();
-    syncParamWidgets();
+    params_->sync();
     updateTitle();
     updateStatus();
     updateCutoffStatus();
@@ -495,77 +496,10 @@ void MainWindow::buildToolbar() {
     fileBar->addAction(action("actionRun"));
     fileBar->addAction(action("actionLive"));
 
-    // Culling controls, generated from the one parameter table (lc::cullParams)
-    // that also defines CullSettings and the CLI's flags.
-    QToolBar* cullBar = addToolBar(tr("Culling"));
-    cullBar->setObjectName("cullToolbar");
-    // The engine limits on a row of their own, after the engine preset that
-    // sets them (docs/ENGINES.md).
-    addToolBarBreak();
-    QToolBar* limitsBar = addToolBar(tr("Limits"));
-    limitsBar->setObjectName("limitsToolbar");
-    auto* presetLabel = new QLabel(tr("Engine preset "));
-    limitsBar->addWidget(presetLabel);
-    presetCombo_ = new QComboBox;
-    presetCombo_->setObjectName("presetCombo");
-    presetCombo_->addItem(tr("(none)"), QString());
-    for (const lc::EnginePreset& p : lc::enginePresets())
-        presetCombo_->addItem(QString::fromStdString(p.name), QString::fromStdString(p.name));
-    presetCombo_->setToolTip(tr("Cull as a shipped engine does: its algorithm, grid and limits (docs/ENGINES.md). "
-                                "Shows the preset the settings equal, (none) once one is changed."));
-    for (int i = 1; i < presetCombo_->count(); ++i) {
-        const lc::EnginePreset& p = lc::enginePreset(presetCombo_->itemData(i).toString().toStdString());
-        presetCombo_->setItemData(i, QString::fromStdString(p.engine + ". Left out: " + p.leftOut), Qt::ToolTipRole);
-    }
-    connect(presetCombo_, qOverload<int>(&QComboBox::activated), this, [this](int i) {
-        const std::string name = presetCombo_->itemData(i).toString().toStdString();
-        if (!name.empty()) applyPreset(name);
-    });
-    limitsBar->addWidget(presetCombo_);
-    limitsBar->addSeparator();
-    QToolBar* bar = cullBar;
-    for (const lc::ParamSpec& p : lc::cullParams()) {
-        bar = p.group == "limits" ? limitsBar : cullBar;
-        const std::string name = p.name;
-        const QString tip = QString::fromStdString(p.help);
-        if (p.type == lc::ParamType::Bool) {
-            auto* cb = new QCheckBox(QString::fromStdString(p.label.empty() ? p.name : p.label));
-            cb->setToolTip(tip);
-            connect(cb, &QCheckBox::toggled, this,
-                    [this, name](bool on) { onParamEdited(name, on ? "true" : "false"); });
-            paramWidgets_[name] = cb;
-            bar->addWidget(cb);
-            continue;
-        }
-        auto* label = new QLabel(QString::fromStdString(p.label.empty() ? p.name : p.label) + " ");
-        label->setToolTip(tip);
-        bar->addWidget(label);
-        QWidget* w = nullptr;
-        if (p.type == lc::ParamType::Choice) {
-            auto* combo = new QComboBox;
-            for (const auto& c : p.choices) combo->addItem(QString::fromStdString(c));
-            connect(combo, &QComboBox::textActivated, this,
-                    [this, name](const QString& v) { onParamEdited(name, v); });
-            w = combo;
-        } else {
-            auto* spin = new QSpinBox;
-            spin->setRange(int(std::max<long long>(p.minValue, -2147483647)),
-                           int(std::min<long long>(p.maxValue, 2147483647)));
-            spin->setKeyboardTracking(false);
-            connect(spin, qOverload<int>(&QSpinBox::valueChanged), this,
-                    [this, name](int v) { onParamEdited(name, QString::number(v)); });
-            w = spin;
-        }
-        w->setToolTip(tip);
-        w->setObjectName(QString::fromStdString("param_" + name));
-        paramWidgets_[name] = w;
-        bar->addWidget(w);
-    }
-    for (auto& [name, w] : paramWidgets_) w->setObjectName(QString::fromStdString("param_" + name));
-    // Ctrl+Z in a culling field undoes the scene's last edit (tile, width and
-    // height are camera edits), as in the properties panel.
-    (new UndoKeysToWindow(cullBar))->watch(cullBar);
-    bar = cullBar;
+    // The culling parameters and the engine limits (param_toolbars.hpp).
+    params_ = new ParamToolbars(this, doc_);
+    connect(params_, &ParamToolbars::logged, this, [this](const QString& m, bool error) { log(m, error); });
+    QToolBar* bar = params_->cullBar();
 
     // What runs the culling (custom shader, backend, device) sits on the
     // first row beside the file actions: with it on the parameter row, a
@@ -617,97 +551,9 @@ void MainWindow::buildStatusBar() {
 
 // --- parameters --------------------------------------------------------------------
 
-void MainWindow::syncParamWidgets() {
-    syncingParams_ = true;
-    for (auto& [name, w] : paramWidgets_) {
-        QString v;
-        try {
-            v = QString::fromStdString(lc::getParam(doc_->settings(), doc_->scene().camera, name));
-        } catch (const lc::Error&) {
-            continue;
-        }
-        if (auto* cb = qobject_cast<QCheckBox*>(w)) cb->setChecked(v == "true" || v == "1");
-        else if (auto* combo = qobject_cast<QComboBox*>(w)) combo->setCurrentText(v);
-        else if (auto* spin = qobject_cast<QSpinBox*>(w)) spin->setValue(v.toInt());
-    }
-    // The preset whose settings these are, for this scene, else "(none)".
-    if (presetCombo_) {
-        int shown = 0;
-        const lc::Camera& cam = doc_->scene().camera;
-        for (int i = 1; i < presetCombo_->count() && !shown; ++i) {
-            lc::CullSettings s;
-            lc::Camera c = cam;
-            lc::applyPreset(lc::enginePreset(presetCombo_->itemData(i).toString().toStdString()), s, c,
-                            doc_->scene().lights.size());
-            bool same = c.tileSize == cam.tileSize;
-            for (const lc::ParamSpec& p : lc::cullParams())
-                same = same && lc::getParam(s, c, p.name) == lc::getParam(doc_->settings(), cam, p.name);
-            if (same) shown = i;
-        }
-        presetCombo_->setCurrentIndex(shown);
-    }
-    syncingParams_ = false;
-}
+bool MainWindow::setParamFromUi(const QString& name, const QString& value) { return params_->setParam(name, value); }
 
-void MainWindow::applyPreset(const std::string& name) {
-    lc::CullSettings s;
-    lc::Camera cam = doc_->scene().camera;
-    try {
-        lc::applyPreset(lc::enginePreset(name), s, cam, doc_->scene().lights.size());
-    } catch (const lc::Error& e) {
-        log(describe(e), true);
-        syncParamWidgets();
-        return;
-    }
-    const lc::EnginePreset& p = lc::enginePreset(name);
-    log(tr("preset %1: %2 (left out: %3)")
-            .arg(QString::fromStdString(name), QString::fromStdString(p.engine), QString::fromStdString(p.leftOut)));
-    doc_->setSettings(s);
-    if (cam.tileSize != doc_->scene().camera.tileSize) doc_->setCamera(cam, tr("Preset %1").arg(QString::fromStdString(name)));
-    syncParamWidgets();
-}
-
-bool MainWindow::setPresetFromUi(const QString& name) {
-    const int i = presetCombo_->findData(name);
-    if (i < 1) return false;
-    presetCombo_->setCurrentIndex(i);
-    emit presetCombo_->activated(i); // what a user's pick emits
-    return presetCombo_->currentIndex() == i;
-}
-
-void MainWindow::onParamEdited(const std::string& name, const QString& value) {
-    if (syncingParams_) return;
-    lc::CullSettings s = doc_->settings();
-    lc::Camera cam = doc_->scene().camera;
-    try {
-        lc::setParam(s, cam, name, value.toStdString());
-    } catch (const lc::Error& e) {
-        log(describe(e), true);
-        syncParamWidgets();
-        return;
-    }
-    const lc::Camera& old = doc_->scene().camera;
-    if (cam.width != old.width || cam.height != old.height || cam.tileSize != old.tileSize)
-        doc_->setCamera(cam, tr("Set %1").arg(QString::fromStdString(name)));
-    else
-        doc_->setSettings(s);
-}
-
-bool MainWindow::setParamFromUi(const QString& name, const QString& value) {
-    auto it = paramWidgets_.find(name.toStdString());
-    if (it == paramWidgets_.end()) return false;
-    QWidget* w = it->second;
-    if (auto* cb = qobject_cast<QCheckBox*>(w)) cb->setChecked(value == "true" || value == "1");
-    else if (auto* combo = qobject_cast<QComboBox*>(w)) {
-        const int i = combo->findText(value);
-        if (i < 0) return false;
-        combo->setCurrentIndex(i);
-        emit combo->textActivated(value); // what a user's pick emits
-    } else if (auto* spin = qobject_cast<QSpinBox*>(w))
-        spin->setValue(value.toInt());
-    return QString::fromStdString(lc::getParam(doc_->settings(), doc_->scene().camera, name.toStdString())) ==
-           value;
-}
+bool MainWindow::setPresetFromUi(const QString& name) { return params_->setPreset(name); }
 
 void MainWindow::setBackend(const QString& backend, const QString& device) {
     backendCombo_->setCurrentText(backend);

@@ -38,6 +38,7 @@ class QFileSystemWatcher;
 namespace lcui {
 
 class MissNavigator;
+class ParamToolbars;
 struct HuntRequest; // hunt_dialog.hpp
 
 class CameraView;
@@ -179,8 +180,6 @@ private:
     void buildStatusBar();
     void buildOverlayMenus(QMenu* file, QMenu* view); // main_window_overlays.cpp
     void buildImageModes(QMenu* view);                // main_window_shading.cpp
-    void syncParamWidgets();
-    void onParamEdited(const std::string& name, const QString& value);
     void onRunFinished(quint64 generation, std::shared_ptr<const lc::RunOutput> out);
     void onRunFailed(quint64 generation, const QString& message);
     void updateStatus();
@@ -209,11 +208,8 @@ private:
     QPlainTextEdit* log_;
     QMenu* recentMenu_ = nullptr;
     QComboBox* backendCombo_ = nullptr;
-    QComboBox* presetCombo_ = nullptr; // "(none)" or the preset the settings equal
-    void applyPreset(const std::string& name);
     QLineEdit* deviceEdit_ = nullptr;
-    std::map<std::string, QWidget*> paramWidgets_;
-    bool syncingParams_ = false;
+    ParamToolbars* params_ = nullptr; // the Culling and Limits rows
     QLabel* statusBackend_;
     QLabel* statusTimes_;
     QLabel* statusFn_;
