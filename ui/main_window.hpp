@@ -6,6 +6,8 @@
 // Dialogs that ask the user something go through the replaceable functions in
 // `prompts`, so tests (and scripts) can answer them without a modal loop.
 
+#include "prompts.hpp"
+
 #include "culling/core/params.hpp"
 #include "culling/scene/scene_io.hpp"
 
@@ -39,6 +41,7 @@ namespace lcui {
 
 class MissNavigator;
 class ParamToolbars;
+class SceneFiles;
 struct HuntRequest; // hunt_dialog.hpp
 
 class CameraView;
@@ -51,17 +54,6 @@ class SceneTree;
 class StatusProgress;
 class TileInspector;
 
-struct Prompts {
-    // Unsaved changes: Save, Discard or Cancel.
-    std::function<QMessageBox::StandardButton(QWidget*, const QString& text)> askUnsaved;
-    std::function<void(QWidget*, const QString& title, const QString& text)> showError;
-    // File dialogs; an empty string means cancelled.
-    std::function<QString(QWidget*, const QString& caption, const QString& filter)> openPath;
-    std::function<QString(QWidget*, const QString& caption, const QString& filter)> savePath;
-    // A number in [min, max]; false when cancelled.
-    std::function<bool(QWidget*, const QString& title, const QString& label, double min, double max, double& value)>
-        askNumber;
-};
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -185,8 +177,6 @@ private:
     void updateStatus();
     void updateCutoffStatus(); // the glTF cut-off label: the scene, not the run
     void updateTitle();
-    void addRecentFile(const QString& path);
-    void rebuildRecentMenu();
     void setTabbedViews(bool tabbed);
     void restoreSettings();
     void saveSettings();
@@ -210,6 +200,7 @@ private:
     QComboBox* backendCombo_ = nullptr;
     QLineEdit* deviceEdit_ = nullptr;
     ParamToolbars* params_ = nullptr; // the Culling and Limits rows
+    SceneFiles* files_ = nullptr;     // open, save, import, recent files
     QLabel* statusBackend_;
     QLabel* statusTimes_;
     QLabel* statusFn_;
