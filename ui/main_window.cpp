@@ -2,6 +2,7 @@
 #include "miss_navigator.hpp"
 #include "param_toolbars.hpp"
 #include "scene_files.hpp"
+#include "custom_shader_source.hpp"
 
 #include "camera_view.hpp"
 #include "cull_worker.hpp"
@@ -34,7 +35,6 @@
 #include <QDragEnterEvent>
 #include <QDropEvent>
 #include <QElapsedTimer>
-#include <QFileSystemWatcher>
 #include <QFile>
 #include <QFileDialog>
 #include <QHBoxLayout>
@@ -133,6 +133,9 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
     buildMenus();
     buildToolbar();
     buildStatusBar();
+    customShader_ = new CustomShaderSource(this);
+    connect(customShader_, &CustomShaderSource::changed, this, [this] { runCulling(); });
+    connect(customShader_, &CustomShaderSource::logged, this, [this](const QString& m, bool error) { log(m, error); });
     files_ = new SceneFiles(this, doc_, statusProgress_, prompts, gltfOptions);
     files_->setRecentMenu(recentMenu_);
     connect(files_, &SceneFiles::logged, this, [this](const QString& m, bool error) { log(m, error); });
@@ -275,7 +278,7 @@ void MainWindow::buildDocks() {
     // with the built-in algorithm, so the views show its result.
     connect(report, &ReportDock::cullRequested, this, [this](const QString& backend) {
         if (backendCombo_->findText(backend) >= 0) backendCombo_->setCurrentText(backend);
-        if (customShader_)
+        if (customShader_->options())
             setCustomShader({}); // runs culling
         else
             runCulling();
@@ -570,7 +573,7 @@ quint64 MainWindow::runCulling(bool liveEdit) {
     const quint64 gen = service_->request(doc_->scene(), doc_->settings(), backendCombo_->currentText(),
                                           deviceEdit_->text(), liveEdit,
                                           CameraView::needsShading(cameraView_->imageMode()),
-                                          doc_->geometryRevision(), customShader_);
+                                          doc_->geometryRevision(), customShader_->options());
     doc_->noteRunRequested(gen);
     statusBar()->showMessage(tr("culling (run %1)...").arg(gen));
     return gen;
@@ -892,53 +895,25 @@ void MainWindow::setTabbedViews(bool tabbed) {
 }
 
 bool MainWindow::setCustomShader(const QString& path) {
-    if (!shaderWatcher_) {
-        shaderWatcher_ = new QFileSystemWatcher(this);
-        connect(shaderWatcher_, &QFileSystemWatcher::fileChanged, this, [this] { reloadCustomShader(); });
-    }
-    if (!shaderWatcher_->files().isEmpty()) shaderWatcher_->removePaths(shaderWatcher_->files());
-    if (path.isEmpty()) {
-        if (customShader_) log(tr("culling with the built-in algorithm again"));
-        customShader_.reset();
-        runCulling();
-        return true;
-    }
-    std::shared_ptr<const lc::CustomShaderOptions> o;
+    const bool had = customShader_->options() != nullptr;
     try {
-        o = std::make_shared<const lc::CustomShaderOptions>(lc::shaderOptionsFromFile(path.toStdString()));
+        customShader_->set(path);
     } catch (const std::exception& e) {
         log(tr("cannot use %1: %2").arg(path, describe(e)), true);
         prompts.showError(this, tr("Custom shader"), describe(e));
         return false;
     }
-    customShader_ = o;
-    shaderWatcher_->addPath(path);
-    log(tr("culling with custom shader %1 (layout %2, lists %3); saving it re-runs")
-            .arg(path, QString::fromStdString(lc::toString(o->layout)), QString::fromStdString(lc::toString(o->lists))));
+    if (const auto o = customShader_->options())
+        log(tr("culling with custom shader %1 (layout %2, lists %3); saving it re-runs")
+                .arg(path, QString::fromStdString(lc::toString(o->layout)),
+                     QString::fromStdString(lc::toString(o->lists))));
+    else if (had)
+        log(tr("culling with the built-in algorithm again"));
     runCulling();
     return true;
 }
 
-QString MainWindow::customShaderPath() const {
-    return customShader_ ? QString::fromStdString(customShader_->path) : QString();
-}
-
-void MainWindow::reloadCustomShader() {
-    if (!customShader_) return;
-    const QString path = customShaderPath();
-    // Editors often save by replacing the file: watch the new one.
-    if (QFileInfo::exists(path) && !shaderWatcher_->files().contains(path)) shaderWatcher_->addPath(path);
-    if (!QFileInfo::exists(path)) return; // mid-save; the new file's change follows
-    log(tr("%1 changed: culling again").arg(path));
-    try {
-        // The first line may have changed its settings.
-        customShader_ = std::make_shared<const lc::CustomShaderOptions>(lc::shaderOptionsFromFile(path.toStdString()));
-    } catch (const std::exception& e) {
-        log(tr("cannot use %1: %2").arg(path, describe(e)), true);
-        return;
-    }
-    runCulling();
-}
+QString MainWindow::customShaderPath() const { return customShader_->path(); }
 
 void MainWindow::setGltfMinIntensity(double lux) {
     if (!(lux > 0.0) || !std::isfinite(lux)) return;

@@ -35,13 +35,13 @@ namespace lc {
 struct RunOutput;
 }
 
-class QFileSystemWatcher;
 
 namespace lcui {
 
 class MissNavigator;
 class ParamToolbars;
 class SceneFiles;
+class CustomShaderSource;
 struct HuntRequest; // hunt_dialog.hpp
 
 class CameraView;
@@ -163,7 +163,6 @@ protected:
 private:
     // The time, `level` ("ERROR ", "WARNING " or none) and the message.
     void logLine(const QString& level, const QString& message);
-    void reloadCustomShader(); // the watched file changed
     void huntFromDialog();     // Culling > Hunt for a miss... (main_window_hunt.cpp)
     void buildActions();
     void buildMenus();
@@ -214,8 +213,7 @@ private:
     quint64 failedGeneration_ = 0;
     bool restoringSettings_ = false; // restoreSettings() is setting the widgets
     ExplainPanel* explain_ = nullptr;
-    std::shared_ptr<const lc::CustomShaderOptions> customShader_;
-    QFileSystemWatcher* shaderWatcher_ = nullptr;
+    CustomShaderSource* customShader_ = nullptr; // the user's culling shader, watched
     quint64 pendingRuns_ = 0;
     quint64 firstMissOfRun_ = 0; // selectFirstMissOfRun's generation; 0: none
 };

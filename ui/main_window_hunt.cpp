@@ -3,6 +3,7 @@
 // background with the status bar's progress and Cancel; the repro it writes
 // opens as the scene, its miss selected and explained.
 #include "main_window.hpp"
+#include "custom_shader_source.hpp"
 
 #include "document.hpp"
 #include "hunt_dialog.hpp"
@@ -53,8 +54,8 @@ void MainWindow::huntFromDialog() {
     initial.vary = st.value("hunt/vary", lc::HuntAll).toUInt() & lc::HuntAll;
     if (initial.vary == 0) initial.vary = lc::HuntAll;
     initial.openScene = st.value("hunt/openScene", true).toBool();
-    HuntDialog dlg(initial, underTestText(doc_->settings(), customShader_.get(), backendCombo_->currentText()),
-                   !doc_->scene().meshes.empty(), customShader_ != nullptr, this);
+    HuntDialog dlg(initial, underTestText(doc_->settings(), customShader_->options().get(), backendCombo_->currentText()),
+                   !doc_->scene().meshes.empty(), customShader_->options() != nullptr, this);
     if (dlg.exec() != QDialog::Accepted) return;
     const HuntRequest r = dlg.request();
     st.setValue("hunt/folder", r.folder);
@@ -74,7 +75,7 @@ bool MainWindow::hunt(const HuntRequest& r) {
     }
     lc::HuntOptions o;
     o.settings = doc_->settings();
-    if (customShader_) o.shader = *customShader_;
+    if (const auto shader = customShader_->options()) o.shader = *shader;
     o.seed = r.seed;
     o.maxTrials = r.trials;
     o.maxSeconds = r.seconds;
