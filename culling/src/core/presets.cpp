@@ -56,6 +56,9 @@ void deriveUnreal(CullSettings& s, Camera& c, std::size_t) {
     s.maxEntries = std::uint32_t(std::min<std::uint64_t>(cells * 32, 100000000));
 }
 
+// Each preset: name, engine, settings, the grid it derives (and how), what
+// it leaves out, and how far the engine lets each limit go (the setting or
+// constant that sets it, cited in docs/ENGINES.md; 0: no fixed maximum).
 std::vector<EnginePreset> buildPresets() {
     std::vector<EnginePreset> p;
     p.push_back({"urp",
@@ -64,13 +67,15 @@ std::vector<EnginePreset> buildPresets() {
                  deriveUrp,
                  "tile: 8 px doubled until tiles x ceil(lights/32) words <= 16384; bins: 4096 / (2 + words per tile)",
                  "URP's Z bins are log2 in perspective (ours linear); reflection probes share the tile masks; "
-                 "directional lights are not binned"});
+                 "directional lights are not binned",
+                 {{"max-lights", 256, "URP's k_MaxVisibleLightCountDesktop"}}});
     p.push_back({"urp-mobile",
                  "Unity URP Forward+ (mobile, OpenGL, WebGPU)",
                  {{"algorithm", "zbin"}, {"max-lights", "32"}, {"limit-keep", "nearest"}},
                  deriveUrp,
                  "tile: 8 px doubled until tiles x ceil(lights/32) words <= 4096; bins: 4096 / (2 + words per tile)",
-                 "as urp; GLES 3.0 and older keep 16 lights"});
+                 "as urp; GLES 3.0 and older keep 16 lights",
+                 {{"max-lights", 32, "URP's k_MaxVisibleLightCountMobile"}}});
     p.push_back({"hdrp-fptl",
                  "Unity HDRP fine-pruned tiles (FPTL)",
                  {{"algorithm", "fptl"}, {"tile", "16"}, {"cap", "63"}, {"overflow-policy", "index"}, {"max-lights", "512"},
@@ -78,7 +83,8 @@ std::vector<EnginePreset> buildPresets() {
                  nullptr,
                  "",
                  "the coarse list of 64 is filled in GPU atomic order before pruning (not modelled); caps are per "
-                 "light category; which lights HDRP keeps past 512 on screen was not found (modelled by index)"});
+                 "light category; which lights HDRP keeps past 512 on screen was not found (modelled by index)",
+                 {{"cap", 63, "ShaderConfig FPTLMaxLightCount"}, {"max-lights", 2048, "the HDRP asset's maximum punctual lights on screen"}}});
     p.push_back({"hdrp-cluster",
                  "Unity HDRP clustered",
                  {{"algorithm", "clustered"}, {"tile", "32"}, {"cells", "32"}, {"slicing", "log"}, {"cap", "63"},
@@ -86,7 +92,8 @@ std::vector<EnginePreset> buildPresets() {
                  nullptr,
                  "",
                  "HDRP has 64 slices with a per-tile log base fitted to the tile's depth (ours: 32 log slices over "
-                 "the camera range); the coarse list of 128 is filled in GPU atomic order"});
+                 "the camera range); the coarse list of 128 is filled in GPU atomic order",
+                 {{"cap", 63, "the cluster count's 6 bits"}, {"max-lights", 2048, "the HDRP asset's maximum punctual lights on screen"}}});
     p.push_back({"unreal-5",
                  "Unreal Engine 5 forward light grid (linked-list culling, the default)",
                  {{"algorithm", "clustered"}, {"tile", "64"}, {"cells", "32"}, {"slicing", "log"},
@@ -94,14 +101,16 @@ std::vector<EnginePreset> buildPresets() {
                  deriveUnreal,
                  "max-entries: grid cells (64 px x 32 slices) x 32, one pool for every cell",
                  "Unreal's slices are log2(z*B + O)*S with a near offset and a reserved last slice (ours: log over "
-                 "the camera range); HZB cell culling"});
+                 "the camera range); HZB cell culling",
+                 {{"max-entries", 0, "r.Forward.MaxCulledLightsPerCell (the pool is cells x it)"}}});
     p.push_back({"unreal-5-fixed",
                  "Unreal Engine 5 forward light grid, r.Forward.LightLinkedListCulling 0",
                  {{"algorithm", "clustered"}, {"tile", "64"}, {"cells", "32"}, {"slicing", "log"}, {"cap", "32"},
                   {"overflow-policy", "index"}},
                  nullptr,
                  "",
-                 "as unreal-5"});
+                 "as unreal-5",
+                 {{"cap", 0, "r.Forward.MaxCulledLightsPerCell"}}});
     p.push_back({"godot-4",
                  "Godot 4 clustered forward",
                  {{"algorithm", "clustered"}, {"tile", "32"}, {"cells", "32"}, {"slicing", "linear"},
@@ -110,7 +119,8 @@ std::vector<EnginePreset> buildPresets() {
                  "",
                  "Godot rasterises overfit proxy meshes at a quarter resolution (modelled by the sphere test); its "
                  "32 depth bits span 0..far (ours near..far); 512 is per element type (omni, spot), ours for all "
-                 "lights together"});
+                 "lights together",
+                 {{"max-lights", 8192, "rendering/limits/cluster_builder/max_clustered_elements"}}});
     p.push_back({"filament",
                  "Filament froxels",
                  {{"algorithm", "clustered"}, {"cells", "16"}, {"slicing", "log"}, {"max-lights", "256"}, {"limit-keep", "index"}, {"max-entries", "65535"},
@@ -119,21 +129,24 @@ std::vector<EnginePreset> buildPresets() {
                  "tile: square froxels, side a multiple of 8 px, at most 4096 / 16 per slice",
                  "Filament's slice 0 is 0..5 m and slices 1..15 log to 100 m (ours: log over the camera range); "
                  "records are shared with a left or upper neighbour; its count clamp of 255 per froxel (reached only "
-                 "with all 256 lights in one froxel) is not modelled; which lights it keeps past 256 was not read"});
+                 "with all 256 lights in one froxel) is not modelled; which lights it keeps past 256 was not read",
+                 {{"max-lights", 256, "CONFIG_MAX_LIGHT_COUNT"}, {"max-entries", 65535, "the record buffer (16-bit offsets)"}}});
     p.push_back({"bevy",
                  "Bevy clustered forward (storage buffers)",
                  {{"algorithm", "clustered"}, {"cells", "24"}, {"slicing", "log"}},
                  deriveBevy,
                  "tile: 4096 clusters over 24 slices, square in screen space",
                  "Bevy's first slice is near..5 and its far plane the farthest light's range (ours: log over the "
-                 "camera range); dynamic resizing shrinks the grid before an index list overflows"});
+                 "camera range); dynamic resizing shrinks the grid before an index list overflows",
+                 {}});
     p.push_back({"bevy-webgl2",
                  "Bevy clustered forward (WebGL2 uniform buffers)",
                  {{"algorithm", "clustered"}, {"cells", "24"}, {"slicing", "log"}, {"max-lights", "204"},
                   {"limit-keep", "index"}, {"max-entries", "16384"}, {"overflow-policy", "index"}},
                  deriveBevy,
                  "tile: as bevy; 204 objects and 16384 indices in all",
-                 "as bevy; the order Bevy keeps objects in past 204 was not verified (modelled by index)"});
+                 "as bevy; the order Bevy keeps objects in past 204 was not verified (modelled by index)",
+                 {{"max-lights", 204, "MAX_UNIFORM_BUFFER_CLUSTERABLE_OBJECTS"}, {"max-entries", 16384, "ViewClusterBindings::MAX_INDICES"}}});
     p.push_back({"threejs",
                  "three.js TiledLightsNode (WebGPU renderer)",
                  {{"algorithm", "naive"}, {"tile", "32"}, {"cap", "8"}, {"overflow-policy", "index"},
@@ -141,27 +154,8 @@ std::vector<EnginePreset> buildPresets() {
                  nullptr,
                  "",
                  "three.js tiles have no depth at all and test a screen-space circle against the tile (ours: the "
-                 "tile's side planes with the camera's near and far); spot lights are not tiled there"});
-    // How far each engine lets its limits go (docs/ENGINES.md cites each).
-    const auto setRoom = [&](const std::string& name, std::vector<EnginePreset::Room> r) {
-        for (EnginePreset& e : p)
-            if (e.name == name) e.room = std::move(r);
-    };
-    setRoom("urp", {{"max-lights", 256, "URP's k_MaxVisibleLightCountDesktop"}});
-    setRoom("urp-mobile", {{"max-lights", 32, "URP's k_MaxVisibleLightCountMobile"}});
-    setRoom("hdrp-fptl", {{"cap", 63, "ShaderConfig FPTLMaxLightCount"},
-                          {"max-lights", 2048, "the HDRP asset's maximum punctual lights on screen"}});
-    setRoom("hdrp-cluster", {{"cap", 63, "the cluster count's 6 bits"},
-                             {"max-lights", 2048, "the HDRP asset's maximum punctual lights on screen"}});
-    setRoom("unreal-5", {{"max-entries", 0, "r.Forward.MaxCulledLightsPerCell (the pool is cells x it)"}});
-    setRoom("unreal-5-fixed", {{"cap", 0, "r.Forward.MaxCulledLightsPerCell"}});
-    setRoom("godot-4", {{"max-lights", 8192, "rendering/limits/cluster_builder/max_clustered_elements"}});
-    setRoom("filament", {{"max-lights", 256, "CONFIG_MAX_LIGHT_COUNT"},
-                         {"max-entries", 65535, "the record buffer (16-bit offsets)"}});
-    setRoom("bevy-webgl2", {{"max-lights", 204, "MAX_UNIFORM_BUFFER_CLUSTERABLE_OBJECTS"},
-                            {"max-entries", 16384, "ViewClusterBindings::MAX_INDICES"}});
-    setRoom("threejs", {{"cap", 0, "TiledLightsNode's tileLightCount"},
-                        {"max-lights", 0, "TiledLightsNode's maxLights (its constructor's first argument)"}});
+                 "tile's side planes with the camera's near and far); spot lights are not tiled there",
+                 {{"cap", 0, "TiledLightsNode's tileLightCount"}, {"max-lights", 0, "TiledLightsNode's maxLights (its constructor's first argument)"}}});
     return p;
 }
 
