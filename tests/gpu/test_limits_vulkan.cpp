@@ -4,6 +4,7 @@
 // lists, so wherever the two backends' tests listed the same lights, the
 // limits must keep and drop the same lights; and the misses they cause must
 // be counted the same.
+#include "result_lists.hpp"
 #include "gpu_test_env.hpp"
 
 #include "culling/core/limits.hpp"
@@ -18,14 +19,8 @@ using lc::gputest::GpuTest;
 
 namespace {
 
-std::vector<std::uint32_t> listAt(const CullResult& r, std::size_t l) {
-    return {r.lightIndices.begin() + r.listOffset[l], r.lightIndices.begin() + r.listOffset[l] + r.listCount[l]};
-}
-
-std::vector<std::uint32_t> droppedAt(const CullResult& r, std::uint32_t l) {
-    const auto [a, b] = r.limits.droppedFrom(l);
-    return a ? std::vector<std::uint32_t>(a, b) : std::vector<std::uint32_t>{};
-}
+using test::droppedAt;
+using test::listAt;
 
 } // namespace
 

@@ -1,6 +1,7 @@
 // Engine limits (core/limits.hpp): the per-list cap, the record buffer and the
 // per-view light limit with their policies, the false negatives they cause
 // counted by cause, Explain's verdict, the exports, and the engine presets.
+#include "result_lists.hpp"
 #include "culling/core/errors.hpp"
 #include "culling/core/limits.hpp"
 #include "culling/core/pipeline.hpp"
@@ -21,6 +22,9 @@
 using namespace lc;
 
 namespace {
+
+using test::droppedAt;
+using test::listAt;
 
 // A result of `lists` lists with the given entries, over `lights` lights.
 CullResult listsOf(const std::vector<std::vector<std::uint32_t>>& lists) {
@@ -45,15 +49,6 @@ ViewLights lightsAtDepths(std::size_t n, bool farFirst = false) {
         v.power.push_back({1, 1, 1});
     }
     return v;
-}
-
-std::vector<std::uint32_t> listAt(const CullResult& r, std::size_t l) {
-    return {r.lightIndices.begin() + r.listOffset[l], r.lightIndices.begin() + r.listOffset[l] + r.listCount[l]};
-}
-
-std::vector<std::uint32_t> droppedAt(const CullResult& r, std::uint32_t l) {
-    const auto [a, b] = r.limits.droppedFrom(l);
-    return a ? std::vector<std::uint32_t>(a, b) : std::vector<std::uint32_t>{};
 }
 
 } // namespace
