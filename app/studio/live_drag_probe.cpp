@@ -1,10 +1,10 @@
 #include "live_drag_probe.hpp"
 
-#include "camera_view.hpp"
-#include "cull_worker.hpp"
-#include "document.hpp"
-#include "inspector_view.hpp"
-#include "main_window.hpp"
+#include "views/camera_view.hpp"
+#include "work/cull_worker.hpp"
+#include "document/document.hpp"
+#include "views/inspector_view.hpp"
+#include "window/main_window.hpp"
 #include "probe_stats.hpp"
 
 #include "culling/core/pipeline.hpp"

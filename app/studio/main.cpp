@@ -10,12 +10,12 @@
 // rendered; --quit exits afterwards (exit code 0 only when
 // every requested step worked).
 
-#include "camera_view.hpp"
-#include "cull_worker.hpp"
-#include "document.hpp"
+#include "views/camera_view.hpp"
+#include "work/cull_worker.hpp"
+#include "document/document.hpp"
 #include "live_drag_probe.hpp"
-#include "main_window.hpp"
-#include "miss_navigator.hpp"
+#include "window/main_window.hpp"
+#include "document/miss_navigator.hpp"
 #include "shading_probe.hpp"
 
 #include "culling/core/backend.hpp"

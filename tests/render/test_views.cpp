@@ -25,10 +25,10 @@
 #include "../ui/studio_test_support.hpp"
 #include "../support/box_mesh.hpp"
 
-#include "camera_view.hpp"
-#include "document.hpp"
-#include "inspector_view.hpp"
-#include "overlay_actors.hpp"
+#include "views/camera_view.hpp"
+#include "document/document.hpp"
+#include "views/inspector_view.hpp"
+#include "views/overlay_actors.hpp"
 
 #include "culling/core/backend.hpp"
 #include "culling/diagnostics/overlays.hpp"

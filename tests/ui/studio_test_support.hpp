@@ -13,8 +13,8 @@
 #include <QTest>
 #include <QVTKOpenGLNativeWidget.h>
 
-#include "document.hpp"
-#include "main_window.hpp"
+#include "document/document.hpp"
+#include "window/main_window.hpp"
 
 #include <cstdio>
 #include <cstdlib>

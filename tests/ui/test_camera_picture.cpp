@@ -4,9 +4,9 @@
 // moved or the view resized, or frames of one camera that differ. Real widgets under Xvfb, real llvmpipe
 // frames. (The picture's anti-aliased edges differ slightly from meshes drawn under the overlay; the render
 // baselines, within their tolerance, cover that.)
-#include "camera_view.hpp"
+#include "views/camera_view.hpp"
 #include "culling/scene/scene_io.hpp"
-#include "document.hpp"
+#include "document/document.hpp"
 #include "studio_test_support.hpp"
 
 #include <QImage>

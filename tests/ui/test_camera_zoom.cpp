@@ -4,9 +4,9 @@
 // another tile than the one under the cursor, a pan that leaves the image,
 // the legend or the toolbar's extension arrow eating what they came to see.
 // Real widgets under Xvfb: wheel and drag events go through Qt's event path.
-#include "camera_view.hpp"
-#include "document.hpp"
-#include "main_window.hpp"
+#include "views/camera_view.hpp"
+#include "document/document.hpp"
+#include "window/main_window.hpp"
 #include "studio_test_support.hpp"
 
 #include "culling/math/tile_math.hpp"

@@ -10,10 +10,10 @@
 #include <QDockWidget>
 #include <QLabel>
 
-#include "document.hpp"
-#include "explain_panel.hpp"
-#include "main_window.hpp"
-#include "tile_inspector.hpp"
+#include "document/document.hpp"
+#include "panels/explain_panel.hpp"
+#include "window/main_window.hpp"
+#include "panels/tile_inspector.hpp"
 
 #include "culling/custom/custom_cull.hpp"
 #include "culling/scene/scene_io.hpp"

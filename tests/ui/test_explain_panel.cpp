@@ -5,14 +5,14 @@
 
 #include "studio_test_support.hpp"
 
-#include "document.hpp"
-#include "explain_panel.hpp"
-#include "main_window.hpp"
-#include "camera_view.hpp"
-#include "inspector_view.hpp"
-#include "overlay_actors.hpp"
-#include "tile_inspector.hpp"
-#include "scene_tree.hpp"
+#include "document/document.hpp"
+#include "panels/explain_panel.hpp"
+#include "window/main_window.hpp"
+#include "views/camera_view.hpp"
+#include "views/inspector_view.hpp"
+#include "views/overlay_actors.hpp"
+#include "panels/tile_inspector.hpp"
+#include "panels/scene_tree.hpp"
 
 #include "culling/diagnostics/explain.hpp"
 #include "culling/truth/ground_truth.hpp"

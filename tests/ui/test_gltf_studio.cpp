@@ -6,8 +6,8 @@
 
 #include "studio_test_support.hpp"
 
-#include "document.hpp"
-#include "main_window.hpp"
+#include "document/document.hpp"
+#include "window/main_window.hpp"
 
 #include "culling/core/file_io.hpp"
 #include "culling/scene/gltf_io.hpp"

@@ -8,11 +8,11 @@
 
 #include "studio_test_support.hpp"
 
-#include "document.hpp"
-#include "explain_panel.hpp"
-#include "main_window.hpp"
-#include "hunt_dialog.hpp"
-#include "miss_navigator.hpp"
+#include "document/document.hpp"
+#include "panels/explain_panel.hpp"
+#include "window/main_window.hpp"
+#include "panels/hunt_dialog.hpp"
+#include "document/miss_navigator.hpp"
 
 #include "culling/custom/custom_cull.hpp"
 #include "culling/scene/scene_io.hpp"

@@ -15,13 +15,13 @@
 #include "studio_test_support.hpp"
 #include "../support/box_mesh.hpp"
 
-#include "document.hpp"
-#include "inspector_view.hpp"
-#include "light_silhouettes.hpp"
-#include "main_window.hpp"
-#include "overlay_actors.hpp"
-#include "spot_actor.hpp"
-#include "spot_handles.hpp"
+#include "document/document.hpp"
+#include "views/inspector_view.hpp"
+#include "views/light_silhouettes.hpp"
+#include "window/main_window.hpp"
+#include "views/overlay_actors.hpp"
+#include "views/spot_actor.hpp"
+#include "views/spot_handles.hpp"
 
 #include "culling/diagnostics/overlays.hpp"
 

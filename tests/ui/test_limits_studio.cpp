@@ -7,11 +7,11 @@
 
 #include "studio_test_support.hpp"
 
-#include "camera_view.hpp"
-#include "document.hpp"
-#include "explain_panel.hpp"
-#include "main_window.hpp"
-#include "scene_tree.hpp"
+#include "views/camera_view.hpp"
+#include "document/document.hpp"
+#include "panels/explain_panel.hpp"
+#include "window/main_window.hpp"
+#include "panels/scene_tree.hpp"
 
 #include "culling/diagnostics/explain.hpp"
 #include "culling/diagnostics/overlays.hpp"

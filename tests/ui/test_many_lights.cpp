@@ -5,15 +5,15 @@
 // whose sphere is under the cursor; a Live drag ends on the newest result;
 // the document's geometry revision follows mesh edits only.
 
-#include "cull_worker.hpp"
+#include "work/cull_worker.hpp"
 #include "culling/core/backend.hpp"
 #include "culling/core/pipeline.hpp"
 #include "culling/scene/scene_io.hpp"
-#include "document.hpp"
-#include "inspector_view.hpp"
-#include "light_silhouettes.hpp"
-#include "overlay_actors.hpp"
-#include "main_window.hpp"
+#include "document/document.hpp"
+#include "views/inspector_view.hpp"
+#include "views/light_silhouettes.hpp"
+#include "views/overlay_actors.hpp"
+#include "window/main_window.hpp"
 #include "studio_test_support.hpp"
 
 #include <QDir>

@@ -7,12 +7,12 @@
 
 #include "studio_test_support.hpp"
 
-#include "camera_view.hpp"
-#include "document.hpp"
-#include "inspector_view.hpp"
-#include "main_window.hpp"
-#include "overlay_actors.hpp"
-#include "tile_inspector.hpp"
+#include "views/camera_view.hpp"
+#include "document/document.hpp"
+#include "views/inspector_view.hpp"
+#include "window/main_window.hpp"
+#include "views/overlay_actors.hpp"
+#include "panels/tile_inspector.hpp"
 
 #include "culling/diagnostics/overlays.hpp"
 #include "culling/scene/scene_io.hpp"

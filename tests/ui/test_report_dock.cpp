@@ -8,9 +8,9 @@
 // and culls it, so the views show its result.
 #include "studio_test_support.hpp"
 
-#include "document.hpp"
-#include "main_window.hpp"
-#include "report_dock.hpp"
+#include "document/document.hpp"
+#include "window/main_window.hpp"
+#include "panels/report_dock.hpp"
 
 #include "culling/core/pipeline.hpp"
 

@@ -10,10 +10,10 @@
 
 #include "studio_test_support.hpp"
 
-#include "camera_view.hpp"
-#include "cull_worker.hpp"
-#include "document.hpp"
-#include "main_window.hpp"
+#include "views/camera_view.hpp"
+#include "work/cull_worker.hpp"
+#include "document/document.hpp"
+#include "window/main_window.hpp"
 
 #include "culling/core/backend.hpp"
 #include "culling/diagnostics/export.hpp"

@@ -5,12 +5,12 @@
 // to look at), and a culling run with the spot-test parameter set from the
 // toolbar, checked against the CLI's library path.
 #include "studio_test_support.hpp"
-#include "document.hpp"
-#include "generate_dialog.hpp"
-#include "inspector_view.hpp"
-#include "main_window.hpp"
-#include "property_panel.hpp"
-#include "spot_actor.hpp"
+#include "document/document.hpp"
+#include "panels/generate_dialog.hpp"
+#include "views/inspector_view.hpp"
+#include "window/main_window.hpp"
+#include "panels/property_panel.hpp"
+#include "views/spot_actor.hpp"
 
 #include "culling/core/pipeline.hpp"
 #include "culling/math/spot_tests.hpp"

@@ -6,13 +6,13 @@
 // and the overlay draws exactly lc::spotTestPrimitive for every spot test.
 // A screenshot with both handles and the primitive is written to look at.
 #include "studio_test_support.hpp"
-#include "document.hpp"
-#include "inspector_view.hpp"
-#include "main_window.hpp"
-#include "overlay_actors.hpp"
-#include "property_panel.hpp"
-#include "spot_actor.hpp"
-#include "spot_handles.hpp"
+#include "document/document.hpp"
+#include "views/inspector_view.hpp"
+#include "window/main_window.hpp"
+#include "views/overlay_actors.hpp"
+#include "panels/property_panel.hpp"
+#include "views/spot_actor.hpp"
+#include "views/spot_handles.hpp"
 
 #include "culling/diagnostics/overlays.hpp"
 

@@ -4,15 +4,15 @@
 
 #include "studio_test_support.hpp"
 
-#include "camera_view.hpp"
-#include "cull_worker.hpp"
-#include "document.hpp"
-#include "inspector_view.hpp"
-#include "main_window.hpp"
+#include "views/camera_view.hpp"
+#include "work/cull_worker.hpp"
+#include "document/document.hpp"
+#include "views/inspector_view.hpp"
+#include "window/main_window.hpp"
 #include "culling/diagnostics/overlays.hpp"
-#include "property_panel.hpp"
-#include "scene_tree.hpp"
-#include "tile_inspector.hpp"
+#include "panels/property_panel.hpp"
+#include "panels/scene_tree.hpp"
+#include "panels/tile_inspector.hpp"
 
 #include "culling/truth/ground_truth.hpp"
 #include "culling/core/pipeline.hpp"

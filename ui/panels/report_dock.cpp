@@ -1,0 +1,724 @@
+#include "panels/report_dock.hpp"
+
+#include "document/document.hpp"
+
+#include "culling/core/backend.hpp"
+#include "culling/core/errors.hpp"
+#include "culling/core/pipeline.hpp"
+
+#include <QComboBox>
+#include <QEvent>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QLocale>
+#include <QMenu>
+#include <QMessageBox>
+#include <QMouseEvent>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QSpinBox>
+#include <QToolButton>
+#include <QVBoxLayout>
+#include <QVTKOpenGLNativeWidget.h>
+
+#include <vtkAxis.h>
+#include <vtkChartXY.h>
+#include <vtkCommand.h>
+#include <vtkContextScene.h>
+#include <vtkContextView.h>
+#include <vtkDoubleArray.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkPen.h>
+#include <vtkPlot.h>
+#include <vtkPlotPoints.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkRenderer.h>
+#include <vtkStringArray.h>
+#include <vtkTable.h>
+#include <vtkTextProperty.h>
+#include <vtkTooltipItem.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace lcui {
+
+namespace {
+
+// "4 h 34 min", "12 min", "40 s".
+QString duration(double seconds) {
+    if (seconds < 1) return ReportDock::tr("under a second");
+    if (seconds < 90) return ReportDock::tr("%1 s").arg(qRound(seconds));
+    const int minutes = qRound(seconds / 60);
+    if (minutes < 90) return ReportDock::tr("%1 min").arg(minutes);
+    return ReportDock::tr("%1 h %2 min").arg(minutes / 60).arg(minutes % 60);
+}
+QString aboutTime(double seconds) {
+    return seconds < 1 ? duration(seconds) : ReportDock::tr("about %1").arg(duration(seconds));
+}
+
+QString count(std::size_t n) { return QLocale(QLocale::English).toString(qulonglong(n)); }
+
+QString join(const std::vector<std::string>& values) {
+    std::string s;
+    for (const std::string& v : values) s += (s.empty() ? "" : ",") + v;
+    return QString::fromStdString(s);
+}
+
+// A held parameter's menu stays open while values are toggled.
+class StayOpen : public QObject {
+public:
+    using QObject::QObject;
+    bool eventFilter(QObject* o, QEvent* e) override {
+        auto* menu = qobject_cast<QMenu*>(o);
+        if (menu && e->type() == QEvent::MouseButtonRelease) {
+            QAction* a = menu->actionAt(static_cast<QMouseEvent*>(e)->pos());
+            if (a && a->isCheckable() && a->isEnabled()) {
+                a->trigger();
+                return true;
+            }
+        }
+        return QObject::eventFilter(o, e);
+    }
+};
+
+} // namespace
+
+ReportDock::ReportDock(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
+    confirm = [](QWidget* parent, const QString& title, const QString& text) {
+        return QMessageBox::question(parent, title, text, QMessageBox::Yes | QMessageBox::No, QMessageBox::No) ==
+               QMessageBox::Yes;
+    };
+    auto* layout = new QVBoxLayout(this);
+    auto* row = new QHBoxLayout;
+    backendBox_ = new QComboBox;
+    backendBox_->setObjectName("reportBackend");
+    backendBox_->addItem(tr("every backend"), QString());
+    for (const std::string& b : lc::availableBackends()) backendBox_->addItem(QString::fromStdString(b), QString::fromStdString(b));
+    repeatBox_ = new QSpinBox;
+    repeatBox_->setObjectName("reportRepeat");
+    repeatBox_->setRange(1, 50);
+    repeatBox_->setValue(3);
+    repeatBox_->setPrefix(tr("repeat "));
+    yBox_ = new QComboBox;
+    yBox_->setObjectName("reportYAxis");
+    yBox_->addItem(tr("time vs efficiency"));
+    yBox_->addItem(tr("time vs image error"));
+    runButton_ = new QPushButton(tr("Run report"));
+    runButton_->setObjectName("reportRun");
+    cancelButton_ = new QPushButton(tr("Cancel"));
+    cancelButton_->setObjectName("reportCancel");
+    cancelButton_->setEnabled(false);
+    row->addWidget(backendBox_);
+    row->addWidget(repeatBox_);
+    row->addWidget(runButton_);
+    row->addWidget(cancelButton_);
+    row->addWidget(yBox_);
+    row->addStretch(1);
+    layout->addLayout(row);
+
+    // One menu per swept parameter, from the parameter table: every value
+    // the sweep would take, checked; unchecking holds the parameter at the
+    // rest (ReportOptions::fixed, as the CLI's flags do). Int parameters
+    // other than tile and cells keep their default in the sweep: no menu.
+    auto* paramRow = new QHBoxLayout;
+    paramRow->addWidget(new QLabel(tr("Sweep:")));
+    auto asText = [](const std::vector<std::uint32_t>& v) {
+        std::vector<std::string> s;
+        for (auto x : v) s.push_back(std::to_string(x));
+        return s;
+    };
+    for (const lc::ParamSpec& p : lc::cullParams()) {
+        if (p.name == "tile")
+            addParamControl(p, {"4", "8", "12", "16", "20", "24", "32", "48", "64"}, asText(options_.tileSizes));
+        else if (p.name == "cells")
+            addParamControl(p, {"1", "2", "4", "8", "16", "32"}, asText(options_.cellCounts));
+        else if (p.type == lc::ParamType::Choice)
+            addParamControl(p, p.choices, p.choices);
+        else if (p.type == lc::ParamType::Bool)
+            addParamControl(p, {"false", "true"}, {"false", "true"});
+    }
+    for (const auto& c : params_) paramRow->addWidget(c->button);
+    paramRow->addStretch(1);
+    layout->addLayout(paramRow);
+
+    queue_ = new QLabel;
+    queue_->setObjectName("reportQueue");
+    queue_->setWordWrap(true);
+    layout->addWidget(queue_);
+    progress_ = new QProgressBar;
+    progress_->setObjectName("reportProgress");
+    progress_->setRange(0, 1);
+    progress_->setValue(0);
+    // Counts, not a percentage: one configuration of thousands is 0%.
+    progress_->setFormat(tr("%v of %m"));
+    status_ = new QLabel(tr("Sweeps the culling configurations chosen above; click a point to load and run it."));
+    status_->setObjectName("reportStatus");
+    status_->setWordWrap(true);
+    auto* row2 = new QHBoxLayout;
+    row2->addWidget(progress_, 1);
+    row2->addWidget(status_, 2);
+    layout->addLayout(row2);
+
+    chartWidget_ = new QVTKOpenGLNativeWidget;
+    chartWidget_->setObjectName("reportChart");
+    chartWidget_->setMinimumHeight(220);
+    vtkNew<vtkGenericOpenGLRenderWindow> rw;
+    chartWidget_->setRenderWindow(rw);
+    view_ = vtkSmartPointer<vtkContextView>::New();
+    view_->SetRenderWindow(rw);
+    view_->SetInteractor(chartWidget_->interactor());
+    view_->GetRenderer()->SetBackground(1.0, 1.0, 1.0);
+    chart_ = vtkSmartPointer<vtkChartXY>::New();
+    chart_->SetShowLegend(true);
+    view_->GetScene()->AddItem(chart_);
+    // Left click notifies (vtkChart::NOTIFY, the default) with the point's
+    // series and index: that is the click-to-load.
+    chart_->AddObserver(vtkCommand::InteractionEvent, this, &ReportDock::onChartClick);
+    layout->addWidget(chartWidget_, 1);
+
+    connect(runButton_, &QPushButton::clicked, this, [this] { start(); });
+    connect(cancelButton_, &QPushButton::clicked, this, &ReportDock::cancel);
+    connect(yBox_, qOverload<int>(&QComboBox::currentIndexChanged), this, [this] { rebuildChart(); });
+    connect(backendBox_, qOverload<int>(&QComboBox::currentIndexChanged), this, &ReportDock::updateQueueLabel);
+    connect(repeatBox_, qOverload<int>(&QSpinBox::valueChanged), this, &ReportDock::updateQueueLabel);
+    // What changes the count (spot lights) or the pace (size, lights, meshes).
+    connect(doc_, &Document::sceneEdited, this, &ReportDock::updateQueueLabel);
+    connect(doc_, &Document::cameraChanged, this, &ReportDock::updateQueueLabel);
+    connect(doc_, &Document::runOutputChanged, this, &ReportDock::onRunOutput);
+    // A report describes the scene it swept: another scene (New, Open, a
+    // built-in) drops it, and a sweep still running is cancelled and its
+    // result never shown, so no click loads one scene's point into another.
+    connect(doc_, &Document::sceneReset, this, [this] {
+        loadedRow_ = -1;
+        updateQueueLabel();
+        if (running_) {
+            stopSweep();
+            ++sweepsDropped_;
+        }
+        if (!report_ && !running_) return;
+        report_.reset();
+        rebuildChart();
+        progress_->setRange(0, 1);
+        progress_->setValue(0);
+        status_->setText(tr("Another scene was opened: run the report for it."));
+    });
+    updateQueueLabel();
+    rebuildChart();
+}
+
+ReportDock::~ReportDock() {
+    stopSweep();
+    if (thread_.joinable()) thread_.join();
+}
+
+void ReportDock::addParamControl(const lc::ParamSpec& p, const std::vector<std::string>& values,
+                                 const std::vector<std::string>& checked) {
+    auto c = std::make_unique<ParamControl>();
+    c->name = p.name;
+    c->values = values;
+    c->button = new QToolButton;
+    c->button->setObjectName(QString::fromStdString("reportParam_" + p.name));
+    c->button->setPopupMode(QToolButton::InstantPopup);
+    c->menu = new QMenu(c->button);
+    c->menu->installEventFilter(new StayOpen(c->menu));
+    QAction* every = c->menu->addAction(tr("Every value"));
+    every->setObjectName("every");
+    c->menu->addSeparator();
+    for (const std::string& v : values) {
+        QAction* a = c->menu->addAction(QString::fromStdString(v));
+        a->setCheckable(true);
+        a->setData(QString::fromStdString(v));
+        a->setChecked(std::find(checked.begin(), checked.end(), v) != checked.end());
+    }
+    c->button->setMenu(c->menu);
+    ParamControl* raw = c.get();
+    connect(c->menu, &QMenu::triggered, this, [this, raw](QAction* a) { paramToggled(*raw, a); });
+    params_.push_back(std::move(c));
+    paramToggled(*raw, nullptr);
+}
+
+void ReportDock::paramToggled(ParamControl& c, QAction* changed) {
+    std::vector<QAction*> values;
+    for (QAction* a : c.menu->actions())
+        if (a->isCheckable()) values.push_back(a);
+    if (changed && !changed->isCheckable()) // Every value
+        for (QAction* a : values) a->setChecked(true);
+    // A parameter holds at least one value: the last one stays checked.
+    if (std::none_of(values.begin(), values.end(), [](QAction* a) { return a->isChecked(); }) && changed)
+        changed->setChecked(true);
+    QStringList on;
+    for (QAction* a : values)
+        if (a->isChecked()) on << a->data().toString();
+    const QString label = QString::fromStdString(lc::cullParam(c.name).label);
+    QString text;
+    if (c.name == "tile" || c.name == "cells" || (on.size() <= 2 && on.size() < int(values.size())))
+        text = on.join(",");
+    else if (on.size() == int(values.size()))
+        text = tr("every (%1)").arg(on.size());
+    else
+        text = tr("%1 of %2").arg(on.size()).arg(values.size());
+    c.button->setText(tr("%1: %2").arg(label, text));
+    c.button->setToolTip(tr("%1 swept over: %2").arg(label, on.join(", ")));
+    if (queue_) updateQueueLabel();
+}
+
+lc::ReportOptions ReportDock::optionsFromControls() const {
+    lc::ReportOptions o = options_;
+    o.backends.clear();
+    if (const QString b = backendBox_->currentData().toString(); !b.isEmpty()) o.backends = {b.toStdString()};
+    o.repeat = repeatBox_->value();
+    for (const auto& c : params_) {
+        std::vector<std::string> on;
+        for (QAction* a : c->menu->actions())
+            if (a->isCheckable() && a->isChecked()) on.push_back(a->data().toString().toStdString());
+        if (c->name == "tile" || c->name == "cells") {
+            std::vector<std::uint32_t>& list = c->name == "tile" ? o.tileSizes : o.cellCounts;
+            list.clear();
+            for (const std::string& v : on) list.push_back(std::uint32_t(std::stoul(v)));
+            o.fixed.erase(c->name);
+        } else if (on.size() == c->values.size()) {
+            o.fixed.erase(c->name); // swept over all its values
+        } else {
+            o.fixed[c->name] = join(on).toStdString();
+        }
+    }
+    return o;
+}
+
+std::vector<std::string> ReportDock::sweptBackends() const {
+    if (const QString b = backendBox_->currentData().toString(); !b.isEmpty()) return {b.toStdString()};
+    return lc::availableBackends();
+}
+
+std::map<std::string, std::size_t> ReportDock::queuedPerBackend() const {
+    const lc::ReportOptions o = optionsFromControls();
+    const auto& lights = doc_->scene().lights;
+    const bool spots = std::any_of(lights.begin(), lights.end(), [](const lc::PointLight& l) { return l.isSpot(); });
+    std::map<std::string, std::size_t> n;
+    for (const std::string& b : sweptBackends()) n[b] = lc::reportConfigs(o, b, spots).size();
+    return n;
+}
+
+std::size_t ReportDock::queuedConfigurations() const {
+    std::size_t total = 0;
+    for (const auto& [b, k] : queuedPerBackend()) total += k;
+    return total;
+}
+
+std::optional<double> ReportDock::estimatedSeconds() const {
+    if (pace_.empty() || paceKey_ != paceKey()) return std::nullopt;
+    double seconds = 0;
+    for (const auto& [b, k] : queuedPerBackend()) {
+        auto it = pace_.find(b);
+        if (it == pace_.end()) return std::nullopt;
+        seconds += double(k) * it->second;
+    }
+    return seconds;
+}
+
+QString ReportDock::paceKey() const {
+    const lc::Scene& s = doc_->scene();
+    return QString("%1|%2x%3|%4 lights|geometry %5|repeat %6 warmup %7")
+        .arg(QString::fromStdString(s.name))
+        .arg(s.camera.width)
+        .arg(s.camera.height)
+        .arg(s.lights.size())
+        .arg(doc_->geometryRevision())
+        .arg(repeatBox_->value())
+        .arg(options_.warmup);
+}
+
+void ReportDock::updateQueueLabel() {
+    // spot-* parameters are swept only for a scene with spot lights.
+    const auto& lights = doc_->scene().lights;
+    const bool spots = std::any_of(lights.begin(), lights.end(), [](const lc::PointLight& l) { return l.isSpot(); });
+    for (const auto& c : params_)
+        if (c->name.rfind("spot-", 0) == 0) {
+            c->button->setEnabled(spots);
+            if (!spots) c->button->setToolTip(tr("The scene has no spot light: not swept."));
+        }
+    std::size_t n = 0;
+    try {
+        n = queuedConfigurations();
+    } catch (const std::exception& e) {
+        queue_->setText(tr("Cannot queue the sweep: %1").arg(QString::fromStdString(e.what())));
+        return;
+    }
+    QString text = n == 1 ? tr("Queues 1 configuration") : tr("Queues %1 configurations").arg(count(n));
+    if (const std::optional<double> s = estimatedSeconds()) {
+        double perConfig = 0;
+        for (const auto& [b, pace] : pace_) perConfig = std::max(perConfig, pace);
+        text += tr(": %1 (an estimate from the last run on this scene, up to %2 s a configuration).")
+                    .arg(aboutTime(*s))
+                    .arg(perConfig, 0, 'g', 2);
+    } else {
+        text += tr("; the time is not known yet: Run times the first configuration and asks before going on "
+                   "when the whole sweep would take over %1.")
+                    .arg(duration(confirmAboveSeconds));
+    }
+    queue_->setText(text);
+}
+
+void ReportDock::releaseGate() {
+    if (!gate_) return;
+    {
+        std::lock_guard lock(gate_->mutex);
+        gate_->open = true;
+    }
+    gate_->cv.notify_all();
+    gate_.reset();
+}
+
+void ReportDock::stopSweep() {
+    cancel_.cancelled = true;
+    releaseGate();
+}
+
+bool ReportDock::start() {
+    if (running_) return false;
+    if (thread_.joinable()) thread_.join();
+    std::size_t queued = 0;
+    try {
+        queued = queuedConfigurations();
+    } catch (const std::exception& e) {
+        status_->setText(tr("Failed: %1").arg(QString::fromStdString(e.what())));
+        return false;
+    }
+    const std::optional<double> estimate = estimatedSeconds();
+    if (estimate && *estimate > confirmAboveSeconds &&
+        !confirm(this, tr("Run report"),
+                 tr("This sweep queues %1 configurations: %2 (an estimate from the last run on this scene). "
+                    "Run it?")
+                     .arg(count(queued), aboutTime(*estimate)))) {
+        status_->setText(tr("Not started: hold some parameters above to queue fewer configurations."));
+        return false;
+    }
+    options_ = optionsFromControls();
+    cancel_.cancelled = false;
+    // Without a pace the first configuration is the timing: the worker waits
+    // after it until onProgress has estimated the rest.
+    gate_ = !estimate && queued > 1 ? std::make_shared<Gate>() : nullptr;
+    running_ = true;
+    runButton_->setEnabled(false);
+    cancelButton_->setEnabled(true);
+    progress_->setRange(0, 0); // busy until the first configuration
+    status_->setText(tr("Opening backends, depth pre-pass..."));
+    runPace_.clear();
+    runPaceKey_ = paceKey();
+    activeMs_ = lastProgressMs_ = 0;
+    clock_.start();
+    emit started();
+    const lc::Scene scene = doc_->scene();
+    lc::ReportOptions options = options_;
+    options.partialOnCancel = true;
+    const int dropped = sweepsDropped_;
+    thread_ = std::thread([this, scene, options, dropped, gate = gate_] {
+        std::shared_ptr<lc::Report> rep;
+        QString error;
+        bool cancelled = false;
+        try {
+            auto progress = [this, dropped, gate](std::size_t done, std::size_t total, const std::string& label) {
+                const QString text = QString::fromStdString(label);
+                QMetaObject::invokeMethod(
+                    this,
+                    [this, done, total, text, dropped] {
+                        if (dropped == sweepsDropped_) onProgress(int(done), int(total), text);
+                    },
+                    Qt::QueuedConnection);
+                if (gate && done == 1) {
+                    std::unique_lock lock(gate->mutex);
+                    gate->cv.wait(lock, [&] { return gate->open; });
+                }
+            };
+            rep = std::make_shared<lc::Report>(lc::runReport(scene, options, progress, &cancel_));
+        } catch (const lc::Cancelled&) {
+            cancelled = true;
+        } catch (const std::exception& e) {
+            error = QString::fromStdString(e.what());
+        }
+        QMetaObject::invokeMethod(
+            this,
+            [this, rep, error, cancelled, dropped] {
+                // Of a scene no longer open: finish the sweep, show nothing of it.
+                const bool sceneGone = dropped != sweepsDropped_;
+                onDone(sceneGone ? nullptr : rep, error, cancelled || sceneGone, sceneGone);
+            },
+            Qt::QueuedConnection);
+    });
+    return true;
+}
+
+void ReportDock::cancel() {
+    if (!running_) return;
+    stopSweep();
+    status_->setText(tr("Cancelling..."));
+}
+
+void ReportDock::onProgress(int done, int total, const QString& label) {
+    const qint64 now = clock_.elapsed();
+    activeMs_ += now - lastProgressMs_;
+    auto& [ms, n] = runPace_[label.section(' ', 0, 0).toStdString()]; // the label starts with the backend
+    ms += now - lastProgressMs_;
+    ++n;
+    lastProgressMs_ = now;
+    progress_->setRange(0, std::max(total, 1));
+    progress_->setValue(done);
+    const double left = double(activeMs_) / std::max(done, 1) * (total - done) / 1000.0;
+    status_->setText(done < total ? tr("%1 left (at this run's pace); last: %2").arg(aboutTime(left), label)
+                                  : tr("last: %1").arg(label));
+    emit progressed(done, total, label);
+    if (done == 1 && gate_) {
+        // The first configuration timed: the estimate of the whole sweep.
+        const double estimate = double(activeMs_) / 1000.0 * total;
+        if (estimate > confirmAboveSeconds) {
+            const bool go = confirm(
+                this, tr("Run report"),
+                tr("This sweep queues %1 configurations: %2 (an estimate from its first configuration, which took "
+                   "%3 s). Go on? No keeps the one that finished.")
+                    .arg(count(std::size_t(total)), aboutTime(estimate))
+                    .arg(double(activeMs_) / 1000.0, 0, 'g', 2));
+            if (!go) cancel_.cancelled = true;
+            lastProgressMs_ = clock_.elapsed(); // the question's time is not the sweep's
+        }
+        releaseGate();
+    }
+}
+
+void ReportDock::onDone(std::shared_ptr<lc::Report> report, const QString& error, bool cancelled, bool sceneGone) {
+    if (thread_.joinable()) thread_.join();
+    gate_.reset();
+    running_ = false;
+    runButton_->setEnabled(true);
+    cancelButton_->setEnabled(false);
+    if (progress_->maximum() == 0) progress_->setRange(0, 1);
+    // The pace of this sweep estimates the next one of the same scene.
+    if (!sceneGone && !runPace_.empty()) {
+        pace_.clear();
+        for (const auto& [backend, msn] : runPace_) pace_[backend] = double(msn.first) / 1000.0 / msn.second;
+        paceKey_ = runPaceKey_;
+    }
+    const bool partial = report && report->cancelled;
+    if (report && !(partial && report->rows.empty())) {
+        report_ = std::move(report);
+        loadedRow_ = -1;
+        rebuildChart();
+        if (partial) {
+            status_->setText(tr("Partial report: cancelled after %1 of %2 configurations. %3")
+                                 .arg(report_->rows.size())
+                                 .arg(report_->queued)
+                                 .arg(summary()));
+        } else {
+            progress_->setValue(progress_->maximum());
+            status_->setText(tr("%1 configurations in %2. %3")
+                                 .arg(report_->rows.size())
+                                 .arg(duration(clock_.elapsed() / 1000.0))
+                                 .arg(summary()));
+        }
+    } else if (!sceneGone) { // else the message of the scene's reset stays
+        progress_->setValue(0);
+        status_->setText(partial || cancelled ? tr("Cancelled before a configuration finished; the previous report is kept.")
+                                              : tr("Failed: %1").arg(error));
+    }
+    updateQueueLabel();
+    emit finished(report_ != nullptr && !partial && !cancelled && error.isEmpty() && !sceneGone);
+}
+
+QString ReportDock::summary() const {
+    if (!report_) return {};
+    const lc::ReportRow* fastest = nullptr;
+    for (const lc::ReportRow& r : report_->rows)
+        if (r.falseNegatives == 0 && r.totalMs > 0 && (!fastest || r.totalMs < fastest->totalMs)) fastest = &r;
+    QString s = fastest ? tr("Fastest without false negatives: %1 on %2, %3 ms (efficiency %4).")
+                              .arg(QString::fromStdString(fastest->config.label()),
+                                   QString::fromStdString(fastest->config.backend))
+                              .arg(fastest->totalMs, 0, 'f', 3)
+                              .arg(fastest->efficiency, 0, 'f', 3)
+                        : tr("Every configuration misses lights.");
+    return s + tr(" Click a point to load and run it.");
+}
+
+double ReportDock::yOf(const lc::ReportRow& r) const {
+    return yBox_->currentIndex() == 0 ? r.efficiency : r.imageRmse;
+}
+
+vtkPlot* ReportDock::addSeries(int plotType, const std::string& name, const std::vector<std::size_t>& rowIndices) {
+    const auto& rows = report_->rows;
+    vtkNew<vtkTable> table;
+    vtkNew<vtkDoubleArray> xs, ys;
+    xs->SetName("total ms");
+    ys->SetName(name.c_str());
+    table->AddColumn(xs);
+    table->AddColumn(ys);
+    table->SetNumberOfRows(vtkIdType(rowIndices.size()));
+    for (std::size_t k = 0; k < rowIndices.size(); ++k) {
+        table->SetValue(vtkIdType(k), 0, rows[rowIndices[k]].totalMs);
+        table->SetValue(vtkIdType(k), 1, yOf(rows[rowIndices[k]]));
+    }
+    vtkPlot* plot = chart_->AddPlot(plotType);
+    plot->SetInputData(table, 0, 1);
+    plot->SetLabel(name);
+    // Hovering a point names its configuration, not just its numbers.
+    vtkNew<vtkStringArray> labels;
+    for (std::size_t row : rowIndices) labels->InsertNextValue(tooltipOf(row).toStdString());
+    plot->SetIndexedLabels(labels);
+    plot->SetTooltipLabelFormat("%i");
+    return plot;
+}
+
+void ReportDock::rebuildChart() {
+    chart_->ClearPlots();
+    seriesRows_.clear();
+    const bool efficiency = yBox_->currentIndex() == 0;
+    chart_->GetAxis(vtkAxis::LEFT)->SetTitle(efficiency ? "efficiency E/W" : "image RMSE");
+    chart_->GetAxis(vtkAxis::BOTTOM)->SetTitle("total ms (cull + shade)");
+    if (!report_ || report_->rows.empty()) {
+        chart_->SetTitle("no report yet");
+        chartWidget_->renderWindow()->Render();
+        return;
+    }
+    const auto& rows = report_->rows;
+    std::string title = report_->sceneName + ", " + std::to_string(report_->width) + "x" +
+                        std::to_string(report_->height) + ", " + std::to_string(report_->lights) + " lights";
+    if (report_->cancelled)
+        title += " (partial: cancelled after " + std::to_string(rows.size()) + " of " +
+                 std::to_string(report_->queued) + ")";
+    chart_->SetTitle(title);
+    double xmin = 1e300, xmax = 0;
+    for (const lc::ReportRow& r : rows)
+        if (r.totalMs > 0) xmin = std::min(xmin, r.totalMs), xmax = std::max(xmax, r.totalMs);
+    const bool logX = xmax > 10 * xmin;
+    // One point series per algorithm and backend (the second backend hollow:
+    // circles instead of squares).
+    const auto algorithms = lc::cullParam("algorithm").choices;
+    for (std::size_t b = 0; b < report_->backendDevices.size(); ++b) {
+        const std::string& backend = report_->backendDevices[b].first;
+        for (std::size_t a = 0; a < algorithms.size(); ++a) {
+            std::vector<std::size_t> members;
+            for (std::size_t i = 0; i < rows.size(); ++i)
+                if (rows[i].config.backend == backend && lc::toString(rows[i].config.settings.algorithm) == algorithms[a] &&
+                    rows[i].totalMs > 0 && std::isfinite(yOf(rows[i])))
+                    members.push_back(i);
+            if (members.empty()) continue;
+            const std::string name = algorithms[a] + " (" + backend + ")";
+            vtkPlot* plot = addSeries(vtkChart::POINTS, name, members);
+            const glm::dvec3 rgb = lc::algorithmColour(lc::algorithmFromString(algorithms[a])) * 255.0;
+            plot->SetColor(static_cast<unsigned char>(rgb.r + 0.5), static_cast<unsigned char>(rgb.g + 0.5),
+                           static_cast<unsigned char>(rgb.b + 0.5), 255);
+            if (auto* pts = vtkPlotPoints::SafeDownCast(plot)) {
+                pts->SetMarkerStyle(b == 0 ? vtkPlotPoints::SQUARE : vtkPlotPoints::CIRCLE);
+                pts->SetMarkerSize(7);
+            }
+            seriesRows_[name] = std::move(members);
+        }
+        // The Pareto front of this backend, fastest first.
+        std::vector<std::size_t> front;
+        for (std::size_t i = 0; i < rows.size(); ++i)
+            if (rows[i].config.backend == backend && rows[i].totalMs > 0 &&
+                (efficiency ? rows[i].paretoEfficiency : rows[i].paretoError))
+                front.push_back(i);
+        std::sort(front.begin(), front.end(), [&](auto x, auto y) { return rows[x].totalMs < rows[y].totalMs; });
+        if (front.size() >= 2) {
+            const std::string name = "Pareto front (" + backend + ")";
+            vtkPlot* line = addSeries(vtkChart::LINE, name, front);
+            line->SetColor(217, 26, 26, 255);
+            line->SetWidth(2.0);
+            seriesRows_[name] = std::move(front);
+        }
+    }
+    chart_->GetAxis(vtkAxis::BOTTOM)->SetLogScale(logX);
+    chart_->RecalculateBounds();
+    chartWidget_->renderWindow()->Render();
+}
+
+void ReportDock::onChartClick(vtkObject*, unsigned long, void* callData) {
+    const auto* data = static_cast<const vtkChartPlotData*>(callData);
+    if (!data || !report_) return;
+    auto it = seriesRows_.find(data->SeriesName);
+    if (it == seriesRows_.end() || data->Index < 0 || std::size_t(data->Index) >= it->second.size()) return;
+    loadRow(it->second[std::size_t(data->Index)]);
+}
+
+void ReportDock::loadRow(std::size_t row) {
+    if (!report_ || row >= report_->rows.size()) return;
+    const lc::ReportConfig& cfg = report_->rows[row].config;
+    doc_->setSettings(cfg.settings);
+    if (doc_->scene().camera.tileSize != cfg.tileSize) {
+        lc::Camera cam = doc_->scene().camera;
+        cam.tileSize = cfg.tileSize;
+        doc_->setCamera(cam, tr("Set tile size (from the report)"));
+    }
+    loadedRow_ = int(row);
+    status_->setText(tr("Loaded %1 (%2): culling it...").arg(QString::fromStdString(cfg.label()),
+                                                            QString::fromStdString(cfg.backend)));
+    emit configurationLoaded(int(row));
+    // Loading alone would leave the previous run on screen as if it were
+    // this configuration's.
+    emit cullRequested(QString::fromStdString(cfg.backend));
+}
+
+void ReportDock::onRunOutput() {
+    if (!report_ || loadedRow_ < 0 || std::size_t(loadedRow_) >= report_->rows.size()) return;
+    const auto run = doc_->runOutput();
+    if (!run) return;
+    // Is the run the loaded configuration's? Every parameter the row names.
+    const lc::ReportRow& r = report_->rows[std::size_t(loadedRow_)];
+    lc::Camera cam;
+    cam.tileSize = run->result.grid.tileSize;
+    for (const auto& [name, value] : r.config.params)
+        if (!value.empty() && lc::getParam(run->result.settings, cam, name) != value) return;
+    status_->setText(tr("Showing %1: the views show its run (false negatives %2, efficiency %3; in the report %4, "
+                        "%5).")
+                         .arg(QString::fromStdString(r.config.label()))
+                         .arg(run->truthComputed ? QString::number(run->truth.metrics.falseNegatives) : tr("not yet"))
+                         .arg(run->truthComputed ? QString::number(run->truth.metrics.efficiency, 'f', 3) : tr("not yet"))
+                         .arg(r.falseNegatives)
+                         .arg(r.efficiency, 0, 'f', 3));
+    if (run->truthComputed) loadedRow_ = -1;
+}
+
+QString ReportDock::tooltipOf(std::size_t row) const {
+    if (!report_ || row >= report_->rows.size()) return {};
+    const lc::ReportRow& r = report_->rows[row];
+    return tr("%1 (%2)\ntotal %3 ms = cull %4 + shade %5\nefficiency %6, false negatives %7, image RMSE %8")
+        .arg(QString::fromStdString(r.config.label()), QString::fromStdString(r.config.backend))
+        .arg(r.totalMs, 0, 'f', 3)
+        .arg(r.cullMs, 0, 'f', 3)
+        .arg(r.shadeMs, 0, 'f', 3)
+        .arg(r.efficiency, 0, 'f', 3)
+        .arg(r.falseNegatives)
+        .arg(r.imageRmse, 0, 'g', 3);
+}
+
+QString ReportDock::chartTooltip() const { return QString::fromStdString(chart_->GetTooltip()->GetText()); }
+bool ReportDock::chartTooltipVisible() const { return chart_->GetTooltip()->GetVisible(); }
+QString ReportDock::chartTitle() const { return QString::fromStdString(chart_->GetTitle()); }
+
+std::optional<QPoint> ReportDock::chartPositionOf(std::size_t row) const {
+    if (!report_ || row >= report_->rows.size()) return std::nullopt;
+    const lc::ReportRow& r = report_->rows[row];
+    bool plotted = false;
+    for (const auto& [name, members] : seriesRows_)
+        if (name.rfind("Pareto", 0) != 0 && std::find(members.begin(), members.end(), row) != members.end())
+            plotted = true;
+    if (!plotted) return std::nullopt;
+    // Axis ends in scene pixels (origin bottom-left, device pixels).
+    vtkAxis* ax = chart_->GetAxis(vtkAxis::BOTTOM);
+    vtkAxis* ay = chart_->GetAxis(vtkAxis::LEFT);
+    const float* x1 = ax->GetPoint1();
+    const float* x2 = ax->GetPoint2();
+    const float* y1 = ay->GetPoint1();
+    const float* y2 = ay->GetPoint2();
+    auto axisT = [](vtkAxis* a, double v) {
+        double lo = a->GetUnscaledMinimum(), hi = a->GetUnscaledMaximum();
+        if (a->GetLogScaleActive()) lo = std::log10(lo), hi = std::log10(hi), v = std::log10(v);
+        return (v - lo) / (hi - lo);
+    };
+    const double sx = x1[0] + axisT(ax, r.totalMs) * (x2[0] - x1[0]);
+    const double sy = y1[1] + axisT(ay, yOf(r)) * (y2[1] - y1[1]);
+    const double dpr = chartWidget_->devicePixelRatioF();
+    const int h = chartWidget_->renderWindow()->GetSize()[1];
+    return QPoint(int(std::lround(sx / dpr)), int(std::lround((h - sy) / dpr)));
+}
+
+} // namespace lcui

@@ -1,0 +1,221 @@
+#pragma once
+// The studio's main window: the document, the culling worker, the two VTK
+// views, the docks (scene tree, properties, tile inspector, message log), the
+// toolbar generated from lc::cullParams(), the status bar and every action.
+//
+// Dialogs that ask the user something go through the replaceable functions in
+// `prompts`, so tests (and scripts) can answer them without a modal loop.
+
+#include "window/prompts.hpp"
+
+#include "culling/core/params.hpp"
+#include "culling/scene/scene_io.hpp"
+
+#include "culling/custom/custom_cull.hpp"
+#include "culling/scene/gltf_io.hpp"
+
+#include <QMainWindow>
+#include <QMessageBox>
+
+#include <functional>
+#include <map>
+#include <memory>
+
+class QAction;
+class QCheckBox;
+class QComboBox;
+class QLabel;
+class QLineEdit;
+class QMenu;
+class QPlainTextEdit;
+class QSplitter;
+class QTabBar;
+
+namespace lc {
+struct RunOutput;
+}
+
+
+namespace lcui {
+
+class MissNavigator;
+class ParamToolbars;
+class SceneFiles;
+class CustomShaderSource;
+struct HuntRequest; // hunt_dialog.hpp
+
+class CameraView;
+class CullService;
+class ExplainPanel;
+class Document;
+class InspectorView;
+class PropertyPanel;
+class SceneTree;
+class StatusProgress;
+class TileInspector;
+
+
+class MainWindow : public QMainWindow {
+    Q_OBJECT
+public:
+    explicit MainWindow(QWidget* parent = nullptr);
+    ~MainWindow() override;
+
+    Document* document() const { return doc_; }
+    CullService* cullService() const { return service_; }
+    CameraView* cameraView() const { return cameraView_; }
+    InspectorView* inspectorView() const { return inspectorView_; }
+    SceneTree* sceneTree() const { return tree_; }
+    PropertyPanel* propertyPanel() const { return properties_; }
+    TileInspector* tileInspector() const { return tileInspector_; }
+    ExplainPanel* explainPanel() const { return explain_; }
+    MissNavigator* missNavigator() const { return misses_; }
+    QPlainTextEdit* messageLog() const { return log_; }
+    QAction* action(const QString& objectName) const; // e.g. "actionRun"
+    Prompts prompts;
+    // Opening a scene runs culling once (tests turn this off to set up first).
+    bool runOnOpen = true;
+    // How glTF scenes are read: I_min of lights without `range` (File > glTF
+    // light cut-off..., kept in the settings) and the camera (empty: the
+    // file's first).
+    lc::GltfReadOptions gltfOptions;
+    void setGltfMinIntensity(double lux);
+
+    // A custom culling shader (Culling > Custom shader...; docs/CUSTOM_CULLING.md)
+    // runs instead of the built-in algorithm, its first-line settings applied.
+    // The file is watched: saving it re-runs culling. An empty path goes back
+    // to the built-in algorithm. False (logged, shown) for a bad first line.
+    bool setCustomShader(const QString& path);
+    QString customShaderPath() const;
+
+    // --- file operations (return false on failure or cancel; the current
+    // scene is then untouched and the error is logged and shown) -------------
+    bool newScene();
+    bool openBuiltin(const QString& name);
+    bool openSceneFile(const QString& path);
+    bool importMeshFile(const QString& path);
+    bool save();
+    bool saveAs(const QString& path);
+    // Unsaved changes: asks Save/Discard/Cancel. True when it is fine to go on.
+    bool maybeSave();
+
+    // --- culling ----------------------------------------------------------------
+    // Posts a run of the current scene and settings; returns its generation.
+    // `liveEdit`: a Live re-run after a scene edit; its lists are shown first
+    // and ground truth follows (CullRequest::deferTruth).
+    quint64 runCulling(bool liveEdit = false);
+    void setLive(bool live);
+    bool isLive() const;
+    // The backend and device selector the next run uses.
+    void setBackend(const QString& backend, const QString& device = {});
+    // Sets one culling parameter through its toolbar control (as a user would).
+    bool setParamFromUi(const QString& name, const QString& value);
+    // Picks an engine preset in the Limits toolbar's combo (as a user would):
+    // its algorithm, grid and limits for this scene. False for an unknown name.
+    bool setPresetFromUi(const QString& name);
+
+    // --- editing ----------------------------------------------------------------
+    // Adds a light under the inspector-view position `pos` (logical px) when a
+    // surface is there, else at the scene centre. Returns its index. A spot
+    // light stands off the surface and points back at it (30 degrees).
+    int addLightAt(const QPoint& inspectorPos, lc::LightKind kind = lc::LightKind::Point);
+    int addLightAtCentre();
+    // Generates lights as one undo step (progress + cancel for large counts).
+    bool generateLights(const lc::LightGenSettings& settings);
+    // Culling > Hunt for a miss... (main_window_hunt.cpp): hunts the window's
+    // culling (its settings or custom shader, on its backend) with the status
+    // bar's progress and Cancel, writes the repro into r.folder and, when a
+    // miss is found, opens the repro scene with the miss selected and
+    // Explain showing it. False when nothing was found, on error or cancel.
+    bool hunt(const HuntRequest& r);
+    // Once run `generation` (or a newer one) shows with its ground truth,
+    // selects its first miss as Culling > Next miss does and shows Explain
+    // (a hunt's repro; the studio's --first-miss).
+    void selectFirstMissOfRun(quint64 generation) { firstMissOfRun_ = generation; }
+    void setCullingCameraFromInspector();
+
+    // Export diagnostics (File menu): summary.json, tiles.csv, heatmap.png,
+    // overlays.vtm and PNG screenshots of both views, through the CLI's
+    // lc::exportDiagnostics, atomically into `dir`. False (logged, shown) on
+    // failure or when there is no run to export.
+    bool exportDiagnostics(const QString& dir);
+    // The shown run with its shaded images: as it is when it has them, else
+    // shaded on the worker now (waits, "shading..." in the status bar). Null
+    // (logged) when shading failed or a newer run replaced this one.
+    std::shared_ptr<const lc::RunOutput> shadedRunOutput();
+
+    // Whole-window image with both views' GL content.
+    QImage grabWindow();
+    void log(const QString& message, bool error = false);
+    // A line marked WARNING: the action went through, with something to know
+    // (faces dropped on import, a glTF light skipped, false negatives).
+    void warn(const QString& message);
+
+signals:
+    void runFinished(quint64 generation);
+    void runFailed(quint64 generation, const QString& message);
+
+protected:
+    void closeEvent(QCloseEvent* e) override;
+    void dragEnterEvent(QDragEnterEvent* e) override;
+    void dropEvent(QDropEvent* e) override;
+
+private:
+    // The time, `level` ("ERROR ", "WARNING " or none) and the message.
+    void logLine(const QString& level, const QString& message);
+    void huntFromDialog();     // Culling > Hunt for a miss... (main_window_hunt.cpp)
+    void buildActions();
+    void buildMenus();
+    void buildToolbar();
+    void buildDocks();
+    void buildStatusBar();
+    void buildOverlayMenus(QMenu* file, QMenu* view); // main_window_overlays.cpp
+    void buildImageModes(QMenu* view);                // main_window_shading.cpp
+    void onRunFinished(quint64 generation, std::shared_ptr<const lc::RunOutput> out);
+    void onRunFailed(quint64 generation, const QString& message);
+    void updateStatus();
+    void updateCutoffStatus(); // the glTF cut-off label: the scene, not the run
+    void updateTitle();
+    void setTabbedViews(bool tabbed);
+    void restoreSettings();
+    void saveSettings();
+    void afterSceneOpened(const QString& what);
+
+    Document* doc_;
+    CullService* service_;
+    MissNavigator* misses_;
+    CameraView* cameraView_;
+    InspectorView* inspectorView_;
+    QSplitter* viewSplitter_;
+    // The bottom area's height before the Report tab grew it, and what it grew
+    // it to (0: not grown).
+    int stripHeight_ = 0, grownHeight_ = 0;
+    QTabBar* viewTabs_;
+    SceneTree* tree_;
+    PropertyPanel* properties_;
+    TileInspector* tileInspector_;
+    QPlainTextEdit* log_;
+    QMenu* recentMenu_ = nullptr;
+    QComboBox* backendCombo_ = nullptr;
+    QLineEdit* deviceEdit_ = nullptr;
+    ParamToolbars* params_ = nullptr; // the Culling and Limits rows
+    SceneFiles* files_ = nullptr;     // open, save, import, recent files
+    QLabel* statusBackend_;
+    QLabel* statusTimes_;
+    QLabel* statusFn_;
+    QLabel* statusEfficiency_;
+    QLabel* statusLists_;
+    QLabel* statusCutoff_;
+    StatusProgress* statusProgress_ = nullptr; // loads, shading and reports, with Cancel
+    QString lastBackendName_, lastDeviceName_;
+    // The newest run that failed (0: none): while it is newer than the run
+    // shown, the status bar says the figures are an older run's.
+    quint64 failedGeneration_ = 0;
+    bool restoringSettings_ = false; // restoreSettings() is setting the widgets
+    ExplainPanel* explain_ = nullptr;
+    CustomShaderSource* customShader_ = nullptr; // the user's culling shader, watched
+    quint64 pendingRuns_ = 0;
+    quint64 firstMissOfRun_ = 0; // selectFirstMissOfRun's generation; 0: none
+};
+
+} // namespace lcui
