@@ -30,7 +30,7 @@ void LiveDragProbe::start() {
     // The light nearest the middle of the list: any light would do, this one
     // is deterministic for a given scene and seed.
     light_ = int(doc->scene().lights.size() / 2);
-    doc->setSelectedLights({light_});
+    doc->selection().setSelectedLights({light_});
     // Each view's frame on its own, before anything moves.
     std::vector<double> iv, cv;
     for (int i = 0; i < 3; ++i) {
@@ -82,13 +82,13 @@ void LiveDragProbe::step() {
 
 void LiveDragProbe::onFinished(quint64 generation) {
     if (firstEditMs_ < 0) return; // a run from before the drag
-    if (const auto run = window_->document()->runOutput(); run && run->truthComputed)
+    if (const auto run = window_->document()->runs().runOutput(); run && run->truthComputed)
         truth_.push_back(run->result.timings.groundTruthMs);
     const auto it = editAtMs_.find(generation);
     if (it == editAtMs_.end()) return;
     const double editAt = it->second;
     editAtMs_.erase(it); // the same generation's ground truth may follow: count it once
-    if (const auto run = window_->document()->runOutput()) {
+    if (const auto run = window_->document()->runs().runOutput()) {
         cull_.push_back(run->result.timings.cullMs);
         depth_.push_back(run->result.timings.depthMs);
     }

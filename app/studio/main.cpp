@@ -322,7 +322,7 @@ int main(int argc, char** argv) {
                     std::fprintf(stderr, "lightcull-studio: cannot write screenshot %s\n", qPrintable(shot));
                     code = 1;
                 } else {
-                    const auto run = window.document()->runOutput();
+                    const auto run = window.document()->runs().runOutput();
                     std::fprintf(stdout, "screenshot written to %s%s\n", qPrintable(shot),
                                  run && !run->shadedAll.empty() ? " (with the shaded pictures)" : "");
                 }
@@ -341,7 +341,7 @@ int main(int argc, char** argv) {
                 if (!std::exchange(*done, true)) finish(runOk);
             };
             QObject::connect(&window, &lcui::MainWindow::runFinished, &window, [&window, once, target](quint64 g) {
-                const auto run = window.document()->runOutput();
+                const auto run = window.document()->runs().runOutput();
                 const bool pictures = !lcui::CameraView::needsShading(window.cameraView()->imageMode()) ||
                                       (run && !run->shadedAll.empty());
                 if (g >= target && pictures) once(true);

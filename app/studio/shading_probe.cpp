@@ -28,8 +28,8 @@ void ShadingProbe::start() {
     // The first pictures (of the opening run) come before any round: they
     // have no earlier run to keep an image from.
     generation_ = window_->cullService()->lastGeneration();
-    const auto run = window_->document()->runOutput();
-    if (run && !run->shadedAll.empty() && window_->document()->runGeneration() == generation_) {
+    const auto run = window_->document()->runs().runOutput();
+    if (run && !run->shadedAll.empty() && window_->document()->runs().runGeneration() == generation_) {
         QTimer::singleShot(200, this, &ShadingProbe::nextRound); // shaded with the run already
         return;
     }
@@ -51,7 +51,7 @@ void ShadingProbe::nextRound() {
         doc->moveLight(light, p + glm::dvec3(0.05, 0.0, 0.0), doc->newDragId());
         generation_ = window_->runCulling(/*liveEdit=*/true);
     } else {
-        const bool clustered = doc->settings().algorithm == lc::Algorithm::Clustered;
+        const bool clustered = doc->runs().settings().algorithm == lc::Algorithm::Clustered;
         window_->setParamFromUi("algorithm", clustered ? "2.5d" : "clustered");
         generation_ = window_->runCulling();
     }
@@ -59,7 +59,7 @@ void ShadingProbe::nextRound() {
 
 void ShadingProbe::onFinished(quint64 generation) {
     if (!started_ || generation != generation_) return;
-    const auto run = window_->document()->runOutput();
+    const auto run = window_->document()->runs().runOutput();
     if (!run) return;
     const double now = clock_.nsecsElapsed() * 1e-6;
     if (run->shadedAll.empty()) {

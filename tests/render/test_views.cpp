@@ -113,16 +113,16 @@ lc::Scene fixedScene() {
 std::shared_ptr<const lc::RunOutput> cullFixedScene(Document& doc, lc::Algorithm algorithm, std::uint32_t cells = 32,
                                                     bool shadedImages = false) {
     doc.resetScene(fixedScene(), {});
-    lc::CullSettings s = doc.settings();
+    lc::CullSettings s = doc.runs().settings();
     s.algorithm = algorithm;
     s.cells = cells;
-    doc.setSettings(s);
+    doc.runs().setSettings(s);
     auto backend = lc::makeBackend("cpu");
     lc::RunOptions opt;
     opt.truthOptions.imageError = shadedImages;
     opt.keepShadedImages = shadedImages;
-    auto run = std::make_shared<lc::RunOutput>(lc::runPipeline(doc.scene(), doc.settings(), *backend, opt));
-    if (run->truth.metrics.falseNegatives != 0 || !doc.setRunOutput(run, 1)) return nullptr;
+    auto run = std::make_shared<lc::RunOutput>(lc::runPipeline(doc.scene(), doc.runs().settings(), *backend, opt));
+    if (run->truth.metrics.falseNegatives != 0 || !doc.runs().setRunOutput(run, 1)) return nullptr;
     return run;
 }
 
@@ -197,10 +197,10 @@ class RenderTest : public QObject {
 private slots:
     void initTestCase() {
         doc_ = std::make_unique<Document>();
-        const auto run = cullFixedScene(*doc_, doc_->settings().algorithm);
+        const auto run = cullFixedScene(*doc_, doc_->runs().settings().algorithm);
         QVERIFY(run);
-        doc_->setSelectedLights({1});
-        doc_->setSelectedTile(int(run->result.grid.tileIndex(9, 6)));
+        doc_->selection().setSelectedLights({1});
+        doc_->selection().setSelectedTile(int(run->result.grid.tileIndex(9, 6)));
     }
 
     void cameraView() {
@@ -215,7 +215,7 @@ private slots:
         QVERIFY(!shot.isNull());
         QCOMPARE(shot.size(), QSize(720, 360) * view.devicePixelRatio());
         const Comparison c =
-            compareWithBaseline(shot, "camera_view", tileRegions(view, doc_->runOutput()->result.grid));
+            compareWithBaseline(shot, "camera_view", tileRegions(view, doc_->runs().runOutput()->result.grid));
         QVERIFY2(c.ok, qPrintable(c.message));
         qInfo("%s", qPrintable(c.message));
     }
@@ -225,10 +225,10 @@ private slots:
     // the whole view for the whole-image limit, and fails the tile check.
     void selectionOnTheWrongTileFailsTheComparison() {
         Document doc;
-        const auto run = cullFixedScene(doc, doc.settings().algorithm);
+        const auto run = cullFixedScene(doc, doc.runs().settings().algorithm);
         QVERIFY(run);
-        doc.setSelectedLights({1});
-        doc.setSelectedTile(int(run->result.grid.tileIndex(10, 6))); // the baseline has 9,6
+        doc.selection().setSelectedLights({1});
+        doc.selection().setSelectedTile(int(run->result.grid.tileIndex(10, 6))); // the baseline has 9,6
         CameraView view(&doc);
         view.resize(720, 360);
         view.show();
@@ -276,11 +276,11 @@ private slots:
             if (run->result.listCount[t] > run->result.listCount[tile]) tile = t;
         const std::uint32_t first = run->result.tileLists(tile).first;
         QVERIFY(run->result.listCount[first] >= 2); // the picture shows listed lights and dimmed others
-        doc.setSelectedTile(int(tile));
-        doc.setSelectedLights({int(run->result.lightIndices[run->result.listOffset[first]])});
-        auto o = doc.overlays();
+        doc.selection().setSelectedTile(int(tile));
+        doc.selection().setSelectedLights({int(run->result.lightIndices[run->result.listOffset[first]])});
+        auto o = doc.viewOptions().overlays();
         o.heat = lc::HeatMode::Efficiency;
-        doc.setOverlays(o);
+        doc.viewOptions().setOverlays(o);
 
         InspectorView iv(&doc);
         iv.resize(640, 480);
@@ -334,8 +334,8 @@ private slots:
                     break;
                 }
         QVERIFY(tile >= 0);
-        doc.setSelectedTile(tile);
-        doc.setSelectedLights({light});
+        doc.selection().setSelectedTile(tile);
+        doc.selection().setSelectedLights({light});
 
         InspectorView iv(&doc);
         iv.resize(640, 480);
@@ -372,7 +372,7 @@ private slots:
         spot.direction = {0.2, -1, 0.3};
         spot.outerAngleDeg = 35;
         doc.resetScene(std::move(s), {});
-        doc.setSelectedLights({3});
+        doc.selection().setSelectedLights({3});
         InspectorView iv(&doc);
         iv.resize(640, 480);
         iv.show();
@@ -401,7 +401,7 @@ private slots:
         const auto run = cullFixedScene(doc, lc::Algorithm::TwoPointFiveD, 4, true);
         QVERIFY(run);
         QVERIFY(run->truth.metrics.imageMaxError > 0); // the picture is not black
-        doc.setSelectedTile(int(run->result.grid.tileIndex(9, 6)));
+        doc.selection().setSelectedTile(int(run->result.grid.tileIndex(9, 6)));
 
         CameraView cv(&doc);
         cv.resize(720, 360);

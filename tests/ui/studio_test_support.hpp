@@ -4,6 +4,7 @@
 // QSettings, the test window every ui test starts from, opening a built-in
 // scene with parameters set through the UI, and waiting for a run.
 
+#include <QAction>
 #include <QApplication>
 #include <QDir>
 #include <QElapsedTimer>
@@ -73,7 +74,7 @@ inline bool waitRun(lcui::MainWindow& w, quint64 generation, bool truth = false)
     QSignalSpy failed(&w, &lcui::MainWindow::runFailed);
     const lcui::Document* doc = w.document();
     auto shown = [&] {
-        return doc->runGeneration() >= generation && doc->runOutput() && (!truth || doc->runOutput()->truthComputed);
+        return doc->runs().runGeneration() >= generation && doc->runs().runOutput() && (!truth || doc->runs().runOutput()->truthComputed);
     };
     QElapsedTimer t;
     t.start();
@@ -83,6 +84,17 @@ inline bool waitRun(lcui::MainWindow& w, quint64 generation, bool truth = false)
         done.wait(100);
     }
     return shown();
+}
+
+// Exports diagnostics as File > Export diagnostics... does (into `dir`: the
+// save prompt answered) and waits until the export ends (a run shown as a
+// heat map is shaded first). True when it was written.
+inline bool exportAndWait(lcui::MainWindow& w, const QString& dir) {
+    QSignalSpy ended(&w, &lcui::MainWindow::diagnosticsExported);
+    w.prompts.savePath = [dir](QWidget*, const QString&, const QString&) { return dir; };
+    w.action("actionExportDiagnostics")->trigger();
+    if (ended.isEmpty() && !ended.wait(kRunTimeoutMs)) return false;
+    return ended.at(0).at(0).toString() == dir && ended.at(0).at(1).toBool();
 }
 
 // Opens a built-in scene and sets culling parameters through the UI as a user

@@ -170,7 +170,7 @@ private slots:
         const QPoint at = widgetPosOf(px).toPoint();
         QTest::mouseClick(v, Qt::LeftButton, Qt::NoModifier, at);
         const lc::TileGrid g = lc::TileGrid::make(cam.width, cam.height, cam.tileSize);
-        QCOMPARE(doc()->selectedTile(), int(g.tileOfPixel(230, 110)));
+        QCOMPARE(doc()->selection().selectedTile(), int(g.tileOfPixel(230, 110)));
     }
 
     // A right or middle drag pans by what the mouse moved, and never out of
@@ -187,7 +187,7 @@ private slots:
         // 40 / width of the image to the left (and 20 px up, down the image).
         QVERIFY(std::abs(v->viewCentre().x() - (0.5 - 40.0 / img.width())) < 1e-9);
         QVERIFY(std::abs(v->viewCentre().y() - (0.5 - 20.0 / img.height())) < 1e-9);
-        QCOMPARE(doc()->selectedTile(), -1); // a pan is not a click
+        QCOMPARE(doc()->selection().selectedTile(), -1); // a pan is not a click
         drag(v, Qt::MiddleButton, mid, mid + QPoint(10 * r.width(), 10 * r.height()));
         // Clamped: the image's top-left corner stops at the viewport's.
         QVERIFY(std::abs(v->zoomedImageRect().left() - v->imageRect().left()) <= 1.0);

@@ -62,7 +62,7 @@ class CustomShaderStudioTest : public QObject {
                     if (failure) *failure = f.at(1).toString();
                     return false;
                 }
-            if (doc()->runGeneration() > after && doc()->runOutput() && doc()->runOutput()->truthComputed) return true;
+            if (doc()->runs().runGeneration() > after && doc()->runs().runOutput() && doc()->runs().runOutput()->truthComputed) return true;
             done.wait(100);
         }
         return false;
@@ -94,12 +94,12 @@ private slots:
         w_->prompts.openPath = [&](QWidget*, const QString&, const QString& filter) {
             return filter.contains("*.hlsl") && filter.contains("*.spv") ? mine : QString();
         };
-        quint64 before = doc()->runGeneration();
+        quint64 before = doc()->runs().runGeneration();
         w_->action("actionCustomShader")->trigger();
         QCOMPARE(w_->customShaderPath(), mine);
         QString why;
         QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
-        auto run = doc()->runOutput();
+        auto run = doc()->runs().runOutput();
         QVERIFY(run->custom);
         QCOMPARE(run->truth.metrics.falseNegatives, std::uint64_t(0));
         QCOMPARE(QString::fromStdString(run->custom->layout), QString("fixed:256")); // its first line
@@ -108,10 +108,10 @@ private slots:
         // Save a flawed version: the watcher re-runs, and the misses show.
         std::string flawed = readAll(kExamples + "flawed_tile_edges.comp");
         flawed.replace(flawed.find("fixed:256"), 9, "bitmask"); // no overflow: only the drift misses
-        before = doc()->runGeneration();
+        before = doc()->runs().runGeneration();
         save(mine, flawed);
         QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
-        run = doc()->runOutput();
+        run = doc()->runs().runOutput();
         QVERIFY(run->custom);
         QCOMPARE(QString::fromStdString(run->custom->layout), QString("bitmask"));
         QVERIFY(run->truth.metrics.falseNegatives > 0);
@@ -126,7 +126,7 @@ private slots:
         // The tile of the first located miss shows it as MISSING, in red.
         const auto missed = lc::locateFalseNegatives(*run, lc::Projection(doc()->scene().camera));
         QVERIFY(!missed.empty());
-        doc()->setSelectedTile(int(missed[0].tile));
+        doc()->selection().setSelectedTile(int(missed[0].tile));
         TileInspector* ti = w_->tileInspector();
         bool shown = false;
         for (int r = 0; r < ti->model()->rowCount(); ++r) {
@@ -143,11 +143,11 @@ private slots:
         // selected, Explain shown on it with MISSING; Previous goes back.
         auto* explainDock = w_->findChild<QDockWidget*>("explainDock");
         explainDock->hide();
-        doc()->setSelectedTile(-1);
+        doc()->selection().setSelectedTile(-1);
         w_->action("actionNextMiss")->trigger(); // F8 (test_studio checks the binding)
-        QCOMPARE(doc()->selectedTile(), int(missed[0].tile));
-        QCOMPARE(doc()->currentLight(), int(missed[0].light));
-        QCOMPARE(doc()->explainedList(), int(missed[0].list));
+        QCOMPARE(doc()->selection().selectedTile(), int(missed[0].tile));
+        QCOMPARE(doc()->selection().currentLight(), int(missed[0].light));
+        QCOMPARE(doc()->selection().explainedList(), int(missed[0].list));
         QVERIFY(explainDock->isVisible());
         QVERIFY(w_->explainPanel()->explanation());
         QCOMPARE(w_->explainPanel()->explanation()->light, missed[0].light);
@@ -158,16 +158,16 @@ private slots:
         QVERIFY(w_->messageLog()->toPlainText().contains("cause: culling test"));
         QVERIFY(missed.size() > 2); // the drift misses lights in several tiles: a walk to test
         w_->action("actionNextMiss")->trigger();
-        QCOMPARE(doc()->selectedTile(), int(missed[1].tile));
-        QCOMPARE(doc()->currentLight(), int(missed[1].light));
+        QCOMPARE(doc()->selection().selectedTile(), int(missed[1].tile));
+        QCOMPARE(doc()->selection().currentLight(), int(missed[1].light));
         w_->action("actionPreviousMiss")->trigger();
-        QCOMPARE(doc()->selectedTile(), int(missed[0].tile));
+        QCOMPARE(doc()->selection().selectedTile(), int(missed[0].tile));
         w_->action("actionPreviousMiss")->trigger(); // wraps to the last
-        QCOMPARE(doc()->selectedTile(), int(missed.back().tile));
+        QCOMPARE(doc()->selection().selectedTile(), int(missed.back().tile));
 
         // A syntax error: the run fails with file and line, the scene stays.
         const std::string sceneBefore = lc::serializeScene(doc()->scene());
-        before = doc()->runGeneration();
+        before = doc()->runs().runGeneration();
         std::string broken = readAll(kExamples + "tiled_fixed.comp");
         broken.replace(broken.find("void main() {"), 13, "void main() { undeclaredThing = 1;");
         save(mine, broken);
@@ -180,16 +180,16 @@ private slots:
         auto* times = w_->findChild<QLabel*>("statusTimes");
         QVERIFY(times);
         QVERIFY2(times->text().startsWith(QString("run %1 failed, showing run %2 (custom shader)")
-                                              .arg(doc()->runGeneration() + 1)
-                                              .arg(doc()->runGeneration())),
+                                              .arg(doc()->runs().runGeneration() + 1)
+                                              .arg(doc()->runs().runGeneration())),
                  qPrintable(times->text()));
 
         // Back to the built-in algorithm.
-        before = doc()->runGeneration();
+        before = doc()->runs().runGeneration();
         w_->action("actionBuiltinAlgorithm")->trigger();
         QVERIFY(w_->customShaderPath().isEmpty());
         QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
-        QVERIFY(!doc()->runOutput()->custom);
+        QVERIFY(!doc()->runs().runOutput()->custom);
         QVERIFY2(!times->text().contains("failed"), qPrintable(times->text()));
     }
 

@@ -47,7 +47,7 @@ class ExplainPanelTest : public QObject {
     Document* doc() const { return w_->document(); }
     // The tile whose list is longest in the shown run (the first of them).
     std::uint32_t busiestTile() const {
-        const lc::CullResult& r = doc()->runOutput()->result;
+        const lc::CullResult& r = doc()->runs().runOutput()->result;
         std::uint32_t tile = 0;
         for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t)
             if (r.listCount[t] > r.listCount[tile]) tile = t;
@@ -75,9 +75,9 @@ private slots:
     // is chosen: a double-clicked row gives way to a light picked in the
     // scene tree (or the 3D view).
     void theHighlightedRowFollowsTheCurrentLight() {
-        auto run = doc()->runOutput();
+        auto run = doc()->runs().runOutput();
         const std::uint32_t tile = busiestTile();
-        doc()->setSelectedTile(int(tile));
+        doc()->selection().setSelectedTile(int(tile));
         TileInspector* ti = w_->tileInspector();
         QVERIFY(ti->proxy()->rowCount() >= 2);
         auto selectedLights = [&] {
@@ -91,10 +91,10 @@ private slots:
         const QRect rowA = ti->table()->visualRect(ti->proxy()->index(0, TileLightsModel::ColName));
         QTest::mouseClick(ti->table()->viewport(), Qt::LeftButton, {}, rowA.center());
         QTest::mouseDClick(ti->table()->viewport(), Qt::LeftButton, {}, rowA.center());
-        QCOMPARE(doc()->currentLight(), a);
+        QCOMPARE(doc()->selection().currentLight(), a);
         QCOMPARE(selectedLights(), std::set<int>{a});
         w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(b)); // as a click in the tree
-        QCOMPARE(doc()->currentLight(), b);
+        QCOMPARE(doc()->selection().currentLight(), b);
         QCOMPARE(selectedLights(), std::set<int>{b});
         // A light the tile's lists do not hold: no row stays highlighted.
         int other = -1;
@@ -105,25 +105,25 @@ private slots:
             if (!listed) other = i;
         }
         QVERIFY(other >= 0);
-        doc()->setSelectedLights({other});
+        doc()->selection().setSelectedLights({other});
         QVERIFY(selectedLights().empty());
     }
 
     // While a Live edit's lists wait for their ground truth, the panel says
     // so; it does not ask for a tile and a light already selected.
     void aRunWithoutTruthYetIsWaitedFor() {
-        doc()->setSelectedTile(0);
-        doc()->setSelectedLights({0});
+        doc()->selection().setSelectedTile(0);
+        doc()->selection().setSelectedLights({0});
         ExplainPanel* panel = w_->explainPanel();
         auto* verdict = panel->findChild<QLabel*>("explainVerdict");
         QVERIFY(panel->explanation());
-        auto listsOnly = std::make_shared<lc::RunOutput>(*doc()->runOutput());
+        auto listsOnly = std::make_shared<lc::RunOutput>(*doc()->runs().runOutput());
         listsOnly->truthComputed = false;
         listsOnly->truth = {};
-        QVERIFY(doc()->setRunOutput(listsOnly, doc()->runGeneration() + 1));
+        QVERIFY(doc()->runs().setRunOutput(listsOnly, doc()->runs().runGeneration() + 1));
         QVERIFY(!panel->explanation());
         QVERIFY2(verdict->text().startsWith("Waiting for the ground truth"), qPrintable(verdict->text()));
-        doc()->setSelectedTile(-1);
+        doc()->selection().setSelectedTile(-1);
         QVERIFY2(verdict->text().startsWith("Select a tile"), qPrintable(verdict->text()));
     }
 
@@ -131,12 +131,12 @@ private slots:
         ExplainPanel* panel = w_->explainPanel();
         QVERIFY(panel);
         QVERIFY(!panel->explanation()); // nothing selected yet: a hint
-        auto run = doc()->runOutput();
+        auto run = doc()->runs().runOutput();
         // The busiest tile and a light listed there, chosen as a user would:
         // the tile in the camera view, the light in the scene tree.
         const std::uint32_t tile = busiestTile();
         const std::uint32_t light = run->result.lightIndices[run->result.listOffset[tile]];
-        doc()->setSelectedTile(int(tile));
+        doc()->selection().setSelectedTile(int(tile));
         w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(light)));
         QVERIFY(panel->explanation());
         const lc::Explanation expect =
@@ -175,7 +175,7 @@ private slots:
     // Explain in 3D: the plane that decided and the pixel that matters, drawn
     // where the explanation puts them.
     void explainMarkersIn3D() {
-        auto run = doc()->runOutput();
+        auto run = doc()->runs().runOutput();
         const lc::Projection proj(doc()->scene().camera);
         const glm::dmat4 world = lc::worldFromView(doc()->scene().camera);
         auto toWorld = [&](const glm::dvec3& v) { return glm::dvec3(world * glm::dvec4(v, 1.0)); };
@@ -197,7 +197,7 @@ private slots:
             if (fp >= 0 && needed >= 0) tile = t, fpLight = std::uint32_t(fp), neededLight = std::uint32_t(needed), found = true;
         }
         QVERIFY(found);
-        doc()->setSelectedTile(int(tile));
+        doc()->selection().setSelectedTile(int(tile));
         w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(fpLight)));
         InspectorOverlays* ov = w_->inspectorView()->overlays();
         QVERIFY(ov->explanation());
@@ -268,14 +268,14 @@ private slots:
     // F flies the inspector to the selected tile's frustum: afterwards all its
     // corners project inside the view. C looks through the culling camera.
     void frameSelectedAndLookThrough() {
-        auto run = doc()->runOutput();
+        auto run = doc()->runs().runOutput();
         const lc::Projection proj(doc()->scene().camera);
         std::uint32_t tile = run->result.grid.tileIndex(7, 5);
         auto chunk = lc::tileFrustum(run->result, proj, run->lights, tile);
         for (std::uint32_t t = 0; !chunk && t < run->result.grid.tileCount(); ++t)
             if ((chunk = lc::tileFrustum(run->result, proj, run->lights, t))) tile = t;
         QVERIFY(chunk);
-        doc()->setSelectedTile(int(tile));
+        doc()->selection().setSelectedTile(int(tile));
         InspectorView* iv = w_->inspectorView();
         vtkRenderer* ren = iv->renderer();
         const glm::dmat4 world = lc::worldFromView(doc()->scene().camera);
@@ -332,10 +332,10 @@ private slots:
         QVERIFY(iv->pickChunk(displayOf(centreOf(*chunk)), &pickedTile, &pickedCell));
         QCOMPARE(pickedTile, int(tile));
         QCOMPARE(pickedCell, 0);
-        Document::OverlayOptions ov = doc()->overlays();
+        OverlayOptions ov = doc()->viewOptions().overlays();
         ov.cells = false;
         ov.allTileFrustums = true;
-        doc()->setOverlays(ov);
+        doc()->viewOptions().setOverlays(ov);
         std::uint32_t other = tile;
         std::optional<lc::FrustumChunk> otherChunk;
         for (std::uint32_t t = 0; t < run->result.grid.tileCount() && !otherChunk; ++t)
@@ -355,7 +355,7 @@ private slots:
     // Readable at a glance: a tile's hover tooltip, the tile inspector's
     // verdict filter and column sort, the scene tree's filter and orders.
     void tooltipsFiltersAndSorting() {
-        auto run = doc()->runOutput();
+        auto run = doc()->runs().runOutput();
         const std::uint32_t tile = busiestTile();
         CameraView* cv = w_->cameraView();
         const QString tip = cv->tileTooltip(int(tile));
@@ -367,7 +367,7 @@ private slots:
         const QPoint centre = cv->rect().center();
         QCOMPARE(cv->tileTooltip(cv->tileAtWidgetPos(centre)).isEmpty(), cv->tileAtWidgetPos(centre) < 0);
 
-        doc()->setSelectedTile(int(tile));
+        doc()->selection().setSelectedTile(int(tile));
         TileInspector* ti = w_->tileInspector();
         const int all = ti->proxy()->rowCount();
         int fp = 0;
@@ -416,7 +416,7 @@ private slots:
             QVERIFY(doc()->scene().lights[std::size_t(order[k - 1])].radius() >= doc()->scene().lights[std::size_t(order[k])].radius());
         // Selection still maps rows to lights after sorting.
         tree->setCurrentIndex(tree->lightIndex(order[0]));
-        QCOMPARE(doc()->currentLight(), order[0]);
+        QCOMPARE(doc()->selection().currentLight(), order[0]);
         sort->setCurrentIndex(sort->findData(int(SceneTree::LightSort::TilesReached)));
         const std::vector<int> byTiles = tree->lightOrder();
         auto tilesOf = [&](int light) { return lc::tilesHoldingLight(run->result, std::uint32_t(light)).size(); };
@@ -428,19 +428,19 @@ private slots:
     // land on other lights. The inspector, Explain and the export say so
     // until the next run; a run of the edited scene brings them back.
     void anEditLeavesTheRunStaleUntilTheNextRun() {
-        auto run = doc()->runOutput();
+        auto run = doc()->runs().runOutput();
         const std::uint32_t tile = busiestTile();
-        doc()->setSelectedTile(int(tile));
+        doc()->selection().setSelectedTile(int(tile));
         TileInspector* ti = w_->tileInspector();
         QVERIFY(ti->model()->rows().size() >= 2);
         const int second = int(ti->model()->rows()[1].light);
-        doc()->setSelectedLights({second});
+        doc()->selection().setSelectedLights({second});
         ExplainPanel* panel = w_->explainPanel();
         QVERIFY(panel->explanation());
-        QVERIFY(!doc()->runIsStale());
+        QVERIFY(!doc()->runs().runIsStale());
 
         doc()->deleteLights({int(ti->model()->rows()[0].light)}); // an earlier light: `second` moves down one
-        QVERIFY(doc()->runIsStale());
+        QVERIFY(doc()->runs().runIsStale());
         QVERIFY(ti->model()->rows().empty());
         QVERIFY2(ti->summaryText().contains("changed since the last run"), qPrintable(ti->summaryText()));
         QVERIFY(!panel->explanation());
@@ -459,10 +459,10 @@ private slots:
 
         // The next run is of the edited scene: the same light, one index lower.
         QVERIFY(waitTruth(w_->runCulling()));
-        QVERIFY(!doc()->runIsStale());
-        doc()->setSelectedLights({second - 1});
+        QVERIFY(!doc()->runs().runIsStale());
+        doc()->selection().setSelectedLights({second - 1});
         QVERIFY(panel->explanation());
-        const lc::Explanation expect = lc::explainLight(*doc()->runOutput(), lc::Projection(doc()->scene().camera),
+        const lc::Explanation expect = lc::explainLight(*doc()->runs().runOutput(), lc::Projection(doc()->scene().camera),
                                                         tile, std::uint32_t(second - 1));
         QCOMPARE(panel->explanation()->text(), expect.text());
         QVERIFY(!ti->model()->rows().empty());
@@ -470,16 +470,16 @@ private slots:
         // Undo is an edit too; with Live on an edit is never stale (its run
         // is asked for at once), and a run that fails leaves it stale.
         doc()->undoStack()->undo();
-        QVERIFY(doc()->runIsStale());
+        QVERIFY(doc()->runs().runIsStale());
         w_->setLive(true); // asks for a run of the scene as it is
-        QVERIFY(!doc()->runIsStale());
-        QVERIFY(waitTruth(doc()->runGeneration() + 1));
+        QVERIFY(!doc()->runs().runIsStale());
+        QVERIFY(waitTruth(doc()->runs().runGeneration() + 1));
         QVERIFY(!ti->model()->rows().empty());
         // A Live edit's run is asked for before anything hears of the edit:
         // the inspector keeps its rows until the new ones come (no flicker).
-        QSignalSpy wentStale(doc(), &Document::runWentStale);
+        QSignalSpy wentStale(&doc()->runs(), &RunState::runWentStale);
         doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(0.5, 0, 0), doc()->newDragId());
-        QVERIFY(!doc()->runIsStale());
+        QVERIFY(!doc()->runs().runIsStale());
         QVERIFY(wentStale.isEmpty());
         QVERIFY(!ti->model()->rows().empty());
         w_->setLive(false);
@@ -487,11 +487,11 @@ private slots:
         lc::Camera bad = doc()->scene().camera;
         bad.target = bad.position;
         doc()->setCamera(bad);
-        QVERIFY(doc()->runIsStale());
+        QVERIFY(doc()->runs().runIsStale());
         const quint64 failing = w_->runCulling();
-        QVERIFY(!doc()->runIsStale()); // on its way
+        QVERIFY(!doc()->runs().runIsStale()); // on its way
         QVERIFY(!lctest::waitRun(*w_, failing));
-        QVERIFY(doc()->runIsStale());
+        QVERIFY(doc()->runs().runIsStale());
         QVERIFY(wentStale.size() >= 2); // the camera edit, then the failed run
     }
 
@@ -502,7 +502,7 @@ private slots:
         for (const char* algo : {"halfz", "clustered"}) {
             QVERIFY(w_->setParamFromUi("algorithm", algo));
             QVERIFY(waitTruth(w_->runCulling()));
-            auto run = doc()->runOutput();
+            auto run = doc()->runs().runOutput();
             const lc::Projection proj(doc()->scene().camera);
             const std::uint32_t per = run->result.listsPerTile;
             QVERIFY(per > 1);
@@ -522,7 +522,7 @@ private slots:
                 }
             }
             QVERIFY2(later, algo);
-            doc()->setSelectedTile(int(tile));
+            doc()->selection().setSelectedTile(int(tile));
             TileInspector* ti = w_->tileInspector();
             int row = -1;
             for (int r = 0; r < ti->proxy()->rowCount(); ++r) {
@@ -538,7 +538,7 @@ private slots:
             const QPoint at = ti->table()->visualRect(ti->proxy()->index(row, 0)).center();
             QTest::mouseClick(ti->table()->viewport(), Qt::LeftButton, {}, at);
             QTest::mouseDClick(ti->table()->viewport(), Qt::LeftButton, {}, at);
-            QCOMPARE(doc()->currentLight(), int(later->light));
+            QCOMPARE(doc()->selection().currentLight(), int(later->light));
             // The answer shows without scrolling: light, name, verdict, pixels.
             for (int c : {TileLightsModel::ColLight, TileLightsModel::ColName, TileLightsModel::ColVerdict,
                           TileLightsModel::ColPixels})
@@ -551,8 +551,8 @@ private slots:
             QCOMPARE(panel->explanation()->text(), expect.text());
             QVERIFY(panel->explanation()->listed);
             // The same light chosen in the scene tree: its first listing list.
-            doc()->setSelectedTile(-1);
-            doc()->setSelectedTile(int(tile));
+            doc()->selection().setSelectedTile(-1);
+            doc()->selection().setSelectedTile(int(tile));
             w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(later->light)));
             QVERIFY(panel->explanation());
             QVERIFY2(panel->explanation()->listed, algo);

@@ -69,8 +69,8 @@ class GltfStudioTest : public QObject {
         QSignalSpy failed(w_.get(), &MainWindow::runFailed);
         QElapsedTimer t;
         t.start();
-        while (!doc()->runOutput() && failed.isEmpty() && t.elapsed() < lctest::kRunTimeoutMs) done.wait(200);
-        return doc()->runOutput() != nullptr;
+        while (!doc()->runs().runOutput() && failed.isEmpty() && t.elapsed() < lctest::kRunTimeoutMs) done.wait(200);
+        return doc()->runs().runOutput() != nullptr;
     }
     QString writeAtrium(const QString& name) {
         const QString p = tmp_.path() + "/" + name;
@@ -101,7 +101,7 @@ private slots:
         QCOMPARE(doc()->scene().camera.width, 320u); // the file's camera, its resolution kept
         QVERIFY(doc()->scene().camera == lc::loadGltfScene(p.toStdString()).camera);
         QVERIFY(waitRun());
-        const auto out = doc()->runOutput();
+        const auto out = doc()->runs().runOutput();
         QCOMPARE(out->truth.metrics.falseNegatives, std::uint64_t(0));
         QVERIFY(out->truth.metrics.shadingWork > 0);
         QVERIFY(w_->messageLog()->toPlainText().contains("48 lights, camera: cameras[0] 'culling camera'"));
@@ -184,7 +184,7 @@ private slots:
         // edited scene is there to reproduce the figures.
         QVERIFY(lctest::waitRun(*w_, w_->runCulling(), true));
         const QString dir = tmp_.path() + "/export";
-        QVERIFY(w_->exportDiagnostics(dir));
+        QVERIFY(lctest::exportAndWait(*w_, dir));
         const auto summary = nlohmann::json::parse(bytes(dir + "/summary.json"));
         const auto& source = summary["scene_source"];
         QCOMPARE(QString::fromStdString(source["file"].get<std::string>()), QFileInfo(src).absoluteFilePath());

@@ -162,12 +162,12 @@ private slots:
         QCOMPARE(w_->customShaderPath(), mine);
         // Its run selects the first miss and shows Explain.
         QTRY_VERIFY_WITH_TIMEOUT(w_->missNavigator()->current() == 0, lctest::kRunTimeoutMs);
-        const auto run = doc()->runOutput();
+        const auto run = doc()->runs().runOutput();
         QVERIFY(run && run->truthComputed && run->truth.metrics.falseNegatives > 0);
         const auto missed = lc::locateFalseNegatives(*run, lc::Projection(doc()->scene().camera));
-        QCOMPARE(doc()->selectedTile(), int(missed.front().tile));
-        QCOMPARE(doc()->selectedLights(), std::vector<int>{int(missed.front().light)});
-        QCOMPARE(doc()->explainedList(), int(missed.front().list));
+        QCOMPARE(doc()->selection().selectedTile(), int(missed.front().tile));
+        QCOMPARE(doc()->selection().selectedLights(), std::vector<int>{int(missed.front().light)});
+        QCOMPARE(doc()->selection().explainedList(), int(missed.front().list));
         QVERIFY(w_->findChild<QDockWidget*>("explainDock")->isVisible());
         w_->grabWindow().save(QStringLiteral(LC_RENDER_OUT_DIR "/hunt_repro_open.png")); // to look at
         // verdict.txt names the same light and tile.

@@ -180,7 +180,7 @@ class InspectorBuildingTest : public QObject {
     }
     // The selected tile's chunk: world corners and the near face's centre.
     std::vector<glm::dvec3> tileCorners(int tile) {
-        const auto run = doc()->runOutput();
+        const auto run = doc()->runs().runOutput();
         const lc::Projection proj(doc()->scene().camera);
         const auto chunk = lc::tileFrustum(run->result, proj, run->lights, std::uint32_t(tile));
         std::vector<glm::dvec3> out;
@@ -191,7 +191,7 @@ class InspectorBuildingTest : public QObject {
     }
     // The tile holding the most lights (ties: the lowest index).
     int busiestTile() {
-        const auto run = doc()->runOutput();
+        const auto run = doc()->runs().runOutput();
         int best = -1;
         std::uint32_t most = 0;
         for (std::uint32_t t = 0; t < run->result.grid.tileCount(); ++t)
@@ -218,7 +218,7 @@ private slots:
         QVERIFY(QTest::qWaitForWindowExposed(w_.get()));
         doc()->resetScene(roomScene(), {});
         QVERIFY(lctest::waitRun(*w_, w_->runCulling()));
-        QCOMPARE(doc()->runOutput()->truth.metrics.falseNegatives, std::uint64_t(0));
+        QCOMPARE(doc()->runs().runOutput()->truth.metrics.falseNegatives, std::uint64_t(0));
     }
 
     void cleanup() {
@@ -235,7 +235,7 @@ private slots:
         const std::vector<glm::dvec3> corners = tileCorners(tile);
         QCOMPARE(corners.size(), std::size_t(8));
         const glm::dvec3 nearCentre = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
-        doc()->setSelectedTile(tile);
+        doc()->selection().setSelectedTile(tile);
         lookFromBehind(nearCentre);
         QVERIFY(!insideRoom(eye()));
         QVERIFY(segmentHit(doc()->scene(), eye(), nearCentre)); // hidden from here
@@ -273,8 +273,8 @@ private slots:
     void frameLightBehindAWall() {
         const glm::dvec3 light = doc()->scene().lights[kSideLight].position;
         QVERIFY(segmentHit(doc()->scene(), doc()->scene().camera.position, light)); // the partition
-        doc()->setSelectedTile(-1);
-        doc()->setSelectedLights({kSideLight});
+        doc()->selection().setSelectedTile(-1);
+        doc()->selection().setSelectedLights({kSideLight});
         lookFromBehind(light);
         QVERIFY(!insideRoom(eye()));
         trigger("actionFrameSelected");
@@ -297,14 +297,14 @@ private slots:
         doc()->resetScene(std::move(s), {});
         QVERIFY(lctest::waitRun(*w_, w_->runCulling()));
         const glm::dvec3 light = doc()->scene().lights[kSideLight].position;
-        doc()->setSelectedLights({kSideLight});
+        doc()->selection().setSelectedLights({kSideLight});
         lookFromBehind(light);
-        QVERIFY(doc()->overlays().meshes == Document::OverlayOptions::MeshDisplay::Normal);
+        QVERIFY(doc()->viewOptions().overlays().meshes == OverlayOptions::MeshDisplay::Normal);
         trigger("actionFrameSelected");
         QTest::qWait(600);
         const glm::dvec3 e = eye();
         QVERIFY2(glm::length(e - light) > 3.0, qPrintable(QString("eye %1 from the light").arg(glm::length(e - light))));
-        QVERIFY(doc()->overlays().meshes == Document::OverlayOptions::MeshDisplay::XRay);
+        QVERIFY(doc()->viewOptions().overlays().meshes == OverlayOptions::MeshDisplay::XRay);
         QVERIFY2(w_->statusBar()->currentMessage().contains("x-ray"), qPrintable(w_->statusBar()->currentMessage()));
         // The whole sphere in view.
         for (const glm::dvec3& d : {glm::dvec3(1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 1)}) {
@@ -317,20 +317,20 @@ private slots:
     // unless the tile lists it (then the tile, as Explain frames it).
     void frameFramesTheLightPickedAfterTheTile() {
         const int tile = busiestTile();
-        doc()->setSelectedTile(tile);
-        const auto held = lc::tilesHoldingLight(doc()->runOutput()->result, kSideLight);
+        doc()->selection().setSelectedTile(tile);
+        const auto held = lc::tilesHoldingLight(doc()->runs().runOutput()->result, kSideLight);
         QVERIFY(std::find(held.begin(), held.end(), std::uint32_t(tile)) == held.end());
-        doc()->setSelectedLights({kSideLight});
-        QVERIFY(doc()->lightSelectedLast());
+        doc()->selection().setSelectedLights({kSideLight});
+        QVERIFY(doc()->selection().lightSelectedLast());
         QVERIFY(view()->frameSelected(0));
         const glm::dvec3 light = doc()->scene().lights[kSideLight].position;
         double fp[3];
         view()->renderer()->GetActiveCamera()->GetFocalPoint(fp);
         QVERIFY2(glm::length(glm::dvec3(fp[0], fp[1], fp[2]) - light) < 1.0, "F did not frame the light picked last");
         // Picking the tile again makes it the subject.
-        doc()->setSelectedTile(-1);
-        doc()->setSelectedTile(tile);
-        QVERIFY(!doc()->lightSelectedLast());
+        doc()->selection().setSelectedTile(-1);
+        doc()->selection().setSelectedTile(tile);
+        QVERIFY(!doc()->selection().lightSelectedLast());
         QVERIFY(view()->frameSelected(0));
         view()->renderer()->GetActiveCamera()->GetFocalPoint(fp);
         QVERIFY(glm::length(glm::dvec3(fp[0], fp[1], fp[2]) - light) > 1.0);
@@ -339,19 +339,19 @@ private slots:
     // View > Meshes: x-ray draws them translucent and lets a click through to
     // the light behind the partition; hidden does not draw them.
     void meshesXRayAndHidden() {
-        QCOMPARE(doc()->overlays().meshes, Document::OverlayOptions::MeshDisplay::Normal);
+        QCOMPARE(doc()->viewOptions().overlays().meshes, OverlayOptions::MeshDisplay::Normal);
         view()->lookThroughCullingCamera();
         const glm::dvec3 light = doc()->scene().lights[kSideLight].position;
         QVERIFY(inView(light));
         const QPoint at = toWidget(light);
         // Normal: the partition takes the click.
-        doc()->setSelectedLights({});
+        doc()->selection().setSelectedLights({});
         QTest::mouseClick(view(), Qt::LeftButton, {}, at);
         QTest::qWait(50);
-        QVERIFY(doc()->selectedLights().empty());
+        QVERIFY(doc()->selection().selectedLights().empty());
 
         trigger("actionMeshesXRay");
-        QCOMPARE(doc()->overlays().meshes, Document::OverlayOptions::MeshDisplay::XRay);
+        QCOMPARE(doc()->viewOptions().overlays().meshes, OverlayOptions::MeshDisplay::XRay);
         QVERIFY(w_->action("actionMeshesXRay")->isChecked());
         QVERIFY(!view()->meshActors().empty());
         for (const auto& a : view()->meshActors()) {
@@ -359,11 +359,11 @@ private slots:
             QVERIFY(a->GetProperty()->GetOpacity() < 0.5);
         }
         QTest::mouseClick(view(), Qt::LeftButton, {}, at);
-        QTRY_COMPARE_WITH_TIMEOUT(doc()->selectedLights(), std::vector<int>{kSideLight}, 2000);
+        QTRY_COMPARE_WITH_TIMEOUT(doc()->selection().selectedLights(), std::vector<int>{kSideLight}, 2000);
 
         // The screenshot: the room from above and outside, in x-ray, a tile
         // selected with its lights and the side room's light current.
-        doc()->setSelectedTile(busiestTile());
+        doc()->selection().setSelectedTile(busiestTile());
         view()->resetCamera();
         view()->renderNow();
         QTest::qWait(50);
@@ -373,14 +373,14 @@ private slots:
 
         // X again: back to normal; then hidden.
         trigger("actionMeshesXRay");
-        QCOMPARE(doc()->overlays().meshes, Document::OverlayOptions::MeshDisplay::Normal);
+        QCOMPARE(doc()->viewOptions().overlays().meshes, OverlayOptions::MeshDisplay::Normal);
         QVERIFY(w_->action("actionMeshesNormal")->isChecked());
         trigger("actionMeshesHidden");
         for (const auto& a : view()->meshActors()) QVERIFY(!a->GetVisibility());
         // The state is the document's: set there, the menu follows.
-        Document::OverlayOptions o = doc()->overlays();
-        o.meshes = Document::OverlayOptions::MeshDisplay::Normal;
-        doc()->setOverlays(o);
+        OverlayOptions o = doc()->viewOptions().overlays();
+        o.meshes = OverlayOptions::MeshDisplay::Normal;
+        doc()->viewOptions().setOverlays(o);
         QVERIFY(w_->action("actionMeshesNormal")->isChecked());
         for (const auto& a : view()->meshActors()) {
             QVERIFY(a->GetVisibility());
@@ -392,17 +392,17 @@ private slots:
     // exactly the tile's list (and the spot cones only its spots).
     void onlyTheSelectedTilesLights() {
         const int tile = busiestTile();
-        const auto run = doc()->runOutput();
+        const auto run = doc()->runs().runOutput();
         const std::uint32_t count = run->result.listCount[std::size_t(tile)];
         QVERIFY(count > 3 && count < doc()->scene().lights.size());
         std::vector<int> listed;
         for (std::uint32_t k = 0; k < count; ++k)
             listed.push_back(int(run->result.lightIndices[run->result.listOffset[std::size_t(tile)] + k]));
-        doc()->setSelectedTile(tile);
+        doc()->selection().setSelectedTile(tile);
         QCOMPARE(view()->drawnLights().size(), doc()->scene().lights.size());
 
         trigger("actionLightsOnlyTile");
-        QVERIFY(doc()->overlays().onlyTileLights);
+        QVERIFY(doc()->viewOptions().overlays().onlyTileLights);
         view()->renderNow();
         QCOMPARE(view()->drawnLights(), listed);
         vtkAlgorithm* input = view()->lightActor()->GetMapper()->GetInputAlgorithm();
@@ -423,10 +423,10 @@ private slots:
         for (std::uint32_t t = 0; t < run->result.grid.tileCount() && other < 0; ++t)
             if (int(t) != tile && run->result.listCount[t] > 0 && run->result.listCount[t] != count) other = int(t);
         QVERIFY(other >= 0);
-        doc()->setSelectedTile(other);
+        doc()->selection().setSelectedTile(other);
         QCOMPARE(view()->drawnLights().size(), std::size_t(run->result.listCount[std::size_t(other)]));
         // No tile: every light, and the note says to pick one.
-        doc()->setSelectedTile(-1);
+        doc()->selection().setSelectedTile(-1);
         QCOMPARE(view()->drawnLights().size(), doc()->scene().lights.size());
         QVERIFY(QString(view()->lightNote()->GetInput()).contains("select a tile"));
         trigger("actionLightsOnlyTile");
@@ -439,10 +439,10 @@ private slots:
     // exceeds the cap is highlighted with rings, not a fog of spheres.
     void sphereCapShowsMore() {
         const std::size_t n = doc()->scene().lights.size();
-        doc()->setSelectedLights({kSideLight});
+        doc()->selection().setSelectedLights({kSideLight});
         trigger("actionLightsSpheres");
         trigger("actionSphereCap16");
-        QCOMPARE(doc()->overlays().sphereCap, 16);
+        QCOMPARE(doc()->viewOptions().overlays().sphereCap, 16);
         QVERIFY(w_->action("actionSphereCap16")->isChecked());
         view()->renderNow();
         QVERIFY(!view()->silhouettes());
@@ -467,11 +467,11 @@ private slots:
         QVERIFY(!view()->lightNote()->GetVisibility());
         // A tile listing more lights than the cap: its highlight is rings.
         int tile = -1;
-        const auto run = doc()->runOutput();
+        const auto run = doc()->runs().runOutput();
         for (std::uint32_t t = 0; t < run->result.grid.tileCount() && tile < 0; ++t)
             if (run->result.listCount[t] > 16) tile = int(t);
         QVERIFY(tile >= 0);
-        doc()->setSelectedTile(tile);
+        doc()->selection().setSelectedTile(tile);
         QVERIFY(view()->overlays()->listedActor()->GetVisibility());
         QVERIFY(view()->overlays()->listedAsRings());
         QVERIFY(LightSilhouettes::SafeDownCast(view()->overlays()->listedActor()->GetMapper()->GetInputAlgorithm()));
@@ -487,9 +487,9 @@ private slots:
     void hidingLightsHidesSpotCones() {
         QVERIFY(view()->spotCones()->data()->GetNumberOfLines() > 0);
         QVERIFY(view()->spotCones()->actor()->GetVisibility());
-        doc()->setSelectedTile(busiestTile());
+        doc()->selection().setSelectedTile(busiestTile());
         trigger("actionLightsShow");
-        QVERIFY(!doc()->overlays().showLights);
+        QVERIFY(!doc()->viewOptions().overlays().showLights);
         QVERIFY(!view()->lightActor()->GetVisibility());
         QVERIFY(!view()->spotCones()->actor()->GetVisibility());
         QVERIFY(!view()->overlays()->listedActor()->GetVisibility());
@@ -520,7 +520,7 @@ private slots:
         };
         view()->renderNow();
         const int without = warmAround(view()->grabFramebuffer());
-        doc()->setSelectedLights({kSideLight});
+        doc()->selection().setSelectedLights({kSideLight});
         view()->renderNow();
         QVERIFY(view()->handleWidget()->GetEnabled());
         QCOMPARE(view()->handleRepresentation()->GetRenderer(), view()->handleLayer());
@@ -534,14 +534,14 @@ private slots:
         QVERIFY2(with > without + 20, "the partition hides the handle");
 
         // Spot handles too.
-        doc()->setSelectedLights({kSpotLight});
+        doc()->selection().setSelectedLights({kSpotLight});
         QVERIFY(view()->spotHandles()->directionWidget()->GetEnabled());
         QCOMPARE(view()->spotHandles()->directionRepresentation()->GetRenderer(), view()->handleLayer());
         QCOMPARE(view()->spotHandles()->angleRepresentation()->GetRenderer(), view()->handleLayer());
 
         // A drag as the mouse makes it (the interactor's events in display
         // coordinates) still grabs the handle in its layer.
-        doc()->setSelectedLights({kSideLight});
+        doc()->selection().setSelectedLights({kSideLight});
         view()->renderNow();
         const glm::dvec3 d = display(light);
         vtkRenderWindowInteractor* iren = view()->interactor();

@@ -70,7 +70,7 @@ private slots:
 
         QVERIFY(w_->setPresetFromUi("threejs"));
         QCOMPARE(combo->currentText(), QString("threejs"));
-        const lc::CullSettings& s = doc()->settings();
+        const lc::CullSettings& s = doc()->runs().settings();
         QVERIFY(s.algorithm == lc::Algorithm::Naive);
         QCOMPARE(s.cap, 8u);
         QCOMPARE(s.maxLights, 1024u);
@@ -80,7 +80,7 @@ private slots:
 
         // A setting changed by hand: the settings are no longer the preset's.
         QVERIFY(w_->setParamFromUi("cap", "4"));
-        QCOMPARE(doc()->settings().cap, 4u);
+        QCOMPARE(doc()->runs().settings().cap, 4u);
         QCOMPARE(combo->currentText(), QString("(none)"));
         // Back to exactly the preset's: it shows again.
         QVERIFY(w_->setParamFromUi("cap", "8"));
@@ -91,7 +91,7 @@ private slots:
         QVERIFY(w_->setParamFromUi("algorithm", "minmax"));
         QVERIFY(w_->setParamFromUi("cap", "3"));
         QVERIFY(lctest::waitRun(*w_, w_->runCulling(), true));
-        auto run = doc()->runOutput();
+        auto run = doc()->runs().runOutput();
         QVERIFY(run);
         const lc::ListLimits& lim = run->result.limits;
         QVERIFY(!lim.overflowLists.empty());
@@ -130,7 +130,7 @@ private slots:
         const std::vector<lc::MissedLight> missed = lc::locateFalseNegatives(*run, lc::Projection(doc()->scene().camera));
         QVERIFY(!missed.empty());
         QVERIFY(missed.front().cause == lc::MissCause::ListFull);
-        doc()->setSelectedTile(int(missed.front().tile));
+        doc()->selection().setSelectedTile(int(missed.front().tile));
         w_->sceneTree()->setCurrentIndex(w_->sceneTree()->lightIndex(int(missed.front().light)));
         ExplainPanel* panel = w_->explainPanel();
         QVERIFY(panel->explanation());

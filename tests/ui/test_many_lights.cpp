@@ -209,7 +209,7 @@ class ManyLightsTest : public QObject {
         }
         QVERIFY(pick >= 0);
         const QImage before = view()->grabFramebuffer();
-        doc()->setSelectedLights({pick});
+        doc()->selection().setSelectedLights({pick});
         view()->renderNow();
         const QImage after = view()->grabFramebuffer();
         QDir().mkpath(LC_RENDER_OUT_DIR);
@@ -250,7 +250,7 @@ class ManyLightsTest : public QObject {
     // lights draws exactly its list.
     void busyTileIsHighlightedWithRings() {
         openWithLights(1024);
-        const auto run = doc()->runOutput();
+        const auto run = doc()->runs().runOutput();
         const lc::CullResult& r = run->result;
         QCOMPARE(r.listsPerTile, 1u);
         int tile = -1;
@@ -258,10 +258,10 @@ class ManyLightsTest : public QObject {
             if (tile < 0 || r.listCount[t] > r.listCount[std::size_t(tile)]) tile = int(t);
         const std::uint32_t count = r.listCount[std::size_t(tile)];
         QVERIFY(count > 20);
-        Document::OverlayOptions o = doc()->overlays();
+        OverlayOptions o = doc()->viewOptions().overlays();
         o.sphereCap = int(std::min<std::uint32_t>(count - 1, 256));
-        doc()->setOverlays(o);
-        doc()->setSelectedTile(tile);
+        doc()->viewOptions().setOverlays(o);
+        doc()->selection().setSelectedTile(tile);
         InspectorOverlays* ov = view()->overlays();
         QVERIFY(ov->listedActor()->GetVisibility());
         QVERIFY(ov->listedAsRings());
@@ -271,7 +271,7 @@ class ManyLightsTest : public QObject {
         QCOMPARE(rings->GetOutput()->GetNumberOfLines(), vtkIdType(ov->listedLights().size()));
 
         o.onlyTileLights = true;
-        doc()->setOverlays(o);
+        doc()->viewOptions().setOverlays(o);
         view()->renderNow();
         QCOMPARE(view()->drawnLights().size(), std::size_t(count));
         QVERIFY(view()->silhouettes()); // more than the cap: rings
@@ -296,10 +296,10 @@ class ManyLightsTest : public QObject {
             for (std::size_t j = 0; j < lights.size(); ++j)
                 best = std::min(best, entry(o, d, j));
             if (!std::isfinite(best)) continue; // the eye is inside every sphere on this ray
-            doc()->setSelectedLights({});
+            doc()->selection().setSelectedLights({});
             QTest::mouseClick(view(), Qt::LeftButton, {}, pos);
-            QTRY_COMPARE_WITH_TIMEOUT(doc()->selectedLights().size(), std::size_t(1), 2000);
-            const int sel = doc()->currentLight();
+            QTRY_COMPARE_WITH_TIMEOUT(doc()->selection().selectedLights().size(), std::size_t(1), 2000);
+            const int sel = doc()->selection().currentLight();
             // No sphere is entered before the selected one (a mesh in front would
             // have left the selection empty, which the comparison above rejects).
             QVERIFY2(entry(o, d, std::size_t(sel)) <= best * (1 + 1e-9),
@@ -312,7 +312,7 @@ class ManyLightsTest : public QObject {
         QVERIFY(clicked > 0);
 
         // Somewhere no sphere is hit: the selection stays as it was.
-        const std::vector<int> selBefore = doc()->selectedLights();
+        const std::vector<int> selBefore = doc()->selection().selectedLights();
         bool found = false;
         for (int y = 12; y < view()->height() - 12 && !found; y += 17)
             for (int x = 12; x < view()->width() - 12 && !found; x += 17) {
@@ -327,7 +327,7 @@ class ManyLightsTest : public QObject {
                 found = true;
                 QTest::mouseClick(view(), Qt::LeftButton, {}, QPoint(x, y));
                 QTest::qWait(50);
-                QCOMPARE(doc()->selectedLights(), selBefore);
+                QCOMPARE(doc()->selection().selectedLights(), selBefore);
             }
         QVERIFY(found);
     }
@@ -337,7 +337,7 @@ class ManyLightsTest : public QObject {
     void liveDragEndsOnNewestResult() {
         openWithLights(1024);
         const int k = 500;
-        doc()->setSelectedLights({k});
+        doc()->selection().setSelectedLights({k});
         w_->setLive(true);
         QVERIFY(waitRun(w_->cullService()->lastGeneration()));
         vtkHandleWidget* handle = view()->handleWidget();
@@ -355,14 +355,14 @@ class ManyLightsTest : public QObject {
         handle->InvokeEvent(vtkCommand::EndInteractionEvent);
         const quint64 last = w_->cullService()->lastGeneration();
         QVERIFY(waitRun(last, /*truth=*/true));
-        QCOMPARE(doc()->runGeneration(), last);
-        const auto run = doc()->runOutput();
+        QCOMPARE(doc()->runs().runGeneration(), last);
+        const auto run = doc()->runs().runOutput();
         QVERIFY(run->depthReused); // only a light moved
         const lc::ViewLights expected = lc::makeViewLights(doc()->scene());
         QVERIFY(glm::length(run->lights.centers[k] - expected.centers[k]) < 1e-9);
         // The lists equal a direct run on the final scene.
         auto cpu = lc::makeBackend("cpu");
-        const lc::RunOutput direct = lc::runPipeline(doc()->scene(), doc()->settings(), *cpu);
+        const lc::RunOutput direct = lc::runPipeline(doc()->scene(), doc()->runs().settings(), *cpu);
         QVERIFY(run->result.listCount == direct.result.listCount);
         QVERIFY(run->result.listOffset == direct.result.listOffset);
         QVERIFY(run->result.lightIndices == direct.result.lightIndices);
@@ -399,8 +399,8 @@ class ManyLightsTest : public QObject {
         QVERIFY(waitRun(w_->cullService()->lastGeneration()));
         doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(0.3, 0, 0), doc()->newDragId());
         QVERIFY(waitRun(w_->cullService()->lastGeneration()));
-        QVERIFY(doc()->runOutput()->depthReused);
-        const std::vector<float> depthBefore = doc()->runOutput()->depth.depth;
+        QVERIFY(doc()->runs().runOutput()->depthReused);
+        const std::vector<float> depthBefore = doc()->runs().runOutput()->depth.depth;
 
         // A box right in front of the culling camera: same camera, new depth.
         lc::Mesh box;
@@ -417,16 +417,16 @@ class ManyLightsTest : public QObject {
         const quint64 r1 = doc()->geometryRevision();
         QVERIFY(r1 != r0);
         QVERIFY(waitRun(w_->cullService()->lastGeneration()));
-        QVERIFY(!doc()->runOutput()->depthReused);
-        QVERIFY(doc()->runOutput()->depth.depth != depthBefore);
+        QVERIFY(!doc()->runs().runOutput()->depthReused);
+        QVERIFY(doc()->runs().runOutput()->depth.depth != depthBefore);
         QCOMPARE(w_->cullService()->meshSnapshot()->size(), doc()->scene().meshes.size());
         QVERIFY(w_->cullService()->meshSnapshot() != snapshot);
 
         doc()->undoStack()->undo();
         QVERIFY(doc()->geometryRevision() != r1 && doc()->geometryRevision() != r0);
         QVERIFY(waitRun(w_->cullService()->lastGeneration()));
-        QVERIFY(!doc()->runOutput()->depthReused);
-        QVERIFY(doc()->runOutput()->depth.depth == depthBefore);
+        QVERIFY(!doc()->runs().runOutput()->depthReused);
+        QVERIFY(doc()->runs().runOutput()->depth.depth == depthBefore);
         w_->setLive(false);
 
         const quint64 r2 = doc()->geometryRevision();

@@ -204,7 +204,7 @@ class OverlaysTest : public QObject {
 
     // The tile with the most listed lights.
     std::uint32_t busiestTile() {
-        const lc::CullResult& r = doc()->runOutput()->result;
+        const lc::CullResult& r = doc()->runs().runOutput()->result;
         std::uint32_t best = 0, bestCount = 0;
         for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t) {
             std::uint32_t n = 0;
@@ -230,10 +230,10 @@ private slots:
     // out of the list shows up as MISSING, in red, in the dock and in 3D.
     void tileInspectorListsAndVerdicts() {
         openSmall();
-        auto run = doc()->runOutput();
+        auto run = doc()->runs().runOutput();
         const lc::CullResult& r = run->result;
         const std::uint32_t t = busiestTile();
-        doc()->setSelectedTile(int(t));
+        doc()->selection().setSelectedTile(int(t));
         TileInspector* ti = w_->tileInspector();
         QCOMPARE(ti->listedLights(), lightsOfList(r, t));
         const lc::Projection proj(doc()->scene().camera);
@@ -271,7 +271,7 @@ private slots:
         auto it = std::find(first, first + br.listCount[t], std::uint32_t(victim));
         std::rotate(it, it + 1, first + br.listCount[t]);
         --br.listCount[t];
-        QVERIFY(doc()->setRunOutput(broken, doc()->runGeneration() + 1));
+        QVERIFY(doc()->runs().setRunOutput(broken, doc()->runs().runGeneration() + 1));
         std::vector<int> expect = lightsOfList(r, t);
         expect.erase(std::find(expect.begin(), expect.end(), victim));
         QCOMPARE(ti->listedLights(), expect);
@@ -288,10 +288,10 @@ private slots:
     // every cell outlined; the current light's cell range.
     void cellsAndCellSelection() {
         openSmall();
-        const auto run = doc()->runOutput();
+        const auto run = doc()->runs().runOutput();
         const lc::CullResult& r = run->result;
         const std::uint32_t t = busiestTile();
-        doc()->setSelectedTile(int(t));
+        doc()->selection().setSelectedTile(int(t));
         InspectorOverlays* ov = w_->inspectorView()->overlays();
         const std::uint32_t mask = r.cellMask[t];
         QCOMPARE(int(ov->cellFill()->GetNumberOfPolys()), 6 * std::popcount(mask));
@@ -303,7 +303,7 @@ private slots:
         TileInspector* ti = w_->tileInspector();
         for (const auto& row : ti->rows()) whole[int(row.light)] += int(row.pixelsNeeding);
         for (std::uint32_t k = 0; k < r.settings.cells; ++k) {
-            doc()->setSelectedCell(int(k));
+            doc()->selection().setSelectedCell(int(k));
             QVERIFY(ti->summaryText().contains(QString("cell %1").arg(k)));
             for (const auto& row : ti->rows()) byCell[int(row.light)] += int(row.pixelsNeeding);
             if ((mask >> k) & 1u) QCOMPARE(ti->listedLights(), lightsOfList(r, t)); // one list per 2.5d tile
@@ -312,7 +312,7 @@ private slots:
 
         // The current light's cell range: the cells its depth interval overlaps.
         const int light = lightsOfList(r, t).front();
-        doc()->setSelectedLights({light});
+        doc()->selection().setSelectedLights({light});
         const double d = -run->lights.centers[std::size_t(light)].z, rad = run->lights.radii[std::size_t(light)];
         int spanned = 0;
         for (const auto& c : lc::tileCells(r, lc::Projection(doc()->scene().camera), t))
@@ -322,7 +322,7 @@ private slots:
 
         // Toggles through the View > Overlays actions.
         w_->action("actionOverlayCells")->trigger();
-        QVERIFY(!doc()->overlays().cells);
+        QVERIFY(!doc()->viewOptions().overlays().cells);
         QCOMPARE(int(ov->cellFill()->GetNumberOfCells()), 0);
         w_->action("actionOverlayTileFrustum")->trigger();
         QCOMPARE(int(ov->tileSolid()->GetNumberOfCells()), 0);
@@ -337,12 +337,12 @@ private slots:
         openSmall("zbin");
         QVERIFY(w_->setParamFromUi("bins", "256"));
         QVERIFY(waitRun(w_->runCulling()));
-        const auto run = doc()->runOutput();
+        const auto run = doc()->runs().runOutput();
         const lc::CullResult& r = run->result;
         QVERIFY(r.algorithm == lc::Algorithm::ZBin);
         QCOMPARE(r.zbinLo.size(), std::size_t(256));
         const std::uint32_t t = busiestTile();
-        doc()->setSelectedTile(int(t));
+        doc()->selection().setSelectedTile(int(t));
         InspectorOverlays* ov = w_->inspectorView()->overlays();
         const lc::Projection proj(doc()->scene().camera);
         const auto cells = lc::tileCells(r, proj, t);
@@ -356,7 +356,7 @@ private slots:
             QCOMPARE(cells[k].chunk.depthMin, cells[k - 1].chunk.depthMax);
 
         const int light = lightsOfList(r, t).front();
-        doc()->setSelectedLights({light});
+        doc()->selection().setSelectedLights({light});
         const auto slab = lc::zbinLightSlab(r, proj, run->lights, std::uint32_t(light));
         QVERIFY(slab);
         const double d = -run->lights.centers[std::size_t(light)].z, rad = run->lights.radii[std::size_t(light)];
@@ -384,7 +384,7 @@ private slots:
     void reverseLookupInBothViews() {
         for (const QString alg : {"2.5d", "halfz"}) {
             openSmall(alg);
-            const lc::CullResult& r = doc()->runOutput()->result;
+            const lc::CullResult& r = doc()->runs().runOutput()->result;
             // A light held by several lists.
             int light = -1;
             std::set<int> expectTiles;
@@ -398,14 +398,14 @@ private slots:
                 if (tiles.size() >= 3) light = int(i), expectTiles = tiles, expectLists = lists;
             }
             QVERIFY(light >= 0);
-            doc()->setSelectedLights({light});
+            doc()->selection().setSelectedLights({light});
             const auto& shown = w_->cameraView()->highlightedTiles();
             QCOMPARE(std::set<int>(shown.begin(), shown.end()), expectTiles);
             InspectorOverlays* ov = w_->inspectorView()->overlays();
             QCOMPARE(ov->reverseLists(), expectLists);
             QCOMPARE(int(ov->reverse()->GetNumberOfLines()), 12 * int(expectLists.size()));
             if (alg == "halfz") {
-                doc()->setSelectedTile(*expectTiles.begin());
+                doc()->selection().setSelectedTile(*expectTiles.begin());
                 QCOMPARE(int(ov->splitQuad()->GetNumberOfPolys()), 1); // the split between the halves
             }
             w_->action("actionOverlayReverse")->trigger(); // off
@@ -419,12 +419,12 @@ private slots:
     // truth's per-list work.
     void heatMapModes() {
         openSmall("halfz");
-        const auto run = doc()->runOutput();
+        const auto run = doc()->runs().runOutput();
         const lc::CullResult& r = run->result;
         const auto& gt = run->truth;
         CameraView* cv = w_->cameraView();
         w_->action("actionHeat_false-positives")->trigger();
-        QVERIFY(doc()->overlays().heat == lc::HeatMode::FalsePositives);
+        QVERIFY(doc()->viewOptions().overlays().heat == lc::HeatMode::FalsePositives);
         // Two lines beside the image, one under it (CameraView::legendPlace).
         const QString sep = cv->legendPlace() == CameraView::LegendPlace::Below ? " " : "\n";
         QCOMPARE(QString(cv->legend()->GetTitle()), "false" + sep + "positives");
@@ -460,7 +460,7 @@ private slots:
     // is printed (a measurement, not an assertion).
     void allTileFrustumsIsOneActor() {
         openSmall("minmax", "640x360", "4");
-        const lc::CullResult& r = doc()->runOutput()->result;
+        const lc::CullResult& r = doc()->runs().runOutput()->result;
         QCOMPARE(r.grid.tileCount(), 160u * 90u);
         InspectorView* iv = w_->inspectorView();
         auto frameMs = [iv] {
@@ -493,10 +493,9 @@ private slots:
     // overlays.vtm (read back with VTK) and both views' screenshots.
     void exportFromStudioReadsBackInVtk() {
         openSmall();
-        doc()->setSelectedTile(int(busiestTile()));
+        doc()->selection().setSelectedTile(int(busiestTile()));
         const QString dir = tmp_.path() + "/studio-export";
-        w_->prompts.savePath = [dir](QWidget*, const QString&, const QString&) { return dir; };
-        w_->action("actionExportDiagnostics")->trigger();
+        QVERIFY(lctest::exportAndWait(*w_, dir));
         for (const char* f : {"summary.json", "tiles.csv", "heatmap.png", "overlays.vtm", "camera_view.png",
                               "inspector_view.png"})
             QVERIFY2(QFileInfo(dir + "/" + f).isFile(), f);
@@ -508,7 +507,7 @@ private slots:
                 for (int x = 0; x < img.width(); x += 7) colours.insert(img.pixel(x, y));
             QVERIFY2(colours.size() > 20, f); // a real picture, not a blank frame
         }
-        checkVtm(dir + "/overlays.vtm", doc()->scene(), *doc()->runOutput());
+        checkVtm(dir + "/overlays.vtm", doc()->scene(), *doc()->runs().runOutput());
         // No staging folder left beside it.
         QCOMPARE(QDir(tmp_.path()).entryList(QDir::AllEntries | QDir::NoDotAndDotDot | QDir::Hidden),
                  QStringList{"studio-export"});

@@ -331,8 +331,8 @@ private slots:
     void clickingAPointLoadsAndRunsItsConfiguration() {
         // A run of the document's own settings is on screen first.
         w_->runCulling();
-        QTRY_VERIFY_WITH_TIMEOUT(doc()->runOutput() && doc()->runOutput()->truthComputed, kTimeoutMs);
-        const auto before = doc()->runOutput();
+        QTRY_VERIFY_WITH_TIMEOUT(doc()->runs().runOutput() && doc()->runs().runOutput()->truthComputed, kTimeoutMs);
+        const auto before = doc()->runs().runOutput();
         QCOMPARE(before->result.grid.tileSize, 16u);
 
         runSmall25d();
@@ -357,15 +357,15 @@ private slots:
         QVERIFY(gotAt.has_value());
         QVERIFY((*gotAt - *at).manhattanLength() <= 8);
         const lc::ReportConfig& c = rep->rows[got].config;
-        QVERIFY(doc()->settings().algorithm == c.settings.algorithm);
-        QVERIFY(doc()->settings().test == c.settings.test);
-        QCOMPARE(doc()->settings().cells, c.settings.cells);
-        QVERIFY(doc()->settings().slicing == c.settings.slicing);
+        QVERIFY(doc()->runs().settings().algorithm == c.settings.algorithm);
+        QVERIFY(doc()->runs().settings().test == c.settings.test);
+        QCOMPARE(doc()->runs().settings().cells, c.settings.cells);
+        QVERIFY(doc()->runs().settings().slicing == c.settings.slicing);
         QCOMPARE(doc()->scene().camera.tileSize, c.tileSize);
         // ... and it was culled: the run on screen is this configuration's,
         // not the one before the click.
-        QTRY_VERIFY_WITH_TIMEOUT(doc()->runOutput() != before && doc()->runOutput()->truthComputed, kTimeoutMs);
-        const auto run = doc()->runOutput();
+        QTRY_VERIFY_WITH_TIMEOUT(doc()->runs().runOutput() != before && doc()->runs().runOutput()->truthComputed, kTimeoutMs);
+        const auto run = doc()->runs().runOutput();
         QCOMPARE(run->result.grid.tileSize, c.tileSize);
         QVERIFY(run->result.settings.algorithm == c.settings.algorithm);
         QVERIFY(run->result.settings.test == c.settings.test);

@@ -117,9 +117,9 @@ class ShadedViewTest : public QObject {
         QElapsedTimer t;
         t.start();
         while (t.elapsed() < lctest::kRunTimeoutMs) {
-            const auto run = doc()->runOutput();
-            if (doc()->runGeneration() == generation && run && !run->shadedAll.empty()) return true;
-            if (doc()->runGeneration() > generation) return false;
+            const auto run = doc()->runs().runOutput();
+            if (doc()->runs().runGeneration() == generation && run && !run->shadedAll.empty()) return true;
+            if (doc()->runs().runGeneration() > generation) return false;
             QTest::qWait(20);
         }
         return false;
@@ -180,10 +180,10 @@ private slots:
         pickMode("shaded-culled");
         const quint64 gen = w_->runCulling();
         QVERIFY(waitShaded(gen));
-        QCOMPARE(QString::fromStdString(doc()->runOutput()->result.backend), backend);
+        QCOMPARE(QString::fromStdString(doc()->runs().runOutput()->result.backend), backend);
         QCOMPARE(shadingStarted.count(), 1); // shaded once, for this run
         QTRY_VERIFY(cv()->shownImage() != nullptr);
-        QVERIFY(cv()->shownImageRun() == doc()->runOutput().get());
+        QVERIFY(cv()->shownImageRun() == doc()->runs().runOutput().get());
 
         const nlohmann::json summary = readJson(cli + "/summary.json");
         QVERIFY(summary.is_object());
@@ -211,7 +211,7 @@ private slots:
         const QPoint click(int((vp[0] + u * (vp[2] - vp[0])) * cv()->width()),
                            int((1.0 - (vp[3] - v * (vp[3] - vp[1]))) * cv()->height()));
         QTest::mouseClick(cv(), Qt::LeftButton, {}, click);
-        QTRY_COMPARE(doc()->selectedTile(), ty * 20 + tx);
+        QTRY_COMPARE(doc()->selection().selectedTile(), ty * 20 + tx);
     }
 
     // Comparing algorithms in Difference mode: the next run keeps the
@@ -227,13 +227,13 @@ private slots:
         openSmall("vulkan");
         pickMode("difference");
         QVERIFY(waitShaded(w_->runCulling()));
-        QVERIFY(!doc()->runOutput()->allLightsReused);
-        const std::vector<float> all = doc()->runOutput()->shadedAll;
+        QVERIFY(!doc()->runs().runOutput()->allLightsReused);
+        const std::vector<float> all = doc()->runs().runOutput()->shadedAll;
 
         QVERIFY(w_->setParamFromUi("algorithm", "clustered"));
         QVERIFY(waitShaded(w_->runCulling()));
-        QVERIFY(doc()->runOutput()->allLightsReused);
-        QVERIFY(doc()->runOutput()->shadedAll == all);
+        QVERIFY(doc()->runs().runOutput()->allLightsReused);
+        QVERIFY(doc()->runs().runOutput()->shadedAll == all);
         for (int i = 0; i < 3; ++i) {
             pickMode(kModes[i]);
             cv()->renderNow();
@@ -245,7 +245,7 @@ private slots:
         const glm::dvec3 p = doc()->scene().lights[0].position;
         doc()->moveLight(0, p + glm::dvec3(0.3, 0, 0), doc()->newDragId());
         QVERIFY(waitShaded(w_->runCulling()));
-        const auto moved = doc()->runOutput();
+        const auto moved = doc()->runs().runOutput();
         QVERIFY(!moved->allLightsReused);
         QVERIFY(moved->shadedAll != all);
         QVERIFY(moved->allLightsUpdate.has_value());
@@ -270,7 +270,7 @@ private slots:
         QVERIFY(waitRun(gen));
         QTest::qWait(100); // any shading would have started by now
         QCOMPARE(started.count(), 0);
-        QVERIFY(doc()->runOutput()->shadedAll.empty());
+        QVERIFY(doc()->runs().runOutput()->shadedAll.empty());
         QVERIFY(cv()->shownImage() == nullptr);
         QVERIFY(cv()->imageLabelText().isEmpty());
 
@@ -290,7 +290,7 @@ private slots:
         QCOMPARE(ended.at(0).at(1).toBool(), true);
         QTRY_VERIFY(!w_->findChild<QLabel*>("statusTask_shading"));
         QVERIFY(cv()->shownImage() != nullptr);
-        QVERIFY(doc()->runOutput()->truth.metrics.imageErrorComputed);
+        QVERIFY(doc()->runs().runOutput()->truth.metrics.imageErrorComputed);
     }
 
     // Shading shows its progress in the status bar and stops at its Cancel:
@@ -317,9 +317,9 @@ private slots:
         QCOMPARE(ended.at(0).at(0).value<quint64>(), gen);
         QCOMPARE(ended.at(0).at(1).toBool(), false);
         QTRY_VERIFY(!w_->findChild<QProgressBar*>("statusProgress_shading"));
-        QCOMPARE(doc()->runGeneration(), gen);
-        QVERIFY(doc()->runOutput()->shadedAll.empty());
-        QVERIFY(doc()->runOutput()->truthComputed);
+        QCOMPARE(doc()->runs().runGeneration(), gen);
+        QVERIFY(doc()->runs().runOutput()->shadedAll.empty());
+        QVERIFY(doc()->runs().runOutput()->truthComputed);
         QVERIFY(cv()->shownImage() == nullptr);
     }
 
@@ -331,9 +331,9 @@ private slots:
         QVERIFY(waitShaded(w_->runCulling()));
         std::vector<std::pair<quint64, int>> seen; // generation, 0 lists / 1 truth / 2 images
         QObject ctx;
-        connect(doc(), &Document::runOutputChanged, &ctx, [&] {
-            const auto run = doc()->runOutput();
-            seen.push_back({doc()->runGeneration(), !run->shadedAll.empty() ? 2 : run->truthComputed ? 1 : 0});
+        connect(&doc()->runs(), &RunState::runOutputChanged, &ctx, [&] {
+            const auto run = doc()->runs().runOutput();
+            seen.push_back({doc()->runs().runGeneration(), !run->shadedAll.empty() ? 2 : run->truthComputed ? 1 : 0});
         });
         w_->setLive(true);
         QVERIFY(waitShaded(w_->cullService()->lastGeneration()));
@@ -347,7 +347,7 @@ private slots:
         for (const auto& [g, phase] : seen)
             if (g == gen) phases.push_back(phase);
         QCOMPARE(phases, (std::vector<int>{0, 1, 2}));
-        QVERIFY(cv()->shownImageRun() == doc()->runOutput().get());
+        QVERIFY(cv()->shownImageRun() == doc()->runs().runOutput().get());
         w_->setLive(false);
     }
 
@@ -396,10 +396,9 @@ private slots:
         QVERIFY(!cli.isEmpty());
         openSmall();
         QVERIFY(waitRun(w_->runCulling()));
-        QVERIFY(doc()->runOutput()->shadedAll.empty());
+        QVERIFY(doc()->runs().runOutput()->shadedAll.empty());
         const QString dir = tmp_.path() + "/studio-export";
-        w_->prompts.savePath = [dir](QWidget*, const QString&, const QString&) { return dir; };
-        w_->action("actionExportDiagnostics")->trigger();
+        QVERIFY(lctest::exportAndWait(*w_, dir));
         for (const char* f : kPngOfMode) {
             QImage studio(dir + "/" + f), fromCli(cli + "/" + f);
             QVERIFY2(!studio.isNull(), f);

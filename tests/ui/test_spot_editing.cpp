@@ -160,7 +160,7 @@ private slots:
         QVERIFY(l.validate().empty());
         QCOMPARE(l.outerAngleDeg, 30.0);
         QCOMPARE(doc()->undoStack()->count(), undoBefore + 1);
-        QCOMPARE(doc()->currentLight(), i);
+        QCOMPARE(doc()->selection().currentLight(), i);
         doc()->undoStack()->undo();
         QCOMPARE(int(doc()->scene().lights.size()), i);
     }
@@ -258,13 +258,13 @@ private slots:
         const int i = addSpot();
         QVERIFY(i >= 0);
         QVERIFY(w_->setParamFromUi("spot-test", "cone-planes"));
-        QVERIFY(doc()->settings().spotTest == lc::SpotTest::ConePlanes);
+        QVERIFY(doc()->runs().settings().spotTest == lc::SpotTest::ConePlanes);
         const quint64 gen = w_->runCulling();
         QElapsedTimer t;
         t.start();
-        while (doc()->runGeneration() < gen && t.elapsed() < lctest::kRunTimeoutMs) QTest::qWait(50);
-        QVERIFY(doc()->runGeneration() >= gen);
-        auto run = doc()->runOutput();
+        while (doc()->runs().runGeneration() < gen && t.elapsed() < lctest::kRunTimeoutMs) QTest::qWait(50);
+        QVERIFY(doc()->runs().runGeneration() >= gen);
+        auto run = doc()->runs().runOutput();
         QVERIFY(run);
         QVERIFY(run->result.settings.spotTest == lc::SpotTest::ConePlanes);
         QCOMPARE(run->truth.metrics.falseNegatives, std::uint64_t(0));
@@ -273,7 +273,7 @@ private slots:
         auto backend = lc::makeBackend("cpu");
         lc::RunOptions opt;
         opt.truthOptions.imageError = false;
-        const lc::RunOutput direct = lc::runPipeline(doc()->scene(), doc()->settings(), *backend, opt);
+        const lc::RunOutput direct = lc::runPipeline(doc()->scene(), doc()->runs().settings(), *backend, opt);
         QVERIFY(direct.result.lightIndices == run->result.lightIndices);
         QCOMPARE(direct.truth.metrics.exactWork, run->truth.metrics.exactWork);
         QVERIFY(direct.truth.metrics.exactWork > 0); // the spot lights the wall

@@ -214,13 +214,13 @@ private slots:
         for (int k = 0; k < int(doc()->scene().lights.size()); ++k)
             if (!light(k).isSpot()) point = k;
         QVERIFY(point >= 0);
-        doc()->setSelectedLights({point});
+        doc()->selection().setSelectedLights({point});
         QVERIFY(!handles()->directionWidget()->GetEnabled());
         QVERIFY(!handles()->angleWidget()->GetEnabled());
         QVERIFY(w_->inspectorView()->handleWidget()->GetEnabled()); // the position handle still shows
-        doc()->setSelectedLights({point, spot});
+        doc()->selection().setSelectedLights({point, spot});
         QVERIFY(!handles()->directionWidget()->GetEnabled());
-        doc()->setSelectedLights({spot});
+        doc()->selection().setSelectedLights({spot});
         QVERIFY(handles()->directionWidget()->GetEnabled());
         auto* kind = panelField<QComboBox>("lightKind");
         kind->setCurrentIndex(kind->findText("point"));
@@ -228,7 +228,7 @@ private slots:
         QVERIFY(!handles()->angleWidget()->GetEnabled());
         doc()->undoStack()->undo();
         QVERIFY(handles()->angleWidget()->GetEnabled());
-        doc()->setSelectedLights({});
+        doc()->selection().setSelectedLights({});
         QVERIFY(!handles()->angleWidget()->GetEnabled());
     }
 
@@ -251,7 +251,7 @@ private slots:
         QElapsedTimer t;
         t.start();
         auto turned = [&] {
-            const auto run = doc()->runOutput();
+            const auto run = doc()->runs().runOutput();
             return run && run->lights.isSpot(std::size_t(i)) &&
                    glm::length(run->lights.spotAxes[std::size_t(i)] - targetView) < 1e-9;
         };
@@ -275,14 +275,14 @@ private slots:
         for (const char* test : {"apex-sphere", "tight-sphere", "cone-sphere", "cone-planes"}) {
             QVERIFY(w_->setParamFromUi("spot-test", test));
             QVERIFY(runAndWait());
-            const auto run = doc()->runOutput();
+            const auto run = doc()->runs().runOutput();
             QCOMPARE(QString(lc::toString(run->result.settings.spotTest)), QString(test));
             // A tile whose lists hold the spot.
             const auto tiles = lc::tilesHoldingLight(run->result, std::uint32_t(i));
             QVERIFY(!tiles.empty());
             const int tile = int(tiles[tiles.size() / 2]);
-            doc()->setSelectedTile(tile);
-            doc()->setSelectedLights({i});
+            doc()->selection().setSelectedTile(tile);
+            doc()->selection().setSelectedLights({i});
             toggle->setChecked(false);
             QVERIFY(!ov->spotPrimitive());
             QCOMPARE(ov->spotCullSphere()->GetNumberOfCells(), vtkIdType(0));
@@ -351,7 +351,7 @@ private slots:
         // A point light shows no spot primitive.
         for (int k = 0; k < int(doc()->scene().lights.size()); ++k)
             if (!light(k).isSpot()) {
-                doc()->setSelectedLights({k});
+                doc()->selection().setSelectedLights({k});
                 break;
             }
         QVERIFY(!ov->spotPrimitive());
@@ -378,10 +378,10 @@ private slots:
         for (const char* test : {"cone-sphere", "cone-planes"}) {
             QVERIFY(w_->setParamFromUi("spot-test", test));
             QVERIFY(runAndWait());
-            const auto tiles = lc::tilesHoldingLight(doc()->runOutput()->result, std::uint32_t(i));
+            const auto tiles = lc::tilesHoldingLight(doc()->runs().runOutput()->result, std::uint32_t(i));
             QVERIFY(!tiles.empty());
-            doc()->setSelectedTile(int(tiles[tiles.size() / 2]));
-            doc()->setSelectedLights({i});
+            doc()->selection().setSelectedTile(int(tiles[tiles.size() / 2]));
+            doc()->selection().setSelectedLights({i});
             QVERIFY(handles()->directionWidget()->GetEnabled() && handles()->angleWidget()->GetEnabled());
             InspectorView* view = w_->inspectorView();
             QVERIFY(view->isVisible());

@@ -127,8 +127,8 @@ private slots:
         const QModelIndex idx = tree->lightIndex(3);
         QVERIFY(idx.isValid());
         tree->setCurrentIndex(idx); // what a click on the row does
-        QCOMPARE(doc()->selectedLights(), std::vector<int>{3});
-        QCOMPARE(doc()->currentLight(), 3);
+        QCOMPARE(doc()->selection().selectedLights(), std::vector<int>{3});
+        QCOMPARE(doc()->selection().currentLight(), 3);
         auto* name = w_->propertyPanel()->findChild<QLineEdit*>("lightName");
         QCOMPARE(name->text().toStdString(), doc()->scene().lights[3].name);
         // The drag handle sits on the selected light.
@@ -139,12 +139,12 @@ private slots:
         QVERIFY(std::abs(p[0] - lp.x) < 1e-9 && std::abs(p[1] - lp.y) < 1e-9 && std::abs(p[2] - lp.z) < 1e-9);
         // Multi-select in the tree selects several lights.
         tree->selectionModel()->select(tree->lightIndex(5), QItemSelectionModel::Select);
-        QCOMPARE(doc()->selectedLights().size(), std::size_t(2));
+        QCOMPARE(doc()->selection().selectedLights().size(), std::size_t(2));
     }
 
     void dragMovesLightAsOneUndoStep() {
         openSmall();
-        doc()->setSelectedLights({2});
+        doc()->selection().setSelectedLights({2});
         const glm::dvec3 start = doc()->scene().lights[2].position;
         vtkHandleWidget* handle = w_->inspectorView()->handleWidget();
         vtkPointHandleRepresentation3D* rep = w_->inspectorView()->handleRepresentation();
@@ -185,7 +185,7 @@ private slots:
 
     void dragSphereSetsRadiusAsOneUndoStep() {
         openSmall();
-        doc()->setSelectedLights({6});
+        doc()->selection().setSelectedLights({6});
         const lc::PointLight before = doc()->scene().lights[6];
         vtkHandleWidget* handle = w_->inspectorView()->radiusHandleWidget();
         vtkPointHandleRepresentation3D* rep = w_->inspectorView()->radiusHandleRepresentation();
@@ -213,7 +213,7 @@ private slots:
 
     void runMatchesCli() {
         openSmall();
-        const auto run = doc()->runOutput();
+        const auto run = doc()->runs().runOutput();
         QVERIFY(run);
         QCOMPARE(QString::fromStdString(run->result.backend), QString("cpu"));
         QCOMPARE(run->result.grid.width, 320u);
@@ -262,7 +262,7 @@ private slots:
         const QPoint click(int((vp[0] + u * (vp[2] - vp[0])) * cv->width()),
                            int((1.0 - (vp[3] - v * (vp[3] - vp[1]))) * cv->height()));
         QTest::mouseClick(cv, Qt::LeftButton, {}, click);
-        QTRY_COMPARE(doc()->selectedTile(), bestY * 20 + bestX);
+        QTRY_COMPARE(doc()->selection().selectedTile(), bestY * 20 + bestX);
         QCOMPARE(w_->tileInspector()->listedLights(), bestLights);
     }
 
@@ -314,8 +314,8 @@ private slots:
 
     void backendSwitchAndBadBackend() {
         openSmall();
-        QVERIFY(lctest::waitRun(*w_, doc()->runGeneration(), true)); // with its ground truth
-        const auto cpu = doc()->runOutput();
+        QVERIFY(lctest::waitRun(*w_, doc()->runs().runGeneration(), true)); // with its ground truth
+        const auto cpu = doc()->runs().runOutput();
         QCOMPARE(QString::fromStdString(cpu->result.backend), QString("cpu"));
         const auto names = lc::availableBackends();
         // The switch is this test's point: lavapipe is part of the stack
@@ -324,7 +324,7 @@ private slots:
         // The worker recreates its backend and runs the same scene on it.
         w_->setBackend("vulkan");
         QVERIFY(lctest::waitRun(*w_, w_->runCulling(), true));
-        const auto vk = doc()->runOutput();
+        const auto vk = doc()->runs().runOutput();
         QCOMPARE(QString::fromStdString(vk->result.backend), QString("vulkan"));
         QVERIFY(w_->findChild<QLabel*>("statusBackend")->text().startsWith("vulkan"));
         // The two backends' lists. They are not identical by design
@@ -348,7 +348,7 @@ private slots:
             const lc::Projection proj(doc()->scene().camera);
             auto cpuBackend = lc::makeBackend("cpu");
             const lc::CullResult ref =
-                cpuBackend->cull(vk->depth, proj, vk->result.grid, vk->lights, doc()->settings());
+                cpuBackend->cull(vk->depth, proj, vk->result.grid, vk->lights, doc()->runs().settings());
             QCOMPARE(ref.listCount.size(), vk->result.listCount.size());
             std::uint64_t extra = 0, lacking = 0;
             for (std::size_t l = 0; l < ref.listCount.size(); ++l) {
@@ -367,7 +367,7 @@ private slots:
         // Back on cpu: exactly the lists of the first cpu run, entry for entry.
         w_->setBackend("cpu");
         QVERIFY(lctest::waitRun(*w_, w_->runCulling(), true));
-        const auto cpuAgain = doc()->runOutput();
+        const auto cpuAgain = doc()->runs().runOutput();
         QCOMPARE(QString::fromStdString(cpuAgain->result.backend), QString("cpu"));
         QVERIFY(cpuAgain != cpu); // a new run, not the old one shown again
         QVERIFY(cpuAgain->result.listOffset == cpu->result.listOffset);
@@ -378,13 +378,13 @@ private slots:
         // An unknown backend is an error in the log; the last result stays.
         w_->setBackend("cpu", "");
         QSignalSpy failed(w_.get(), &MainWindow::runFailed);
-        const quint64 shown = doc()->runGeneration();
-        w_->cullService()->request(doc()->scene(), doc()->settings(), "no-such-backend", "");
+        const quint64 shown = doc()->runs().runGeneration();
+        w_->cullService()->request(doc()->scene(), doc()->runs().settings(), "no-such-backend", "");
         QVERIFY(failed.wait(lctest::kRunTimeoutMs));
-        QCOMPARE(doc()->runGeneration(), shown);
+        QCOMPARE(doc()->runs().runGeneration(), shown);
         QVERIFY(w_->messageLog()->toPlainText().contains("no-such-backend"));
         QVERIFY(waitRun(w_->runCulling())); // and cpu works again
-        QCOMPARE(QString::fromStdString(doc()->runOutput()->result.backend), QString("cpu"));
+        QCOMPARE(QString::fromStdString(doc()->runs().runOutput()->result.backend), QString("cpu"));
     }
 
     void undoRedoEveryEditKind() {
@@ -404,23 +404,23 @@ private slots:
         };
         check("move", [&] { doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(1, 0, 0), doc()->newDragId()); });
         check("property", [&] {
-            doc()->setSelectedLights({1});
+            doc()->selection().setSelectedLights({1});
             auto* spin = w_->propertyPanel()->findChild<QDoubleSpinBox*>("lightIntensity");
             spin->setValue(spin->value() + 2.5);
         });
         check("colour", [&] {
-            doc()->setSelectedLights({1});
+            doc()->selection().setSelectedLights({1});
             w_->propertyPanel()->pickColor = [](QWidget*, QColor) { return QColor(255, 0, 0); };
             w_->propertyPanel()->findChild<QPushButton*>("lightColor")->click();
             QCOMPARE(doc()->scene().lights[1].color, glm::dvec3(1, 0, 0));
         });
         check("add", [&] { w_->addLightAtCentre(); });
         check("duplicate", [&] {
-            doc()->setSelectedLights({0, 4});
+            doc()->selection().setSelectedLights({0, 4});
             w_->action("actionDuplicate")->trigger();
         });
         check("delete", [&] {
-            doc()->setSelectedLights({1, 3, 7});
+            doc()->selection().setSelectedLights({1, 3, 7});
             const std::string l2 = doc()->scene().lights[2].name;
             w_->action("actionDelete")->trigger();
             QCOMPARE(doc()->scene().lights[1].name, l2);
@@ -431,7 +431,7 @@ private slots:
             QCOMPARE(doc()->scene().lights.size(), n + 1000);
         });
         check("camera", [&] {
-            doc()->selectCamera();
+            doc()->selection().selectCamera();
             auto* fov = w_->propertyPanel()->findChild<QDoubleSpinBox*>("cameraFov");
             fov->setValue(fov->value() - 10);
         });
@@ -568,24 +568,24 @@ private slots:
             last = w_->runCulling();
         }
         QVERIFY(waitRun(last));
-        QCOMPARE(doc()->runGeneration(), last);
+        QCOMPARE(doc()->runs().runGeneration(), last);
         QTest::qWait(100);
         // Every request either ran or was replaced while still queued.
         QCOMPARE(quint64(finished.size()) + w_->cullService()->worker()->droppedRequests(), quint64(6));
         // A late, older result is not shown over the newer one.
-        QVERIFY(!doc()->setRunOutput(doc()->runOutput(), last - 1));
-        QCOMPARE(doc()->runGeneration(), last);
+        QVERIFY(!doc()->runs().setRunOutput(doc()->runs().runOutput(), last - 1));
+        QCOMPARE(doc()->runs().runGeneration(), last);
     }
 
     void liveModeRerunsAfterEdit() {
         openSmall();
-        const quint64 gen = doc()->runGeneration();
+        const quint64 gen = doc()->runs().runGeneration();
         w_->setLive(true);
         QVERIFY(waitRun(gen + 1)); // turning Live on runs once
-        const quint64 g2 = doc()->runGeneration();
+        const quint64 g2 = doc()->runs().runGeneration();
         doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(0, 0.5, 0), doc()->newDragId());
         QVERIFY(waitRun(g2 + 1));
-        QCOMPARE(doc()->runOutput()->lights.centers.size(), doc()->scene().lights.size());
+        QCOMPARE(doc()->runs().runOutput()->lights.centers.size(), doc()->scene().lights.size());
         w_->setLive(false);
     }
 
@@ -632,7 +632,7 @@ private slots:
     // the field shows the old value and the log says why.
     void anInvalidCameraEditIsRefused() {
         openSmall();
-        doc()->selectCamera();
+        doc()->selection().selectCamera();
         auto* panel = w_->findChild<PropertyPanel*>();
         QVERIFY(panel);
         QSignalSpy refused(panel, &PropertyPanel::editRefused);
@@ -665,7 +665,7 @@ private slots:
         for (const char* scene : {"sky", "atrium"}) {
             openSmall(scene);
             double top = 0;
-            for (double v : lc::tileHeat(*doc()->runOutput(), lc::HeatMode::ListLength))
+            for (double v : lc::tileHeat(*doc()->runs().runOutput(), lc::HeatMode::ListLength))
                 if (!std::isnan(v)) top = std::max(top, v);
             top = std::max(top, 1.0);
             vtkScalarBarActor* legend = w_->cameraView()->legend();
@@ -682,7 +682,7 @@ private slots:
     // 0.0004 cd) can be typed in: the field keeps six decimals.
     void smallIntensitiesCanBeTyped() {
         openSmall();
-        doc()->setSelectedLights({0});
+        doc()->selection().setSelectedLights({0});
         auto* panel = w_->findChild<PropertyPanel*>();
         auto* intensity = panel->findChild<QDoubleSpinBox*>("lightIntensity");
         QVERIFY(intensity);
@@ -699,7 +699,7 @@ private slots:
         std::set<std::string> names;
         for (const auto& l : doc()->scene().lights) names.insert(l.name);
         QCOMPARE(names.size(), before + 30);
-        doc()->setSelectedLights({0});
+        doc()->selection().setSelectedLights({0});
         auto* panel = w_->findChild<PropertyPanel*>();
         QSignalSpy refused(panel, &PropertyPanel::editRefused);
         auto* name = panel->findChild<QLineEdit*>("lightName");
@@ -716,7 +716,7 @@ private slots:
     // scene edit (the field's own text undo took it, and nothing happened).
     void ctrlZInAFieldUndoesTheEdit() {
         openSmall();
-        doc()->setSelectedLights({0});
+        doc()->selection().setSelectedLights({0});
         auto* panel = w_->findChild<PropertyPanel*>();
         auto* intensity = panel->findChild<QDoubleSpinBox*>("lightIntensity");
         const double before = doc()->scene().lights[0].intensity;
@@ -755,7 +755,7 @@ private slots:
     // 1e-6 and the radius to 2 km).
     void theWheelScrollsThePropertiesUntilAFieldHasFocus() {
         openSmall();
-        doc()->setSelectedLights({0});
+        doc()->selection().setSelectedLights({0});
         auto* panel = w_->findChild<PropertyPanel*>();
         auto* minIntensity = panel->findChild<QDoubleSpinBox*>("lightMinIntensity");
         QVERIFY(minIntensity);
@@ -815,43 +815,43 @@ private slots:
     // skipped and the status bar says so); a camera edit renders depth again.
     void liveLightMoveReusesDepthCameraEditDoesNot() {
         openSmall();
-        const quint64 gen = doc()->runGeneration();
-        QVERIFY(!doc()->runOutput()->depthReused);
+        const quint64 gen = doc()->runs().runGeneration();
+        QVERIFY(!doc()->runs().runOutput()->depthReused);
         // The run that rendered depth says how many triangles it drew (the CPU
         // rasteriser: all), in its result and in the message log.
         const std::size_t triangles = doc()->scene().triangleCount();
-        QCOMPARE(doc()->runOutput()->result.depthTriangles, triangles);
-        QCOMPARE(doc()->runOutput()->result.depthTrianglesDrawn, triangles);
+        QCOMPARE(doc()->runs().runOutput()->result.depthTriangles, triangles);
+        QCOMPARE(doc()->runs().runOutput()->result.depthTrianglesDrawn, triangles);
         QVERIFY(w_->messageLog()->toPlainText().contains(QString("(%1 of %1 triangles)").arg(triangles)));
         w_->setLive(true);
         QVERIFY(waitRun(gen + 1));
-        const std::vector<float> depth = doc()->runOutput()->depth.depth;
+        const std::vector<float> depth = doc()->runs().runOutput()->depth.depth;
         doc()->moveLight(1, doc()->scene().lights[1].position + glm::dvec3(0.5, 0, 0), doc()->newDragId());
         QVERIFY(waitRun(gen + 2));
-        QVERIFY(doc()->runOutput()->depthReused);
-        QCOMPARE(doc()->runOutput()->result.depthTriangles, std::size_t(0));
-        QVERIFY(doc()->runOutput()->depth.depth == depth);
+        QVERIFY(doc()->runs().runOutput()->depthReused);
+        QCOMPARE(doc()->runs().runOutput()->result.depthTriangles, std::size_t(0));
+        QVERIFY(doc()->runs().runOutput()->depth.depth == depth);
         bool saysReused = false;
         for (QLabel* l : w_->statusBar()->findChildren<QLabel*>())
             saysReused = saysReused || l->text().startsWith("depth reused");
         QVERIFY(saysReused);
         // The log says so too (not "depth 0.00 ms"), once the truth is in, and
         // the run knows whose depth it culled against (summary.json's depth_source).
-        QTRY_VERIFY(doc()->runOutput()->truthComputed);
+        QTRY_VERIFY(doc()->runs().runOutput()->truthComputed);
         const QString log = w_->messageLog()->toPlainText();
         const QString last = log.section('\n', -1);
         QVERIFY2(last.contains("depth reused (camera and meshes unchanged)"), qPrintable(last));
-        QVERIFY2(QString::fromStdString(doc()->runOutput()->depthFrom)
+        QVERIFY2(QString::fromStdString(doc()->runs().runOutput()->depthFrom)
                      .startsWith("the previous run's pre-pass on cpu ("),
-                 doc()->runOutput()->depthFrom.c_str());
-        QVERIFY(QString::fromStdString(doc()->runOutput()->depthFrom).endsWith("(camera and meshes unchanged)"));
+                 doc()->runs().runOutput()->depthFrom.c_str());
+        QVERIFY(QString::fromStdString(doc()->runs().runOutput()->depthFrom).endsWith("(camera and meshes unchanged)"));
 
         lc::Camera c = doc()->scene().camera;
         c.position += glm::dvec3(0.0, 0.5, 0.0);
         doc()->setCamera(c);
         QVERIFY(waitRun(gen + 3));
-        QVERIFY(!doc()->runOutput()->depthReused);
-        QVERIFY(doc()->runOutput()->depth.depth != depth);
+        QVERIFY(!doc()->runs().runOutput()->depthReused);
+        QVERIFY(doc()->runs().runOutput()->depth.depth != depth);
         w_->setLive(false);
     }
 
@@ -860,11 +860,11 @@ private slots:
     void liveEditShowsListsThenGroundTruth() {
         openSmall();
         w_->setLive(true);
-        QVERIFY(waitRun(doc()->runGeneration() + 1));
+        QVERIFY(waitRun(doc()->runs().runGeneration() + 1));
         QSignalSpy finished(w_->cullService(), &CullService::finished);
         doc()->moveLight(2, doc()->scene().lights[2].position + glm::dvec3(0, 0.4, 0), doc()->newDragId());
         const quint64 g = w_->cullService()->lastGeneration();
-        QTRY_VERIFY_WITH_TIMEOUT(doc()->runGeneration() == g && doc()->runOutput()->truthComputed, 60000);
+        QTRY_VERIFY_WITH_TIMEOUT(doc()->runs().runGeneration() == g && doc()->runs().runOutput()->truthComputed, 60000);
         std::vector<std::shared_ptr<const lc::RunOutput>> ofG;
         for (const auto& args : finished)
             if (args.at(0).value<quint64>() == g)
@@ -888,7 +888,7 @@ private slots:
         iv->renderNow();
         const QPoint centre(iv->width() / 2, iv->height() / 2);
         glm::dvec3 hit, normal;
-        doc()->setSelectedLights({});
+        doc()->selection().setSelectedLights({});
         // Aim at the mesh, not at a light sphere: hide none, the picker ignores spheres here.
         QVERIFY(iv->pickSurface(centre, &hit, &normal));
         const int n = int(doc()->scene().lights.size());
@@ -897,7 +897,7 @@ private slots:
         const auto [lo, hi] = doc()->scene().bounds();
         const double dist = glm::length(doc()->scene().lights[std::size_t(added)].position - hit);
         QVERIFY2(dist <= 0.011 * glm::length(hi - lo), qPrintable(QString::number(dist)));
-        QCOMPARE(doc()->selectedLights(), std::vector<int>{added});
+        QCOMPARE(doc()->selection().selectedLights(), std::vector<int>{added});
         // Outside the view: the scene centre.
         const int atCentre = w_->addLightAtCentre();
         QCOMPARE(doc()->scene().lights[std::size_t(atCentre)].position, 0.5 * (lo + hi));
@@ -961,8 +961,8 @@ private slots:
         QVERIFY(w_->saveAs(path));
         QVERIFY(w_->close());
         w_ = std::make_unique<MainWindow>();
-        QVERIFY(doc()->settings().algorithm == lc::Algorithm::HalfZ);
-        QCOMPARE(doc()->settings().cells, 8u);
+        QVERIFY(doc()->runs().settings().algorithm == lc::Algorithm::HalfZ);
+        QCOMPARE(doc()->runs().settings().cells, 8u);
         QVERIFY(w_->action("actionTabbedViews")->isChecked());
         bool listed = false;
         for (QAction* a : w_->findChildren<QAction*>())
@@ -1074,7 +1074,7 @@ private slots:
         for (int i = 0; i < 3; ++i) view->renderNow();
         qInfo("inspector view %dx%d, %zu light spheres in one glyph actor: %.0f ms per frame (Xvfb, llvmpipe)",
               view->width(), view->height(), doc()->scene().lights.size(), t.elapsed() / 3.0);
-        QVERIFY(doc()->selectedLights().empty()); // a generated cloud is not selected wholesale
+        QVERIFY(doc()->selection().selectedLights().empty()); // a generated cloud is not selected wholesale
         // Picking a light through the glyph maps back to the light index: aim
         // at a light's centre; the hit lies on the picked light's sphere (the
         // 12x8 facets sit up to 8% inside it).

@@ -13,6 +13,15 @@ namespace lcui {
 
 Document::Document(QObject* parent) : QObject(parent) {
     connect(&undo_, &QUndoStack::cleanChanged, this, [this](bool clean) { emit dirtyChanged(!clean); });
+    // First receivers: the new run's receivers see no list picked from the
+    // old one, and no explanation of an earlier selection or run.
+    connect(&runs_, &RunState::generationChanging, this, [this] { selection_.forgetExplainedList(); });
+    const auto forget = [this] { explained_.invalidate(); };
+    connect(&selection_, &Selection::changed, this, forget);
+    connect(&selection_, &Selection::tileChanged, this, forget);
+    connect(&runs_, &RunState::runOutputChanged, this, forget);
+    connect(&runs_, &RunState::runWentStale, this, forget);
+    connect(this, &Document::sceneEdited, this, forget);
 }
 
 void Document::resetScene(lc::Scene scene, const QString& path) {
@@ -21,16 +30,15 @@ void Document::resetScene(lc::Scene scene, const QString& path) {
     undo_.clear();
     undo_.setClean();
     filePath_ = path;
-    selectedLights_.clear();
-    cameraSelected_ = false;
-    selectedTile_ = -1;
-    selectedCell_ = -1;
-    explainedList_ = -1;
-    run_.reset();
+    // Every part reset before anyone hears of it: no receiver sees a
+    // selection or run of the old scene beside the new one.
+    selection_.reset();
+    runs_.resetRun();
+    explained_.invalidate();
     emit sceneReset();
-    emit selectionChanged();
-    emit tileSelectionChanged(-1);
-    emit runOutputChanged();
+    emit selection_.changed();
+    emit selection_.tileChanged(-1);
+    emit runs_.runOutputChanged();
     emit filePathChanged(path);
     emit dirtyChanged(false);
     edited();
@@ -49,55 +57,6 @@ void Document::markSaved(const QString& path) {
     undo_.setClean();
     emit filePathChanged(path);
     emit dirtyChanged(false);
-}
-
-void Document::setSettings(const lc::CullSettings& s) {
-    settings_ = s;
-    emit settingsChanged();
-}
-
-void Document::setSelectedLights(std::vector<int> lights) {
-    const int n = int(scene_.lights.size());
-    lights.erase(std::remove_if(lights.begin(), lights.end(), [n](int i) { return i < 0 || i >= n; }),
-                 lights.end());
-    // Deduplicate keeping the order: the last one is the current light.
-    std::vector<int> unique;
-    for (int i : lights)
-        if (std::find(unique.begin(), unique.end(), i) == unique.end()) unique.push_back(i);
-    lights = std::move(unique);
-    if (lights == selectedLights_ && !cameraSelected_) return;
-    lightSelectedLast_ = !lights.empty();
-    selectedLights_ = std::move(lights);
-    cameraSelected_ = false;
-    emit selectionChanged();
-}
-
-void Document::selectCamera() {
-    selectedLights_.clear();
-    cameraSelected_ = true;
-    emit selectionChanged();
-}
-
-void Document::setSelectedTile(int tile) {
-    if (tile == selectedTile_) return;
-    selectedTile_ = tile;
-    if (tile >= 0) lightSelectedLast_ = false;
-    selectedCell_ = -1;
-    explainedList_ = -1;
-    emit tileSelectionChanged(tile);
-}
-
-void Document::setSelectedCell(int cell) {
-    if (cell == selectedCell_) return;
-    selectedCell_ = cell;
-    explainedList_ = -1;
-    emit tileSelectionChanged(selectedTile_);
-}
-
-void Document::setOverlays(const OverlayOptions& o) {
-    if (o == overlays_) return;
-    overlays_ = o;
-    emit overlaysChanged();
 }
 
 void Document::moveLight(int index, const glm::dvec3& position, int dragId) {
@@ -155,40 +114,10 @@ void Document::setCamera(const lc::Camera& camera, const QString& text) {
 
 void Document::importMesh(lc::Mesh mesh) { undo_.push(new AddMeshCommand(this, std::move(mesh))); }
 
-bool Document::setRunOutput(std::shared_ptr<const lc::RunOutput> run, quint64 generation) {
-    if (generation < runGeneration_) return false;
-    // A run nobody noted (a test's) counts as made from the scene as it is.
-    runRevision_ = sceneRevision_;
-    for (const auto& [g, revision] : pending_)
-        if (g == generation) runRevision_ = revision;
-    // A generation answers twice (lists, then truth); older ones never will.
-    std::erase_if(pending_, [generation](const auto& p) { return p.first < generation; });
-    if (generation != runGeneration_) explainedList_ = -1;
-    run_ = std::move(run);
-    runGeneration_ = generation;
-    emit runOutputChanged();
-    return true;
-}
-
 void Document::edited() {
-    ++sceneRevision_;
+    runs_.noteSceneEdit();
     emit sceneEdited();
-    // After every receiver: a Live re-run asked for by one of them is on its way.
-    if (runIsStale()) emit runWentStale();
-}
-
-void Document::noteRunRequested(quint64 generation) { pending_.emplace_back(generation, sceneRevision_); }
-
-void Document::noteRunFailed(quint64 generation) {
-    std::erase_if(pending_, [generation](const auto& p) { return p.first == generation; });
-    if (runIsStale()) emit runWentStale(); // the scene may now be without a run on its way
-}
-
-bool Document::runIsStale() const {
-    if (!run_ || runRevision_ == sceneRevision_) return false;
-    for (const auto& p : pending_)
-        if (p.second == sceneRevision_) return false;
-    return true;
+    runs_.afterSceneEdit();
 }
 
 int Document::setGltfCutoff(double lux) {
@@ -205,12 +134,6 @@ void Document::applyGltfCutoff(const std::vector<int>& lights, double lux) {
     scene_.origin.gltfMinIntensity = lux;
     emit lightsChanged();
     edited();
-}
-
-void Document::setExplainedList(int list) {
-    if (list == explainedList_) return;
-    explainedList_ = list;
-    emit selectionChanged();
 }
 
 // --- applied by the commands --------------------------------------------------
@@ -238,28 +161,29 @@ void Document::applyInsertLights(const std::vector<int>& indices,
     // Ascending final indices: inserting in order puts each light exactly there.
     for (std::size_t k = 0; k < indices.size(); ++k)
         scene_.lights.insert(scene_.lights.begin() + indices[k], lights[k]);
-    selectedLights_ = select ? indices : std::vector<int>{};
-    cameraSelected_ = false;
+    selection_.replaceLights(select ? indices : std::vector<int>{}, true);
+    explained_.invalidate();
     emit lightsChanged();
-    emit selectionChanged();
+    emit selection_.changed();
     edited();
 }
 
 void Document::applyRemoveLights(const std::vector<int>& indices) {
     for (auto it = indices.rbegin(); it != indices.rend(); ++it)
         scene_.lights.erase(scene_.lights.begin() + *it);
-    selectedLights_.clear();
+    selection_.replaceLights({}, false);
+    explained_.invalidate();
     emit lightsChanged();
-    emit selectionChanged();
+    emit selection_.changed();
     edited();
 }
 
 void Document::applyCamera(const lc::Camera& c) {
     scene_.camera = c;
-    selectedTile_ = -1;
-    selectedCell_ = -1;
+    selection_.clearTile();
+    explained_.invalidate();
     emit cameraChanged();
-    emit tileSelectionChanged(-1);
+    emit selection_.tileChanged(-1);
     edited();
 }
 

@@ -1,12 +1,18 @@
 #pragma once
-// The studio's central document: the scene being edited, the selection, the
-// file it came from, the culling settings and the latest finished culling run.
-// Panels and views observe it through signals; every edit of the scene goes
-// through its QUndoStack (the public edit functions below push commands).
+// The studio's central document: the scene being edited with its undo stack
+// and the file it came from. Its three other parts are objects of their own,
+// each with its signals: the selection (selection.hpp), how the views show it
+// (view_options.hpp) and what to cull and what came back (run_state.hpp). The
+// Document keeps them consistent with the scene (a new scene clears the
+// selection and the run; removed lights leave the selection; every edit is
+// counted for the run's staleness). Every edit of the scene goes through the
+// QUndoStack (the public edit functions below push commands).
 
-#include "culling/diagnostics/overlays.hpp"
-#include "culling/core/params.hpp"
-#include "culling/core/pipeline.hpp"
+#include "document/explained_selection.hpp"
+#include "document/run_state.hpp"
+#include "document/selection.hpp"
+#include "document/view_options.hpp"
+
 #include "culling/scene/scene.hpp"
 
 #include <QObject>
@@ -36,64 +42,22 @@ public:
     // Unsaved edits: the undo stack is not at its clean index.
     bool isDirty() const { return !undo_.isClean(); }
     // Replaces the whole scene (New, Open, built-in picker): clears the undo
-    // stack, the selection and the last result. Not undoable by design (the
+    // stack, the selection and the shown run. Not undoable by design (the
     // unsaved-changes prompt guards it).
     void resetScene(lc::Scene scene, const QString& path);
     // Marks the current state as saved under `path`.
     void markSaved(const QString& path);
 
-    // --- culling settings (not part of the scene, not undoable) --------------
-    const lc::CullSettings& settings() const { return settings_; }
-    void setSettings(const lc::CullSettings& s);
-
-    // --- selection ----------------------------------------------------------
-    // Selected light indices in selection order; currentLight(): the last one
-    // (what the property panel and the drag handle act on), or -1.
-    const std::vector<int>& selectedLights() const { return selectedLights_; }
-    int currentLight() const { return selectedLights_.empty() ? -1 : selectedLights_.back(); }
-    void setSelectedLights(std::vector<int> lights);
-    bool cameraSelected() const { return cameraSelected_; }
-    void selectCamera();
-    // Tile of the culling grid selected in the camera view (-1: none).
-    int selectedTile() const { return selectedTile_; }
-    void setSelectedTile(int tile);
-    // Whether the current light was picked after the selected tile (Frame
-    // selected then frames the light, unless the tile lists it).
-    bool lightSelectedLast() const { return lightSelectedLast_; }
-
-    // Depth cell of the selected tile (tileCells order, -1: the whole tile).
-    // Emits tileSelectionChanged; selecting another tile clears it.
-    int selectedCell() const { return selectedCell_; }
-    void setSelectedCell(int cell);
-
-    // --- inspection overlays (view state: not part of the scene, not undoable)
-    struct OverlayOptions {
-        bool tileFrustum = true;      // the selected tile's frustum, translucent + outline
-        bool allTileFrustums = false; // every tile's frustum, one wireframe by list length
-        bool cells = true;            // 2.5d cells, halfz split, clustered froxels
-        bool lightCellRange = true;   // cells the current light's sphere spans
-        bool listHighlight = true;    // listed lights highlighted, others dimmed, missing red
-        bool reverseLookup = true;    // tiles whose lists hold the current light
-        bool explainMarkers = true;   // Explain in 3D: the deciding plane, the nearest or needing pixel
-        lc::HeatMode heat = lc::HeatMode::ListLength;
-        // The inspector inside a building (View > Meshes, View > Lights; docs/STUDIO.md):
-        // meshes drawn as they are, translucent without depth writes (x-ray:
-        // they hide and block nothing), or not at all.
-        enum class MeshDisplay { Normal, XRay, Hidden };
-        MeshDisplay meshes = MeshDisplay::Normal;
-        // Lights: filled spheres up to sphereCap and silhouette rings above it
-        // (Auto), spheres only (at most sphereCap, "+N more" for the rest), or
-        // rings only. showLights hides them and the spot cones together;
-        // onlyTileLights draws only the selected tile's (cell's) listed lights.
-        enum class LightDisplay { Auto, Spheres, Outlines };
-        LightDisplay lights = LightDisplay::Auto;
-        bool showLights = true;
-        bool onlyTileLights = false;
-        int sphereCap = 256;
-        bool operator==(const OverlayOptions&) const = default;
-    };
-    const OverlayOptions& overlays() const { return overlays_; }
-    void setOverlays(const OverlayOptions& o);
+    // --- the document's other parts ---------------------------------------------
+    Selection& selection() { return selection_; }
+    const Selection& selection() const { return selection_; }
+    ViewOptions& viewOptions() { return view_; }
+    const ViewOptions& viewOptions() const { return view_; }
+    RunState& runs() { return runs_; }
+    const RunState& runs() const { return runs_; }
+    // The explanation of the selection in the shown run (explained_selection.hpp),
+    // worked out once per selection and run.
+    const ExplainedSelection::Result& explained() const { return explained_.of(*this); }
 
     // --- edits: each pushes one undo command ----------------------------------
     // A light drag: every call with the same `dragId` for the same light merges
@@ -116,31 +80,6 @@ public:
     int setGltfCutoff(double lux);
     void importMesh(lc::Mesh mesh);
 
-    // --- latest culling run ----------------------------------------------------
-    // The newest finished run, or null. `generation` is the request number the
-    // worker answered; older generations than the one shown are dropped.
-    std::shared_ptr<const lc::RunOutput> runOutput() const { return run_; }
-    quint64 runGeneration() const { return runGeneration_; }
-    // Returns false (and ignores it) when `generation` is older than the shown one.
-    bool setRunOutput(std::shared_ptr<const lc::RunOutput> run, quint64 generation);
-    // A run asked for the scene as it is now (its result, when it comes,
-    // belongs to this scene), or that run failed.
-    void noteRunRequested(quint64 generation);
-    void noteRunFailed(quint64 generation);
-    // The shown run was made from an earlier scene (an edit since), and no run
-    // of the scene as it is now is on its way: its lists, truth and light
-    // indices no longer describe the scene, so what reads them per light (the
-    // tile inspector, Explain, the export) must not. A Live edit's run is on
-    // its way at once, so Live does not go stale.
-    bool runIsStale() const;
-
-    // The list the user picked for Explain (a tile inspector row: halfz and
-    // clustered tiles have several), or -1: the panel then takes the tile's
-    // first list that holds or needs the current light. Cleared with the tile
-    // or cell selection and by a new run.
-    int explainedList() const { return explainedList_; }
-    void setExplainedList(int list);
-
     // --- used by the undo commands only --------------------------------------
     void applyLightPosition(int index, const glm::dvec3& p);
     void applyLight(int index, const lc::PointLight& l);
@@ -159,15 +98,7 @@ signals:
     void lightChanged(int index);   // one light's values changed
     void cameraChanged();
     void meshesChanged();
-    void selectionChanged();
-    void tileSelectionChanged(int tile); // also when the selected cell changes
-    void overlaysChanged();
-    void settingsChanged();
     void sceneEdited();             // any scene edit (for Live re-runs)
-    // The shown run became stale (runIsStale): after an edit's receivers
-    // have all run, or when the run asked for the scene as it is failed.
-    void runWentStale();
-    void runOutputChanged();
     void filePathChanged(const QString& path);
     void dirtyChanged(bool dirty);
 
@@ -177,23 +108,13 @@ private:
 
     lc::Scene scene_;
     quint64 geometryRevision_ = 1;
-    lc::CullSettings settings_;
     QUndoStack undo_;
     QString filePath_;
-    std::vector<int> selectedLights_;
-    bool cameraSelected_ = false;
-    int selectedTile_ = -1;
-    bool lightSelectedLast_ = false;
-    int selectedCell_ = -1;
-    OverlayOptions overlays_;
     int dragCounter_ = 0;
-    std::shared_ptr<const lc::RunOutput> run_;
-    quint64 runGeneration_ = 0;
-    // Scene edits counted (edited()), the count the shown run was
-    // asked for, and the runs asked for and not yet answered.
-    quint64 sceneRevision_ = 0, runRevision_ = 0;
-    std::vector<std::pair<quint64, quint64>> pending_; // generation, scene revision
-    int explainedList_ = -1;
+    Selection selection_{scene_};
+    ViewOptions view_;
+    RunState runs_;
+    mutable ExplainedSelection explained_;
 };
 
 } // namespace lcui

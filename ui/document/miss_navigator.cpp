@@ -19,9 +19,9 @@ MissNavigator::MissNavigator(Document* doc, QObject* parent) : QObject(parent), 
     previous_->setToolTip(tr("Select the previous miss (Shift+F8)"));
     connect(next_, &QAction::triggered, this, [this] { step(+1); });
     connect(previous_, &QAction::triggered, this, [this] { step(-1); });
-    connect(doc_, &Document::runOutputChanged, this, &MissNavigator::forget);
+    connect(&doc_->runs(), &RunState::runOutputChanged, this, &MissNavigator::forget);
     connect(doc_, &Document::sceneReset, this, &MissNavigator::forget);
-    connect(doc_, &Document::runWentStale, this, &MissNavigator::forget);
+    connect(&doc_->runs(), &RunState::runWentStale, this, &MissNavigator::forget);
 }
 
 void MissNavigator::forget() {
@@ -31,8 +31,8 @@ void MissNavigator::forget() {
 }
 
 const std::vector<lc::MissedLight>& MissNavigator::misses() {
-    const auto run = doc_->runOutput();
-    if (!located_ && run && run->truthComputed && !doc_->runIsStale()) {
+    const auto run = doc_->runs().runOutput();
+    if (!located_ && run && run->truthComputed && !doc_->runs().runIsStale()) {
         misses_ = lc::locateFalseNegatives(*run, lc::Projection(doc_->scene().camera));
         located_ = true;
     }
@@ -40,12 +40,12 @@ const std::vector<lc::MissedLight>& MissNavigator::misses() {
 }
 
 bool MissNavigator::step(int delta) {
-    const auto run = doc_->runOutput();
+    const auto run = doc_->runs().runOutput();
     if (!run) {
         emit message(tr("no culling run yet (F5): no misses to show"));
         return false;
     }
-    if (doc_->runIsStale()) {
+    if (doc_->runs().runIsStale()) {
         emit message(tr("the scene changed since the last run: run it again (F5) to find its misses"));
         return false;
     }
@@ -62,9 +62,9 @@ bool MissNavigator::step(int delta) {
     current_ = current_ < 0 ? (delta >= 0 ? 0 : n - 1) : ((current_ + delta) % n + n) % n;
     const lc::MissedLight& m = all[std::size_t(current_)];
     const lc::TileGrid& g = run->result.grid;
-    doc_->setSelectedTile(int(m.tile));
-    doc_->setSelectedLights({int(m.light)});
-    doc_->setExplainedList(int(m.list));
+    doc_->selection().setSelectedTile(int(m.tile));
+    doc_->selection().setSelectedLights({int(m.light)});
+    doc_->selection().setExplainedList(int(m.list));
     const auto& lights = doc_->scene().lights;
     const QString name = m.light < lights.size() ? QString::fromStdString(lights[m.light].name) : QString();
     emit message(tr("miss %1 of %2: light %3 '%4' in tile %5,%6 (list %7), %8 %9; cause: %10")

@@ -2,7 +2,8 @@
 // The Explain panel: for the selected tile (or cell) and the current light,
 // why the light is or is not in that list (lc::explainLight): the
 // algorithm's tests with their numbers, and the ground truth of the list's
-// pixels. Follows the document's selection and latest run.
+// pixels. Follows the document's selection and latest run; the explanation
+// is the document's (explained_selection.hpp).
 
 #include "culling/diagnostics/explain.hpp"
 
@@ -16,12 +17,6 @@ class QPlainTextEdit;
 namespace lcui {
 
 class Document;
-
-// The explanation of the document's selection: the selected tile (its
-// selected cell, or its first list when it has several and none is
-// selected) and the current light, in the latest run once its ground truth
-// is in. nullopt when something is missing; throws what lc::explainLight throws.
-std::optional<lc::Explanation> explainSelection(const Document& doc);
 
 class ExplainPanel : public QWidget {
     Q_OBJECT

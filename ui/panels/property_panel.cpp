@@ -185,9 +185,9 @@ PropertyPanel::PropertyPanel(Document* doc, QWidget* parent) : QWidget(parent), 
     connect(projection_, qOverload<int>(&QComboBox::currentIndexChanged), this, &PropertyPanel::commitCamera);
     connect(farInfinite_, &QCheckBox::toggled, this, &PropertyPanel::commitCamera);
 
-    connect(doc_, &Document::selectionChanged, this, &PropertyPanel::refresh);
+    connect(&doc_->selection(), &Selection::changed, this, &PropertyPanel::refresh);
     connect(doc_, &Document::lightChanged, this, [this](int i) {
-        if (i == doc_->currentLight()) refresh();
+        if (i == doc_->selection().currentLight()) refresh();
     });
     connect(doc_, &Document::lightsChanged, this, &PropertyPanel::refresh);
     connect(doc_, &Document::cameraChanged, this, &PropertyPanel::refresh);
@@ -200,7 +200,7 @@ PropertyPanel::PropertyPanel(Document* doc, QWidget* parent) : QWidget(parent), 
 void PropertyPanel::refresh() {
     updating_ = true;
     const auto& s = doc_->scene();
-    const int cur = doc_->currentLight();
+    const int cur = doc_->selection().currentLight();
     if (cur >= 0 && cur < int(s.lights.size())) {
         const auto& l = s.lights[std::size_t(cur)];
         stack_->setCurrentIndex(1);
@@ -220,7 +220,7 @@ void PropertyPanel::refresh() {
         const std::string err = l.validate();
         radius_->setText(err.empty() ? QString::number(l.radius(), 'g', 6)
                                      : tr("invalid: %1").arg(QString::fromStdString(err)));
-    } else if (doc_->cameraSelected()) {
+    } else if (doc_->selection().cameraSelected()) {
         const auto& c = s.camera;
         stack_->setCurrentIndex(2);
         for (int i = 0; i < 3; ++i) {
@@ -246,7 +246,7 @@ void PropertyPanel::refresh() {
 
 void PropertyPanel::commitLight() {
     if (updating_) return;
-    const int cur = doc_->currentLight();
+    const int cur = doc_->selection().currentLight();
     if (cur < 0 || cur >= int(doc_->scene().lights.size())) return;
     lc::PointLight l = doc_->scene().lights[std::size_t(cur)];
     const lc::PointLight before = l;

@@ -25,8 +25,8 @@ SceneTree::SceneTree(Document* doc, QWidget* parent) : QTreeView(parent), doc_(d
         syncFromDocument();
     });
     connect(doc_, &Document::lightChanged, this, &SceneTree::updateLightRow);
-    connect(doc_, &Document::selectionChanged, this, &SceneTree::syncFromDocument);
-    connect(doc_, &Document::runOutputChanged, this, [this] {
+    connect(&doc_->selection(), &Selection::changed, this, &SceneTree::syncFromDocument);
+    connect(&doc_->runs(), &RunState::runOutputChanged, this, [this] {
         if (sort_ == LightSort::TilesReached) setLightSort(sort_); // the counts changed
     });
 }
@@ -96,7 +96,7 @@ void SceneTree::rebuildLights() {
         std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) { return r[std::size_t(a)] > r[std::size_t(b)]; });
     } else if (sort_ == LightSort::TilesReached) {
         std::vector<std::size_t> tiles(lights.size(), 0);
-        if (const auto run = doc_->runOutput(); run && run->result.algorithm != lc::Algorithm::All) {
+        if (const auto run = doc_->runs().runOutput(); run && run->result.algorithm != lc::Algorithm::All) {
             // One pass over the lists: each light's distinct tiles.
             const auto& res = run->result;
             std::vector<std::uint32_t> lastTile(lights.size(), UINT32_MAX);
@@ -140,13 +140,13 @@ void SceneTree::syncFromDocument() {
     if (syncing_) return;
     syncing_ = true;
     QItemSelection sel;
-    for (int i : doc_->selectedLights()) {
+    for (int i : doc_->selection().selectedLights()) {
         const QModelIndex idx = lightIndex(i);
         if (idx.isValid()) sel.select(idx, idx);
     }
-    if (doc_->cameraSelected() && camera_) sel.select(camera_->index(), camera_->index());
+    if (doc_->selection().cameraSelected() && camera_) sel.select(camera_->index(), camera_->index());
     selectionModel()->select(sel, QItemSelectionModel::ClearAndSelect);
-    if (!doc_->selectedLights().empty()) scrollTo(lightIndex(doc_->currentLight()));
+    if (!doc_->selection().selectedLights().empty()) scrollTo(lightIndex(doc_->selection().currentLight()));
     syncing_ = false;
 }
 
@@ -167,8 +167,8 @@ void SceneTree::syncToDocument() {
         std::erase(lights, c);
         lights.push_back(c);
     }
-    if (lights.empty() && camera) doc_->selectCamera();
-    else doc_->setSelectedLights(lights);
+    if (lights.empty() && camera) doc_->selection().selectCamera();
+    else doc_->selection().setSelectedLights(lights);
     syncing_ = false;
 }
 

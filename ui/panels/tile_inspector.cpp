@@ -103,27 +103,27 @@ TileInspector::TileInspector(Document* doc, QWidget* parent) : QWidget(parent), 
     l->addWidget(summary_);
     l->addWidget(verdictFilter_);
     l->addWidget(table_, 1);
-    connect(doc_, &Document::tileSelectionChanged, this, &TileInspector::refresh);
-    connect(doc_, &Document::runOutputChanged, this, &TileInspector::refresh);
-    connect(doc_, &Document::runWentStale, this, &TileInspector::refresh);
+    connect(&doc_->selection(), &Selection::tileChanged, this, &TileInspector::refresh);
+    connect(&doc_->runs(), &RunState::runOutputChanged, this, &TileInspector::refresh);
+    connect(&doc_->runs(), &RunState::runWentStale, this, &TileInspector::refresh);
     // The highlighted row follows the current light wherever it was chosen
     // (scene tree, 3D view, this table): a row left highlighted beside
     // Explain's text about another light misleads.
-    connect(doc_, &Document::selectionChanged, this, &TileInspector::showCurrentLight);
+    connect(&doc_->selection(), &Selection::changed, this, &TileInspector::showCurrentLight);
     connect(table_, &QTableView::doubleClicked, this, [this](const QModelIndex& shown) {
         const QModelIndex i = proxy_->mapToSource(shown);
         if (!i.isValid() || i.row() >= int(model_->rows().size())) return;
         const lc::TileLightRow& row = model_->rows()[std::size_t(i.row())];
         // The row's own list: a halfz or clustered tile has several.
-        doc_->setExplainedList(int(row.list));
-        doc_->setSelectedLights({int(row.light)});
+        doc_->selection().setExplainedList(int(row.list));
+        doc_->selection().setSelectedLights({int(row.light)});
     });
     refresh();
 }
 
 void TileInspector::showCurrentLight() {
-    const int light = doc_->currentLight();
-    const int list = doc_->explainedList();
+    const int light = doc_->selection().currentLight();
+    const int list = doc_->selection().explainedList();
     QItemSelectionModel* sel = table_->selectionModel();
     QModelIndex first;
     QItemSelection rows;
@@ -149,15 +149,15 @@ std::vector<int> TileInspector::listedLights() const {
 QString TileInspector::summaryText() const { return summary_->text(); }
 
 void TileInspector::refresh() {
-    const auto run = doc_->runOutput();
-    const int tile = doc_->selectedTile();
+    const auto run = doc_->runs().runOutput();
+    const int tile = doc_->selection().selectedTile();
     const lc::Camera& cam = doc_->scene().camera;
     if (!run || tile < 0 || std::uint32_t(tile) >= run->result.grid.tileCount()) {
         model_->setRows({}, run);
         summary_->setText(run ? tr("Click a tile in the camera view.") : tr("No culling run yet (F5)."));
         return;
     }
-    if (doc_->runIsStale()) {
+    if (doc_->runs().runIsStale()) {
         model_->setRows({}, run);
         summary_->setText(tr("The scene changed since the last run: run culling again (F5)."));
         summary_->setStyleSheet({});
@@ -169,7 +169,7 @@ void TileInspector::refresh() {
         return;
     }
     const lc::Projection proj(cam);
-    const int cell = doc_->selectedCell();
+    const int cell = doc_->selection().selectedCell();
     model_->setRows(lc::tileLightRows(*run, proj, std::uint32_t(tile), cell), run);
     // With one list per tile the list column only repeats the tile's index.
     table_->setColumnHidden(TileLightsModel::ColList, run->result.listsPerTile <= 1);

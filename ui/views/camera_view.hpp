@@ -144,6 +144,12 @@ protected:
     void resizeEvent(QResizeEvent* e) override;
 
 private:
+    // Empties an overlay's polydata but keeps a (empty) point set: the zoom's
+    // transform filter reports an error for polydata without one.
+    static void clearOverlay(vtkPolyData* pd);
+    // A scalar bar's title for its orientation: two short lines beside the
+    // image, one line under it.
+    static std::string barTitle(const std::string& twoLines, bool horizontal);
     bool renderPending_ = false;
     // Zoom and pan (setZoom); the overlay's normalised points go through
     // overlayTransform_ into the zoomed viewport.

@@ -244,7 +244,7 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
         rebuildMeshes();
         scheduleRender();
     });
-    connect(doc_, &Document::overlaysChanged, this, [this] {
+    connect(&doc_->viewOptions(), &ViewOptions::overlaysChanged, this, [this] {
         applyMeshDisplay();
         scheduleRender();
     });
@@ -258,7 +258,7 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
         updateSelection();
         scheduleRender();
     });
-    connect(doc_, &Document::selectionChanged, this, [this] {
+    connect(&doc_->selection(), &Selection::changed, this, [this] {
         updateSelection();
         scheduleRender();
     });
@@ -268,18 +268,17 @@ InspectorView::InspectorView(Document* doc, QWidget* parent)
         scheduleRender();
     });
     // A stale run's overlays go (the light indices they use may have moved).
-    for (auto sig : {&Document::runOutputChanged, &Document::overlaysChanged, &Document::selectionChanged,
-                     &Document::lightsChanged, &Document::runWentStale})
-        connect(doc_, sig, this, [this] {
-            refreshLightSet();
-            updateOverlays();
-            scheduleRender();
-        });
-    connect(doc_, &Document::tileSelectionChanged, this, [this] {
+    const auto refresh = [this] {
         refreshLightSet();
         updateOverlays();
         scheduleRender();
-    });
+    };
+    connect(&doc_->runs(), &RunState::runOutputChanged, this, refresh);
+    connect(&doc_->runs(), &RunState::runWentStale, this, refresh);
+    connect(&doc_->viewOptions(), &ViewOptions::overlaysChanged, this, refresh);
+    connect(&doc_->selection(), &Selection::changed, this, refresh);
+    connect(&doc_->selection(), &Selection::tileChanged, this, refresh);
+    connect(doc_, &Document::lightsChanged, this, refresh);
     rebuildMeshes();
     rebuildLights();
     updateFrustum();
@@ -298,11 +297,11 @@ void InspectorView::updateOverlays() {
     ringActor_->GetProperty()->SetOpacity(overlays_->dimLights() ? 0.15 * rings : rings);
     spotCones_->actor()->GetProperty()->SetOpacity(overlays_->dimLights() ? 0.25 : 1.0);
     // The note: which tile's lights are shown, and what the sphere cap left out.
-    const auto& ov = doc_->overlays();
+    const auto& ov = doc_->viewOptions().overlays();
     QStringList note;
     if (ov.showLights && ov.onlyTileLights) {
         if (drawnAreTileLights_)
-            note << tr("only tile %1's %2 listed lights").arg(doc_->selectedTile()).arg(drawn_.size() + leftOut_);
+            note << tr("only tile %1's %2 listed lights").arg(doc_->selection().selectedTile()).arg(drawn_.size() + leftOut_);
         else
             note << tr("only the selected tile's lights: select a tile (after a run)");
     }
@@ -337,333 +336,6 @@ void InspectorView::renderNow() {
     update();
 }
 
-void InspectorView::resetCamera() {
-    // Frame the meshes (not every light sphere: a generated cloud can be far
-    // larger than the scene) from above and to the side of the culling camera.
-    const auto [lo, hi] = doc_->scene().bounds();
-    const lc::Camera& c = doc_->scene().camera;
-    glm::dvec3 center = 0.5 * (lo + hi);
-    double diag = glm::length(hi - lo);
-    if (diag <= 0) {
-        center = c.target;
-        diag = std::max(1.0, glm::length(c.target - c.position));
-    }
-    glm::dvec3 dir = c.position - c.target;
-    if (glm::length(dir) < 1e-9) dir = {0, 0, 1};
-    dir = glm::normalize(dir);
-    const glm::dvec3 up = glm::normalize(c.up);
-    // Rotate 35 degrees around up and lift: the frustum is seen from outside.
-    const glm::dvec3 side = glm::normalize(glm::cross(up, dir));
-    glm::dvec3 eyeDir = glm::normalize(std::cos(0.6) * dir + std::sin(0.6) * side + 0.55 * up);
-    vtkCamera* vc = renderer_->GetActiveCamera();
-    vc->SetFocalPoint(center.x, center.y, center.z);
-    const glm::dvec3 eye = center + eyeDir * diag;
-    vc->SetPosition(eye.x, eye.y, eye.z);
-    vc->SetViewUp(up.x, up.y, up.z);
-    vc->SetViewAngle(30);
-    vc->ParallelProjectionOff();
-    // Keep the direction, move back until the scene and the culling camera's
-    // eye (the apex of the frustum) fit.
-    if (glm::length(hi - lo) > 0) {
-        const glm::dvec3 blo = glm::min(lo, c.position), bhi = glm::max(hi, c.position);
-        double b[6] = {blo.x, bhi.x, blo.y, bhi.y, blo.z, bhi.z};
-        renderer_->ResetCamera(b);
-        vc->Zoom(1.15); // ResetCamera frames the bounding sphere, which leaves a wide margin
-    }
-    renderer_->ResetCameraClippingRange();
-    cameraFramed_ = true;
-    renderNow();
-}
-
-std::pair<glm::dvec3, glm::dvec3> InspectorView::viewRay(const QPoint& pos) const {
-    const double dpr = devicePixelRatioF();
-    const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
-    auto worldAt = [&](double z) {
-        renderer_->SetDisplayPoint(x, y, z);
-        renderer_->DisplayToWorld();
-        double w[4];
-        renderer_->GetWorldPoint(w);
-        return glm::dvec3(w[0], w[1], w[2]) / (w[3] != 0.0 ? w[3] : 1.0);
-    };
-    return {worldAt(0.0), worldAt(1.0)};
-}
-
-bool InspectorView::frameSelected(int ms) {
-    // What to frame (world points, for the view basis they are seen in), the
-    // point to look from the culling camera's side at, and the points whose
-    // view must not be blocked: the chunk's near face centre and corners (the
-    // tile's nearest geometry lies on that face, and the culling camera sees
-    // them), or the light's centre and four points halfway to its sphere.
-    std::function<std::vector<glm::dvec3>(const ViewBasis&)> pointsFor;
-    std::function<std::vector<glm::dvec3>(const ViewBasis&)> samplesFor;
-    glm::dvec3 anchor(0.0);
-    double keepOutside = 0; // a light's radius: an eye inside its sphere sees only its wireframe
-    frameNote_.clear();
-    const auto run = doc_->runOutput();
-    const int tile = doc_->selectedTile();
-    // A light picked after the tile (the scene tree, a click in 3D) is what
-    // the user looks at now, unless the tile lists it (Explain's question:
-    // the tile's framing then takes in the light's nearest point).
-    bool lightFirst = false;
-    if (run && doc_->lightSelectedLast() && doc_->currentLight() >= 0 && tile >= 0 &&
-        std::uint32_t(tile) < run->result.grid.tileCount()) {
-        const auto held = lc::tilesHoldingLight(run->result, std::uint32_t(doc_->currentLight()));
-        lightFirst = std::find(held.begin(), held.end(), std::uint32_t(tile)) == held.end();
-    }
-    if (!lightFirst && run && tile >= 0 && std::uint32_t(tile) < run->result.grid.tileCount()) {
-        const lc::Projection proj(doc_->scene().camera);
-        std::optional<lc::FrustumChunk> chunk;
-        const int cell = doc_->selectedCell();
-        if (cell >= 0)
-            for (const lc::DepthCell& c : lc::tileCells(run->result, proj, std::uint32_t(tile)))
-                if (int(c.cell) == cell) chunk = c.chunk;
-        if (!chunk) chunk = lc::tileFrustum(run->result, proj, run->lights, std::uint32_t(tile));
-        if (chunk) {
-            const glm::dmat4 world = lc::worldFromView(doc_->scene().camera);
-            std::vector<glm::dvec3> corners;
-            for (const glm::dvec3& v : chunk->corners) corners.push_back(glm::dvec3(world * glm::dvec4(v, 1.0)));
-            anchor = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
-            // Pulled a little towards the face's centre: a corner can touch a wall.
-            const std::vector<glm::dvec3> samples = {anchor, glm::mix(anchor, corners[0], 0.9), glm::mix(anchor, corners[1], 0.9),
-                                                     glm::mix(anchor, corners[2], 0.9), glm::mix(anchor, corners[3], 0.9)};
-            samplesFor = [samples](const ViewBasis&) { return samples; };
-            // With Explain's markers shown: the pixel that matters (and the
-            // nearest point of the light's sphere) come into view too.
-            vtkPolyData* marker = overlays_->explainPixel();
-            for (vtkIdType i = 0; marker->GetNumberOfCells() > 0 && i < marker->GetNumberOfPoints(); ++i) {
-                double p[3];
-                marker->GetPoint(i, p);
-                corners.push_back({p[0], p[1], p[2]});
-            }
-            pointsFor = [corners](const ViewBasis&) { return corners; };
-        }
-    }
-    const int light = doc_->currentLight();
-    if (!pointsFor && light >= 0 && std::size_t(light) < doc_->scene().lights.size()) {
-        const lc::PointLight& l = doc_->scene().lights[std::size_t(light)];
-        const glm::dvec3 c = l.position;
-        const double r = std::max(l.radius(), 1e-3);
-        anchor = c;
-        keepOutside = r;
-        // The sphere's six extreme points along the view axes bound it well enough.
-        pointsFor = [c, r](const ViewBasis& b) {
-            return std::vector<glm::dvec3>{c + r * b.right, c - r * b.right, c + r * b.up,
-                                           c - r * b.up,    c + r * b.dir,   c - r * b.dir};
-        };
-        samplesFor = [c, r](const ViewBasis& b) {
-            const double h = 0.5 * r;
-            return std::vector<glm::dvec3>{c, c + h * b.right, c - h * b.right, c + h * b.up, c - h * b.up};
-        };
-    }
-    if (!pointsFor) return false;
-
-    framedFromCullingSide_ = false;
-    const ViewBasis b = viewBasis();
-    glm::dvec3 center;
-    const double distance = fitDistance(pointsFor(b), b, &center);
-    const glm::dvec3 eye = center - b.dir * distance;
-    const lc::Scene& scene = doc_->scene();
-    // The kept direction works unless shown meshes stand between the eye and
-    // most of the selection (the roof of a building framed from outside; a
-    // block hiding a corner of a tile is no reason to turn). Nearly at a
-    // sample does not count: that is the selection's own surface.
-    const bool meshesShown = doc_->overlays().meshes != Document::OverlayOptions::MeshDisplay::Hidden;
-    auto blocked = [&](const glm::dvec3& from) {
-        const std::vector<glm::dvec3> samples = samplesFor(b);
-        std::size_t hidden = 0;
-        for (const glm::dvec3& p : samples) {
-            const auto hit = firstMeshHit(scene, from, p);
-            hidden += hit && *hit < 1.0 - 1e-3;
-        }
-        return 2 * hidden > samples.size();
-    };
-    if (!meshesShown || !blocked(eye)) {
-        flyToEye(eye, center, std::nullopt, ms);
-        return true;
-    }
-    // From the culling camera's side: along the line from its eye through the
-    // anchor (orthographic: along its direction). The culling camera sees the
-    // tile's geometry, so that line is free up to the anchor's depth.
-    const lc::Camera& cam = scene.camera;
-    glm::dvec3 dir = anchor - cam.position;
-    if (lc::isOrthographic(cam.projection) || glm::length(dir) < 1e-9) dir = cam.target - cam.position;
-    if (glm::length(dir) < 1e-12) dir = b.dir;
-    ViewBasis cb;
-    cb.dir = glm::normalize(dir);
-    cb.right = glm::cross(cb.dir, glm::normalize(cam.up));
-    if (glm::length(cb.right) < 1e-9) cb.right = glm::cross(cb.dir, b.up);
-    if (glm::length(cb.right) < 1e-9) cb.right = b.right;
-    cb.right = glm::normalize(cb.right);
-    cb.up = glm::cross(cb.right, cb.dir);
-    glm::dvec3 sideCenter;
-    const double sideDistance = fitDistance(pointsFor(cb), cb, &sideCenter);
-    // The eye on the line through the anchor (the fit's centre lies near it),
-    // pulled in to just before the first surface between them.
-    glm::dvec3 sideEye = anchor - cb.dir * (sideDistance + glm::dot(anchor - sideCenter, cb.dir));
-    const glm::dvec3 back = sideEye - anchor;
-    const glm::dvec3 start = anchor + 1e-3 * back;
-    if (const auto hit = firstMeshHit(scene, start, sideEye)) {
-        const double along = glm::length(sideEye - start) * *hit;
-        const glm::dvec3 pulled = start + glm::normalize(back) * (0.9 * along);
-        if (glm::length(pulled - anchor) > keepOutside) {
-            sideEye = pulled;
-        } else {
-            // The room is smaller than the light's sphere: an eye pulled in
-            // to the wall would sit inside it and see a wall of wireframe.
-            // Frame the whole sphere through the wall, with the meshes in
-            // x-ray so that the wall hides nothing.
-            Document::OverlayOptions o = doc_->overlays();
-            if (o.meshes == Document::OverlayOptions::MeshDisplay::Normal) {
-                o.meshes = Document::OverlayOptions::MeshDisplay::XRay;
-                doc_->setOverlays(o);
-                frameNote_ = tr("Walls stand closer to the light than its radius: meshes in x-ray (X toggles)");
-            }
-        }
-    }
-    cb.eye = sideEye;
-    framedFromCullingSide_ = true;
-    flyToEye(sideEye, anchor + cb.dir * std::max(glm::dot(sideCenter - anchor, cb.dir), 0.0), cb.up, ms);
-    return true;
-}
-
-std::optional<double> InspectorView::firstMeshHit(const lc::Scene& scene, const glm::dvec3& a, const glm::dvec3& b) {
-    // Moller-Trumbore against every triangle; a few rays per F, so no
-    // acceleration structure (a 260k-triangle glTF takes milliseconds).
-    const glm::dvec3 d = b - a;
-    double best = 2.0;
-    for (const lc::Mesh& m : scene.meshes) {
-        const bool identity = m.transform == glm::dmat4(1.0);
-        auto vert = [&](std::uint32_t i) {
-            const glm::dvec3 v(m.vertex(i));
-            return identity ? v : glm::dvec3(m.transform * glm::dvec4(v, 1.0));
-        };
-        for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
-            if (m.indices[t] >= m.vertexCount() || m.indices[t + 1] >= m.vertexCount() ||
-                m.indices[t + 2] >= m.vertexCount())
-                continue;
-            const glm::dvec3 v0 = vert(m.indices[t]), e1 = vert(m.indices[t + 1]) - v0, e2 = vert(m.indices[t + 2]) - v0;
-            const glm::dvec3 p = glm::cross(d, e2);
-            const double det = glm::dot(e1, p);
-            if (std::abs(det) < 1e-300) continue;
-            const double inv = 1.0 / det;
-            const glm::dvec3 s = a - v0;
-            const double u = glm::dot(s, p) * inv;
-            if (u < 0.0 || u > 1.0) continue;
-            const glm::dvec3 q = glm::cross(s, e1);
-            const double v = glm::dot(d, q) * inv;
-            if (v < 0.0 || u + v > 1.0) continue;
-            const double h = glm::dot(e2, q) * inv;
-            if (h >= 0.0 && h <= 1.0 && h < best) best = h;
-        }
-    }
-    if (best > 1.0) return std::nullopt;
-    return best;
-}
-
-void InspectorView::flyTo(const glm::dvec3& center, double radius, int ms) {
-    // The sphere's six extreme points along the view axes bound it well enough.
-    const ViewBasis b = viewBasis();
-    flyToPoints({center + radius * b.right, center - radius * b.right, center + radius * b.up, center - radius * b.up,
-                 center + radius * b.dir, center - radius * b.dir},
-                ms);
-}
-
-InspectorView::ViewBasis InspectorView::viewBasis() const {
-    vtkCamera* vc = renderer_->GetActiveCamera();
-    double p0[3], f0[3], vu[3];
-    vc->GetPosition(p0);
-    vc->GetFocalPoint(f0);
-    vc->GetViewUp(vu);
-    ViewBasis b;
-    b.eye = {p0[0], p0[1], p0[2]};
-    b.focal = {f0[0], f0[1], f0[2]};
-    b.dir = b.focal - b.eye;
-    if (glm::length(b.dir) < 1e-12) b.dir = {0, 0, -1};
-    b.dir = glm::normalize(b.dir);
-    b.right = glm::cross(b.dir, glm::dvec3(vu[0], vu[1], vu[2]));
-    if (glm::length(b.right) < 1e-12) b.right = glm::dvec3(1, 0, 0);
-    b.right = glm::normalize(b.right);
-    b.up = glm::cross(b.right, b.dir);
-    return b;
-}
-
-double InspectorView::fitDistance(const std::vector<glm::dvec3>& points, const ViewBasis& b, glm::dvec3* centerOut) {
-    vtkCamera* vc = renderer_->GetActiveCamera();
-    glm::dvec3 center(0.0);
-    for (const glm::dvec3& p : points) center += p;
-    center /= double(std::max<std::size_t>(points.size(), 1));
-    // The nearest eye distance from `center` at which every point projects
-    // inside the view, with a 10% margin: x / (d + z) <= tan.
-    const double halfY = 0.5 * vc->GetViewAngle() * 3.14159265358979323846 / 180.0;
-    const double aspect = height() > 0 ? double(width()) / double(height()) : 1.0;
-    const double tanY = std::tan(halfY) / 1.1, tanX = std::tan(halfY) * aspect / 1.1;
-    double distance = 1e-6, extentX = 1e-6, extentY = 1e-6;
-    for (const glm::dvec3& p : points) {
-        const glm::dvec3 q = p - center;
-        const double x = std::abs(glm::dot(q, b.right)), y = std::abs(glm::dot(q, b.up)), z = glm::dot(q, b.dir);
-        distance = std::max({distance, x / tanX - z, y / tanY - z});
-        extentX = std::max(extentX, x);
-        extentY = std::max(extentY, y);
-    }
-    if (vc->GetParallelProjection()) vc->SetParallelScale(1.1 * std::max(extentY, extentX / aspect));
-    *centerOut = center;
-    return distance;
-}
-
-void InspectorView::flyToPoints(const std::vector<glm::dvec3>& points, int ms) {
-    if (points.empty()) return;
-    // Keep the direction.
-    const ViewBasis b = viewBasis();
-    glm::dvec3 center;
-    const double distance = fitDistance(points, b, &center);
-    flyToEye(center - b.dir * distance, center, std::nullopt, ms);
-}
-
-void InspectorView::flyToEye(const glm::dvec3& toEye, const glm::dvec3& toFocal, std::optional<glm::dvec3> toUp,
-                             int ms) {
-    vtkCamera* vc = renderer_->GetActiveCamera();
-    const ViewBasis b = viewBasis();
-    const glm::dvec3 fromEye = b.eye, fromFocal = b.focal, fromUp = b.up;
-    const int steps = std::max(1, ms / 25);
-    auto apply = [this, vc, fromEye, fromFocal, fromUp, toEye, toFocal, toUp](double t) {
-        const double s = t * t * (3.0 - 2.0 * t); // ease in and out
-        const glm::dvec3 e = glm::mix(fromEye, toEye, s), f = glm::mix(fromFocal, toFocal, s);
-        vc->SetFocalPoint(f.x, f.y, f.z);
-        vc->SetPosition(e.x, e.y, e.z);
-        // The view up is left alone when the direction is kept (an orbit
-        // turns about it).
-        if (toUp) {
-            glm::dvec3 u = glm::mix(fromUp, *toUp, s);
-            if (glm::length(u) < 1e-9) u = *toUp;
-            vc->SetViewUp(u.x, u.y, u.z);
-            vc->OrthogonalizeViewUp();
-        }
-        renderer_->ResetCameraClippingRange();
-        placeRadiusHandle();
-        spotHandles_->update();
-        renderNow();
-    };
-    if (ms <= 0) {
-        ++flight_; // stops a flight in progress
-        apply(1.0);
-        return;
-    }
-    ++flight_;
-    const int flight = flight_;
-    for (int i = 1; i <= steps; ++i)
-        QTimer::singleShot(i * ms / steps, this, [apply, i, steps, flight, this] {
-            if (flight == flight_) apply(double(i) / steps); // a newer flight takes over
-        });
-}
-
-void InspectorView::lookThroughCullingCamera() {
-    ++flight_; // stops a flight in progress
-    const lc::Camera& c = doc_->scene().camera;
-    applyCullingCamera(renderer_->GetActiveCamera(), c);
-    renderer_->ResetCameraClippingRange();
-    renderNow();
-}
-
 void InspectorView::rebuildMeshes() {
     for (auto& a : meshActors_) renderer_->RemoveActor(a);
     meshActors_.clear();
@@ -683,8 +355,8 @@ void InspectorView::rebuildMeshes() {
 }
 
 void InspectorView::applyMeshDisplay() {
-    using MD = Document::OverlayOptions::MeshDisplay;
-    const MD mode = doc_->overlays().meshes;
+    using MD = OverlayOptions::MeshDisplay;
+    const MD mode = doc_->viewOptions().overlays().meshes;
     for (auto& a : meshActors_) {
         // X-ray: translucent, so VTK draws it in the translucent pass without
         // depth writes: it shades what lies behind and hides none of it.
@@ -701,25 +373,25 @@ void InspectorView::refreshLightSet() {
 }
 
 std::vector<long long> InspectorView::lightSetKey() const {
-    const auto& ov = doc_->overlays();
+    const auto& ov = doc_->viewOptions().overlays();
     std::vector<long long> key = {(long long)doc_->scene().lights.size(), int(ov.lights), ov.showLights,
                                   ov.onlyTileLights, ov.sphereCap, int(ov.meshes)};
     if (ov.onlyTileLights || leftOut_ > 0) {
-        key.push_back(doc_->selectedTile());
-        key.push_back(doc_->selectedCell());
-        key.push_back((long long)(std::intptr_t)doc_->runOutput().get());
-        key.push_back(doc_->runIsStale());
+        key.push_back(doc_->selection().selectedTile());
+        key.push_back(doc_->selection().selectedCell());
+        key.push_back((long long)(std::intptr_t)doc_->runs().runOutput().get());
+        key.push_back(doc_->runs().runIsStale());
     }
     if (leftOut_ > 0) // the selection is drawn first
-        key.insert(key.end(), doc_->selectedLights().begin(), doc_->selectedLights().end());
+        key.insert(key.end(), doc_->selection().selectedLights().begin(), doc_->selection().selectedLights().end());
     return key;
 }
 
 void InspectorView::rebuildLights() {
     const auto& lights = doc_->scene().lights;
-    const auto& ov = doc_->overlays();
-    using LD = Document::OverlayOptions::LightDisplay;
-    using MD = Document::OverlayOptions::MeshDisplay;
+    const auto& ov = doc_->viewOptions().overlays();
+    using LD = OverlayOptions::LightDisplay;
+    using MD = OverlayOptions::MeshDisplay;
     // Which lights: every one, or the selected tile's listed ones.
     std::vector<int> set;
     drawnAreTileLights_ = false;
@@ -741,20 +413,20 @@ void InspectorView::rebuildLights() {
         // the selected tile's frustum, else the current light, else the view's
         // focal point.
         glm::dvec3 focus = viewBasis().focal;
-        const auto run = doc_->runOutput();
-        const int tile = doc_->selectedTile();
-        if (run && tile >= 0 && std::uint32_t(tile) < run->result.grid.tileCount() && !doc_->runIsStale()) {
+        const auto run = doc_->runs().runOutput();
+        const int tile = doc_->selection().selectedTile();
+        if (run && tile >= 0 && std::uint32_t(tile) < run->result.grid.tileCount() && !doc_->runs().runIsStale()) {
             const lc::Projection proj(doc_->scene().camera);
             if (const auto chunk = lc::tileFrustum(run->result, proj, run->lights, std::uint32_t(tile))) {
                 glm::dvec3 c(0.0);
                 for (const glm::dvec3& v : chunk->corners) c += v;
                 focus = glm::dvec3(lc::worldFromView(doc_->scene().camera) * glm::dvec4(c / 8.0, 1.0));
             }
-        } else if (doc_->currentLight() >= 0 && std::size_t(doc_->currentLight()) < lights.size()) {
-            focus = lights[std::size_t(doc_->currentLight())].position;
+        } else if (doc_->selection().currentLight() >= 0 && std::size_t(doc_->selection().currentLight()) < lights.size()) {
+            focus = lights[std::size_t(doc_->selection().currentLight())].position;
         }
         std::vector<char> selected(lights.size(), 0);
-        for (int i : doc_->selectedLights())
+        for (int i : doc_->selection().selectedLights())
             if (i >= 0 && std::size_t(i) < lights.size()) selected[std::size_t(i)] = 1;
         std::stable_sort(set.begin(), set.end(), [&](int a, int b) {
             if (selected[std::size_t(a)] != selected[std::size_t(b)]) return selected[std::size_t(a)] > selected[std::size_t(b)];
@@ -825,12 +497,12 @@ void InspectorView::updateSelection() {
     // of spheres hide the scene and cost more than the spheres themselves.
     constexpr std::size_t kMaxOutlined = 256;
     std::vector<lc::PointLight> sel;
-    const auto& selected = doc_->selectedLights();
+    const auto& selected = doc_->selection().selectedLights();
     for (std::size_t k = selected.size() > kMaxOutlined ? selected.size() - kMaxOutlined : 0; k < selected.size(); ++k)
         if (selected[k] < int(lights.size())) sel.push_back(lights[std::size_t(selected[k])]);
     selData_ = lightsToPolyData(sel);
     selGlyph_->SetInputData(selData_);
-    const int cur = doc_->currentLight();
+    const int cur = doc_->selection().currentLight();
     if (cur >= 0 && cur < int(lights.size())) {
         // Keep the handle where the light is, except while it is being dragged
         // (then the handle leads and the light follows).
@@ -890,196 +562,6 @@ void InspectorView::updateFrustum() {
     } catch (const std::exception&) {
         // An invalid camera shows no frustum; the run reports the error.
     }
-}
-
-void InspectorView::onHandleStart() {
-    handleActive_ = true;
-    dragLight_ = doc_->currentLight();
-    dragId_ = doc_->newDragId();
-}
-
-void InspectorView::onHandleMove() {
-    if (dragLight_ < 0) return;
-    double p[3];
-    handleRep_->GetWorldPosition(p);
-    doc_->moveLight(dragLight_, {p[0], p[1], p[2]}, dragId_);
-}
-
-void InspectorView::onHandleEnd() {
-    onHandleMove();
-    handleActive_ = false;
-    dragLight_ = -1;
-}
-
-void InspectorView::placeRadiusHandle() {
-    const int cur = doc_->currentLight();
-    const auto& lights = doc_->scene().lights;
-    if (radiusActive_ || cur < 0 || cur >= int(lights.size())) return;
-    // The view's right vector: direction of projection x view up.
-    vtkCamera* vc = renderer_->GetActiveCamera();
-    double dop[3], up[3];
-    vc->GetDirectionOfProjection(dop);
-    vc->GetViewUp(up);
-    glm::dvec3 right = glm::cross(glm::dvec3(dop[0], dop[1], dop[2]), glm::dvec3(up[0], up[1], up[2]));
-    right = glm::length(right) > 0 ? glm::normalize(right) : glm::dvec3(1, 0, 0);
-    const auto& l = lights[std::size_t(cur)];
-    const glm::dvec3 p = l.position + right * lightDisplayRadius(l);
-    double wp[3] = {p.x, p.y, p.z};
-    radiusRep_->SetWorldPosition(wp);
-}
-
-void InspectorView::onRadiusStart() {
-    radiusActive_ = true;
-    dragLight_ = doc_->currentLight();
-    dragId_ = doc_->newDragId();
-}
-
-void InspectorView::onRadiusMove() {
-    if (dragLight_ < 0 || dragLight_ >= int(doc_->scene().lights.size())) return;
-    double p[3];
-    radiusRep_->GetWorldPosition(p);
-    const glm::dvec3 c = doc_->scene().lights[std::size_t(dragLight_)].position;
-    doc_->resizeLight(dragLight_, glm::length(glm::dvec3(p[0], p[1], p[2]) - c), dragId_);
-}
-
-void InspectorView::onRadiusEnd() {
-    onRadiusMove();
-    radiusActive_ = false;
-    dragLight_ = -1;
-    placeRadiusHandle();
-}
-
-int InspectorView::pickLight(const QPoint& pos, glm::dvec3* hit) {
-    const double dpr = devicePixelRatioF();
-    const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
-    const auto [origin, farPoint] = viewRay(pos);
-    double nearest = glm::length(farPoint - origin);
-    if (!(nearest > 0)) return -1;
-    const glm::dvec3 dir = (farPoint - origin) / nearest;
-    // A mesh surface in front hides the spheres behind it (not an x-ray one:
-    // what the view shows through it can be clicked; a hidden one is not picked).
-    if (!doc_->overlays().showLights) return -1;
-    if (doc_->overlays().meshes == Document::OverlayOptions::MeshDisplay::Normal && picker_->Pick(x, y, 0, renderer_) &&
-        picker_->GetActor()) {
-        double p[3];
-        picker_->GetPickPosition(p);
-        nearest = std::min(nearest, glm::dot(glm::dvec3(p[0], p[1], p[2]) - origin, dir));
-    }
-    // The first sphere the ray enters. A sphere around the ray's origin is
-    // skipped: its surface is behind the viewer, nothing of it is in view.
-    // Only the lights drawn (View > Lights) can be clicked.
-    int best = -1;
-    const auto& lights = doc_->scene().lights;
-    for (int k : drawn_) {
-        const std::size_t i = std::size_t(k);
-        if (i >= lights.size()) continue;
-        const double r = lightDisplayRadius(lights[i]);
-        if (!(r > 0)) continue;
-        const glm::dvec3 oc = lights[i].position - origin;
-        const double b = glm::dot(oc, dir), c = glm::dot(oc, oc) - r * r;
-        if (c <= 0) continue;
-        const double disc = b * b - c;
-        if (disc < 0) continue;
-        const double t = b - std::sqrt(disc);
-        if (t > 0 && t < nearest) {
-            nearest = t;
-            best = int(i);
-        }
-    }
-    if (best >= 0 && hit) *hit = origin + nearest * dir;
-    return best;
-}
-
-bool InspectorView::pickSurface(const QPoint& pos, glm::dvec3* point, glm::dvec3* normal) {
-    const double dpr = devicePixelRatioF();
-    const double x = pos.x() * dpr, y = (height() - 1 - pos.y()) * dpr;
-    if (!picker_->Pick(x, y, 0, renderer_) || !picker_->GetActor()) return false;
-    double p[3], n[3];
-    picker_->GetPickPosition(p);
-    picker_->GetPickNormal(n);
-    *point = {p[0], p[1], p[2]};
-    if (normal) {
-        glm::dvec3 nn(n[0], n[1], n[2]);
-        double cp[3];
-        renderer_->GetActiveCamera()->GetPosition(cp);
-        if (glm::dot(nn, glm::dvec3(cp[0], cp[1], cp[2]) - *point) < 0) nn = -nn;
-        *normal = glm::length(nn) > 0 ? glm::normalize(nn) : glm::dvec3(0, 1, 0);
-    }
-    return true;
-}
-
-void InspectorView::onLeftPress() { interactor()->GetEventPosition(pressX_, pressY_); }
-
-void InspectorView::onLeftRelease() {
-    int x = 0, y = 0;
-    interactor()->GetEventPosition(x, y);
-    if (std::abs(x - pressX_) > 3 || std::abs(y - pressY_) > 3 || handleActive_ || radiusActive_ ||
-        spotHandles_->dragging())
-        return; // an orbit or a handle drag, not a click
-    const double dpr = devicePixelRatioF();
-    const QPoint pos(int(x / dpr), int(height() - 1 - y / dpr));
-    const int light = pickLight(pos);
-    if (light >= 0) {
-        const bool add = interactor()->GetControlKey() || interactor()->GetShiftKey();
-        std::vector<int> sel = add ? doc_->selectedLights() : std::vector<int>{};
-        sel.push_back(light);
-        doc_->setSelectedLights(sel);
-        return;
-    }
-    int tile = -1, cell = -1;
-    if (pickChunk(pos, &tile, &cell)) {
-        doc_->setSelectedTile(tile);
-        doc_->setSelectedCell(cell);
-    }
-}
-
-bool InspectorView::pickChunk(const QPoint& pos, int* tileOut, int* cellOut) {
-    const auto run = doc_->runOutput();
-    if (!run) return false;
-    const auto& ov = doc_->overlays();
-    const auto [nearPoint, farPoint] = viewRay(pos);
-    // The click ray in the culling camera's view space, where chunks live.
-    const glm::dmat4 view = doc_->scene().camera.viewFromWorld();
-    const glm::dvec3 o = glm::dvec3(view * glm::dvec4(nearPoint, 1.0));
-    glm::dvec3 d = glm::dvec3(view * glm::dvec4(farPoint, 1.0)) - o;
-    if (!(glm::length(d) > 0)) return false;
-    d = glm::normalize(d);
-    // Entry distance of the ray into a convex chunk (inside: n.p + w >= 0), or -1.
-    auto enter = [&](const lc::FrustumChunk& c) {
-        double t0 = 0, t1 = 1e300;
-        for (const lc::Plane& pl : c.planes) {
-            const double denom = pl.x * d.x + pl.y * d.y + pl.z * d.z, dist = lc::signedDistance(pl, o);
-            if (denom == 0.0) {
-                if (dist < 0) return -1.0;
-                continue;
-            }
-            const double t = -dist / denom;
-            if (denom > 0) t0 = std::max(t0, t);
-            else t1 = std::min(t1, t);
-        }
-        return t0 <= t1 ? t0 : -1.0;
-    };
-    const lc::Projection proj(doc_->scene().camera);
-    const lc::CullResult& r = run->result;
-    double best = 1e300;
-    // The selected tile's cells (drawn with the cells overlay) first: they are
-    // inside its frustum, so a click on one must select the cell.
-    const int sel = doc_->selectedTile();
-    if (ov.cells && sel >= 0 && std::uint32_t(sel) < r.grid.tileCount())
-        for (const lc::DepthCell& c : lc::tileCells(r, proj, std::uint32_t(sel))) {
-            const double t = enter(c.chunk);
-            if (t >= 0 && t < best) best = t, *tileOut = sel, *cellOut = int(c.cell);
-        }
-    if (best < 1e300) return true;
-    // Then every tile's frustum, when they are drawn; else the selected one.
-    for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t) {
-        if (!ov.allTileFrustums && !(ov.tileFrustum && int(t) == sel)) continue;
-        const auto chunk = lc::tileFrustum(r, proj, run->lights, t);
-        if (!chunk) continue;
-        const double h = enter(*chunk);
-        if (h >= 0 && h < best) best = h, *tileOut = int(t), *cellOut = -1;
-    }
-    return best < 1e300;
 }
 
 } // namespace lcui

@@ -14,7 +14,7 @@
 // sphere the view ray through the cursor enters first, unless a mesh surface
 // is nearer (exact spheres in world space, whichever way they are drawn).
 //
-// Inside a building (Document::OverlayOptions, View > Meshes and View >
+// Inside a building (OverlayOptions, View > Meshes and View >
 // Lights): the meshes can be drawn as x-ray (translucent, no depth writes;
 // they then hide no light from a click) or hidden; the lights drawn can be
 // only the selected tile's listed ones, as spheres, rings or automatic, with

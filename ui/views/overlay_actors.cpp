@@ -1,161 +1,33 @@
-#include "views/overlay_actors.hpp"
+#include "views/overlay_actors_parts.hpp"
 
 #include "document/document.hpp"
-#include "panels/explain_panel.hpp"
-#include "views/light_silhouettes.hpp"
-#include "views/vtk_adapters.hpp"
-
-#include <vtkActor.h>
-#include <vtkCamera.h>
-#include <vtkCellArray.h>
-#include <vtkCellData.h>
-#include <vtkDoubleArray.h>
-#include <vtkGlyph3D.h>
-#include <vtkLookupTable.h>
-#include <vtkPoints.h>
-#include <vtkPolyData.h>
-#include <vtkPolyDataMapper.h>
-#include <vtkProperty.h>
-#include <vtkRenderer.h>
-#include <vtkSphereSource.h>
-#include <vtkTextActor.h>
-#include <vtkTextProperty.h>
-
-#include <glm/gtc/constants.hpp>
-
-#include <QObject>
-#include <QString>
-
-#include <algorithm>
-#include <cmath>
-#include <tuple>
 
 namespace lcui {
 
-namespace {
-
-// Accumulates world-space chunk geometry into one poly data.
-struct ChunkGeometry {
-    vtkNew<vtkPoints> points;
-    vtkNew<vtkCellArray> lines, polys;
-    glm::dmat4 worldFromView{1.0};
-
-    vtkIdType corner(const glm::dvec3& v) {
-        const glm::dvec4 w = worldFromView * glm::dvec4(v, 1.0);
-        return points->InsertNextPoint(w.x, w.y, w.z);
-    }
-    // corners: near tl,tr,br,bl; far tl,tr,br,bl
-    void faces(const lc::FrustumChunk& c) {
-        vtkIdType id[8];
-        for (int i = 0; i < 8; ++i) id[i] = corner(c.corners[i]);
-        const int f[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 3, 7, 4}, {1, 5, 6, 2}, {0, 4, 5, 1}, {3, 2, 6, 7}};
-        for (const auto& q : f) {
-            const vtkIdType ids[4] = {id[q[0]], id[q[1]], id[q[2]], id[q[3]]};
-            polys->InsertNextCell(4, ids);
-        }
-    }
-    void edges(const lc::FrustumChunk& c) {
-        vtkIdType id[8];
-        for (int i = 0; i < 8; ++i) id[i] = corner(c.corners[i]);
-        static constexpr int e[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
-                                         {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
-        for (const auto& k : e) {
-            const vtkIdType ids[2] = {id[k[0]], id[k[1]]};
-            lines->InsertNextCell(2, ids);
-        }
-    }
-    // The near face of a chunk only (the halfz split of the far half).
-    void nearFace(const lc::FrustumChunk& c) {
-        vtkIdType id[4];
-        for (int i = 0; i < 4; ++i) id[i] = corner(c.corners[i]);
-        polys->InsertNextCell(4, id);
-    }
-    void into(vtkPolyData* pd) {
-        pd->Initialize();
-        pd->SetPoints(points);
-        if (lines->GetNumberOfCells()) pd->SetLines(lines);
-        if (polys->GetNumberOfCells()) pd->SetPolys(polys);
-    }
-};
-
-// A sphere as three orthogonal great circles (view-space centre, world
-// lines): light enough for dozens of cells, and every point lies on it.
-void addSphereCircles(vtkPoints* points, vtkCellArray* lines, const glm::dmat4& worldFromView,
-                      const lc::BoundingSphere& s, int segments = 48) {
-    const glm::dvec3 axes[3][2] = {{{1, 0, 0}, {0, 1, 0}}, {{0, 1, 0}, {0, 0, 1}}, {{0, 0, 1}, {1, 0, 0}}};
-    for (const auto& e : axes) {
-        std::vector<vtkIdType> ids;
-        for (int i = 0; i <= segments; ++i) {
-            const double t = 2.0 * glm::pi<double>() * (i % segments) / segments;
-            const glm::dvec3 v = s.center + s.radius * (std::cos(t) * e[0] + std::sin(t) * e[1]);
-            const glm::dvec4 w = worldFromView * glm::dvec4(v, 1.0);
-            ids.push_back(points->InsertNextPoint(w.x, w.y, w.z));
-        }
-        lines->InsertNextCell(vtkIdType(ids.size()), ids.data());
-    }
-}
-
-vtkSmartPointer<vtkActor> makeActor(vtkPolyData* pd, double r, double g, double b, double opacity,
-                                    double lineWidth = 1.0) {
-    vtkNew<vtkPolyDataMapper> m;
-    m->SetInputData(pd);
-    m->ScalarVisibilityOff();
-    auto a = vtkSmartPointer<vtkActor>::New();
-    a->SetMapper(m);
-    a->GetProperty()->SetColor(r, g, b);
-    a->GetProperty()->SetOpacity(opacity);
-    a->GetProperty()->SetLineWidth(lineWidth);
-    a->GetProperty()->SetLighting(false);
-    a->PickableOff();
-    return a;
-}
-
-} // namespace
-
-struct InspectorOverlays::Impl {
-    vtkRenderer* renderer;
-    vtkNew<vtkPolyData> spotSphere, spotPassed, spotRejected;
-    vtkSmartPointer<vtkActor> spotSphereA, spotPassedA, spotRejectedA;
-    vtkNew<vtkTextActor> spotCaption;
-    vtkNew<vtkPolyData> explainPlane, explainPixel, zbinSlab;
-    vtkSmartPointer<vtkActor> zbinSlabA;
-    vtkSmartPointer<vtkActor> explainPlaneA, explainEdgeA, explainPixelA;
-    vtkNew<vtkPolyData> tileSolid, tileOutline, cellFill, cellOutline, cellSelected, splitQuad, lightRange,
-        allTiles, reverse;
-    vtkSmartPointer<vtkActor> tileSolidA, tileOutlineA, cellFillA, cellOutlineA, cellSelectedA, splitA, rangeA,
-        allTilesA, reverseA;
-    vtkNew<vtkLookupTable> lut;
-    vtkSmartPointer<vtkPolyData> listedData, missingData;
-    vtkNew<vtkGlyph3D> listedGlyph, missingGlyph;
-    vtkNew<vtkActor> listedA, missingA;
-    // The listed lights as silhouette rings (many of them, or View > Lights > Outlines).
-    vtkNew<LightSilhouettes> listedRings;
-    vtkSmartPointer<vtkMapper> listedGlyphMapper;
-    vtkNew<vtkPolyDataMapper> listedRingMapper;
-};
+using namespace overlay_parts;
 
 namespace {
 
 // The run still describes the scene and its grid is the camera's.
 bool usableRun(const Document& doc) {
-    const auto run = doc.runOutput();
+    const auto run = doc.runs().runOutput();
     const lc::Camera& cam = doc.scene().camera;
-    return run && !doc.runIsStale() && run->result.grid.width == cam.width && run->result.grid.height == cam.height &&
+    return run && !doc.runs().runIsStale() && run->result.grid.width == cam.width && run->result.grid.height == cam.height &&
            run->result.grid.tileSize == cam.tileSize && cam.validate().empty();
 }
 
 } // namespace
 
 std::optional<std::vector<int>> InspectorOverlays::tileListLights(const Document& doc) {
-    const int tile = doc.selectedTile();
+    const int tile = doc.selection().selectedTile();
     if (!usableRun(doc) || tile < 0) return std::nullopt;
-    const auto run = doc.runOutput();
+    const auto run = doc.runs().runOutput();
     const lc::CullResult& r = run->result;
     if (std::uint32_t(tile) >= r.grid.tileCount()) return std::nullopt;
     auto [first, count] = r.tileLists(std::uint32_t(tile));
     // As the tile inspector's rows (lc::tileLightRows): a cell of halfz or
     // clustered has a list of its own.
-    const int cell = doc.selectedCell();
+    const int cell = doc.selection().selectedCell();
     if (cell >= 0 && (r.algorithm == lc::Algorithm::HalfZ || r.algorithm == lc::Algorithm::Clustered) &&
         std::uint32_t(cell) < count) {
         first += std::uint32_t(cell);
@@ -305,10 +177,10 @@ void InspectorOverlays::update(const Document& doc) {
     listedRings_ = false;
     listedLeftOut_ = 0;
 
-    const auto run = doc.runOutput();
+    const auto run = doc.runs().runOutput();
     const lc::Camera& cam = doc.scene().camera;
-    const auto& opt = doc.overlays();
-    const bool usable = run && !doc.runIsStale() && run->result.grid.width == cam.width && run->result.grid.height == cam.height &&
+    const auto& opt = doc.viewOptions().overlays();
+    const bool usable = run && !doc.runs().runIsStale() && run->result.grid.width == cam.width && run->result.grid.height == cam.height &&
                         run->result.grid.tileSize == cam.tileSize && cam.validate().empty();
     auto show = [](vtkActor* a, bool on) { a->SetVisibility(on); };
     if (!usable) {
@@ -326,7 +198,7 @@ void InspectorOverlays::update(const Document& doc) {
     const lc::CullResult& r = run->result;
     const lc::Projection proj(cam);
     const glm::dmat4 w = lc::worldFromView(cam);
-    const int tile = doc.selectedTile();
+    const int tile = doc.selection().selectedTile();
     const bool tileOk = tile >= 0 && std::uint32_t(tile) < r.grid.tileCount();
 
     // Selected tile frustum.
@@ -351,7 +223,7 @@ void InspectorOverlays::update(const Document& doc) {
         for (const lc::DepthCell& c : cells) {
             if (c.occupied) fill.faces(c.chunk);
             outline.edges(c.chunk);
-            if (int(c.cell) == doc.selectedCell()) {
+            if (int(c.cell) == doc.selection().selectedCell()) {
                 selected.faces(c.chunk);
                 selected.edges(c.chunk);
             }
@@ -367,7 +239,7 @@ void InspectorOverlays::update(const Document& doc) {
     show(d_->cellSelectedA, d_->cellSelected->GetNumberOfCells() > 0);
     show(d_->splitA, d_->splitQuad->GetNumberOfCells() > 0);
 
-    const int light = doc.currentLight();
+    const int light = doc.selection().currentLight();
     const bool lightOk = light >= 0 && std::size_t(light) < run->lights.size();
     if (opt.lightCellRange && lightOk && !cells.empty()) {
         const std::uint32_t range =
@@ -421,7 +293,7 @@ void InspectorOverlays::update(const Document& doc) {
     const auto& lights = doc.scene().lights;
     bool drawListed = false;
     if (opt.listHighlight && tileOk) {
-        const auto rows = lc::tileLightRows(*run, proj, std::uint32_t(tile), doc.selectedCell());
+        const auto rows = lc::tileLightRows(*run, proj, std::uint32_t(tile), doc.selection().selectedCell());
         std::vector<lc::PointLight> missingL;
         for (const auto& row : rows) {
             if (row.light >= lights.size()) continue;
@@ -433,7 +305,7 @@ void InspectorOverlays::update(const Document& doc) {
         // View > Lights: with only the tile's lights shown the view draws the
         // listed ones itself (undimmed); hidden lights hide these too.
         drawListed = opt.showLights && !opt.onlyTileLights;
-        using LD = Document::OverlayOptions::LightDisplay;
+        using LD = OverlayOptions::LightDisplay;
         const std::size_t cap = std::size_t(std::max(opt.sphereCap, 1));
         listedRings_ = opt.lights == LD::Outlines || (opt.lights == LD::Auto && listed_.size() > cap);
         std::vector<int> shown = listed_;
@@ -501,153 +373,6 @@ void InspectorOverlays::update(const Document& doc) {
 
     updateSpotPrimitive(doc, run.get(), tileOk ? tile : -1);
     updateExplainMarkers(doc);
-}
-
-const double InspectorOverlays::kExplainPlaneScale = 1.5;
-
-void InspectorOverlays::updateExplainMarkers(const Document& doc) {
-    d_->explainPlane->Initialize();
-    d_->explainPixel->Initialize();
-    explanation_.reset();
-    if (doc.overlays().explainMarkers) {
-        try {
-            explanation_ = explainSelection(doc);
-        } catch (const std::exception&) {
-            // The Explain panel shows the message; nothing to draw.
-        }
-    }
-    const glm::dmat4 w = lc::worldFromView(doc.scene().camera);
-    auto world = [&w](const glm::dvec3& v) {
-        const glm::dvec4 p = w * glm::dvec4(v, 1.0);
-        return glm::dvec3(p);
-    };
-    if (explanation_ && explanation_->hasChunk && explanation_->decisivePlane >= 0) {
-        const lc::Explanation& e = *explanation_;
-        vtkNew<vtkPoints> pts;
-        vtkNew<vtkCellArray> polys, lines;
-        vtkIdType ids[5];
-        // The plane is unbounded: its piece around the chunk's face, half as
-        // large again, so that it shows beside the face's cells and edges.
-        const auto face = lc::chunkFace(e.chunkCorners, e.decisivePlane);
-        const glm::dvec3 mid = 0.25 * (face[0] + face[1] + face[2] + face[3]);
-        for (int i = 0; i < 4; ++i) {
-            const glm::dvec3 p = world(mid + kExplainPlaneScale * (face[std::size_t(i)] - mid));
-            ids[i] = pts->InsertNextPoint(p.x, p.y, p.z);
-        }
-        ids[4] = ids[0];
-        polys->InsertNextCell(4, ids);
-        lines->InsertNextCell(5, ids);
-        d_->explainPlane->SetPoints(pts);
-        d_->explainPlane->SetPolys(polys);
-        d_->explainPlane->SetLines(lines);
-        for (vtkActor* a : {d_->explainPlaneA.Get(), d_->explainEdgeA.Get()}) {
-            if (e.decisiveMargin < 0) a->GetProperty()->SetColor(1.0, 0.15, 0.1);
-            else a->GetProperty()->SetColor(0.55, 0.35, 1.0);
-        }
-    }
-    if (explanation_) {
-        const lc::Explanation& e = *explanation_;
-        vtkNew<vtkPoints> pts;
-        vtkNew<vtkCellArray> verts, lines;
-        if (e.nearestDistance >= 0) {
-            // The nearest pixel of a false positive, and the nearest point of
-            // the light's range sphere: the gap the tests did not see.
-            const glm::dvec3 p = world(e.nearestPosition);
-            const auto& lights = doc.runOutput()->lights;
-            const glm::dvec3 c = lights.centers[e.light];
-            const glm::dvec3 dir = e.nearestPosition - c;
-            const double len = glm::length(dir);
-            const glm::dvec3 q = world(len > 0 ? c + dir * (lights.radii[e.light] / len) : c);
-            const vtkIdType a = pts->InsertNextPoint(p.x, p.y, p.z);
-            const vtkIdType b = pts->InsertNextPoint(q.x, q.y, q.z);
-            verts->InsertNextCell(1, &a);
-            const vtkIdType seg[2] = {a, b};
-            lines->InsertNextCell(2, seg);
-            d_->explainPixelA->GetProperty()->SetColor(1.0, 1.0, 1.0);
-        } else if (e.hasNeededPixel) {
-            const glm::dvec3 p = world(e.neededPosition);
-            const vtkIdType a = pts->InsertNextPoint(p.x, p.y, p.z);
-            verts->InsertNextCell(1, &a);
-            d_->explainPixelA->GetProperty()->SetColor(0.2, 1.0, 0.3);
-        }
-        d_->explainPixel->SetPoints(pts);
-        if (verts->GetNumberOfCells()) d_->explainPixel->SetVerts(verts);
-        if (lines->GetNumberOfCells()) d_->explainPixel->SetLines(lines);
-    }
-    d_->explainPlaneA->SetVisibility(d_->explainPlane->GetNumberOfCells() > 0);
-    d_->explainEdgeA->SetVisibility(d_->explainPlane->GetNumberOfCells() > 0);
-    d_->explainPixelA->SetVisibility(d_->explainPixel->GetNumberOfCells() > 0);
-}
-
-void InspectorOverlays::updateSpotPrimitive(const Document& doc, const lc::RunOutput* run, int tile) {
-    for (vtkPolyData* pd : {d_->spotSphere.Get(), d_->spotPassed.Get(), d_->spotRejected.Get()}) pd->Initialize();
-    spotPrimitive_.reset();
-    const int light = doc.currentLight();
-    // The run's own light (what was culled), not the scene's current one.
-    if (showSpotPrimitive_ && run && light >= 0 && std::size_t(light) < run->lights.size()) {
-        const lc::Camera& cam = doc.scene().camera;
-        spotPrimitive_ = lc::spotTestPrimitive(*run, lc::Projection(cam), std::uint32_t(light), tile);
-    }
-    QString caption;
-    if (spotPrimitive_) {
-        const lc::SpotTestPrimitive& p = *spotPrimitive_;
-        const glm::dmat4 w = lc::worldFromView(doc.scene().camera);
-        {
-            vtkNew<vtkPoints> pts;
-            vtkNew<vtkCellArray> lines;
-            addSphereCircles(pts, lines, w, p.cullSphere);
-            d_->spotSphere->SetPoints(pts);
-            d_->spotSphere->SetLines(lines);
-        }
-        ChunkGeometry passedEdges, rejectedEdges;
-        passedEdges.worldFromView = rejectedEdges.worldFromView = w;
-        vtkNew<vtkPoints> passedPts, rejectedPts;
-        vtkNew<vtkCellArray> passedLines, rejectedLines;
-        std::size_t passed = 0;
-        for (const lc::SpotTestChunk& c : p.chunks) {
-            passed += c.passed;
-            if (p.test == lc::SpotTest::ConeSphere)
-                addSphereCircles(c.passed ? passedPts : rejectedPts, c.passed ? passedLines : rejectedLines, w,
-                                 c.sphere, 32);
-            else if (p.test == lc::SpotTest::ConePlanes)
-                (c.passed ? passedEdges : rejectedEdges).edges(c.chunk);
-        }
-        if (p.test == lc::SpotTest::ConeSphere) {
-            for (auto [pd, pts, lines] : {std::tuple{d_->spotPassed.Get(), passedPts.Get(), passedLines.Get()},
-                                          std::tuple{d_->spotRejected.Get(), rejectedPts.Get(), rejectedLines.Get()}}) {
-                pd->SetPoints(pts);
-                if (lines->GetNumberOfCells()) pd->SetLines(lines);
-            }
-        } else if (p.test == lc::SpotTest::ConePlanes) {
-            passedEdges.into(d_->spotPassed);
-            rejectedEdges.into(d_->spotRejected);
-        }
-        const QString sphere = p.test == lc::SpotTest::ApexSphere ? QObject::tr("apex sphere") : QObject::tr("tight sphere");
-        // Short lines: the inspector is often a narrow dock.
-        caption = QObject::tr("spot test %1, light %2\n%3 r=%4 (pink)")
-                      .arg(lc::toString(p.test))
-                      .arg(light)
-                      .arg(sphere)
-                      .arg(p.cullSphere.radius, 0, 'g', 4);
-        const QString verdict = QObject::tr("%1 passed (blue), %2 rejected (red)")
-                                    .arg(passed)
-                                    .arg(p.chunks.size() - passed);
-        if (tile < 0)
-            caption += QObject::tr("\nselect a tile to see its chunks");
-        else if (p.chunks.empty())
-            caption += QObject::tr("\ntile %1: not tested (no geometry or\nno chunk in the sphere's depth range)").arg(tile);
-        else if (p.test == lc::SpotTest::ConeSphere)
-            caption += QObject::tr("\ntile %1: cone vs each chunk's bounding sphere\n%2").arg(tile).arg(verdict);
-        else if (p.test == lc::SpotTest::ConePlanes)
-            caption += QObject::tr("\ntile %1: cone vs the 6 planes of each chunk\n%2").arg(tile).arg(verdict);
-        else
-            caption += QObject::tr("\ntile %1: sphere vs the tile's chunks\n%2").arg(tile).arg(verdict);
-    }
-    d_->spotCaption->SetInput(caption.toUtf8().constData());
-    d_->spotCaption->SetVisibility(!caption.isEmpty());
-    d_->spotSphereA->SetVisibility(d_->spotSphere->GetNumberOfCells() > 0);
-    d_->spotPassedA->SetVisibility(d_->spotPassed->GetNumberOfCells() > 0);
-    d_->spotRejectedA->SetVisibility(d_->spotRejected->GetNumberOfCells() > 0);
 }
 
 } // namespace lcui

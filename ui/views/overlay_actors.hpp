@@ -23,13 +23,13 @@
 //   tile under cone-sphere the bounding sphere of every chunk the cone was
 //   tested against, under cone-planes those chunks' outlines (blue: passed,
 //   red: rejected), with a caption saying which test and what was tested.
-// - Explain in 3D (explainSelection: the selected list and the current
+// - Explain in 3D (Document::explained: the selected list and the current
 //   light): the chunk plane that decided (red: it rejected the light; violet:
 //   every plane kept it and this one came closest to rejecting it), and the
 //   pixel that matters: for a false positive the nearest pixel of the list
 //   with a white line to the light's sphere (the gap the tests could not
 //   see), for a needed light the needing pixel nearest its centre (green).
-// Each part follows its Document::OverlayOptions toggle. Translucent parts
+// Each part follows its OverlayOptions toggle. Translucent parts
 // rely on the renderer's depth peeling (set up by InspectorView).
 
 #include "culling/diagnostics/explain.hpp"
@@ -87,10 +87,7 @@ public:
     const std::vector<int>& missingLights() const { return missing_; } // red
     const std::vector<std::uint32_t>& reverseLists() const { return reverseLists_; }
 
-    // The spot test primitive overlay: a view toggle, not a document option.
-    void setShowSpotPrimitive(bool on) { showSpotPrimitive_ = on; }
-    bool showSpotPrimitive() const { return showSpotPrimitive_; }
-    // What was drawn last (nullopt: nothing), in view space as the culling has it.
+    // The spot test primitive overlay (OverlayOptions::spotPrimitive): what was drawn last (nullopt: nothing), in view space as the culling has it.
     const std::optional<lc::SpotTestPrimitive>& spotPrimitive() const { return spotPrimitive_; }
     vtkPolyData* spotCullSphere() const;     // 3 great circles, world space
     vtkPolyData* spotChunksPassed() const;   // cone-sphere: circles; cone-planes: chunk edges
@@ -114,7 +111,6 @@ private:
     std::vector<int> listed_, missing_;
     std::vector<std::uint32_t> reverseLists_;
     const void* allTilesRun_ = nullptr; // run the all-tiles wireframe was built for
-    bool showSpotPrimitive_ = false;
     std::optional<lc::SpotTestPrimitive> spotPrimitive_;
     std::optional<lc::Explanation> explanation_;
     void updateSpotPrimitive(const Document& doc, const lc::RunOutput* run, int tile);

@@ -88,8 +88,9 @@ SpotHandles::SpotHandles(Document* doc, vtkRenderer* renderer, vtkRenderWindowIn
     style_ = interactor ? interactor->GetInteractorStyle() : nullptr;
     if (style_) styleTag_ = style_->AddObserver(vtkCommand::EndInteractionEvent, this, &SpotHandles::update);
 
-    for (auto sig : {&Document::lightsChanged, &Document::selectionChanged, &Document::sceneReset})
+    for (auto sig : {&Document::lightsChanged, &Document::sceneReset})
         connect(doc_, sig, this, [this] { update(); });
+    connect(&doc_->selection(), &Selection::changed, this, [this] { update(); });
     connect(doc_, &Document::lightChanged, this, [this](int) { update(); });
     update();
 }
@@ -129,7 +130,7 @@ double SpotHandles::angleFromHandle(const lc::PointLight& l, const glm::dvec3& p
 }
 
 int SpotHandles::selectedSpot() const {
-    const auto& sel = doc_->selectedLights();
+    const auto& sel = doc_->selection().selectedLights();
     const auto& lights = doc_->scene().lights;
     if (sel.size() != 1 || sel[0] < 0 || sel[0] >= int(lights.size())) return -1;
     const lc::PointLight& l = lights[std::size_t(sel[0])];

@@ -1,12 +1,20 @@
 #pragma once
-// The studio's main window: the document, the culling worker, the two VTK
-// views, the docks (scene tree, properties, tile inspector, message log), the
-// toolbar generated from lc::cullParams(), the status bar and every action.
+// The studio's main window: it makes the document, the culling worker and
+// the window's parts, and wires them. Each concern is a class of its own:
+// the views (view_area.hpp), the docks and panels (docks.hpp), the actions
+// (window_actions.hpp), the parameter rows (param_toolbars.hpp), files
+// (scene_files.hpp), the status bar and run log lines (run_status.hpp), new
+// lights (light_placement.hpp), the overlay and image-mode menus
+// (overlay_menus.hpp, image_modes.hpp), the export (diagnostics_export.hpp)
+// and the custom shader's file (custom_shader_source.hpp). What to run (the
+// settings, backend, device and Live) is the document's (run_state.hpp): the
+// toolbar's controls show it.
 //
 // Dialogs that ask the user something go through the replaceable functions in
 // `prompts`, so tests (and scripts) can answer them without a modal loop.
 
 #include "window/prompts.hpp"
+#include "window/window_actions.hpp"
 
 #include "culling/core/params.hpp"
 #include "culling/scene/scene_io.hpp"
@@ -38,8 +46,13 @@ struct RunOutput;
 
 namespace lcui {
 
+class DiagnosticsExport;
+class Docks;
+class LightPlacement;
 class MissNavigator;
 class ParamToolbars;
+class RunStatus;
+class ViewArea;
 class SceneFiles;
 class CustomShaderSource;
 struct HuntRequest; // hunt_dialog.hpp
@@ -65,12 +78,12 @@ public:
     CullService* cullService() const { return service_; }
     CameraView* cameraView() const { return cameraView_; }
     InspectorView* inspectorView() const { return inspectorView_; }
-    SceneTree* sceneTree() const { return tree_; }
-    PropertyPanel* propertyPanel() const { return properties_; }
-    TileInspector* tileInspector() const { return tileInspector_; }
-    ExplainPanel* explainPanel() const { return explain_; }
+    SceneTree* sceneTree() const;
+    PropertyPanel* propertyPanel() const;
+    TileInspector* tileInspector() const;
+    ExplainPanel* explainPanel() const;
     MissNavigator* missNavigator() const { return misses_; }
-    QPlainTextEdit* messageLog() const { return log_; }
+    QPlainTextEdit* messageLog() const;
     QAction* action(const QString& objectName) const; // e.g. "actionRun"
     Prompts prompts;
     // Opening a scene runs culling once (tests turn this off to set up first).
@@ -134,15 +147,11 @@ public:
     void selectFirstMissOfRun(quint64 generation) { firstMissOfRun_ = generation; }
     void setCullingCameraFromInspector();
 
-    // Export diagnostics (File menu): summary.json, tiles.csv, heatmap.png,
-    // overlays.vtm and PNG screenshots of both views, through the CLI's
-    // lc::exportDiagnostics, atomically into `dir`. False (logged, shown) on
-    // failure or when there is no run to export.
+    // Export diagnostics (File menu; diagnostics_export.hpp) into `dir`: ends
+    // with diagnosticsExported, at once when the run has its shaded images,
+    // else once the worker has shaded it. False (logged, shown) when there is
+    // no run to export or the scene changed since it.
     bool exportDiagnostics(const QString& dir);
-    // The shown run with its shaded images: as it is when it has them, else
-    // shaded on the worker now (waits, "shading..." in the status bar). Null
-    // (logged) when shading failed or a newer run replaced this one.
-    std::shared_ptr<const lc::RunOutput> shadedRunOutput();
 
     // Whole-window image with both views' GL content.
     QImage grabWindow();
@@ -154,6 +163,8 @@ public:
 signals:
     void runFinished(quint64 generation);
     void runFailed(quint64 generation, const QString& message);
+    // An export ended: `ok`, or logged and shown why not.
+    void diagnosticsExported(const QString& dir, bool ok);
 
 protected:
     void closeEvent(QCloseEvent* e) override;
@@ -161,22 +172,14 @@ protected:
     void dropEvent(QDropEvent* e) override;
 
 private:
-    // The time, `level` ("ERROR ", "WARNING " or none) and the message.
-    void logLine(const QString& level, const QString& message);
-    void huntFromDialog();     // Culling > Hunt for a miss... (main_window_hunt.cpp)
-    void buildActions();
+    void huntFromDialog(); // Culling > Hunt for a miss... (main_window_hunt.cpp)
+    void wireActions();
+    void wireReport();
     void buildMenus();
-    void buildToolbar();
-    void buildDocks();
-    void buildStatusBar();
-    void buildOverlayMenus(QMenu* file, QMenu* view); // main_window_overlays.cpp
-    void buildImageModes(QMenu* view);                // main_window_shading.cpp
+    void buildToolbars();
     void onRunFinished(quint64 generation, std::shared_ptr<const lc::RunOutput> out);
     void onRunFailed(quint64 generation, const QString& message);
-    void updateStatus();
-    void updateCutoffStatus(); // the glTF cut-off label: the scene, not the run
     void updateTitle();
-    void setTabbedViews(bool tabbed);
     void restoreSettings();
     void saveSettings();
     void afterSceneOpened(const QString& what);
@@ -184,37 +187,22 @@ private:
     Document* doc_;
     CullService* service_;
     MissNavigator* misses_;
+    ViewArea* views_;
     CameraView* cameraView_;
     InspectorView* inspectorView_;
-    QSplitter* viewSplitter_;
-    // The bottom area's height before the Report tab grew it, and what it grew
-    // it to (0: not grown).
-    int stripHeight_ = 0, grownHeight_ = 0;
-    QTabBar* viewTabs_;
-    SceneTree* tree_;
-    PropertyPanel* properties_;
-    TileInspector* tileInspector_;
-    QPlainTextEdit* log_;
+    Docks* docks_;
+    WindowActions actions_;
     QMenu* recentMenu_ = nullptr;
     QComboBox* backendCombo_ = nullptr;
     QLineEdit* deviceEdit_ = nullptr;
     ParamToolbars* params_ = nullptr; // the Culling and Limits rows
     SceneFiles* files_ = nullptr;     // open, save, import, recent files
-    QLabel* statusBackend_;
-    QLabel* statusTimes_;
-    QLabel* statusFn_;
-    QLabel* statusEfficiency_;
-    QLabel* statusLists_;
-    QLabel* statusCutoff_;
     StatusProgress* statusProgress_ = nullptr; // loads, shading and reports, with Cancel
-    QString lastBackendName_, lastDeviceName_;
-    // The newest run that failed (0: none): while it is newer than the run
-    // shown, the status bar says the figures are an older run's.
-    quint64 failedGeneration_ = 0;
+    RunStatus* runStatus_ = nullptr;
+    LightPlacement* lights_ = nullptr;
+    DiagnosticsExport* export_ = nullptr;
     bool restoringSettings_ = false; // restoreSettings() is setting the widgets
-    ExplainPanel* explain_ = nullptr;
     CustomShaderSource* customShader_ = nullptr; // the user's culling shader, watched
-    quint64 pendingRuns_ = 0;
     quint64 firstMissOfRun_ = 0; // selectFirstMissOfRun's generation; 0: none
 };
 

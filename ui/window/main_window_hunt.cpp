@@ -14,9 +14,7 @@
 #include "culling/core/errors.hpp"
 #include "culling/diagnostics/hunt.hpp"
 
-#include <QComboBox>
 #include <QDir>
-#include <QLineEdit>
 #include <QSettings>
 #include <QStatusBar>
 
@@ -54,7 +52,7 @@ void MainWindow::huntFromDialog() {
     initial.vary = st.value("hunt/vary", lc::HuntAll).toUInt() & lc::HuntAll;
     if (initial.vary == 0) initial.vary = lc::HuntAll;
     initial.openScene = st.value("hunt/openScene", true).toBool();
-    HuntDialog dlg(initial, underTestText(doc_->settings(), customShader_->options().get(), backendCombo_->currentText()),
+    HuntDialog dlg(initial, underTestText(doc_->runs().settings(), customShader_->options().get(), doc_->runs().backend()),
                    !doc_->scene().meshes.empty(), customShader_->options() != nullptr, this);
     if (dlg.exec() != QDialog::Accepted) return;
     const HuntRequest r = dlg.request();
@@ -74,7 +72,7 @@ bool MainWindow::hunt(const HuntRequest& r) {
         return false;
     }
     lc::HuntOptions o;
-    o.settings = doc_->settings();
+    o.settings = doc_->runs().settings();
     if (const auto shader = customShader_->options()) o.shader = *shader;
     o.seed = r.seed;
     o.maxTrials = r.trials;
@@ -86,8 +84,8 @@ bool MainWindow::hunt(const HuntRequest& r) {
         o.baseScene = &base;
         o.vary &= ~unsigned(lc::HuntSceneDim); // the open scene's meshes stay
     }
-    const std::string backendName = backendCombo_->currentText().toStdString();
-    const std::string device = deviceEdit_->text().toStdString();
+    const std::string backendName = doc_->runs().backend().toStdString();
+    const std::string device = doc_->runs().device().toStdString();
 
     std::mutex mutex; // guards `label` (the hunt's thread writes, the status bar reads)
     QString label = tr("hunting...");

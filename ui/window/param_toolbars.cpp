@@ -95,7 +95,7 @@ void ParamToolbars::sync() {
     for (auto& [name, w] : widgets_) {
         QString v;
         try {
-            v = QString::fromStdString(lc::getParam(doc_->settings(), doc_->scene().camera, name));
+            v = QString::fromStdString(lc::getParam(doc_->runs().settings(), doc_->scene().camera, name));
         } catch (const lc::Error&) {
             continue;
         }
@@ -112,7 +112,7 @@ void ParamToolbars::sync() {
                         doc_->scene().lights.size());
         bool same = c.tileSize == cam.tileSize;
         for (const lc::ParamSpec& p : lc::cullParams())
-            same = same && lc::getParam(s, c, p.name) == lc::getParam(doc_->settings(), cam, p.name);
+            same = same && lc::getParam(s, c, p.name) == lc::getParam(doc_->runs().settings(), cam, p.name);
         if (same) shown = i;
     }
     presetCombo_->setCurrentIndex(shown);
@@ -134,7 +134,7 @@ void ParamToolbars::applyPreset(const std::string& name) {
                     .arg(QString::fromStdString(name), QString::fromStdString(p.engine),
                          QString::fromStdString(p.leftOut)),
                 false);
-    doc_->setSettings(s);
+    doc_->runs().setSettings(s);
     if (cam.tileSize != doc_->scene().camera.tileSize)
         doc_->setCamera(cam, tr("Preset %1").arg(QString::fromStdString(name)));
     sync();
@@ -150,7 +150,7 @@ bool ParamToolbars::setPreset(const QString& name) {
 
 void ParamToolbars::onEdited(const std::string& name, const QString& value) {
     if (syncing_) return;
-    lc::CullSettings s = doc_->settings();
+    lc::CullSettings s = doc_->runs().settings();
     lc::Camera cam = doc_->scene().camera;
     try {
         lc::setParam(s, cam, name, value.toStdString());
@@ -163,7 +163,7 @@ void ParamToolbars::onEdited(const std::string& name, const QString& value) {
     if (cam.width != old.width || cam.height != old.height || cam.tileSize != old.tileSize)
         doc_->setCamera(cam, tr("Set %1").arg(QString::fromStdString(name)));
     else
-        doc_->setSettings(s);
+        doc_->runs().setSettings(s);
 }
 
 bool ParamToolbars::setParam(const QString& name, const QString& value) {
@@ -180,7 +180,7 @@ bool ParamToolbars::setParam(const QString& name, const QString& value) {
     } else if (auto* spin = qobject_cast<QSpinBox*>(w)) {
         spin->setValue(value.toInt());
     }
-    return QString::fromStdString(lc::getParam(doc_->settings(), doc_->scene().camera, name.toStdString())) ==
+    return QString::fromStdString(lc::getParam(doc_->runs().settings(), doc_->scene().camera, name.toStdString())) ==
            value;
 }
 

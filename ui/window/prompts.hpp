@@ -22,6 +22,9 @@ struct Prompts {
     // A number in [min, max]; false when cancelled.
     std::function<bool(QWidget*, const QString& title, const QString& label, double min, double max, double& value)>
         askNumber;
+
+    // Each question as a modal dialog (QMessageBox, QFileDialog, QInputDialog).
+    static Prompts dialogs();
 };
 
 } // namespace lcui

@@ -1,0 +1,239 @@
+#include "window/run_status.hpp"
+
+#include "document/document.hpp"
+#include "widgets/message_log.hpp"
+
+#include "culling/custom/custom_cull.hpp"
+#include "culling/scene/gltf_io.hpp"
+
+#include <QLabel>
+#include <QStatusBar>
+
+#include <algorithm>
+
+namespace lcui {
+
+namespace {
+
+// How a run's all-lights image was made, when not shaded from every light.
+QString allLightsNote(const lc::RunOutput& out) {
+    if (out.allLightsReused) return RunStatus::tr(" (the all-lights image kept: same pixels and lights)");
+    if (!out.allLightsUpdate) return {};
+    const auto& u = *out.allLightsUpdate;
+    return RunStatus::tr(" (the all-lights image updated for the lights that changed: terms out %1, in %2; "
+                         "pixels shaded again from every light %3)")
+        .arg(qulonglong(u.removed))
+        .arg(qulonglong(u.added))
+        .arg(qulonglong(u.pixelsShadedAgain));
+}
+
+const char* const kStaleStyle = "color: white; background: #b9770e; padding: 0 4px";
+
+} // namespace
+
+RunStatus::RunStatus(Document* doc, MessageLog* log, QStatusBar* bar, QObject* parent)
+    : QObject(parent), doc_(doc), log_(log), bar_(bar) {
+    auto label = [bar](const char* name) {
+        auto* l = new QLabel;
+        l->setObjectName(name);
+        bar->addPermanentWidget(l);
+        return l;
+    };
+    backend_ = label("statusBackend");
+    times_ = label("statusTimes");
+    fn_ = label("statusFalseNegatives");
+    efficiency_ = label("statusEfficiency");
+    lists_ = label("statusLists");
+    cutoff_ = label("statusCutoff");
+    connect(&doc_->runs(), &RunState::runOutputChanged, this, &RunStatus::update);
+    connect(&doc_->runs(), &RunState::runWentStale, this, &RunStatus::update);
+    // The cut-off label follows the scene (a new file, an undone cut-off).
+    connect(doc_, &Document::sceneReset, this, &RunStatus::updateCutoff);
+    connect(doc_, &Document::lightsChanged, this, &RunStatus::updateCutoff);
+    update();
+    updateCutoff();
+}
+
+void RunStatus::backendReady(const QString& name, const QString& device) {
+    lastBackendName_ = name;
+    lastDeviceName_ = device;
+    log_->log(tr("backend %1 on %2").arg(name, device));
+    update();
+}
+
+void RunStatus::finished(quint64 generation, const lc::RunOutput& out) {
+    const auto& m = out.truth.metrics;
+    // A Live edit's lists arrive before its ground truth: log once, with it;
+    // the shaded images come last, with the image error.
+    if (!out.shadedAll.empty()) {
+        log_->log(tr("run %1: image RMSE %2, max error %3, shading %4 ms%5")
+                      .arg(generation)
+                      .arg(m.imageRmse, 0, 'g', 6)
+                      .arg(m.imageMaxError, 0, 'g', 6)
+                      .arg(out.result.timings.shadeMs, 0, 'f', 2)
+                      .arg(allLightsNote(out)));
+        return;
+    }
+    if (out.custom && out.truthComputed) logCustom(out);
+    // The pre-pass's triangles, where it ran (the Vulkan backend draws only
+    // the faces of closed solids turned towards the camera).
+    const QString depthTriangles = out.result.depthTriangles == 0
+                                       ? QString()
+                                       : tr(" (%1 of %2 triangles)")
+                                             .arg(qulonglong(out.result.depthTrianglesDrawn))
+                                             .arg(qulonglong(out.result.depthTriangles));
+    // The worker keeps the last depth image while the camera and meshes stay.
+    const QString depthTime = out.depthReused ? tr("reused (camera and meshes unchanged)")
+                                              : tr("%1 ms").arg(out.result.timings.depthMs, 0, 'f', 2);
+    if (out.truthComputed) {
+        const QString line = tr("run %1: %2, %3 lights, depth %4%8, cull %5 ms, false negatives %6, efficiency %7")
+                                 .arg(generation)
+                                 .arg(out.custom ? QStringLiteral("custom") : QString(lc::toString(out.result.algorithm)))
+                                 .arg(out.lights.size())
+                                 .arg(depthTime)
+                                 .arg(out.result.timings.cullMs, 0, 'f', 2)
+                                 .arg(m.falseNegatives)
+                                 .arg(m.efficiency, 0, 'f', 4)
+                                 .arg(depthTriangles);
+        if (m.falseNegatives > 0) log_->warn(line); // a finding about the culling, not a failure of the run
+        else log_->log(line);
+        logLimits(generation, out);
+    }
+    bar_->showMessage(tr("culling done (run %1)").arg(generation), 4000);
+}
+
+void RunStatus::logCustom(const lc::RunOutput& out) {
+    const lc::CustomCullReport& c = *out.custom;
+    log_->log(tr("custom shader %1 (%2, %3): overflowed lists %4, invalid indices %5, validation messages %6, "
+                 "%7 lists differ from built-in %8")
+                  .arg(QString::fromStdString(c.source), QString::fromStdString(c.layout),
+                       QString::fromStdString(c.lists))
+                  .arg(c.overflowLists)
+                  .arg(c.invalidIndices)
+                  .arg(c.validationMessages.size())
+                  .arg(c.listsDifferingFromBuiltin)
+                  .arg(QString::fromStdString(c.builtinAlgorithm)),
+              c.overflowLists > 0 || c.invalidIndices > 0 || !c.validationMessages.empty());
+    for (const std::string& m : c.validationMessages) log_->log(QString::fromStdString(m), true);
+}
+
+// The engine limits: what they took, by cause, and what would keep it.
+void RunStatus::logLimits(quint64 generation, const lc::RunOutput& out) {
+    const auto& m = out.truth.metrics;
+    const lc::ListLimits& lim = out.result.limits;
+    if (out.custom || !out.result.settings.hasLimits() || (lim.empty() && !m.falseNegatives)) return;
+    QString keep;
+    if (m.falseNegativesListFull) keep += tr("; a cap of %1 (the longest list) never overflows").arg(lim.longestUncapped);
+    if (m.falseNegativesLightLimit)
+        keep += tr("; %1 lights past max-lights %2").arg(qulonglong(lim.lightsOverLimit)).arg(out.result.settings.maxLights);
+    log_->log(tr("run %1 limits: %2 over-full lists, %3 entries dropped; misses by cause: culling test %4, list "
+                 "full %5, light limit %6%7 (lightcull report --presets finds the smallest values that keep every "
+                 "light)")
+                  .arg(generation)
+                  .arg(qulonglong(lim.overflowLists.size()))
+                  .arg(qulonglong(lim.droppedLights.size()))
+                  .arg(qulonglong(m.falseNegativesCullingTest()))
+                  .arg(qulonglong(m.falseNegativesListFull))
+                  .arg(qulonglong(m.falseNegativesLightLimit))
+                  .arg(keep));
+}
+
+void RunStatus::failed(quint64 generation, const QString& message) {
+    failedGeneration_ = std::max(failedGeneration_, generation);
+    log_->log(tr("run %1 failed: %2").arg(generation).arg(message), true);
+    bar_->showMessage(tr("culling failed: %1").arg(message), 10000);
+    update();
+}
+
+void RunStatus::updateCutoff() {
+    // The cut-off that sized the lights without a range: a radius the file
+    // did not give, so the user should see where it came from.
+    const std::size_t cut = lc::gltfCutoffLights(doc_->scene()).size();
+    cutoff_->setVisible(cut > 0);
+    cutoff_->setText(tr("cut-off %1 lux (%2 lights)").arg(doc_->scene().origin.gltfMinIntensity).arg(cut));
+    cutoff_->setToolTip(tr("%1 lights have no glTF range: their radius is sqrt(intensity x colour / I_min) "
+                           "at I_min = %2 lux. File > glTF light cut-off... changes it.")
+                            .arg(cut)
+                            .arg(doc_->scene().origin.gltfMinIntensity));
+}
+
+void RunStatus::update() {
+    const auto run = doc_->runs().runOutput();
+    const QString backend = run ? QString::fromStdString(run->result.backend) : lastBackendName_;
+    const QString device = run ? QString::fromStdString(run->result.device) : lastDeviceName_;
+    backend_->setText(backend.isEmpty() ? tr("no backend yet") : tr("%1 | %2").arg(backend, device));
+    if (!run) {
+        times_->setText(tr("depth - ms | cull - ms"));
+        fn_->setText(tr("FN -"));
+        fn_->setStyleSheet({});
+        efficiency_->setText(tr("efficiency -"));
+        lists_->setText(tr("mean/max list -"));
+        return;
+    }
+    // A run that only moved lights reuses the previous depth image (cull_worker).
+    const QString depth = run->depthReused ? tr("depth reused")
+                                           : tr("depth %1 ms").arg(run->result.timings.depthMs, 0, 'f', 2);
+    times_->setText(tr("%1 | cull %2 ms").arg(depth).arg(run->result.timings.cullMs, 0, 'f', 2));
+    // The figures stay (they describe the run shown) but say they are old.
+    const bool stale = doc_->runs().runIsStale();
+    times_->setStyleSheet(stale ? kStaleStyle : "");
+    times_->setToolTip(stale ? tr("The scene changed since this run: F5 runs it again.") : QString());
+    if (stale) times_->setText(tr("stale: %1").arg(times_->text()));
+    // A failed run (a custom shader that does not compile, settings the
+    // device refuses) leaves the last good run on screen: say whose it is.
+    if (failedGeneration_ > doc_->runs().runGeneration()) {
+        const QString what = run->custom ? tr("custom shader") : QString(lc::toString(run->result.algorithm));
+        times_->setStyleSheet(kStaleStyle);
+        times_->setText(tr("run %1 failed, showing run %2 (%3): %4")
+                            .arg(failedGeneration_)
+                            .arg(doc_->runs().runGeneration())
+                            .arg(what, times_->text()));
+        times_->setToolTip(tr("The last run failed (the message log says why): the view, the tile inspector "
+                              "and these figures are an earlier run's."));
+    }
+    updateFigures(*run);
+}
+
+void RunStatus::updateFigures(const lc::RunOutput& run) {
+    if (!run.truthComputed) {
+        // Live edit: ground truth is still being computed (or was superseded).
+        const auto& counts = run.result.listCount;
+        std::uint64_t sum = 0, mx = 0;
+        for (std::uint32_t c : counts) {
+            sum += c;
+            mx = std::max<std::uint64_t>(mx, c);
+        }
+        fn_->setText(tr("FN ..."));
+        fn_->setStyleSheet("color: gray");
+        efficiency_->setText(tr("efficiency ..."));
+        lists_->setText(tr("mean/max list %1 / %2")
+                            .arg(counts.empty() ? 0.0 : double(sum) / double(counts.size()), 0, 'f', 2)
+                            .arg(mx));
+        return;
+    }
+    const auto& m = run.truth.metrics;
+    fn_->setText(m.falseNegatives > 0 ? tr("MISSES LIGHTS: FN %1").arg(m.falseNegatives)
+                                      : tr("FN %1").arg(m.falseNegatives));
+    // By cause, where the engine limits took some of them.
+    if (m.falseNegativesListFull || m.falseNegativesLightLimit)
+        fn_->setText(fn_->text() + tr(" (test %1, list full %2, light limit %3)")
+                                       .arg(qulonglong(m.falseNegativesCullingTest()))
+                                       .arg(qulonglong(m.falseNegativesListFull))
+                                       .arg(qulonglong(m.falseNegativesLightLimit)));
+    fn_->setStyleSheet(m.falseNegatives > 0 ? "color: white; background: #c0392b; padding: 0 4px" : "color: #2e7d32");
+    // With misses efficiency is no score: lists that drop needed lights look
+    // tighter than any correct list can be.
+    if (m.falseNegatives > 0)
+        efficiency_->setText(tr("efficiency %1: not a score with false negatives").arg(m.efficiency, 0, 'f', 4));
+    else
+        efficiency_->setText(tr("efficiency %1 (%2% of this grid's optimum)")
+                                 .arg(m.efficiency, 0, 'f', 4)
+                                 .arg(100.0 * m.efficiencyVsOptimal, 0, 'f', 1));
+    efficiency_->setToolTip(tr("Exact work / shading work. The optimum is the shading work of lists holding "
+                               "exactly the lights their pixels need together (optimal work %1): no culling "
+                               "with these tiles, cells or froxels can do better.")
+                                .arg(m.optimalWork));
+    lists_->setText(tr("mean/max list %1 / %2").arg(m.meanList, 0, 'f', 2).arg(m.maxList));
+}
+
+} // namespace lcui
