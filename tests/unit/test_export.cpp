@@ -2,6 +2,7 @@
 // read back and checked against the run; the atomic folder write on success
 // and on failure.
 #include "culling/core/errors.hpp"
+#include "culling/core/presets.hpp"
 #include "culling/diagnostics/export.hpp"
 #include "culling/diagnostics/overlays.hpp"
 #include "culling/truth/ground_truth.hpp"
@@ -114,6 +115,27 @@ TEST(Export, ARunOnAGivenDepthImageHasNoDepthTimeOrTriangles) {
     EXPECT_TRUE(j["timings_ms"]["depth"].is_null());
     EXPECT_TRUE(j["depth_triangles"].is_null());
     EXPECT_GE(j["timings_ms"]["cull"].get<double>(), 0.0);
+}
+
+// summary.json names the engine preset the settings are, and none once a
+// parameter differs from it (the preset's own derived values, not its name
+// passed along, so an override is never reported as the engine's choice).
+TEST(Export, SummaryJsonNamesThePresetTheSettingsAre) {
+    PipelineRun r = runBuiltin("atrium", Algorithm::TwoPointFiveD);
+    EXPECT_TRUE(nlohmann::json::parse(summaryJson(r.scene, r.settings, r.out))["preset"].is_null());
+    for (const char* name : {"urp", "hdrp-fptl", "unreal-5", "godot-4", "bevy"}) {
+        CullSettings s;
+        Camera cam = r.scene.camera;
+        applyPreset(enginePreset(name), s, cam, r.scene.lights.size());
+        Scene scene = r.scene;
+        scene.camera = cam;
+        const auto j = nlohmann::json::parse(summaryJson(scene, s, r.out));
+        ASSERT_TRUE(j["preset"].is_string()) << name;
+        EXPECT_EQ(j["preset"].get<std::string>(), name);
+        CullSettings changed = s;
+        changed.cap = s.cap + 1;
+        EXPECT_TRUE(nlohmann::json::parse(summaryJson(scene, changed, r.out))["preset"].is_null()) << name;
+    }
 }
 
 TEST(Export, SummaryJsonHasEveryKeyConsistentWithTheRun) {

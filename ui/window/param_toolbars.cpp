@@ -103,19 +103,9 @@ void ParamToolbars::sync() {
         else if (auto* combo = qobject_cast<QComboBox*>(w)) combo->setCurrentText(v);
         else if (auto* spin = qobject_cast<QSpinBox*>(w)) spin->setValue(v.toInt());
     }
-    int shown = 0;
-    const lc::Camera& cam = doc_->scene().camera;
-    for (int i = 1; i < presetCombo_->count() && !shown; ++i) {
-        lc::CullSettings s;
-        lc::Camera c = cam;
-        lc::applyPreset(lc::enginePreset(presetCombo_->itemData(i).toString().toStdString()), s, c,
-                        doc_->scene().lights.size());
-        bool same = c.tileSize == cam.tileSize;
-        for (const lc::ParamSpec& p : lc::cullParams())
-            same = same && lc::getParam(s, c, p.name) == lc::getParam(doc_->runs().settings(), cam, p.name);
-        if (same) shown = i;
-    }
-    presetCombo_->setCurrentIndex(shown);
+    const lc::EnginePreset* matching =
+        lc::presetMatching(doc_->runs().settings(), doc_->scene().camera, doc_->scene().lights.size());
+    presetCombo_->setCurrentIndex(matching ? presetCombo_->findData(QString::fromStdString(matching->name)) : 0);
     syncing_ = false;
 }
 

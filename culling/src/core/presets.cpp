@@ -195,4 +195,17 @@ void applyPreset(const EnginePreset& preset, CullSettings& settings, Camera& cam
     camera.tileSize = c.tileSize;
 }
 
+const EnginePreset* presetMatching(const CullSettings& settings, const Camera& camera, std::size_t lightCount) {
+    for (const EnginePreset& p : enginePresets()) {
+        CullSettings s;
+        Camera c = camera;
+        applyPreset(p, s, c, lightCount);
+        bool same = c.tileSize == camera.tileSize;
+        for (const ParamSpec& spec : cullParams())
+            same = same && getParam(s, c, spec.name) == getParam(settings, camera, spec.name);
+        if (same) return &p;
+    }
+    return nullptr;
+}
+
 } // namespace lc

@@ -7,6 +7,7 @@
 
 #include "culling/custom/custom_cull.hpp"
 #include "culling/core/file_io.hpp"
+#include "culling/core/presets.hpp"
 #include "culling/diagnostics/overlays.hpp"
 
 #include "culling/core/errors.hpp"
@@ -263,6 +264,10 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     // the built-in settings: they are not reported as if they were.
     if (run.custom)
         for (const char* k : {"test", "cells", "slicing", "skip_empty", "spot_test", "bins"}) j[k] = nullptr;
+    // The engine preset these settings are (docs/ENGINES.md), null when they
+    // equal none (none was picked, or a parameter was changed after it).
+    const EnginePreset* preset = run.custom ? nullptr : presetMatching(settings, scene.camera, scene.lights.size());
+    j["preset"] = preset ? nlohmann::ordered_json(preset->name) : nlohmann::ordered_json(nullptr);
     j["lights"] = run.lights.size();
     std::size_t spots = 0;
     for (std::size_t i = 0; i < run.lights.size(); ++i) spots += run.lights.isSpot(i);

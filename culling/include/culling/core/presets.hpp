@@ -54,4 +54,9 @@ const EnginePreset& enginePreset(const std::string& name);
 void applyPreset(const EnginePreset& preset, CullSettings& settings, Camera& camera, std::size_t lightCount,
                  const std::vector<std::pair<std::string, std::string>>& overrides = {});
 
+// The preset whose settings for this camera and light count are exactly
+// `settings` and the camera's tile size (every culling parameter equal), or
+// null: what the studio's preset combo shows and summary.json's "preset".
+const EnginePreset* presetMatching(const CullSettings& settings, const Camera& camera, std::size_t lightCount);
+
 } // namespace lc
