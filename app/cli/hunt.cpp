@@ -80,6 +80,15 @@ void HuntCommand::add(CLI::App& app) {
         o->type_name(p.type == lc::ParamType::Int ? "INT" : p.type == lc::ParamType::Bool ? "BOOL" : "CHOICE");
         paramOptions_.emplace_back(p.name, o);
     }
+    {
+        std::string names;
+        for (const lc::EnginePreset& p : lc::enginePresets()) names += (names.empty() ? "" : ", ") + p.name;
+        cmd_->add_option("--preset", preset_,
+                         "Hunt an engine's culling (docs/ENGINES.md): each trial culled with the preset's settings "
+                         "for its screen and light count, as the engine derives them; culling flags given beside "
+                         "it override it. NAME: " + names)
+            ->type_name("NAME");
+    }
     CLI::Option* s = cmd_->add_option("--shader", shader_,
                                       "Hunt in your own culling shader instead of a built-in algorithm "
                                       "(docs/CUSTOM_CULLING.md)")
@@ -158,6 +167,15 @@ int HuntCommand::run() {
         if (!shader_.empty() && name != "tile")
             return usage(opt->get_name() + ": has no effect with --shader: the shader culls");
         lc::setParam(options.settings, scratchCamera, name, paramValues_.at(name));
+        if (!preset_.empty()) options.presetOverrides.emplace_back(name, paramValues_.at(name));
+    }
+    if (!preset_.empty()) {
+        if (!shader_.empty()) return usage("--preset: has no effect with --shader: the shader culls");
+        try {
+            options.preset = &lc::enginePreset(preset_);
+        } catch (const lc::Error& e) {
+            return usage(e.what());
+        }
     }
     if (const std::string why = lc::huntOutputProblem(outDir_); !why.empty()) return usage("--out: " + why);
 

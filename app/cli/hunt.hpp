@@ -29,7 +29,7 @@ private:
     int runPath(lc::HuntOptions& options, const lc::Scene& scene, lc::CullBackend& backend);
     CLI::App* cmd_ = nullptr;
     SceneSource source_;
-    std::string outDir_, backend_, device_, shader_, layout_, lists_, vary_ = "all", path_, animation_;
+    std::string outDir_, backend_, device_, shader_, layout_, lists_, vary_ = "all", path_, animation_, preset_;
     unsigned long long seed_ = 1, trials_ = 0;
     double budget_ = 0, timeoutMs_ = 10000, fps_ = 30;
     // The random search's own flags, refused with --path.

@@ -111,6 +111,48 @@ TEST(Hunt, VaryParsesItsDimensionsAndRefusesUnknownOnes) {
     EXPECT_THROW(parseHuntDims("camera,colour"), SettingsError);
 }
 
+// --preset: every trial is culled with the engine's settings for that trial's
+// screen and light count (here URP mobile's light limit and derived tile
+// size), and the repro names them one by one with the preset's tile size in
+// its scene, so that it runs as the trial did.
+TEST(Hunt, APresetIsDerivedForEachTrial) {
+    auto cpu = makeCpuBackend();
+    const EnginePreset& urpMobile = enginePreset("urp-mobile");
+    Scene many = makeBuiltinScene("atrium");
+    many.camera.width = 208;
+    many.camera.height = 92;
+    HuntOptions plain, engine;
+    engine.preset = &urpMobile;
+    Scene derived = many;
+    const CullSettings s = huntSettings(engine, derived);
+    CullSettings expect;
+    Camera expectCamera = many.camera;
+    applyPreset(urpMobile, expect, expectCamera, many.lights.size());
+    EXPECT_EQ(getParam(s, derived.camera, "max-lights"), getParam(expect, expectCamera, "max-lights"));
+    EXPECT_EQ(derived.camera.tileSize, expectCamera.tileSize);
+    ASSERT_LT(s.maxLights, many.lights.size()); // atrium's 512 lights are past a mobile light limit
+    // The same scene over the engine's light limit; without the preset, not.
+    EXPECT_TRUE(judgeHuntTrial(many, engine, *cpu).overCapacity);
+    EXPECT_FALSE(judgeHuntTrial(many, plain, *cpu).overCapacity);
+    EXPECT_EQ(huntSettings(plain, many).algorithm, plain.settings.algorithm);
+
+    // Over capacity as the failure: found, shrunk and written as the engine runs it.
+    engine.overflowIsFailure = true;
+    engine.seed = 1;
+    engine.maxTrials = 40;
+    const HuntResult r = hunt(engine, *cpu);
+    ASSERT_TRUE(r.failure) << r.coverage.text();
+    EXPECT_NE(huntVerdictText(*r.failure, engine).find("engine preset urp-mobile"), std::string::npos);
+    ScratchDir dir;
+    const std::string command = writeHuntRepro(r, engine, *cpu, (dir.path / "repro").string(), "");
+    Scene shrunk = r.failure->shrunk;
+    const CullSettings forShrunk = huntSettings(engine, shrunk);
+    EXPECT_NE(command.find("--max-lights " + std::to_string(forShrunk.maxLights)), std::string::npos) << command;
+    EXPECT_EQ(loadSceneFile((dir.path / "repro" / "scene.json").string()).camera.tileSize, shrunk.camera.tileSize);
+    EXPECT_NE(lc_test::slurp(dir.path / "repro" / "summary.json").find("\"preset\": \"urp-mobile\""),
+              std::string::npos);
+}
+
 TEST(HuntCli, NoCounterexampleExitsZeroWithCoverage) {
     ScratchDir s;
     const auto out = s.path / "hunt";
@@ -134,6 +176,11 @@ TEST(HuntCli, BadFlagsExitTwo) {
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_TRUE(std::filesystem::exists(s.path / "keep.txt"));
     EXPECT_EQ(runCli({"hunt", "--shader", "x.comp", "--algorithm", "naive", "--out", (s.path / "h").string()}, s.path).code,
+              2);
+    const CliResult unknown = runCli({"hunt", "--preset", "quake", "--out", (s.path / "h").string()}, s.path);
+    EXPECT_EQ(unknown.code, 2);
+    EXPECT_NE(unknown.err.find("unknown preset 'quake' (known: urp"), std::string::npos) << unknown.err;
+    EXPECT_EQ(runCli({"hunt", "--preset", "urp", "--shader", "x.comp", "--out", (s.path / "h").string()}, s.path).code,
               2);
     // Numbers that CLI11 would wrap or clamp, and nothing to vary.
     for (const std::vector<std::string>& bad :

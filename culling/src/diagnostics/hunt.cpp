@@ -342,8 +342,21 @@ Scene makeHuntTrial(const Scene* base, std::uint64_t seed, std::uint64_t index, 
     return s;
 }
 
-HuntVerdict judgeHuntTrial(const Scene& scene, const HuntOptions& options, CullBackend& backend, RunOutput* runOut) {
-    scene.validate();
+CullSettings huntSettings(const HuntOptions& options, Scene& scene) {
+    if (!options.preset) return options.settings;
+    CullSettings s;
+    applyPreset(*options.preset, s, scene.camera, scene.lights.size(), options.presetOverrides);
+    return s;
+}
+
+HuntVerdict judgeHuntTrial(const Scene& sceneIn, const HuntOptions& options, CullBackend& backend, RunOutput* runOut) {
+    sceneIn.validate();
+    // With a preset, the trial's own settings and tile size (a copy: the
+    // trial's scene stays the searched one).
+    std::optional<Scene> derived;
+    if (options.preset && !options.shader) derived = sceneIn;
+    const Scene& scene = derived ? *derived : sceneIn;
+    const CullSettings settings = derived ? huntSettings(options, *derived) : options.settings;
     HuntVerdict v;
     RunOptions ro;
     ro.truthOptions.imageError = false;
@@ -353,7 +366,7 @@ HuntVerdict judgeHuntTrial(const Scene& scene, const HuntOptions& options, CullB
             CustomCullReport report;
             run = runCustomPipeline(scene, *options.shader, backend, ro, report);
         } else {
-            run = runPipeline(scene, options.settings, backend, ro);
+            run = runPipeline(scene, settings, backend, ro);
         }
     } catch (const SettingsError&) {
         throw;
@@ -402,12 +415,12 @@ HuntVerdict judgeHuntTrial(const Scene& scene, const HuntOptions& options, CullB
         // Under engine limits the backends' rounding may fill a list's last
         // slots differently: the test's own lists, before the limits, are
         // compared (the limits are one host rule, tested on their own).
-        CullSettings open = options.settings;
+        CullSettings open = settings;
         open.cap = open.maxLights = open.maxEntries = 0;
         const CullResult ref = makeCpuBackend()->cull(run.depth, proj, grid, run.lights, open);
         CullResult unlimited;
-        if (options.settings.hasLimits()) unlimited = backend.cull(run.depth, proj, grid, run.lights, open);
-        const CullResult& got = options.settings.hasLimits() ? unlimited : run.result;
+        if (settings.hasLimits()) unlimited = backend.cull(run.depth, proj, grid, run.lights, open);
+        const CullResult& got = settings.hasLimits() ? unlimited : run.result;
         if (ref.listCount.size() != got.listCount.size()) {
             v.fails = true;
             v.property = "lists differ from the CPU reference (" + std::to_string(got.listCount.size()) +
@@ -700,7 +713,8 @@ HuntResult hunt(const HuntOptions& options, CullBackend& backend) {
 }
 
 std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
-    const Scene& s = f.shrunk;
+    Scene s = f.shrunk;
+    const CullSettings settings = huntSettings(options, s); // with a preset, its tile size for this scene
     const Camera& c = s.camera;
     const HuntVerdict& v = f.verdict;
     auto g = [](double x) {
@@ -712,7 +726,8 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
     o << "The culling under test ("
       << (options.shader ? "custom shader " + options.shader->path + ", layout " + toString(options.shader->layout) +
                                ", lists " + toString(options.shader->lists)
-                         : std::string("built-in ") + toString(options.settings.algorithm))
+                         : options.preset ? "engine preset " + options.preset->name + ": " + toString(settings.algorithm)
+                                          : std::string("built-in ") + toString(settings.algorithm))
       << ") fails the hunt's property (" << v.property << ")";
     if (!f.pathFrame.empty())
         o << " at " << f.pathFrame << ".";
@@ -812,8 +827,12 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
         writeFileSynced((out / "verdict.txt").string(), huntNoMissText(result, options));
         return {};
     }
-    // The `lightcull run` that shows the miss, run from the folder.
+    // The `lightcull run` that shows the miss, run from the folder. With a
+    // preset, its settings for the shrunk scene, each named (and the scene's
+    // tile size the preset's): the repro runs as the trial did.
     const HuntFailure& f = *result.failure;
+    Scene scene = f.shrunk;
+    const CullSettings settings = huntSettings(options, scene);
     std::string command = "lightcull run --scene scene.json --backend " + backend.name();
     // The same culling in the studio, its first miss selected and explained.
     std::string studio = "lightcull-studio --scene scene.json --backend " + backend.name();
@@ -828,14 +847,13 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
         Camera scratch;
         for (const ParamSpec& p : cullParams())
             if (p.name != "tile" && p.name != "width" && p.name != "height") {
-                command += " --" + p.name + " " + shellQuote(getParam(options.settings, scratch, p.name));
-                studio += " --param " + shellQuote(p.name + "=" + getParam(options.settings, scratch, p.name));
+                command += " --" + p.name + " " + shellQuote(getParam(settings, scratch, p.name));
+                studio += " --param " + shellQuote(p.name + "=" + getParam(settings, scratch, p.name));
             }
     }
     command += " --no-image-error --out run";
     studio += " --first-miss";
 
-    Scene scene = f.shrunk;
     saveSceneFile(scene, (out / "scene.json").string());
     saveGltfScene(scene, (out / "scene.glb").string()); // for the user's engine and glTF viewers
     scene.origin.file = fs::absolute(out / "scene.json").string();
@@ -846,7 +864,7 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
     // the repro is the scene and the command that fails the same way.
     const bool runFailed = again.property.rfind("error: ", 0) == 0;
     if (!runFailed) {
-        exportDiagnostics(scene, options.settings, run, (out / "run").string());
+        exportDiagnostics(scene, settings, run, (out / "run").string());
         fs::copy_file(out / "run" / "summary.json", out / "summary.json", fs::copy_options::overwrite_existing);
     }
     writeFileSynced((out / "verdict.txt").string(), huntVerdictText(f, options));

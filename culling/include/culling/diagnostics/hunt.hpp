@@ -15,6 +15,7 @@
 
 #include "culling/core/backend.hpp"
 #include "culling/core/params.hpp"
+#include "culling/core/presets.hpp"
 #include "culling/core/pipeline.hpp"
 #include "culling/custom/custom_cull.hpp"
 #include "culling/scene/camera_path.hpp"
@@ -58,6 +59,12 @@ struct HuntOptions {
     // The culling under test: `shader` when set, else the built-in `settings`
     // on the backend passed to hunt().
     CullSettings settings;
+    // An engine preset instead of `settings` (docs/ENGINES.md): every trial is
+    // culled with the preset's settings derived for that trial's screen and
+    // light count, as the engine derives them (its tile size too), with
+    // `presetOverrides` (parameter, value) over them as lc::applyPreset sets them.
+    const EnginePreset* preset = nullptr;
+    std::vector<std::pair<std::string, std::string>> presetOverrides;
     std::optional<CustomShaderOptions> shader;
     std::uint64_t seed = 1;
     std::uint64_t maxTrials = 200; // 0: no count limit (then maxSeconds must be > 0)
@@ -124,6 +131,11 @@ Scene makeHuntTrial(const Scene* base, std::uint64_t seed, std::uint64_t index, 
 // long), with a framing camera at 160x96 and 8 lights (deterministic in
 // `seed`).
 Scene makeHuntScene(std::uint64_t seed);
+
+// The settings a built-in hunt culls `scene` with: options.settings, or with
+// a preset its settings for this scene (then the camera's tile size is the
+// preset's too).
+CullSettings huntSettings(const HuntOptions& options, Scene& scene);
 
 // Runs the culling on `scene` (depth pre-pass on `backend`, ground truth,
 // no image error) and judges the property. `run` receives the output when
