@@ -136,7 +136,7 @@ private slots:
     }
 
     void cleanup() {
-        doc()->undoStack()->setClean();
+        if (w_) doc()->undoStack()->setClean();
         dock_ = nullptr;
         w_.reset();
     }
@@ -298,6 +298,34 @@ private slots:
         QVERIFY(dock_->findChild<QPushButton*>("reportRun")->isEnabled());
         QTRY_VERIFY(!w_->findChild<QProgressBar*>("statusProgress_report"));
         QVERIFY(prompts_.isEmpty());
+    }
+
+    // The sweep is a job of the culling worker (one device): culling asked
+    // for while it runs is served between its configurations, not after it;
+    // and closing the window mid-sweep stops it (no hang at exit).
+    void cullingRunsWhileASweepDoes() {
+        chooseCpu();
+        QVERIFY(hold("tile", {"4", "8", "12", "16", "20", "24", "32", "48", "64"}));
+        QTest::mouseClick(dock_->findChild<QPushButton*>("reportRun"), Qt::LeftButton);
+        QVERIFY(dock_->isRunning());
+        QTRY_VERIFY_WITH_TIMEOUT(dock_->progressBar()->value() >= 1, kTimeoutMs);
+        QVERIFY(dock_->progressBar()->maximum() > 500);
+        QVERIFY(lctest::waitRun(*w_, w_->runCulling(), true));
+        QVERIFY2(dock_->isRunning() && dock_->progressBar()->value() < dock_->progressBar()->maximum(),
+                 "the run waited for the whole sweep");
+        // Live edits too, one after another, during the sweep.
+        w_->setLive(true);
+        for (int i = 0; i < 3; ++i) {
+            QSignalSpy shown(w_.get(), &MainWindow::runFinished);
+            const lc::PointLight l = doc()->scene().lights[0];
+            doc()->moveLight(0, l.position + glm::dvec3(0.01, 0, 0), doc()->newDragId());
+            QVERIFY(shown.wait(kTimeoutMs));
+        }
+        QVERIFY(dock_->isRunning());
+        w_->setLive(false);
+        doc()->undoStack()->setClean();
+        dock_ = nullptr;
+        w_.reset(); // cancels the sweep on the worker; returns, or the test times out
     }
 
     // Hovering a point shows its configuration (algorithm, parameters, tile,

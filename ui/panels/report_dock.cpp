@@ -1,6 +1,7 @@
 #include "panels/report_dock.hpp"
 
 #include "document/document.hpp"
+#include "work/cull_worker.hpp"
 
 #include "culling/core/backend.hpp"
 #include "culling/core/errors.hpp"
@@ -15,6 +16,7 @@
 #include <QMessageBox>
 #include <QMouseEvent>
 #include <QProgressBar>
+#include <QPointer>
 #include <QPushButton>
 #include <QSpinBox>
 #include <QToolButton>
@@ -22,6 +24,8 @@
 #include <QVTKOpenGLNativeWidget.h>
 
 #include <vtkAxis.h>
+
+#include <chrono>
 #include <vtkChartXY.h>
 #include <vtkCommand.h>
 #include <vtkContextScene.h>
@@ -84,7 +88,8 @@ public:
 
 } // namespace
 
-ReportDock::ReportDock(Document* doc, QWidget* parent) : QWidget(parent), doc_(doc) {
+ReportDock::ReportDock(Document* doc, CullService* service, QWidget* parent)
+    : QWidget(parent), doc_(doc), service_(service) {
     confirm = [](QWidget* parent, const QString& title, const QString& text) {
         return QMessageBox::question(parent, title, text, QMessageBox::Yes | QMessageBox::No, QMessageBox::No) ==
                QMessageBox::Yes;
@@ -207,10 +212,7 @@ ReportDock::ReportDock(Document* doc, QWidget* parent) : QWidget(parent), doc_(d
     rebuildChart();
 }
 
-ReportDock::~ReportDock() {
-    stopSweep();
-    if (thread_.joinable()) thread_.join();
-}
+ReportDock::~ReportDock() { stopSweep(); }
 
 void ReportDock::addParamControl(const lc::ParamSpec& p, const std::vector<std::string>& values,
                                  const std::vector<std::string>& checked) {
@@ -371,13 +373,12 @@ void ReportDock::releaseGate() {
 }
 
 void ReportDock::stopSweep() {
-    cancel_.cancelled = true;
+    if (cancel_) cancel_->cancelled = true;
     releaseGate();
 }
 
 bool ReportDock::start() {
     if (running_) return false;
-    if (thread_.joinable()) thread_.join();
     std::size_t queued = 0;
     try {
         queued = queuedConfigurations();
@@ -395,7 +396,7 @@ bool ReportDock::start() {
         return false;
     }
     options_ = optionsFromControls();
-    cancel_.cancelled = false;
+    cancel_ = std::make_shared<lc::CancelToken>();
     // Without a pace the first configuration is the timing: the worker waits
     // after it until onProgress has estimated the rest.
     gate_ = !estimate && queued > 1 ? std::make_shared<Gate>() : nullptr;
@@ -413,39 +414,53 @@ bool ReportDock::start() {
     lc::ReportOptions options = options_;
     options.partialOnCancel = true;
     const int dropped = sweepsDropped_;
-    thread_ = std::thread([this, scene, options, dropped, gate = gate_] {
+    // A job of the culling worker: its thread and backends (one device).
+    // Between configurations it lets the culling requests that came run.
+    QPointer<ReportDock> self(this);
+    service_->runJob([self, scene, options, dropped, gate = gate_, cancel = cancel_](CullJobContext& job) mutable {
         std::shared_ptr<lc::Report> rep;
         QString error;
         bool cancelled = false;
         try {
-            auto progress = [this, dropped, gate](std::size_t done, std::size_t total, const std::string& label) {
+            options.backendFor = [&job](const std::string& name) -> lc::CullBackend& { return job.backend(name); };
+            auto progress = [self, dropped, gate, cancel, &job](std::size_t done, std::size_t total,
+                                                                const std::string& label) {
                 const QString text = QString::fromStdString(label);
                 QMetaObject::invokeMethod(
-                    this,
-                    [this, done, total, text, dropped] {
-                        if (dropped == sweepsDropped_) onProgress(int(done), int(total), text);
+                    self,
+                    [self, done, total, text, dropped] {
+                        if (self && dropped == self->sweepsDropped_) self->onProgress(int(done), int(total), text);
                     },
                     Qt::QueuedConnection);
+                job.serve();
+                // After the first configuration, until the dock has decided
+                // whether to go on (culling requests still run meanwhile).
                 if (gate && done == 1) {
                     std::unique_lock lock(gate->mutex);
-                    gate->cv.wait(lock, [&] { return gate->open; });
+                    while (!gate->open && !cancel->cancelled) {
+                        lock.unlock();
+                        job.serve();
+                        lock.lock();
+                        gate->cv.wait_for(lock, std::chrono::milliseconds(50));
+                    }
                 }
             };
-            rep = std::make_shared<lc::Report>(lc::runReport(scene, options, progress, &cancel_));
+            rep = std::make_shared<lc::Report>(lc::runReport(scene, options, progress, cancel.get()));
         } catch (const lc::Cancelled&) {
             cancelled = true;
         } catch (const std::exception& e) {
             error = QString::fromStdString(e.what());
         }
         QMetaObject::invokeMethod(
-            this,
-            [this, rep, error, cancelled, dropped] {
+            self,
+            [self, rep, error, cancelled, dropped] {
+                if (!self) return;
                 // Of a scene no longer open: finish the sweep, show nothing of it.
-                const bool sceneGone = dropped != sweepsDropped_;
-                onDone(sceneGone ? nullptr : rep, error, cancelled || sceneGone, sceneGone);
+                const bool sceneGone = dropped != self->sweepsDropped_;
+                self->onDone(sceneGone ? nullptr : rep, error, cancelled || sceneGone, sceneGone);
             },
             Qt::QueuedConnection);
-    });
+    }, cancel_);
     return true;
 }
 
@@ -478,7 +493,7 @@ void ReportDock::onProgress(int done, int total, const QString& label) {
                    "%3 s). Go on? No keeps the one that finished.")
                     .arg(count(std::size_t(total)), aboutTime(estimate))
                     .arg(double(activeMs_) / 1000.0, 0, 'g', 2));
-            if (!go) cancel_.cancelled = true;
+            if (!go) cancel_->cancelled = true;
             lastProgressMs_ = clock_.elapsed(); // the question's time is not the sweep's
         }
         releaseGate();
@@ -486,7 +501,6 @@ void ReportDock::onProgress(int done, int total, const QString& label) {
 }
 
 void ReportDock::onDone(std::shared_ptr<lc::Report> report, const QString& error, bool cancelled, bool sceneGone) {
-    if (thread_.joinable()) thread_.join();
     gate_.reset();
     running_ = false;
     runButton_->setEnabled(true);

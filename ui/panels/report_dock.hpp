@@ -1,7 +1,8 @@
 #pragma once
 // The Report dock: the speed-against-error sweep of culling/diagnostics/report.hpp on the
-// document's scene, run on its own thread (its own backends: a Vulkan sweep
-// opens its own device, so the culling worker is never blocked), plotted with
+// document's scene, run as a job of the culling worker (its thread and
+// backends: one Vulkan device; the worker serves culling requests between the
+// sweep's configurations, so Live stays live), plotted with
 // VTK charts (total time against efficiency or image error, one series per
 // algorithm, the Pareto front as a line).
 //
@@ -29,7 +30,6 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <thread>
 
 #include <vtkChartXY.h>
 #include <vtkContextView.h>
@@ -48,13 +48,14 @@ class vtkPlot;
 
 namespace lcui {
 
+class CullService;
 class Document;
 
 class ReportDock : public QWidget {
     Q_OBJECT
 public:
-    explicit ReportDock(Document* doc, QWidget* parent = nullptr);
-    ~ReportDock() override; // cancels and joins a running sweep
+    ReportDock(Document* doc, CullService* service, QWidget* parent = nullptr);
+    ~ReportDock() override; // cancels a running sweep
 
     // What start() sweeps. The controls set backends, repeat, fixed (the
     // held parameters), tileSizes and cellCounts; tests may set warmup.
@@ -145,6 +146,7 @@ private:
     vtkPlot* addSeries(int plotType, const std::string& name, const std::vector<std::size_t>& rowIndices);
 
     Document* doc_;
+    CullService* service_;
     lc::ReportOptions options_;
     QComboBox* backendBox_ = nullptr;
     QComboBox* yBox_ = nullptr;
@@ -161,8 +163,7 @@ private:
     // Plot series -> report rows, in the order points were added.
     std::map<std::string, std::vector<std::size_t>> seriesRows_;
     std::shared_ptr<lc::Report> report_;
-    std::thread thread_;
-    lc::CancelToken cancel_;
+    std::shared_ptr<lc::CancelToken> cancel_; // the running sweep's
     std::shared_ptr<Gate> gate_; // set while the worker may wait at it
     bool running_ = false;
     // Sweeps cancelled because another scene was opened: a sweep that

@@ -22,7 +22,8 @@
 
 namespace lcui {
 
-Docks::Docks(QMainWindow* window, Document* doc, MissNavigator* misses) : QObject(window), window_(window) {
+Docks::Docks(QMainWindow* window, Document* doc, MissNavigator* misses, CullService* service)
+    : QObject(window), window_(window) {
     tree_ = new SceneTree(doc);
     tree_->setObjectName("sceneTree");
     properties_ = new PropertyPanel(doc);
@@ -32,7 +33,7 @@ Docks::Docks(QMainWindow* window, Document* doc, MissNavigator* misses) : QObjec
     explain_ = new ExplainPanel(doc);
     explain_->setObjectName("explainPanel");
     log_ = new MessageLog;
-    report_ = new ReportDock(doc);
+    report_ = new ReportDock(doc, service);
 
     sceneDock_ = dock(tr("Scene"), "sceneDock", scenePane(), Qt::LeftDockWidgetArea);
     propertiesDock_ = dock(tr("Properties"), "propertiesDock", propertiesPane(), Qt::LeftDockWidgetArea);

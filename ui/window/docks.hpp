@@ -11,6 +11,7 @@ class QMainWindow;
 
 namespace lcui {
 
+class CullService;
 class Document;
 class ExplainPanel;
 class MessageLog;
@@ -23,7 +24,7 @@ class TileInspector;
 class Docks : public QObject {
     Q_OBJECT
 public:
-    Docks(QMainWindow* window, Document* doc, MissNavigator* misses);
+    Docks(QMainWindow* window, Document* doc, MissNavigator* misses, CullService* service);
 
     SceneTree* tree() const { return tree_; }
     PropertyPanel* properties() const { return properties_; }

@@ -59,7 +59,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), prompts(Prompts::
     cameraView_ = views_->camera();
     inspectorView_ = views_->inspector();
     setCentralWidget(views_);
-    docks_ = new Docks(this, doc_, misses_);
+    docks_ = new Docks(this, doc_, misses_, service_);
     actions_ = WindowActions::create(this, doc_->undoStack());
     statusProgress_ = new StatusProgress;
     statusBar()->addPermanentWidget(statusProgress_);

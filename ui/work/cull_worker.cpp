@@ -93,6 +93,9 @@ void CullWorker::requestShading(quint64 generation) {
 void CullWorker::cancelCurrent() {
     std::lock_guard lock(mutex_);
     pending_.reset();
+    for (auto& j : jobs_) j.second->cancelled = true;
+    jobs_.clear();
+    if (jobCancel_) jobCancel_->cancelled = true;
     if (cancel_) cancel_->cancelled = true;
     if (truthCancel_) truthCancel_->cancelled = true;
     if (shadeCancel_) shadeCancel_->cancelled = true;
@@ -188,127 +191,195 @@ bool CullWorker::shadeLast() {
     return shaded;
 }
 
-void CullWorker::drain() {
-    for (;;) {
-        CullRequest req;
-        std::shared_ptr<lc::CancelToken> cancel = std::make_shared<lc::CancelToken>();
-        bool shadeNow = false;
-        std::shared_ptr<const lc::RunOutput> resend;
-        quint64 unknown = 0;
-        {
-            std::lock_guard lock(mutex_);
-            if (!pending_) {
-                const quint64 wanted = std::exchange(shadeWanted_, 0);
-                if (wanted == 0) {
-                    scheduled_ = false;
-                    return;
-                }
-                // requestShading() for a run that is not running any more.
-                if (wanted == lastGeneration_ && last_) {
-                    if (last_->shadedAll.empty()) {
-                        shadeWanted_ = wanted;
-                        shadeNow = true;
-                    } else {
-                        resend = last_;
-                    }
-                } else {
-                    unknown = wanted;
-                }
-            }
+class CullWorker::JobContext : public CullJobContext {
+public:
+    explicit JobContext(CullWorker& w) : w_(w) {}
+    lc::CullBackend& backend(const std::string& name) override {
+        return w_.backendFor(name, w_.deviceSelector_);
+    }
+    void serve() override {
+        while (w_.drainOne(false)) {
         }
-        if (shadeNow) {
-            shadeLast();
-            continue;
-        }
-        if (resend) {
-            emit finished(lastGeneration_, resend);
-            emit shadingEnded(lastGeneration_, true);
-            continue;
-        }
-        if (unknown) {
-            emit shadingEnded(unknown, false);
-            continue;
-        }
-        {
-            std::lock_guard lock(mutex_);
-            req = std::move(*pending_);
-            pending_.reset();
-            cancel_ = cancel;
-        }
-        emit started(req.generation);
+    }
+
+private:
+    CullWorker& w_;
+};
+
+void CullWorker::postJob(CullJob job, std::shared_ptr<lc::CancelToken> cancel) {
+    bool schedule = false;
+    {
+        std::lock_guard lock(mutex_);
+        jobs_.emplace_back(std::move(job), std::move(cancel));
+        if (!scheduled_) scheduled_ = schedule = true;
+    }
+    if (schedule) QMetaObject::invokeMethod(this, "drain", Qt::QueuedConnection);
+}
+
+lc::CullBackend& CullWorker::backendFor(const std::string& name, const std::string& device) {
+    if (device != deviceSelector_) {
+        // A job holds its backends across its steps: no device change under it.
+        if (inJob_)
+            throw lc::Error("device '" + device + "': the Report's sweep is running on device '" + deviceSelector_ +
+                            "'; change the device once it ends (or cancel it)");
+        backend_ = nullptr;
+        backends_.clear(); // release the old device before opening a new one
+        deviceSelector_ = device;
+    }
+    auto& b = backends_[name];
+    if (!b) {
         try {
-            if (!backend_ || req.backend != backendName_ || req.device != deviceSelector_) {
-                backend_.reset(); // release the old device before opening a new one
-                shaded_.reset();  // its images are the old backend's
-                backendName_.clear();
-                depthCamera_.reset();
-                depthMeshes_.reset();
-                depth_.reset();
-                backend_ = lc::makeBackend(req.backend, req.device);
-                backendName_ = req.backend;
-                deviceSelector_ = req.device;
-                emit backendReady(QString::fromStdString(backend_->name()),
-                                  QString::fromStdString(backend_->deviceName()));
-            }
-            lc::RunOptions options;
-            // The Lambert image error (pixels x lights) is left to the shading
-            // phase below, which runs only when asked (CullRequest::shade).
-            options.truthOptions.imageError = false;
-            const bool reuse = sameGeometry(req);
-            if (reuse) options.reuseDepth = depth_.get();
-            // Rendering depth needs the meshes: a scene with them, built here
-            // (worker thread) and only then.
-            std::shared_ptr<const lc::Scene> runScene = req.scene;
-            if (!reuse && req.meshes && runScene->meshes.empty() && !req.meshes->empty()) {
-                auto full = std::make_shared<lc::Scene>(*req.scene);
-                full->meshes = *req.meshes;
-                runScene = std::move(full);
-            }
-            options.groundTruth = !req.deferTruth;
-            std::shared_ptr<lc::RunOutput> out;
-            if (req.custom) {
-                lc::CustomCullReport report;
-                out = std::make_shared<lc::RunOutput>(
-                    lc::runCustomPipeline(*runScene, *req.custom, *backend_, options, report, options.reuseDepth));
-            } else {
-                out = std::make_shared<lc::RunOutput>(
-                    lc::runPipeline(*runScene, req.settings, *backend_, options, cancel.get()));
-            }
-            // A reused depth names the rasteriser that drew it: a custom
-            // shader or another algorithm reuses a pre-pass drawn by the
-            // backend of an earlier run, and rasterisers differ at edges.
-            if (out->depthReused) out->depthFrom = "the previous run's " + depthSource_ + " (camera and meshes unchanged)";
-            if (!out->depthReused) {
-                depthSource_ = out->depthFrom.empty() ? "pre-pass on " + backend_->name() + " (" + backend_->deviceName() + ")"
-                                                      : out->depthFrom;
-                depth_ = std::make_shared<const lc::DepthImage>(out->depth);
-                depthCamera_ = req.scene->camera;
-                depthMeshes_ = req.meshes;
-                if (!depthMeshes_) depthMeshes_ = std::make_shared<const std::vector<lc::Mesh>>(req.scene->meshes);
-                depthRevision_ = req.geometryRevision;
-            }
-            emit finished(req.generation, std::shared_ptr<const lc::RunOutput>(out));
-            lastGeneration_ = req.generation;
-            lastScene_ = req.scene;
-            last_ = out;
-            if (req.deferTruth) {
-                last_ = addDeferredTruth(req, *out);
-                if (!last_) {
-                    last_ = out;
-                    continue; // superseded: so is its shading
-                }
-            }
-            bool shade = req.shade;
-            {
-                std::lock_guard lock(mutex_);
-                shade = shade || shadeWanted_ == req.generation;
-            }
-            if (shade) shadeLast();
-        } catch (const lc::Cancelled&) {
-            emit failed(req.generation, tr("culling cancelled"));
-        } catch (const std::exception& e) {
-            emit failed(req.generation, QString::fromStdString(e.what()));
+            b = lc::makeBackend(name, device);
+        } catch (...) {
+            backends_.erase(name);
+            throw;
         }
+    }
+    return *b;
+}
+
+void CullWorker::drain() {
+    while (drainOne(true)) {
+    }
+}
+
+bool CullWorker::drainOne(bool jobs) {
+    std::shared_ptr<lc::CancelToken> cancel = std::make_shared<lc::CancelToken>();
+    bool shadeNow = false;
+    std::shared_ptr<const lc::RunOutput> resend;
+    quint64 unknown = 0;
+    std::optional<std::pair<CullJob, std::shared_ptr<lc::CancelToken>>> job;
+    {
+        std::lock_guard lock(mutex_);
+        if (!pending_) {
+            const quint64 wanted = std::exchange(shadeWanted_, 0);
+            if (wanted == 0) {
+                if (!jobs || jobs_.empty()) {
+                    if (jobs) scheduled_ = false; // a job's serve() leaves drain() scheduled
+                    return false;
+                }
+                job = std::move(jobs_.front());
+                jobs_.pop_front();
+                jobCancel_ = job->second;
+            } else if (wanted == lastGeneration_ && last_) {
+                // requestShading() for a run that is not running any more.
+                if (last_->shadedAll.empty()) {
+                    shadeWanted_ = wanted;
+                    shadeNow = true;
+                } else {
+                    resend = last_;
+                }
+            } else {
+                unknown = wanted;
+            }
+        }
+    }
+    if (job) {
+        JobContext context(*this);
+        struct InJob {
+            bool& flag;
+            ~InJob() { flag = false; }
+        } inJob{inJob_ = true};
+        job->first(context); // the job reports its own result and errors
+        std::lock_guard lock(mutex_);
+        jobCancel_.reset();
+        return true;
+    }
+    if (shadeNow) {
+        shadeLast();
+        return true;
+    }
+    if (resend) {
+        emit finished(lastGeneration_, resend);
+        emit shadingEnded(lastGeneration_, true);
+        return true;
+    }
+    if (unknown) {
+        emit shadingEnded(unknown, false);
+        return true;
+    }
+    CullRequest req;
+    {
+        std::lock_guard lock(mutex_);
+        req = std::move(*pending_);
+        pending_.reset();
+        cancel_ = cancel;
+    }
+    runRequest(std::move(req), std::move(cancel));
+    return true;
+}
+
+void CullWorker::runRequest(CullRequest req, std::shared_ptr<lc::CancelToken> cancel) {
+    emit started(req.generation);
+    try {
+        if (!backend_ || req.backend != backendName_ || req.device != deviceSelector_) {
+            shaded_.reset(); // its images are the old backend's
+            backendName_.clear();
+            depthCamera_.reset();
+            depthMeshes_.reset();
+            depth_.reset();
+            backend_ = &backendFor(req.backend, req.device);
+            backendName_ = req.backend;
+            emit backendReady(QString::fromStdString(backend_->name()), QString::fromStdString(backend_->deviceName()));
+        }
+        lc::RunOptions options;
+        // The Lambert image error (pixels x lights) is left to the shading
+        // phase below, which runs only when asked (CullRequest::shade).
+        options.truthOptions.imageError = false;
+        const bool reuse = sameGeometry(req);
+        if (reuse) options.reuseDepth = depth_.get();
+        // Rendering depth needs the meshes: a scene with them, built here
+        // (worker thread) and only then.
+        std::shared_ptr<const lc::Scene> runScene = req.scene;
+        if (!reuse && req.meshes && runScene->meshes.empty() && !req.meshes->empty()) {
+            auto full = std::make_shared<lc::Scene>(*req.scene);
+            full->meshes = *req.meshes;
+            runScene = std::move(full);
+        }
+        options.groundTruth = !req.deferTruth;
+        std::shared_ptr<lc::RunOutput> out;
+        if (req.custom) {
+            lc::CustomCullReport report;
+            out = std::make_shared<lc::RunOutput>(
+                lc::runCustomPipeline(*runScene, *req.custom, *backend_, options, report, options.reuseDepth));
+        } else {
+            out = std::make_shared<lc::RunOutput>(
+                lc::runPipeline(*runScene, req.settings, *backend_, options, cancel.get()));
+        }
+        // A reused depth names the rasteriser that drew it: a custom
+        // shader or another algorithm reuses a pre-pass drawn by the
+        // backend of an earlier run, and rasterisers differ at edges.
+        if (out->depthReused) out->depthFrom = "the previous run's " + depthSource_ + " (camera and meshes unchanged)";
+        if (!out->depthReused) {
+            depthSource_ = out->depthFrom.empty() ? "pre-pass on " + backend_->name() + " (" + backend_->deviceName() + ")"
+                                                  : out->depthFrom;
+            depth_ = std::make_shared<const lc::DepthImage>(out->depth);
+            depthCamera_ = req.scene->camera;
+            depthMeshes_ = req.meshes;
+            if (!depthMeshes_) depthMeshes_ = std::make_shared<const std::vector<lc::Mesh>>(req.scene->meshes);
+            depthRevision_ = req.geometryRevision;
+        }
+        emit finished(req.generation, std::shared_ptr<const lc::RunOutput>(out));
+        lastGeneration_ = req.generation;
+        lastScene_ = req.scene;
+        last_ = out;
+        if (req.deferTruth) {
+            last_ = addDeferredTruth(req, *out);
+            if (!last_) {
+                last_ = out;
+                return; // superseded: so is its shading
+            }
+        }
+        bool shade = req.shade;
+        {
+            std::lock_guard lock(mutex_);
+            shade = shade || shadeWanted_ == req.generation;
+        }
+        if (shade) shadeLast();
+    } catch (const lc::Cancelled&) {
+        emit failed(req.generation, tr("culling cancelled"));
+    } catch (const std::exception& e) {
+        emit failed(req.generation, QString::fromStdString(e.what()));
     }
 }
 

@@ -1,7 +1,12 @@
 #pragma once
 // Culling off the UI thread. A CullWorker lives on its own QThread and owns the
-// backend (and with it the Vulkan device); the UI posts requests through
+// backends (and with them the one Vulkan device); the UI posts requests through
 // CullService and gets results back through queued signals.
+//
+// Long work that needs a backend (the Report dock's sweep) runs here too, as
+// a job (CullService::runJob): on the worker's thread and backends, never a
+// second device. A job serves the culling requests that arrive while it runs
+// between its steps (CullJobContext::serve), so Live stays live during a sweep.
 //
 // "Latest request wins": the worker has one pending slot, not a queue. A request
 // posted while another is still waiting replaces it (dragging a light in Live
@@ -20,6 +25,9 @@
 #include <mutex>
 #include <optional>
 #include <condition_variable>
+#include <deque>
+#include <functional>
+#include <map>
 #include <vector>
 
 namespace lcui {
@@ -51,9 +59,26 @@ struct CullRequest {
     std::shared_ptr<const lc::CustomShaderOptions> custom;
 };
 
+// What a job gets: the worker's backends, and a way to let waiting culling
+// requests run between its steps. Only on the worker's thread, during the job.
+class CullJobContext {
+public:
+    virtual ~CullJobContext() = default;
+    // The worker's backend of that name (opened on first use; its device
+    // selector is the last culling request's). Throws lc::Error as
+    // lc::makeBackend does.
+    virtual lc::CullBackend& backend(const std::string& name) = 0;
+    // Runs the culling requests (and shading) waiting now, then returns.
+    virtual void serve() = 0;
+};
+using CullJob = std::function<void(CullJobContext&)>;
+
 class CullWorker : public QObject {
     Q_OBJECT
 public:
+    // Thread-safe: queues `job` after what is waiting; `cancel` is set when
+    // the worker shuts down (the job must then end soon).
+    void postJob(CullJob job, std::shared_ptr<lc::CancelToken> cancel);
     // Thread-safe: replaces the pending request and wakes the worker.
     void post(CullRequest request);
     // Thread-safe: drops the pending request and cancels the run in progress
@@ -87,6 +112,14 @@ private slots:
     void drain();
 
 private:
+    class JobContext;
+    // One step of drain(): a waiting request, shading asked for, or (with
+    // `jobs`) a job. False when there was nothing to do.
+    bool drainOne(bool jobs);
+    void runRequest(CullRequest req, std::shared_ptr<lc::CancelToken> cancel);
+    // The backend `name` on `device`, opened on first use; another device
+    // selector closes every backend first (one device at a time).
+    lc::CullBackend& backendFor(const std::string& name, const std::string& device);
     // Second phase of a deferTruth request (worker thread); null when a newer
     // request superseded it.
     std::shared_ptr<const lc::RunOutput> addDeferredTruth(const CullRequest& req, const lc::RunOutput& partial);
@@ -103,8 +136,12 @@ private:
     std::shared_ptr<lc::CancelToken> truthCancel_; // set by post(): a newer request stops deferred truth
     std::shared_ptr<lc::CancelToken> shadeCancel_; // likewise for shading
     quint64 shadeWanted_ = 0;                      // requestShading()'s generation, 0: none
+    std::deque<std::pair<CullJob, std::shared_ptr<lc::CancelToken>>> jobs_;
+    std::shared_ptr<lc::CancelToken> jobCancel_; // the running job's
     // Touched only on the worker thread:
-    std::unique_ptr<lc::CullBackend> backend_;
+    std::map<std::string, std::unique_ptr<lc::CullBackend>> backends_; // by name, on deviceSelector_
+    lc::CullBackend* backend_ = nullptr; // the culling requests' (one of backends_)
+    bool inJob_ = false;
     std::string backendName_, deviceSelector_;
     // The last run's scene and depth: a request that changes only lights (a
     // Live drag) reuses the depth image instead of re-rendering it.
@@ -144,6 +181,8 @@ public:
                     std::shared_ptr<const lc::CustomShaderOptions> custom = nullptr);
     // CullWorker::requestShading.
     void requestShading(quint64 generation) { worker_->requestShading(generation); }
+    // CullWorker::postJob: long work on the worker's thread and backends.
+    void runJob(CullJob job, std::shared_ptr<lc::CancelToken> cancel) { worker_->postJob(std::move(job), std::move(cancel)); }
     quint64 lastGeneration() const { return generation_; }
     // The meshes the last request shared with the worker (see CullRequest::meshes).
     std::shared_ptr<const std::vector<lc::Mesh>> meshSnapshot() const { return meshes_; }

@@ -362,12 +362,23 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
     const bool hasSpots = std::any_of(sceneIn.lights.begin(), sceneIn.lights.end(),
                                       [](const PointLight& l) { return l.isSpot(); });
     // Open every backend first: the total is known before the first run.
-    std::vector<std::pair<std::unique_ptr<CullBackend>, std::vector<ReportConfig>>> work;
+    struct Swept {
+        std::unique_ptr<CullBackend> owned; // opened for the sweep (no backendFor)
+        CullBackend* backend;
+        std::vector<ReportConfig> cfgs;
+    };
+    std::vector<Swept> work;
     std::size_t total = 0;
     for (const std::string& name : backends) {
-        std::unique_ptr<CullBackend> b;
+        std::unique_ptr<CullBackend> owned;
+        CullBackend* b = nullptr;
         try {
-            b = makeBackend(name, options.device);
+            if (options.backendFor) {
+                b = &options.backendFor(name);
+            } else {
+                owned = makeBackend(name, options.device);
+                b = owned.get();
+            }
         } catch (const Error& e) {
             if (backends.size() == 1) throw;
             rep.notes.push_back(name + ": not run (" + e.what() + ")");
@@ -376,7 +387,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
         std::vector<ReportConfig> cfgs = options.presets.empty() ? reportConfigs(options, b->name(), hasSpots)
                                                                  : presetConfigs(options, b->name(), sceneIn);
         total += cfgs.size();
-        work.emplace_back(std::move(b), std::move(cfgs));
+        work.push_back({std::move(owned), b, std::move(cfgs)});
     }
 
     total += options.shaders.size();
@@ -390,7 +401,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
     std::shared_ptr<const std::vector<float>> shaderAll;
     CullBackend* shaderShade = nullptr;
     try {
-        for (auto& [backend, cfgs] : work) {
+        for (auto& [owned, backend, cfgs] : work) {
             if (cancelled(cancel)) throw Cancelled();
             rep.backendDevices.emplace_back(backend->name(), backend->deviceName());
             rep.backendTiming.emplace_back(backend->name(), backend->timingMethod());
@@ -402,7 +413,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             if (!shaderDepth || backend->name() == "vulkan") {
                 shaderDepth = std::make_shared<const DepthImage>(depth);
                 shaderAll = std::make_shared<const std::vector<float>>(allImage);
-                shaderShade = backend.get();
+                shaderShade = backend;
             }
             for (const ReportConfig& cfg : cfgs) {
                 if (cancelled(cancel)) throw Cancelled();

@@ -93,6 +93,11 @@ struct ReportOptions {
     // A cancel returns the rows finished so far (Report::cancelled set)
     // instead of throwing Cancelled: the studio shows what a long sweep made.
     bool partialOnCancel = false;
+    // Where the swept backends come from. Null: each opened for the sweep
+    // (makeBackend(name, device)). Else the caller's, kept open and shared
+    // (the studio sweeps on its culling worker's device); it may throw
+    // Error as makeBackend does.
+    std::function<CullBackend&(const std::string& name)> backendFor;
 };
 
 struct Report {
