@@ -19,6 +19,8 @@
 #include <QStatusBar>
 
 #include <algorithm>
+#include <chrono>
+#include <future>
 #include <mutex>
 #include <optional>
 
@@ -115,10 +117,34 @@ bool MainWindow::hunt(const HuntRequest& r) {
                                 .arg(c.reversedZ)
                                 .arg(c.wideSpots);
                 };
-                auto backend = lc::makeBackend(backendName, device);
-                lc::HuntResult found = lc::hunt(opt, *backend);
-                command = lc::writeHuntRepro(found, opt, *backend, folder, device);
-                result = std::move(found);
+                // On the culling worker's thread and backend (one device), as
+                // a job that serves culling requests between its trials; this
+                // thread waits for it and passes the status bar's Cancel on.
+                auto jobCancel = std::make_shared<lc::CancelToken>();
+                opt.cancel = jobCancel.get();
+                std::promise<void> finished;
+                std::future<void> done = finished.get_future();
+                service_->runJob(
+                    [&, jobCancel](CullJobContext& job) {
+                        try {
+                            const auto report = opt.progress;
+                            opt.progress = [&](const lc::HuntCoverage& c, double seconds) {
+                                report(c, seconds);
+                                job.serve();
+                            };
+                            lc::CullBackend& backend = job.backend(backendName);
+                            lc::HuntResult found = lc::hunt(opt, backend);
+                            command = lc::writeHuntRepro(found, opt, backend, folder, device);
+                            result = std::move(found);
+                            finished.set_value();
+                        } catch (...) {
+                            finished.set_exception(std::current_exception());
+                        }
+                    },
+                    jobCancel);
+                while (done.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready)
+                    if (cancel.cancelled) jobCancel->cancelled = true;
+                done.get(); // rethrows what the hunt threw
             },
             0,
             [&] {
