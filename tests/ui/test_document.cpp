@@ -5,6 +5,8 @@
 // disagreeing after a new selection, the toolbar showing another backend or
 // Live state than the one the next run uses.
 #include "document/document.hpp"
+#include "views/camera_view.hpp"
+#include "work/cull_worker.hpp"
 #include "panels/explain_panel.hpp"
 #include "views/inspector_view.hpp"
 #include "views/overlay_actors.hpp"
@@ -125,6 +127,11 @@ private slots:
         QCOMPARE(int(w_->explainPanel()->explanation()->light), lightB);
         QCOMPARE(w_->inspectorView()->overlays()->explanation()->list, second->list);
 
+        // The camera view outlines the tiles whose lists hold the current light.
+        QVERIFY(!w_->cameraView()->highlightedTiles().empty());
+        const QString tip = w_->cameraView()->tileTooltip(tileB);
+        QVERIFY2(!tip.contains("changed since"), qPrintable(tip));
+
         // An edit makes the run stale: nothing is explained until it runs
         // again, and whoever hears of the removal first already sees that
         // (not the explanation of a light whose index has moved).
@@ -138,6 +145,29 @@ private slots:
         QVERIFY(doc()->runs().runIsStale());
         QVERIFY(!doc()->explained().explanation);
         QVERIFY(!w_->explainPanel()->explanation());
+        // Another light picked now: the old run's index for it is another
+        // light's, so no tile is outlined as holding it, and a tile's tooltip
+        // says its figures are the last run's.
+        doc()->selection().setSelectedLights({lightB});
+        QVERIFY(w_->cameraView()->highlightedTiles().empty());
+        const QString staleTip = w_->cameraView()->tileTooltip(tileB);
+        QVERIFY2(staleTip.contains("changed since"), qPrintable(staleTip));
+    }
+
+    // Live re-runs on every change of what to run, but not before a scene is
+    // open: settings given first (the studio's --param) are for its first
+    // run, and a run of the empty document would log "0 lights".
+    void liveRunsNothingBeforeASceneIsOpen() {
+        w_->setLive(true);
+        QVERIFY(w_->setParamFromUi("cells", "8"));
+        doc()->runs().setBackend("cpu");
+        QCOMPARE(w_->cullService()->lastGeneration(), quint64(0));
+        QVERIFY(openSmall());
+        QVERIFY(w_->cullService()->lastGeneration() > 0);
+        QVERIFY(lctest::waitRun(*w_, w_->cullService()->lastGeneration()));
+        QVERIFY(doc()->runs().runOutput()->lights.size() > 0);
+        QCOMPARE(doc()->runs().runOutput()->result.settings.cells, 8u);
+        w_->setLive(false);
     }
 
     // The backend and Live are the document's: the toolbar shows them, a

@@ -328,6 +328,27 @@ private slots:
         w_.reset(); // cancels the sweep on the worker; returns, or the test times out
     }
 
+    // A loaded row sets what decides its result and keeps the user's own
+    // values of what does not (the spot test of a scene without spot lights,
+    // zbin's bins under 2.5d): they were not part of the choice.
+    void loadingARowKeepsWhatItDoesNotDecide() {
+        runSmall25d();
+        QVERIFY(std::none_of(doc()->scene().lights.begin(), doc()->scene().lights.end(),
+                             [](const lc::PointLight& l) { return l.isSpot(); }));
+        QVERIFY(w_->setParamFromUi("spot-test", "cone-sphere"));
+        QVERIFY(w_->setParamFromUi("bins", "64"));
+        const std::size_t row = rowUnlikeTheDocument() < dock_->report()->rows.size() ? rowUnlikeTheDocument() : 0;
+        const lc::ReportConfig cfg = dock_->report()->rows[row].config;
+        dock_->loadRow(row);
+        const lc::CullSettings& s = doc()->runs().settings();
+        QVERIFY(s.spotTest == lc::SpotTest::ConeSphere);
+        QCOMPARE(s.bins, 64u);
+        QVERIFY(s.algorithm == cfg.settings.algorithm);
+        QCOMPARE(s.cells, cfg.settings.cells);
+        QVERIFY(s.test == cfg.settings.test);
+        QCOMPARE(doc()->scene().camera.tileSize, cfg.tileSize);
+    }
+
     // Hovering a point shows its configuration (algorithm, parameters, tile,
     // backend) beside its numbers.
     void tooltipNamesTheConfiguration() {

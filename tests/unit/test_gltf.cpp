@@ -768,4 +768,13 @@ TEST(GltfCli, RunAndConvertTakeGltf) {
     r = lc_test::runCli({"run", "--scene", (s.path / "tri.obj").string(), "--out", (s.path / "y").string()}, s.path);
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("tri.obj is a mesh, not a scene"), std::string::npos) << r.err;
+    // The library's reader (the studio's File > Open, --scene) says the same,
+    // not a JSON syntax error at the mesh's first line.
+    try {
+        lc::loadSceneAny((s.path / "tri.obj").string());
+        ADD_FAILURE() << "a mesh read as a scene";
+    } catch (const lc::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("a mesh (obj), not a scene"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("tri.obj"), std::string::npos) << e.what();
+    }
 }

@@ -164,7 +164,19 @@ void ReportDock::onChartClick(vtkObject*, unsigned long, void* callData) {
 void ReportDock::loadRow(std::size_t row) {
     if (!report_ || row >= report_->rows.size()) return;
     const lc::ReportConfig& cfg = report_->rows[row].config;
-    doc_->runs().setSettings(cfg.settings);
+    // The row's settings; where a parameter does not change what the row
+    // computes (the spot test of a scene without spot lights, the bins of
+    // another algorithm), the user's own value stays.
+    lc::CullSettings s = cfg.settings;
+    const lc::CullSettings& mine = doc_->runs().settings();
+    lc::Camera scratch = doc_->scene().camera;
+    const bool spots = std::any_of(doc_->scene().lights.begin(), doc_->scene().lights.end(),
+                                   [](const lc::PointLight& l) { return l.isSpot(); });
+    for (const lc::ParamSpec& p : lc::cullParams())
+        if (p.name != "tile" && p.name != "width" && p.name != "height" &&
+            !lc::paramAppliesTo(p.name, cfg.settings, spots))
+            lc::setParam(s, scratch, p.name, lc::getParam(mine, scratch, p.name));
+    doc_->runs().setSettings(s);
     if (doc_->scene().camera.tileSize != cfg.tileSize) {
         lc::Camera cam = doc_->scene().camera;
         cam.tileSize = cfg.tileSize;

@@ -234,10 +234,14 @@ CameraView::CameraView(Document* doc, QWidget* parent) : QVTKOpenGLNativeWidget(
         scheduleRender();
     });
     connect(&doc_->viewOptions(), &ViewOptions::overlaysChanged, this, &CameraView::updateOverlay);
-    connect(&doc_->selection(), &Selection::changed, this, [this] {
+    // A stale run's light indices no longer name the scene's lights: the
+    // outlines of the tiles holding the current light go with it.
+    const auto refreshReverse = [this] {
         updateReverseLookup();
         scheduleRender();
-    });
+    };
+    connect(&doc_->selection(), &Selection::changed, this, refreshReverse);
+    connect(&doc_->runs(), &RunState::runWentStale, this, refreshReverse);
     rebuildMeshes();
     updateCamera();
     updateOverlay();

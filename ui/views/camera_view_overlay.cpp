@@ -207,7 +207,9 @@ void CameraView::updateReverseLookup() {
     reverseTiles_.clear();
     const auto run = doc_->runs().runOutput();
     const int light = doc_->selection().currentLight();
-    if (!run || !doc_->viewOptions().overlays().reverseLookup || light < 0 || std::size_t(light) >= run->lights.size()) return;
+    if (!run || doc_->runs().runIsStale() || !doc_->viewOptions().overlays().reverseLookup || light < 0 ||
+        std::size_t(light) >= run->lights.size())
+        return;
     const lc::TileGrid& g = run->result.grid;
     for (std::uint32_t t : lc::tilesHoldingLight(run->result, std::uint32_t(light))) reverseTiles_.push_back(int(t));
     // One closed outline per tile, inset by a tenth of a tile so that

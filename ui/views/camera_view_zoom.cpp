@@ -184,6 +184,7 @@ QString CameraView::tileTooltip(int tile) const {
                     .arg(w ? QString::number(double(e) / double(w), 'f', 3) : QStringLiteral("-"));
         if (fn) text += tr("\nMISSING: %1 pixel-lights").arg(fn);
     }
+    if (doc_->runs().runIsStale()) text += tr("\n(the last run's: the scene changed since; F5 runs it again)");
     return text;
 }
 

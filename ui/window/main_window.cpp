@@ -102,23 +102,26 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), prompts(Prompts::
     connect(service_, &CullService::finished, this, &MainWindow::onRunFinished);
     connect(service_, &CullService::failed, this, &MainWindow::onRunFailed);
     connect(service_, &CullService::backendReady, runStatus_, &RunStatus::backendReady);
-    // What to run is the document's; a change of it re-runs under Live.
+    // What to run is the document's; a change of it re-runs under Live, once
+    // a scene is open (settings given before it, as the studio's --param
+    // are, are for its first run: a run of the empty document is no answer).
     RunState& runs = doc_->runs();
+    connect(doc_, &Document::sceneReset, this, [this] { sceneOpen_ = true; });
     connect(doc_, &Document::sceneEdited, this, [this] {
         if (isLive()) runCulling(/*liveEdit=*/true);
     });
     connect(&runs, &RunState::settingsChanged, this, [this] {
         params_->sync();
-        if (isLive()) runCulling();
+        if (isLive() && sceneOpen_) runCulling();
     });
     connect(&runs, &RunState::backendChanged, this, [this] {
         backendCombo_->setCurrentText(doc_->runs().backend());
         deviceEdit_->setText(doc_->runs().device());
-        if (isLive()) runCulling();
+        if (isLive() && sceneOpen_) runCulling();
     });
     connect(&runs, &RunState::liveChanged, this, [this](bool on) {
         actions_.live->setChecked(on);
-        if (on && !restoringSettings_) runCulling();
+        if (on && sceneOpen_ && !restoringSettings_) runCulling();
     });
     connect(doc_, &Document::cameraChanged, params_, &ParamToolbars::sync);
     connect(doc_, &Document::sceneReset, params_, &ParamToolbars::sync);

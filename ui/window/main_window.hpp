@@ -202,6 +202,7 @@ private:
     LightPlacement* lights_ = nullptr;
     DiagnosticsExport* export_ = nullptr;
     bool restoringSettings_ = false; // restoreSettings() is setting the widgets
+    bool sceneOpen_ = false;         // a scene was opened (the document starts empty)
     CustomShaderSource* customShader_ = nullptr; // the user's culling shader, watched
     quint64 firstMissOfRun_ = 0; // selectFirstMissOfRun's generation; 0: none
 };

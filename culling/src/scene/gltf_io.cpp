@@ -1149,6 +1149,16 @@ Scene loadSceneAny(const std::string& path, const GltfReadOptions& options, Gltf
                    const CancelToken* cancel, const Progress& progress) {
     GltfReadReport local;
     GltfReadReport& rep = report ? *report : local;
+    // A mesh file where a scene is asked for: say so, not a JSON syntax
+    // error at its first line.
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    for (const char* mesh : {".obj", ".ply", ".off", ".stl", ".om"})
+        if (ext == mesh)
+            throw InputError(path, "", 0,
+                             "a mesh (" + ext.substr(1) + "), not a scene: open a scene JSON, .gltf or .glb, and "
+                             "import the mesh into it (the studio's File > Import mesh..., or the scene JSON's "
+                             "\"meshes\")");
     Scene s = isGltfPath(path) ? loadGltfScene(path, options, &rep, cancel, progress)
                                : loadSceneFile(path, cancel, progress);
     s.origin = {};
