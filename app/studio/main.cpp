@@ -246,6 +246,9 @@ int main(int argc, char** argv) {
             return 2;
         }
         window.document()->resetScene(std::move(scene), window.document()->filePath());
+        window.log(QString("the scene's lights replaced by %1 generated ones (--lights, seed %2)")
+                       .arg(lightCount)
+                       .arg(seed));
         window.runCulling();
     }
     if (ok && parser.isSet(presetOpt)) {

@@ -152,6 +152,17 @@ private slots:
         QVERIFY(w_->cameraView()->highlightedTiles().empty());
         const QString staleTip = w_->cameraView()->tileTooltip(tileB);
         QVERIFY2(staleTip.contains("changed since"), qPrintable(staleTip));
+        // Export refuses a stale run before asking for a folder.
+        bool asked = false;
+        QString refused;
+        w_->prompts.savePath = [&](QWidget*, const QString&, const QString&) {
+            asked = true;
+            return QString();
+        };
+        w_->prompts.showError = [&](QWidget*, const QString&, const QString& m) { refused = m; };
+        w_->action("actionExportDiagnostics")->trigger();
+        QVERIFY(!asked);
+        QVERIFY2(refused.contains("press F5"), qPrintable(refused));
     }
 
     // Live re-runs on every change of what to run, but not before a scene is

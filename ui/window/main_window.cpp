@@ -166,6 +166,12 @@ void MainWindow::wireActions() {
         if (!p.isEmpty()) saveAs(p);
     });
     connect(a.exportDiagnostics, &QAction::triggered, this, [this] {
+        // Nothing to export (no run, or the scene changed since): say so
+        // before asking for a folder.
+        if (!doc_->runs().runOutput() || doc_->runs().runIsStale()) {
+            exportDiagnostics({});
+            return;
+        }
         const QString dir = prompts.savePath(this, tr("Export diagnostics into a new folder"), tr("Folder (*)"));
         if (!dir.isEmpty()) exportDiagnostics(dir);
     });
