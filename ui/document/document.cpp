@@ -13,15 +13,8 @@ namespace lcui {
 
 Document::Document(QObject* parent) : QObject(parent) {
     connect(&undo_, &QUndoStack::cleanChanged, this, [this](bool clean) { emit dirtyChanged(!clean); });
-    // First receivers: the new run's receivers see no list picked from the
-    // old one, and no explanation of an earlier selection or run.
+    // First receiver: the new run's receivers see no list picked from the old one.
     connect(&runs_, &RunState::generationChanging, this, [this] { selection_.forgetExplainedList(); });
-    const auto forget = [this] { explained_.invalidate(); };
-    connect(&selection_, &Selection::changed, this, forget);
-    connect(&selection_, &Selection::tileChanged, this, forget);
-    connect(&runs_, &RunState::runOutputChanged, this, forget);
-    connect(&runs_, &RunState::runWentStale, this, forget);
-    connect(this, &Document::sceneEdited, this, forget);
 }
 
 void Document::resetScene(lc::Scene scene, const QString& path) {
@@ -34,7 +27,6 @@ void Document::resetScene(lc::Scene scene, const QString& path) {
     // selection or run of the old scene beside the new one.
     selection_.reset();
     runs_.resetRun();
-    explained_.invalidate();
     emit sceneReset();
     emit selection_.changed();
     emit selection_.tileChanged(-1);
@@ -162,7 +154,6 @@ void Document::applyInsertLights(const std::vector<int>& indices,
     for (std::size_t k = 0; k < indices.size(); ++k)
         scene_.lights.insert(scene_.lights.begin() + indices[k], lights[k]);
     selection_.replaceLights(select ? indices : std::vector<int>{}, true);
-    explained_.invalidate();
     emit lightsChanged();
     emit selection_.changed();
     edited();
@@ -172,7 +163,6 @@ void Document::applyRemoveLights(const std::vector<int>& indices) {
     for (auto it = indices.rbegin(); it != indices.rend(); ++it)
         scene_.lights.erase(scene_.lights.begin() + *it);
     selection_.replaceLights({}, false);
-    explained_.invalidate();
     emit lightsChanged();
     emit selection_.changed();
     edited();
@@ -181,7 +171,6 @@ void Document::applyRemoveLights(const std::vector<int>& indices) {
 void Document::applyCamera(const lc::Camera& c) {
     scene_.camera = c;
     selection_.clearTile();
-    explained_.invalidate();
     emit cameraChanged();
     emit selection_.tileChanged(-1);
     edited();

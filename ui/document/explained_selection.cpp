@@ -7,7 +7,9 @@
 namespace lcui {
 
 const ExplainedSelection::Result& ExplainedSelection::of(const Document& doc) {
-    if (valid_) return result_;
+    const std::pair<unsigned long long, unsigned long long> now{doc.selection().revision(), doc.runs().revision()};
+    if (valid_ && revisions_ == now) return result_;
+    revisions_ = now;
     result_ = {};
     try {
         result_.explanation = compute(doc);

@@ -3,13 +3,15 @@
 // selected tile (its selected cell, the list picked in the tile inspector, or
 // the first list that holds or needs the light) and the current light, in
 // the shown run once its ground truth is in. Worked out once per selection
-// and run, when first asked for, and shared by all who show it (the Explain
-// panel, the inspector's Explain markers).
+// and run (their revisions: no one has to remember to invalidate it), when
+// first asked for, and shared by all who show it (the Explain panel, the
+// inspector's Explain markers).
 
 #include "culling/diagnostics/explain.hpp"
 
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace lcui {
 
@@ -23,13 +25,11 @@ public:
     };
     // The explanation of `doc`'s selection as it is now.
     const Result& of(const Document& doc);
-    // The selection or the run changed (the Document calls it before anyone
-    // else hears of the change).
-    void invalidate() { valid_ = false; }
 
 private:
     static std::optional<lc::Explanation> compute(const Document& doc);
     bool valid_ = false;
+    std::pair<unsigned long long, unsigned long long> revisions_; // selection's, run state's
     Result result_;
 };
 

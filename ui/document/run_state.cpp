@@ -36,6 +36,7 @@ bool RunState::setRunOutput(std::shared_ptr<const lc::RunOutput> run, quint64 ge
     if (generation != generation_) emit generationChanging();
     run_ = std::move(run);
     generation_ = generation;
+    ++revision_;
     emit runOutputChanged();
     return true;
 }
@@ -45,10 +46,14 @@ void RunState::afterSceneEdit() {
     if (runIsStale()) emit runWentStale();
 }
 
-void RunState::noteRunRequested(quint64 generation) { pending_.emplace_back(generation, sceneRevision_); }
+void RunState::noteRunRequested(quint64 generation) {
+    pending_.emplace_back(generation, sceneRevision_);
+    ++revision_;
+}
 
 void RunState::noteRunFailed(quint64 generation) {
     std::erase_if(pending_, [generation](const auto& p) { return p.first == generation; });
+    ++revision_;
     if (runIsStale()) emit runWentStale(); // the scene may now be without a run on its way
 }
 

@@ -55,10 +55,20 @@ public:
     // --- for the Document ----------------------------------------------------------
     // The scene was edited (before the edit's receivers run) / all receivers ran
     // (emits runWentStale when no run of the scene as it is is on its way).
-    void noteSceneEdit() { ++sceneRevision_; }
+    void noteSceneEdit() {
+        ++sceneRevision_;
+        ++revision_;
+    }
     void afterSceneEdit();
     // A new scene: no run shown. Silent, like Selection::reset.
-    void resetRun() { run_.reset(); }
+    void resetRun() {
+        run_.reset();
+        ++revision_;
+    }
+
+    // Counts every change of the shown run or of what makes it stale (what is
+    // worked out from the run is kept while it is the same).
+    quint64 revision() const { return revision_; }
 
 signals:
     void settingsChanged();
@@ -82,6 +92,7 @@ private:
     // runs asked for and not yet answered.
     quint64 sceneRevision_ = 0, runRevision_ = 0;
     std::vector<std::pair<quint64, quint64>> pending_; // generation, scene revision
+    quint64 revision_ = 0;
 };
 
 } // namespace lcui

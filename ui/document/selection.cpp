@@ -17,12 +17,14 @@ void Selection::setSelectedLights(std::vector<int> lights) {
     lightLast_ = !unique.empty();
     lights_ = std::move(unique);
     camera_ = false;
+    ++revision_;
     emit changed();
 }
 
 void Selection::selectCamera() {
     lights_.clear();
     camera_ = true;
+    ++revision_;
     emit changed();
 }
 
@@ -32,6 +34,7 @@ void Selection::setSelectedTile(int tile) {
     if (tile >= 0) lightLast_ = false;
     cell_ = -1;
     explainedList_ = -1;
+    ++revision_;
     emit tileChanged(tile);
 }
 
@@ -39,12 +42,14 @@ void Selection::setSelectedCell(int cell) {
     if (cell == cell_) return;
     cell_ = cell;
     explainedList_ = -1;
+    ++revision_;
     emit tileChanged(tile_);
 }
 
 void Selection::setExplainedList(int list) {
     if (list == explainedList_) return;
     explainedList_ = list;
+    ++revision_;
     emit changed();
 }
 
@@ -52,15 +57,18 @@ void Selection::reset() {
     lights_.clear();
     camera_ = lightLast_ = false;
     tile_ = cell_ = explainedList_ = -1;
+    ++revision_;
 }
 
 void Selection::replaceLights(std::vector<int> lights, bool deselectCamera) {
     lights_ = std::move(lights);
     if (deselectCamera) camera_ = false;
+    ++revision_;
 }
 
 void Selection::clearTile() {
     tile_ = cell_ = explainedList_ = -1;
+    ++revision_;
 }
 
 } // namespace lcui

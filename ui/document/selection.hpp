@@ -55,7 +55,14 @@ public:
     // No tile, cell or explained list (the camera, and with it the grid, changed).
     void clearTile();
     // A new run's lists: a picked list index no longer means the same list.
-    void forgetExplainedList() { explainedList_ = -1; }
+    void forgetExplainedList() {
+        explainedList_ = -1;
+        ++revision_;
+    }
+
+    // Counts every change, announced or silent (what is worked out from the
+    // selection is kept while it is the same).
+    quint64 revision() const { return revision_; }
 
 signals:
     void changed();          // lights, camera or the explained list
@@ -69,6 +76,7 @@ private:
     bool lightLast_ = false;
     int cell_ = -1;
     int explainedList_ = -1;
+    quint64 revision_ = 0;
 };
 
 } // namespace lcui
