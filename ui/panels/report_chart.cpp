@@ -170,8 +170,7 @@ void ReportDock::loadRow(std::size_t row) {
     lc::CullSettings s = cfg.settings;
     const lc::CullSettings& mine = doc_->runs().settings();
     lc::Camera scratch = doc_->scene().camera;
-    const bool spots = std::any_of(doc_->scene().lights.begin(), doc_->scene().lights.end(),
-                                   [](const lc::PointLight& l) { return l.isSpot(); });
+    const bool spots = doc_->scene().hasSpotLights();
     for (const lc::ParamSpec& p : lc::cullParams())
         if (p.name != "tile" && p.name != "width" && p.name != "height" &&
             !lc::paramAppliesTo(p.name, cfg.settings, spots))

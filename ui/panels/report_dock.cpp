@@ -295,8 +295,7 @@ std::vector<std::string> ReportDock::sweptBackends() const {
 
 std::map<std::string, std::size_t> ReportDock::queuedPerBackend() const {
     const lc::ReportOptions o = optionsFromControls();
-    const auto& lights = doc_->scene().lights;
-    const bool spots = std::any_of(lights.begin(), lights.end(), [](const lc::PointLight& l) { return l.isSpot(); });
+    const bool spots = doc_->scene().hasSpotLights();
     std::map<std::string, std::size_t> n;
     for (const std::string& b : sweptBackends()) n[b] = lc::reportConfigs(o, b, spots).size();
     return n;
@@ -333,8 +332,7 @@ QString ReportDock::paceKey() const {
 
 void ReportDock::updateQueueLabel() {
     // spot-* parameters are swept only for a scene with spot lights.
-    const auto& lights = doc_->scene().lights;
-    const bool spots = std::any_of(lights.begin(), lights.end(), [](const lc::PointLight& l) { return l.isSpot(); });
+    const bool spots = doc_->scene().hasSpotLights();
     for (const auto& c : params_)
         if (c->name.rfind("spot-", 0) == 0) {
             c->button->setEnabled(spots);

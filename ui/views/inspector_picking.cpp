@@ -28,6 +28,7 @@
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkGlyph3D.h>
 #include <vtkHandleWidget.h>
+#include <vtkInteractorStyle.h>
 #include <vtkInteractorStyleTrackballCamera.h>
 #include <vtkLightsPass.h>
 #include <vtkOpaquePass.h>
@@ -54,6 +55,40 @@
 #include <numeric>
 
 namespace lcui {
+
+void InspectorView::buildHandles(vtkInteractorStyle* style) {
+    handleRep_->SetHandleSize(40);
+    handleRep_->GetProperty()->SetColor(1, 0.45, 0.1);
+    handleRep_->GetProperty()->SetLineWidth(3);
+    handleRep_->GetSelectedProperty()->SetLineWidth(3);
+    handleRep_->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
+    handleRep_->ActiveRepresentationOff();
+    handle_->SetInteractor(interactor());
+    handle_->SetDefaultRenderer(handleLayer_);
+    handle_->SetRepresentation(handleRep_);
+    handle_->AddObserver(vtkCommand::StartInteractionEvent, this, &InspectorView::onHandleStart);
+    handle_->AddObserver(vtkCommand::InteractionEvent, this, &InspectorView::onHandleMove);
+    handle_->AddObserver(vtkCommand::EndInteractionEvent, this, &InspectorView::onHandleEnd);
+    handle_->EnabledOff();
+
+    radiusRep_->SetHandleSize(25);
+    radiusRep_->GetProperty()->SetColor(0.2, 1.0, 0.9);
+    radiusRep_->GetProperty()->SetLineWidth(3);
+    radiusRep_->GetSelectedProperty()->SetLineWidth(3);
+    radiusRep_->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
+    radiusRep_->ActiveRepresentationOff();
+    radiusHandle_->SetInteractor(interactor());
+    radiusHandle_->SetDefaultRenderer(handleLayer_);
+    radiusHandle_->SetRepresentation(radiusRep_);
+    radiusHandle_->AddObserver(vtkCommand::StartInteractionEvent, this, &InspectorView::onRadiusStart);
+    radiusHandle_->AddObserver(vtkCommand::InteractionEvent, this, &InspectorView::onRadiusMove);
+    radiusHandle_->AddObserver(vtkCommand::EndInteractionEvent, this, &InspectorView::onRadiusEnd);
+    radiusHandle_->EnabledOff();
+    // After an orbit, the radius handle goes back to the right of the centre.
+    style->AddObserver(vtkCommand::EndInteractionEvent, this, &InspectorView::placeRadiusHandle);
+    spotHandles_ = std::make_unique<SpotHandles>(doc_, renderer_, interactor(), handleLayer_);
+
+}
 
 void InspectorView::onHandleStart() {
     handleActive_ = true;

@@ -39,8 +39,10 @@
 class vtkActor;
 class vtkCameraPass;
 class vtkCellPicker;
+class vtkGenericOpenGLRenderWindow;
 class vtkGlyph3D;
 class vtkHandleWidget;
+class vtkInteractorStyle;
 class vtkPointHandleRepresentation3D;
 class vtkPolyData;
 class vtkRenderer;
@@ -158,6 +160,11 @@ private:
         glm::dvec3 eye, focal, dir, up, right;
     };
     ViewBasis viewBasis() const;
+    // Construction steps (inspector_actors.cpp, inspector_picking.cpp).
+    void buildLightActors();
+    void buildRenderPasses(vtkGenericOpenGLRenderWindow* renderWindow);
+    void buildHandles(vtkInteractorStyle* style);
+    void buildLightNote();
     void rebuildMeshes();
     void applyMeshDisplay();
     void rebuildLights();

@@ -2,6 +2,8 @@
 
 #include "document/document.hpp"
 #include "document/miss_navigator.hpp"
+#include "document/run_state.hpp"
+#include "document/settings_store.hpp"
 #include "panels/generate_dialog.hpp"
 #include "panels/property_panel.hpp"
 #include "panels/report_dock.hpp"
@@ -17,6 +19,7 @@
 #include "window/overlay_menus.hpp"
 #include "window/param_toolbars.hpp"
 #include "window/run_status.hpp"
+#include "window/run_target_bar.hpp"
 #include "window/scene_files.hpp"
 #include "window/view_area.hpp"
 #include "work/cull_worker.hpp"
@@ -27,14 +30,12 @@
 
 #include <QAction>
 #include <QCloseEvent>
-#include <QComboBox>
 #include <QCursor>
 #include <QDockWidget>
 #include <QDragEnterEvent>
 #include <QDropEvent>
 #include <QFileInfo>
 #include <QLabel>
-#include <QLineEdit>
 #include <QMenuBar>
 #include <QMimeData>
 #include <QSettings>
@@ -115,8 +116,6 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), prompts(Prompts::
         if (isLive() && sceneOpen_) runCulling();
     });
     connect(&runs, &RunState::backendChanged, this, [this] {
-        backendCombo_->setCurrentText(doc_->runs().backend());
-        deviceEdit_->setText(doc_->runs().device());
         if (isLive() && sceneOpen_) runCulling();
     });
     connect(&runs, &RunState::liveChanged, this, [this](bool on) {
@@ -244,7 +243,7 @@ void MainWindow::wireReport() {
     });
     connect(report, &ReportDock::finished, this, [this] { statusProgress_->end("report"); });
     connect(report, &ReportDock::cullRequested, this, [this](const QString& backend) {
-        if (backendCombo_->findText(backend) >= 0) setBackend(backend, doc_->runs().device());
+        if (runTarget_->offers(backend)) setBackend(backend, doc_->runs().device());
         if (customShader_->options())
             setCustomShader({}); // runs culling
         else
@@ -313,26 +312,9 @@ void MainWindow::buildToolbars() {
     // first row beside the file actions: with it on the parameter row, a
     // 1280-pixel window hid Height, Custom shader, backend and device
     // behind the toolbar's extension arrow.
-    auto* bar = new QToolBar(tr("Run target"));
-    bar->setObjectName("runToolbar");
-    insertToolBar(params_->cullBar(), bar);
+    runTarget_ = new RunTargetBar(&doc_->runs(), a.customShader, this);
+    insertToolBar(params_->cullBar(), runTarget_);
     insertToolBarBreak(params_->cullBar());
-    bar->addAction(a.customShader);
-    bar->addSeparator();
-    bar->addWidget(new QLabel(tr("backend ")));
-    backendCombo_ = new QComboBox;
-    backendCombo_->setObjectName("backendCombo");
-    for (const auto& b : lc::availableBackends()) backendCombo_->addItem(QString::fromStdString(b));
-    backendCombo_->setCurrentText(doc_->runs().backend());
-    bar->addWidget(backendCombo_);
-    deviceEdit_ = new QLineEdit;
-    deviceEdit_->setObjectName("deviceEdit");
-    deviceEdit_->setPlaceholderText(tr("device (default)"));
-    deviceEdit_->setToolTip(tr("Vulkan device: index or name substring; empty = LIGHTCULL_DEVICE or the first"));
-    deviceEdit_->setMaximumWidth(140);
-    bar->addWidget(deviceEdit_);
-    connect(backendCombo_, &QComboBox::textActivated, &doc_->runs(), &RunState::setBackend);
-    connect(deviceEdit_, &QLineEdit::editingFinished, this, [this] { doc_->runs().setDevice(deviceEdit_->text()); });
 }
 
 // --- parameters and culling ------------------------------------------------------------
@@ -345,8 +327,7 @@ void MainWindow::setBackend(const QString& backend, const QString& device) {
     const QSignalBlocker quiet(&doc_->runs()); // the two in one change
     doc_->runs().setBackend(backend);
     doc_->runs().setDevice(device);
-    backendCombo_->setCurrentText(backend);
-    deviceEdit_->setText(device);
+    runTarget_->sync();
 }
 
 quint64 MainWindow::runCulling(bool liveEdit) {
@@ -483,23 +464,13 @@ void MainWindow::restoreSettings() {
     actions_.tabbedViews->setChecked(st.value("window/tabbedViews", false).toBool());
     views_->setTabbed(actions_.tabbedViews->isChecked());
     // Last culling parameters (the camera-owned ones belong to the scene).
-    lc::CullSettings s = doc_->runs().settings();
-    lc::Camera dummy;
-    st.beginGroup("params");
-    for (const auto& p : lc::cullParams()) {
-        if (!st.contains(QString::fromStdString(p.name))) continue;
-        try {
-            lc::setParam(s, dummy, p.name, st.value(QString::fromStdString(p.name)).toString().toStdString());
-        } catch (const lc::Error&) {
-        }
-    }
-    st.endGroup();
+    const lc::CullSettings s = readCullSettings(st, doc_->runs().settings());
     // Live comes back on without a run: the window holds no scene yet, and
     // the scene opened next runs once (a run here logged 'run 1: 0 lights').
     restoringSettings_ = true;
     doc_->runs().setSettings(s);
     const QString backend = st.value("backend").toString();
-    setBackend(backendCombo_->findText(backend) >= 0 ? backend : doc_->runs().backend(), st.value("device").toString());
+    setBackend(runTarget_->offers(backend) ? backend : doc_->runs().backend(), st.value("device").toString());
     doc_->runs().setLive(st.value("live", false).toBool());
     restoringSettings_ = false;
 }
@@ -510,12 +481,7 @@ void MainWindow::saveSettings() {
     st.setValue("window/state", saveState());
     views_->save(st);
     st.setValue("window/tabbedViews", views_->tabbed());
-    st.beginGroup("params");
-    lc::Camera dummy;
-    for (const auto& p : lc::cullParams())
-        st.setValue(QString::fromStdString(p.name),
-                    QString::fromStdString(lc::getParam(doc_->runs().settings(), dummy, p.name)));
-    st.endGroup();
+    writeCullSettings(st, doc_->runs().settings());
     st.setValue("backend", doc_->runs().backend());
     st.setValue("device", doc_->runs().device());
     st.setValue("live", isLive());

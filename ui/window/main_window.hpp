@@ -31,9 +31,7 @@
 
 class QAction;
 class QCheckBox;
-class QComboBox;
 class QLabel;
-class QLineEdit;
 class QMenu;
 class QPlainTextEdit;
 class QSplitter;
@@ -52,6 +50,7 @@ class LightPlacement;
 class MissNavigator;
 class ParamToolbars;
 class RunStatus;
+class RunTargetBar;
 class ViewArea;
 class SceneFiles;
 class CustomShaderSource;
@@ -193,8 +192,7 @@ private:
     Docks* docks_;
     WindowActions actions_;
     QMenu* recentMenu_ = nullptr;
-    QComboBox* backendCombo_ = nullptr;
-    QLineEdit* deviceEdit_ = nullptr;
+    RunTargetBar* runTarget_ = nullptr;
     ParamToolbars* params_ = nullptr; // the Culling and Limits rows
     SceneFiles* files_ = nullptr;     // open, save, import, recent files
     StatusProgress* statusProgress_ = nullptr; // loads, shading and reports, with Cancel

@@ -19,8 +19,6 @@
 #include <QStatusBar>
 
 #include <algorithm>
-#include <chrono>
-#include <future>
 #include <mutex>
 #include <optional>
 
@@ -99,9 +97,11 @@ bool MainWindow::hunt(const HuntRequest& r) {
             .arg(r.seconds > 0 ? QString::number(r.seconds) : tr("unlimited"))
             .arg(QString::fromStdString(lc::huntDimsToString(r.vary))));
     try {
-        runWithProgress(
-            statusProgress_, label,
-            [&](const lc::CancelToken& cancel, const lc::Progress& progress) {
+        // On the culling worker's thread and backend (one device), as a job
+        // that serves culling requests between its trials.
+        runJobWithProgress(
+            statusProgress_, service_, label,
+            [&](CullJobContext& job, const lc::CancelToken& cancel, const lc::Progress& progress) {
                 lc::HuntOptions opt = o;
                 opt.cancel = &cancel;
                 opt.progress = [&](const lc::HuntCoverage& c, double seconds) {
@@ -109,44 +109,22 @@ bool MainWindow::hunt(const HuntRequest& r) {
                     if (opt.maxTrials) f = std::max(f, double(c.trials) / double(opt.maxTrials));
                     if (opt.maxSeconds > 0) f = std::max(f, seconds / opt.maxSeconds);
                     progress(std::min(1.0, f));
-                    std::lock_guard<std::mutex> lock(mutex);
-                    label = tr("hunt: %1 trials, %2/s; %3 orthographic, %4 reversed-Z, %5 wide spots")
-                                .arg(c.trials)
-                                .arg(seconds > 0 ? double(c.trials) / seconds : 0.0, 0, 'f', 1)
-                                .arg(c.orthographic)
-                                .arg(c.reversedZ)
-                                .arg(c.wideSpots);
+                    {
+                        std::lock_guard<std::mutex> lock(mutex);
+                        label = tr("hunt: %1 trials, %2/s; %3 orthographic, %4 reversed-Z, %5 wide spots")
+                                    .arg(c.trials)
+                                    .arg(seconds > 0 ? double(c.trials) / seconds : 0.0, 0, 'f', 1)
+                                    .arg(c.orthographic)
+                                    .arg(c.reversedZ)
+                                    .arg(c.wideSpots);
+                    }
+                    job.serve();
                 };
-                // On the culling worker's thread and backend (one device), as
-                // a job that serves culling requests between its trials; this
-                // thread waits for it and passes the status bar's Cancel on.
-                auto jobCancel = std::make_shared<lc::CancelToken>();
-                opt.cancel = jobCancel.get();
-                std::promise<void> finished;
-                std::future<void> done = finished.get_future();
-                service_->runJob(
-                    [&, jobCancel](CullJobContext& job) {
-                        try {
-                            const auto report = opt.progress;
-                            opt.progress = [&](const lc::HuntCoverage& c, double seconds) {
-                                report(c, seconds);
-                                job.serve();
-                            };
-                            lc::CullBackend& backend = job.backend(backendName);
-                            lc::HuntResult found = lc::hunt(opt, backend);
-                            command = lc::writeHuntRepro(found, opt, backend, folder, device);
-                            result = std::move(found);
-                            finished.set_value();
-                        } catch (...) {
-                            finished.set_exception(std::current_exception());
-                        }
-                    },
-                    jobCancel);
-                while (done.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready)
-                    if (cancel.cancelled) jobCancel->cancelled = true;
-                done.get(); // rethrows what the hunt threw
+                lc::CullBackend& backend = job.backend(backendName);
+                lc::HuntResult found = lc::hunt(opt, backend);
+                command = lc::writeHuntRepro(found, opt, backend, folder, device);
+                result = std::move(found);
             },
-            0,
             [&] {
                 std::lock_guard<std::mutex> lock(mutex);
                 return label;

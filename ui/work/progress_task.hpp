@@ -1,8 +1,13 @@
 #pragma once
-// Long operations (loading a 400k-triangle mesh or a scene, generating tens of
-// thousands of lights) run on a background thread while the status bar
-// (StatusProgress) shows how far they got and offers Cancel. The UI keeps
+// Modal work: loading a 400k-triangle mesh or a scene, generating tens of
+// thousands of lights, a hunt. The window waits for it while the status bar
+// (StatusProgress) shows how far it got and offers Cancel; the UI keeps
 // processing events (views repaint) but takes no input besides Cancel.
+//
+// Work that needs a backend runs as a job of the culling worker (one device,
+// culling requests served between its steps); work that needs none (reading
+// files, generating lights) on a thread of its own, so that a long load
+// never holds up a culling run.
 
 #include "culling/core/depth.hpp"
 #include "culling/scene/scene_io.hpp"
@@ -16,7 +21,12 @@
 
 namespace lcui {
 
+class CullJobContext;
+class CullService;
 class StatusProgress;
+
+using ProgressWork = std::function<void(const lc::CancelToken&, const lc::Progress&)>;
+using ProgressJob = std::function<void(CullJobContext&, const lc::CancelToken&, const lc::Progress&)>;
 
 // Runs `work` on a new thread and waits (processing events) until it returns.
 // Its status row ("load": statusCancel_load, ...) shows at once by default:
@@ -26,9 +36,13 @@ class StatusProgress;
 // lc::Cancelled when cancelled. `liveLabel`, when set, is asked for the row's
 // label as often as the progress is shown (it must be safe to call while the
 // work runs).
-void runWithProgress(StatusProgress* status, const QString& label,
-                     const std::function<void(const lc::CancelToken&, const lc::Progress&)>& work,
-                     int showAfterMs = 0, const std::function<QString()>& liveLabel = {});
+void runWithProgress(StatusProgress* status, const QString& label, const ProgressWork& work, int showAfterMs = 0,
+                     const std::function<QString()>& liveLabel = {});
+
+// The same wait for `job` run on the culling worker's thread and backends
+// (CullService::runJob). Its token is also set when the worker shuts down.
+void runJobWithProgress(StatusProgress* status, CullService* service, const QString& label, ProgressJob job,
+                        const std::function<QString()>& liveLabel = {});
 
 template <class T>
 T runWithProgressResult(StatusProgress* status, const QString& label,

@@ -359,8 +359,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
     for (const ParamSpec& p : cullParams())
         if (sweptByTable(p)) rep.paramNames.push_back(p.name);
 
-    const bool hasSpots = std::any_of(sceneIn.lights.begin(), sceneIn.lights.end(),
-                                      [](const PointLight& l) { return l.isSpot(); });
+    const bool hasSpots = sceneIn.hasSpotLights();
     // Open every backend first: the total is known before the first run.
     struct Swept {
         std::unique_ptr<CullBackend> owned; // opened for the sweep (no backendFor)

@@ -166,6 +166,10 @@ std::size_t Scene::triangleCount() const {
     return n;
 }
 
+bool Scene::hasSpotLights() const {
+    return std::any_of(lights.begin(), lights.end(), [](const PointLight& l) { return l.isSpot(); });
+}
+
 void Scene::validate() const {
     if (std::string e = camera.validate(); !e.empty()) {
         const auto colon = e.find(':');

@@ -134,6 +134,8 @@ struct Scene {
     SceneOrigin origin;
 
     std::size_t triangleCount() const;
+    // Whether any light is a spot light (spot parameters decide nothing otherwise).
+    bool hasSpotLights() const;
     // Throws LightError for the first bad light, SettingsError for a bad
     // camera, InputError for a bad mesh.
     void validate() const;
