@@ -503,3 +503,67 @@ TEST(GroundTruthOptimum, MatchesBruteForceForEveryListRule) {
         EXPECT_GT(m.optimalWork, 0u) << toString(a);
     }
 }
+
+// The report judges hundreds of results of one frame with the pixels' needed
+// lights worked out once (computePixelNeeds): every figure must be the one
+// computeGroundTruth finds on its own, for every list rule and under limits
+// (misses by cause), and another frame's needs must be refused.
+TEST(GroundTruthNeeds, PrecomputedNeedsJudgeEveryResultAsWithout) {
+    Scene s = makeBuiltinScene("atrium");
+    LightGenSettings g = defaultLightGen(s, 60, 9);
+    g.spotFraction = 0.3;
+    s.lights = generateLights(g);
+    s.camera.width = 100;
+    s.camera.height = 60;
+    s.camera.tileSize = 8;
+    const Projection proj(s.camera);
+    const DepthImage depth = rasterizeDepthCpu(s, proj);
+    const ViewLights lights = makeViewLights(s);
+    const TileGrid grid = TileGrid::make(s.camera.width, s.camera.height, s.camera.tileSize);
+    const auto needs = computePixelNeeds(depth, proj, lights, std::size_t(1) << 20);
+    ASSERT_TRUE(needs);
+    auto backend = makeCpuBackend();
+    std::uint64_t exactWork = 0;
+    for (const Algorithm a : {Algorithm::All, Algorithm::Naive, Algorithm::TwoPointFiveD, Algorithm::Clustered,
+                              Algorithm::Fptl, Algorithm::ZBin})
+        for (const std::uint32_t cap : {0u, 2u}) {
+            CullSettings cs;
+            cs.algorithm = a;
+            cs.cells = 8;
+            cs.cap = cap;
+            cs.maxLights = cap ? 40 : 0;
+            const CullResult r = backend->cull(depth, proj, grid, lights, cs);
+            GroundTruthOptions alone;
+            alone.imageError = false;
+            GroundTruthOptions shared = alone;
+            shared.needs = needs.get();
+            const GroundTruth want = computeGroundTruth(depth, proj, lights, r, alone);
+            const GroundTruth got = computeGroundTruth(depth, proj, lights, r, shared);
+            const std::string what = std::string(toString(a)) + " cap " + std::to_string(cap);
+            EXPECT_EQ(got.metrics.falseNegatives, want.metrics.falseNegatives) << what;
+            EXPECT_EQ(got.metrics.falseNegativesListFull, want.metrics.falseNegativesListFull) << what;
+            EXPECT_EQ(got.metrics.falseNegativesLightLimit, want.metrics.falseNegativesLightLimit) << what;
+            EXPECT_EQ(got.metrics.shadingWork, want.metrics.shadingWork) << what;
+            EXPECT_EQ(got.metrics.exactWork, want.metrics.exactWork) << what;
+            EXPECT_EQ(got.metrics.optimalWork, want.metrics.optimalWork) << what;
+            EXPECT_EQ(got.metrics.geometryPixels, want.metrics.geometryPixels) << what;
+            EXPECT_EQ(got.listFalseNegatives, want.listFalseNegatives) << what;
+            EXPECT_EQ(got.listExactWork, want.listExactWork) << what;
+            EXPECT_EQ(got.tileGeometryPixels, want.tileGeometryPixels) << what;
+            if (cap) EXPECT_GT(want.metrics.falseNegatives, 0u) << what << ": the limits must drop lights here";
+            exactWork = want.metrics.exactWork;
+        }
+    // The needs are exactly the (pixel, light) pairs: E of any result.
+    EXPECT_EQ(needs->lights.size(), exactWork);
+    EXPECT_FALSE(computePixelNeeds(depth, proj, lights, needs->lights.size() - 1))
+        << "more pairs than allowed must give no needs, not an unbounded allocation";
+
+    CullSettings cs;
+    const CullResult r = backend->cull(depth, proj, grid, lights, cs);
+    GroundTruthOptions other;
+    other.imageError = false;
+    PixelNeeds fewer = *needs;
+    fewer.lightCount = lights.size() - 1;
+    other.needs = &fewer;
+    EXPECT_THROW(computeGroundTruth(depth, proj, lights, r, other), Error);
+}

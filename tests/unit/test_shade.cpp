@@ -211,6 +211,28 @@ TEST(Shade, ZBinPixelsShadeTheirBinsLightsOnly) {
     EXPECT_NE(viaResult, shadeLambertCpu(naive.depth, proj, naive.lights, &naive.result));
 }
 
+// One G-buffer pointed at one result after another (the report's sweep):
+// each time the same inputs and image as inputs made for that result alone,
+// the zbin result's per-pixel lists brought along and dropped again after.
+TEST(Shade, InputsPointedAtAnotherResultAreThoseMadeForIt) {
+    const Scene scene = smallScene("forest", 128, 72, 16, 200);
+    const Projection proj(scene.camera);
+    const RunOutput first = cpuRun(scene, Algorithm::Naive);
+    ShadeInputs in = makeShadeInputs(first.depth, proj, nullptr);
+    for (const Algorithm a : {Algorithm::ZBin, Algorithm::Clustered, Algorithm::TwoPointFiveD, Algorithm::All}) {
+        const RunOutput run = cpuRun(scene, a);
+        setShadeLists(in, run.depth, proj, &run.result);
+        const ShadeInputs fresh = makeShadeInputs(run.depth, proj, &run.result);
+        EXPECT_EQ(in.list, fresh.list) << toString(a);
+        EXPECT_EQ(in.position, fresh.position) << toString(a);
+        EXPECT_EQ(bool(in.perPixelLists), a == Algorithm::ZBin) << toString(a);
+        EXPECT_EQ(shadeCpu(in, run.lights, &run.result), shadeCpu(fresh, run.lights, &run.result)) << toString(a);
+    }
+    const Scene narrow = smallScene("forest", 64, 72, 16, 200);
+    const RunOutput other = cpuRun(narrow, Algorithm::Naive);
+    EXPECT_THROW(setShadeLists(in, other.depth, Projection(narrow.camera), &other.result), Error);
+}
+
 // The all-lights image of an earlier run serves a later one only where the
 // pixels and the lights' shading values are the same: a change of algorithm,
 // tile size or light range keeps it (and the images and error then equal a

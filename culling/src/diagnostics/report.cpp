@@ -191,22 +191,48 @@ void markPareto(std::vector<ReportRow>& rows) {
 
 namespace {
 
+// What every row of one depth image shares: the all-lights image, each
+// pixel's needed lights and the G-buffer (its lists set per row), worked out
+// once per backend instead of once per configuration.
+struct SweepFrame {
+    std::shared_ptr<const DepthImage> depth;
+    std::vector<float> allImage;
+    std::shared_ptr<const PixelNeeds> needs; // null on a scene too crowded to keep them
+    ShadeInputs shadeIn;
+};
+
+// (pixel, light) pairs kept for a sweep: 128 MB of light indices at most.
+constexpr std::size_t kSweepNeedsEntries = std::size_t(1) << 25;
+
+std::shared_ptr<SweepFrame> sweepFrame(DepthImage depth, const Projection& proj, const ViewLights& lights,
+                                       CullBackend& shader, const CancelToken* cancel) {
+    auto f = std::make_shared<SweepFrame>();
+    f->depth = std::make_shared<const DepthImage>(std::move(depth));
+    f->shadeIn = makeShadeInputs(*f->depth, proj, nullptr);
+    f->allImage = shader.shade(f->shadeIn, lights, nullptr);
+    f->needs = computePixelNeeds(*f->depth, proj, lights, kSweepNeedsEntries, cancel);
+    return f;
+}
+
 // A row after its timed culls: ground truth, `repeat` timed shades of the
-// culled lists on `shader`, and the image error against `allImage`.
-void judgeRow(ReportRow& row, const std::vector<double>& cullMs, const CullResult& result, const DepthImage& depth,
-              const Projection& proj, const ViewLights& lights, CullBackend& shader, const std::vector<float>& allImage,
-              const ReportOptions& options, const CancelToken* cancel) {
+// culled lists on `shader`, and the image error against the all-lights image.
+void judgeRow(ReportRow& row, const std::vector<double>& cullMs, const CullResult& result, const Projection& proj,
+              const ViewLights& lights, CullBackend& shader, SweepFrame& frame, const ReportOptions& options,
+              const CancelToken* cancel) {
+    const DepthImage& depth = *frame.depth;
     GroundTruthOptions gto;
     gto.imageError = false;
+    gto.needs = frame.needs.get();
     const GroundTruth truth = computeGroundTruth(depth, proj, lights, result, gto, cancel);
-    const ShadeInputs in = makeShadeInputs(depth, proj, &result);
+    setShadeLists(frame.shadeIn, depth, proj, &result);
+    const ShadeInputs& in = frame.shadeIn;
     std::vector<float> image;
     std::vector<double> shadeMs;
     for (int r = 0; r < options.warmup + options.repeat; ++r) {
         image = shader.shade(in, lights, &result);
         if (r >= options.warmup) shadeMs.push_back(shader.lastShadeMs());
     }
-    const ImageError err = compareShadedImages(depth, image, allImage);
+    const ImageError err = compareShadedImages(depth, image, frame.allImage);
     row.cullMs = median(cullMs);
     row.shadeMs = median(shadeMs);
     row.totalMs = row.cullMs + row.shadeMs;
@@ -269,12 +295,14 @@ std::uint64_t smallestLossless(std::uint64_t from, std::uint64_t to,
 // preset's derived settings worked out again for it as the engine would; and
 // where the engine does not let that limit go so far, what it does allow.
 std::string findFix(const ReportRow& row, const EnginePreset& preset, const Scene& scene, CullBackend& backend,
-                    const DepthImage& depth, const Projection& proj, const ViewLights& lights,
+                    const SweepFrame& frame, const Projection& proj, const ViewLights& lights,
                     const CancelToken* cancel) {
     if (row.falseNegativesListFull == 0 && row.falseNegativesLightLimit == 0)
         return row.falseNegatives ? "none: the misses are the culling test's, not a limit's" : "";
+    const DepthImage& depth = *frame.depth;
     GroundTruthOptions gto;
     gto.imageError = false;
+    gto.needs = frame.needs.get();
     std::vector<std::pair<std::string, std::string>> over;
     auto cullWith = [&](const std::vector<std::pair<std::string, std::string>>& o) {
         if (cancel && cancel->cancelled.load()) throw Cancelled();
@@ -396,22 +424,20 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
     std::size_t done = 0;
     // For the custom shaders: the depth, shading backend and all-lights image
     // of the vulkan backend (else the first that ran).
-    std::shared_ptr<const DepthImage> shaderDepth;
-    std::shared_ptr<const std::vector<float>> shaderAll;
+    std::shared_ptr<SweepFrame> shaderFrame;
     CullBackend* shaderShade = nullptr;
     try {
         for (auto& [owned, backend, cfgs] : work) {
             if (cancelled(cancel)) throw Cancelled();
             rep.backendDevices.emplace_back(backend->name(), backend->deviceName());
             rep.backendTiming.emplace_back(backend->name(), backend->timingMethod());
-            // Depth does not depend on any swept parameter: one pre-pass and one
-            // all-lights image per backend.
-            const DepthImage depth = backend->renderDepth(sceneIn, proj);
-            const ShadeInputs allIn = makeShadeInputs(depth, proj, nullptr);
-            const std::vector<float> allImage = backend->shade(allIn, lights, nullptr);
-            if (!shaderDepth || backend->name() == "vulkan") {
-                shaderDepth = std::make_shared<const DepthImage>(depth);
-                shaderAll = std::make_shared<const std::vector<float>>(allImage);
+            // Depth does not depend on any swept parameter: one pre-pass, one
+            // all-lights image and one G-buffer per backend.
+            const std::shared_ptr<SweepFrame> frame =
+                sweepFrame(backend->renderDepth(sceneIn, proj), proj, lights, *backend, cancel);
+            const DepthImage& depth = *frame->depth;
+            if (!shaderFrame || backend->name() == "vulkan") {
+                shaderFrame = frame;
                 shaderShade = backend;
             }
             for (const ReportConfig& cfg : cfgs) {
@@ -430,9 +456,9 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
                 if (const std::string bad = result.validate(lights.size()); !bad.empty())
                     throw Error("backend '" + backend->name() + "' produced an inconsistent result for " +
                                 cfg.label() + ": " + bad);
-                judgeRow(row, cullMs, result, depth, proj, lights, *backend, allImage, options, cancel);
+                judgeRow(row, cullMs, result, proj, lights, *backend, *frame, options, cancel);
                 if (!cfg.preset.empty())
-                    row.fix = findFix(row, enginePreset(cfg.preset), sceneIn, *backend, depth, proj, lights, cancel);
+                    row.fix = findFix(row, enginePreset(cfg.preset), sceneIn, *backend, *frame, proj, lights, cancel);
                 rep.rows.push_back(std::move(row));
                 ++done;
                 if (progress) progress(done, total, cfg.backend + " " + cfg.label());
@@ -440,7 +466,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
         }
         for (const CustomShaderOptions& so : options.shaders) {
             if (cancelled(cancel)) throw Cancelled();
-            if (!shaderDepth) throw Error("custom shaders need a backend for the depth pre-pass");
+            if (!shaderFrame) throw Error("custom shaders need a backend for the depth pre-pass");
             const TileGrid grid =
                 TileGrid::make(sceneIn.camera.width, sceneIn.camera.height, sceneIn.camera.tileSize);
             ReportRow row;
@@ -455,12 +481,11 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             CustomCullReport crep;
             for (int r = 0; r < options.warmup + options.repeat; ++r) {
                 crep = CustomCullReport{};
-                result = runCustomShader(so, *shaderDepth, proj, grid, lights, crep);
+                result = runCustomShader(so, *shaderFrame->depth, proj, grid, lights, crep);
                 if (r >= options.warmup) cullMs.push_back(crep.passMs);
             }
             row.device = crep.device;
-            judgeRow(row, cullMs, result, *shaderDepth, proj, lights, *shaderShade, *shaderAll, options,
-                     cancel);
+            judgeRow(row, cullMs, result, proj, lights, *shaderShade, *shaderFrame, options, cancel);
             if (crep.overflowLists || crep.invalidIndices || !crep.validationMessages.empty())
                 rep.notes.push_back(row.config.customLabel + ": " + std::to_string(crep.overflowLists) +
                                     " overflowed lists, " + std::to_string(crep.invalidIndices) +

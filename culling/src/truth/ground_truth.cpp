@@ -22,6 +22,7 @@
 #include <exception>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #if defined(__SSE2__)
@@ -156,14 +157,16 @@ GroundTruth zbinTruth(const DepthImage& depth, const Projection& proj, const Vie
 // the shading work, the exact work and the misses (by cause under limits),
 // per tile its geometry pixels, and the optimum's work into gt.metrics.
 void countPixels(const DepthImage& depth, const Projection& proj, const ViewLights& lights,
-                 const CullResult& result, const glm::dvec3& bmin, const glm::dvec3& bmax, unsigned workers,
-                 const CancelToken* cancel, GroundTruth& gt) {
+                 const CullResult& result, const PixelNeeds* needs, const glm::dvec3& bmin, const glm::dvec3& bmax,
+                 unsigned workers, const CancelToken* cancel, GroundTruth& gt) {
     const std::size_t lists = result.listCount.size();
     const std::size_t tiles = result.grid.tileCount();
     const ListLimits& limits = result.limits;
     const bool limited = !limits.empty();
     Metrics& m = gt.metrics;
-    const detail::LightGrid grid(lights, bmin, bmax);
+    // Each pixel's lights: precomputed, or found through a uniform grid.
+    std::optional<detail::LightGrid> grid;
+    if (!needs) grid.emplace(lights, bmin, bmax);
     struct Acc {
         std::vector<std::uint64_t> w, e, fn, fnFull, fnLimit;
         std::vector<std::uint32_t> tilePixels;
@@ -215,9 +218,10 @@ void countPixels(const DepthImage& depth, const Projection& proj, const ViewLigh
             for (std::uint32_t y = y0; y < y1; ++y)
                 for (std::uint32_t x = tx0; x < std::min(depth.width, tx0 + ts); ++x) {
                     if (!depth.hasGeometry(x, y)) continue;
+                    const std::size_t pixel = std::size_t(y) * depth.width + x;
                     const double d = depth.at(x, y);
-                    const glm::dvec3 p = proj.viewPositionFromDepth(x, y, d);
-                    const std::uint32_t l = result.listOfPixel(x, y, proj.viewDepthFromWindowDepth(d));
+                    const double viewDepth = needs ? needs->viewDepth[pixel] : proj.viewDepthFromWindowDepth(d);
+                    const std::uint32_t l = result.listOfPixel(x, y, viewDepth);
                     if (l >= lists) throw Error("ground truth: listOfPixel gave list " + std::to_string(l));
                     const std::uint32_t t = result.grid.tileOfPixel(x, y);
                     ++a.tilePixels[t];
@@ -237,7 +241,7 @@ void countPixels(const DepthImage& depth, const Projection& proj, const ViewLigh
                     const std::uint32_t subBit = oneList || perTileUnion ? 1u : 1u << (l - t * per);
                     const std::uint32_t u = perTileUnion ? t : l; // where the union counts
                     std::uint64_t needed = 0, missed = 0, missedFull = 0, missedLimit = 0;
-                    grid.forEachContaining(p, [&](std::uint32_t i) {
+                    const auto visit = [&](std::uint32_t i) {
                         ++needed;
                         missed += stamp[i] != now;
                         if (limited && stamp[i] != now) {
@@ -253,7 +257,14 @@ void countPixels(const DepthImage& depth, const Projection& proj, const ViewLigh
                             a.unionSubs[i] |= subBit;
                             ++a.listUnion[u];
                         }
-                    });
+                    };
+                    if (needs) {
+                        const std::uint32_t* it = needs->lights.data() + needs->offset[pixel];
+                        const std::uint32_t* end = needs->lights.data() + needs->offset[pixel + 1];
+                        for (; it != end; ++it) visit(*it);
+                    } else {
+                        grid->forEachContaining(proj.viewPositionFromDepth(x, y, d), visit);
+                    }
                     a.e[l] += needed;
                     a.fn[l] += missed;
                     if (limited) a.fnFull[l] += missedFull, a.fnLimit[l] += missedLimit;
@@ -312,6 +323,51 @@ void addImageError(const DepthImage& depth, const Projection& proj, const ViewLi
 
 } // namespace
 
+std::shared_ptr<const PixelNeeds> computePixelNeeds(const DepthImage& depth, const Projection& proj,
+                                                    const ViewLights& lights, std::size_t maxEntries,
+                                                    const CancelToken* cancel) {
+    checkInputs(depth, proj);
+    maxEntries = std::min<std::size_t>(maxEntries, std::numeric_limits<std::uint32_t>::max());
+    auto needs = std::make_shared<PixelNeeds>();
+    needs->width = depth.width;
+    needs->height = depth.height;
+    needs->lightCount = lights.size();
+    const std::size_t n = std::size_t(depth.width) * depth.height;
+    needs->viewDepth.assign(n, 0.0);
+    needs->offset.assign(n + 1, 0);
+    const unsigned workers = workerCount();
+    glm::dvec3 bmin, bmax;
+    if (!geometryBounds(depth, proj, workers, cancel, bmin, bmax)) return needs;
+    const detail::LightGrid grid(lights, bmin, bmax);
+    // Per band of rows its pixels' lights, joined in pixel order after.
+    const std::uint32_t bandRows = 16;
+    std::vector<std::vector<std::uint32_t>> bandLights((depth.height + bandRows - 1) / bandRows);
+    std::atomic<std::size_t> total{0};
+    std::atomic<bool> tooMany{false};
+    forEachRowBand(depth.height, bandRows, workers, cancel, [&](unsigned, std::uint32_t y0, std::uint32_t y1) {
+        if (tooMany.load(std::memory_order_relaxed)) return;
+        std::vector<std::uint32_t>& out = bandLights[y0 / bandRows];
+        for (std::uint32_t y = y0; y < y1; ++y)
+            for (std::uint32_t x = 0; x < depth.width; ++x) {
+                const std::size_t pixel = std::size_t(y) * depth.width + x;
+                if (depth.hasGeometry(x, y)) {
+                    const double d = depth.at(x, y);
+                    needs->viewDepth[pixel] = proj.viewDepthFromWindowDepth(d);
+                    const std::size_t before = out.size();
+                    grid.forEachContaining(proj.viewPositionFromDepth(x, y, d),
+                                           [&](std::uint32_t i) { out.push_back(i); });
+                    needs->offset[pixel + 1] = std::uint32_t(out.size() - before); // a count until joined
+                }
+            }
+        if (total += out.size(); total.load() > maxEntries) tooMany = true;
+    });
+    if (tooMany) return nullptr;
+    needs->lights.reserve(total.load());
+    for (std::size_t i = 0; i < n; ++i) needs->offset[i + 1] += needs->offset[i];
+    for (const auto& band : bandLights) needs->lights.insert(needs->lights.end(), band.begin(), band.end());
+    return needs;
+}
+
 GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
                                const ViewLights& lights, const CullResult& result,
                                const GroundTruthOptions& opt, const CancelToken* cancel) {
@@ -335,9 +391,14 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
     gt.listFalseNegativesLightLimit.assign(lists, 0);
     gt.tileGeometryPixels.assign(tiles, 0);
     Metrics& m = gt.metrics;
-    glm::dvec3 bmin, bmax;
-    if (geometryBounds(depth, proj, workers, cancel, bmin, bmax))
-        countPixels(depth, proj, lights, result, bmin, bmax, workers, cancel, gt);
+    if (const PixelNeeds* needs = opt.needs) {
+        if (needs->width != depth.width || needs->height != depth.height || needs->lightCount != lights.size())
+            throw Error("ground truth: the pixel needs given are of another frame (" + std::to_string(needs->width) +
+                        "x" + std::to_string(needs->height) + ", " + std::to_string(needs->lightCount) + " lights)");
+        countPixels(depth, proj, lights, result, needs, {}, {}, workers, cancel, gt);
+    } else if (glm::dvec3 bmin, bmax; geometryBounds(depth, proj, workers, cancel, bmin, bmax)) {
+        countPixels(depth, proj, lights, result, nullptr, bmin, bmax, workers, cancel, gt);
+    }
 
     for (std::size_t l = 0; l < lists; ++l) {
         m.shadingWork += gt.listShadingWork[l];

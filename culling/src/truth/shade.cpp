@@ -227,7 +227,9 @@ void checkLists(const CullResult& culled, std::size_t lightCount) {
 
 } // namespace
 
-ShadeInputs makeShadeInputs(const DepthImage& depth, const Projection& proj, const CullResult* culled) {
+namespace {
+
+void checkShadeSizes(const DepthImage& depth, const Projection& proj, const CullResult* culled) {
     if (depth.depth.size() != std::size_t(depth.width) * depth.height)
         throw Error("shading: depth image holds " + std::to_string(depth.depth.size()) + " values, expected " +
                     std::to_string(depth.width) + "x" + std::to_string(depth.height));
@@ -238,34 +240,56 @@ ShadeInputs makeShadeInputs(const DepthImage& depth, const Projection& proj, con
         throw Error("shading: cull result grid is " + std::to_string(culled->grid.width) + "x" +
                     std::to_string(culled->grid.height) + ", depth image " + std::to_string(depth.width) + "x" +
                     std::to_string(depth.height));
+}
+
+} // namespace
+
+ShadeInputs makeShadeInputs(const DepthImage& depth, const Projection& proj, const CullResult* culled) {
+    checkShadeSizes(depth, proj, culled);
     ShadeInputs in;
-    if (culled && culled->algorithm == Algorithm::ZBin && culled->pixelList.empty()) {
-        // What a zbin pixel loops over: its tile's mask within its bin's range.
-        in.perPixelLists = std::make_shared<const CullResult>(zbinPixelLists(*culled, depth, proj));
-        culled = in.perPixelLists.get();
-    }
     in.width = depth.width;
     in.height = depth.height;
     const std::size_t n = std::size_t(depth.width) * depth.height;
     in.position.assign(n * 3, 0.0f);
     in.normal.assign(n * 3, 0.0f);
-    in.list.assign(n, ShadeInputs::kNoList);
     forEachRowBand(depth.height, 16, [&](std::uint32_t y0, std::uint32_t y1) {
         for (std::uint32_t y = y0; y < y1; ++y)
             for (std::uint32_t x = 0; x < depth.width; ++x) {
                 if (!depth.hasGeometry(x, y)) continue;
                 const std::size_t i = std::size_t(y) * depth.width + x;
-                const double d = depth.at(x, y);
-                const glm::dvec3 p = proj.viewPositionFromDepth(x, y, d);
+                const glm::dvec3 p = proj.viewPositionFromDepth(x, y, depth.at(x, y));
                 const glm::dvec3 nrm = shadingNormal(depth, proj, x, y, p);
                 for (int c = 0; c < 3; ++c) {
                     in.position[3 * i + c] = float(p[c]);
                     in.normal[3 * i + c] = float(nrm[c]);
                 }
-                in.list[i] = culled ? culled->listOfPixel(x, y, proj.viewDepthFromWindowDepth(d)) : 0u;
             }
     });
+    setShadeLists(in, depth, proj, culled);
     return in;
+}
+
+void setShadeLists(ShadeInputs& in, const DepthImage& depth, const Projection& proj, const CullResult* culled) {
+    checkShadeSizes(depth, proj, culled);
+    if (in.width != depth.width || in.height != depth.height)
+        throw Error("shading: inputs are " + std::to_string(in.width) + "x" + std::to_string(in.height) +
+                    ", depth image " + std::to_string(depth.width) + "x" + std::to_string(depth.height));
+    in.perPixelLists.reset();
+    if (culled && culled->algorithm == Algorithm::ZBin && culled->pixelList.empty()) {
+        // What a zbin pixel loops over: its tile's mask within its bin's range.
+        in.perPixelLists = std::make_shared<const CullResult>(zbinPixelLists(*culled, depth, proj));
+        culled = in.perPixelLists.get();
+    }
+    in.list.assign(std::size_t(depth.width) * depth.height, ShadeInputs::kNoList);
+    forEachRowBand(depth.height, 16, [&](std::uint32_t y0, std::uint32_t y1) {
+        for (std::uint32_t y = y0; y < y1; ++y)
+            for (std::uint32_t x = 0; x < depth.width; ++x) {
+                if (!depth.hasGeometry(x, y)) continue;
+                const double d = depth.at(x, y);
+                in.list[std::size_t(y) * depth.width + x] =
+                    culled ? culled->listOfPixel(x, y, proj.viewDepthFromWindowDepth(d)) : 0u;
+            }
+    });
 }
 
 std::vector<float> shadeCpu(const ShadeInputs& in, const ViewLights& lights, const CullResult* culled) {

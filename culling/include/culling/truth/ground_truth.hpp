@@ -8,6 +8,7 @@
 #include "culling/truth/shade.hpp"
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace lc {
@@ -48,10 +49,31 @@ struct GroundTruth {
     std::vector<std::uint32_t> tileGeometryPixels;
 };
 
+// What the ground truth of one frame (depth image, camera, lights) needs,
+// whatever was culled: per pixel its view depth and the lights whose volume
+// contains its position. Built once, it judges many results of that frame
+// (the report's sweep) without finding each pixel's lights again.
+struct PixelNeeds {
+    std::uint32_t width = 0, height = 0;
+    std::size_t lightCount = 0;
+    std::vector<double> viewDepth; // per pixel; meaningful where the depth has geometry
+    // Pixel i needs lights[offset[i] .. offset[i + 1]) (width x height + 1 offsets).
+    std::vector<std::uint32_t> offset, lights;
+};
+
+// Null when the frame holds more than `maxEntries` (pixel, light) pairs: the
+// caller then judges without (memory stays bounded on a crowded scene).
+std::shared_ptr<const PixelNeeds> computePixelNeeds(const DepthImage& depth, const Projection& proj,
+                                                    const ViewLights& lights, std::size_t maxEntries,
+                                                    const CancelToken* cancel = nullptr);
+
 struct GroundTruthOptions {
     // Lambert image error on the CPU (costs pixels x lights). runPipeline turns
     // this off and takes the error from the backend's shading pass instead.
     bool imageError = true;
+    // computePixelNeeds of this depth image, camera and lights (or null:
+    // worked out here). Another frame's is an Error.
+    const PixelNeeds* needs = nullptr;
 };
 
 GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,

@@ -52,6 +52,10 @@ struct ShadeInputs {
 // list 0 of "every light"; a zbin result brings its per-pixel lists along.
 // Throws Error when sizes disagree.
 ShadeInputs makeShadeInputs(const DepthImage& depth, const Projection& proj, const CullResult* culled);
+// Points `in`, made by makeShadeInputs for this depth image and camera, at the
+// lists of `culled` (null: every light): only the per-pixel list changes, so a
+// sweep over many results of one frame builds the G-buffer once.
+void setShadeLists(ShadeInputs& in, const DepthImage& depth, const Projection& proj, const CullResult* culled);
 
 // The CPU reference of the shading pass: RGB, 3 floats per pixel, background 0.
 // `culled` null: every light in index order. Throws Error when a list is out of
