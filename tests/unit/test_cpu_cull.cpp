@@ -7,6 +7,7 @@
 //    per-light tile rectangles.
 #include "culling/core/backend.hpp"
 #include "culling/core/errors.hpp"
+#include "culling/scene/scene_io.hpp"
 #include "culling/truth/ground_truth.hpp"
 
 #include <gtest/gtest.h>
@@ -539,4 +540,37 @@ TEST(CpuCull, ZBinBinsAreTightAndTheGroundTruthCountsThePixelsLoops) {
     EXPECT_EQ(naive.result.lightIndices, z.lightIndices);
     EXPECT_LT(work, computeGroundTruth(naive.depth, proj, naive.lights, naive.result, o).metrics.shadingWork);
     EXPECT_EQ(z.bytes(), 4u * 64 + 4u * z.grid.tileCount() * ((r.lights.size() + 31) / 32));
+}
+
+// PixelListLookup (every pixel of a result) names the list listOfPixel
+// names, for every algorithm and both slicings, at every pixel's depth.
+TEST(CpuCull, PixelListLookupIsListOfPixel) {
+    Scene s = makeBuiltinScene("atrium");
+    s.lights = generateLights(defaultLightGen(s, 40, 3));
+    s.camera.width = 96;
+    s.camera.height = 64;
+    const Projection proj(s.camera);
+    const DepthImage depth = rasterizeDepthCpu(s, proj);
+    const ViewLights lights = makeViewLights(s);
+    const TileGrid grid = TileGrid::make(s.camera.width, s.camera.height, 16);
+    auto backend = makeCpuBackend();
+    std::size_t compared = 0;
+    for (const Algorithm a : {Algorithm::All, Algorithm::Naive, Algorithm::HalfZ, Algorithm::TwoPointFiveD,
+                              Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin})
+        for (const Slicing sl : {Slicing::Log, Slicing::Linear}) {
+            CullSettings cs;
+            cs.algorithm = a;
+            cs.cells = 8;
+            cs.slicing = sl;
+            const CullResult r = backend->cull(depth, proj, grid, lights, cs);
+            const PixelListLookup lookup(r);
+            for (std::uint32_t y = 0; y < depth.height; ++y)
+                for (std::uint32_t x = 0; x < depth.width; ++x) {
+                    if (!depth.hasGeometry(x, y)) continue;
+                    const double d = proj.viewDepthFromWindowDepth(depth.at(x, y));
+                    ASSERT_EQ(lookup(x, y, d), r.listOfPixel(x, y, d)) << toString(a) << " at " << x << "," << y;
+                    ++compared;
+                }
+        }
+    EXPECT_GT(compared, 10000u);
 }

@@ -221,3 +221,32 @@ TEST(Names, TestAndSlicingStrings) {
     EXPECT_STREQ(toString(Slicing::Log), "log");
     EXPECT_STREQ(toString(Slicing::Linear), "linear");
 }
+
+// SliceLocator answers as sliceOfDepth does, bit for bit: at every boundary,
+// one ulp either side, random depths, out of range, NaN and degenerate ranges
+// (the ground truth and the shading inputs look up every pixel through it).
+TEST(Slicing, LocatorAnswersAsSliceOfDepth) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    std::uint64_t checked = 0;
+    for (Slicing s : {Slicing::Log, Slicing::Linear})
+        for (std::uint32_t cells : {1u, 2u, 3u, 8u, 17u, 32u})
+            for (auto [lo, hi] : std::initializer_list<std::pair<double, double>>{
+                     {0.1, 100.0}, {1.0, 1.0 + 1e-9}, {-2.0, 5.0}, {0.0, 3.0}, {2.0, 2.0}, {5.0, 1.0}, {1e-6, 1e6}}) {
+                const SliceLocator locate(s, lo, hi, cells);
+                std::vector<double> depths = {lo, hi, -1e300, 1e300, nan, std::nextafter(lo, -1e300),
+                                              std::nextafter(hi, 1e300)};
+                for (std::uint32_t i = 0; i <= cells; ++i) {
+                    const double b = sliceBoundary(s, lo, hi, cells, i);
+                    depths.insert(depths.end(), {b, std::nextafter(b, -1e300), std::nextafter(b, 1e300)});
+                }
+                for (int k = 0; k < 200; ++k) depths.push_back(lo + (hi - lo) * (1.2 * u(rng) - 0.1));
+                for (double d : depths) {
+                    ASSERT_EQ(locate(d), sliceOfDepth(s, lo, hi, cells, d))
+                        << toString(s) << " cells " << cells << " [" << lo << ", " << hi << "] d " << d;
+                    ++checked;
+                }
+            }
+    EXPECT_GT(checked, 10000u);
+}

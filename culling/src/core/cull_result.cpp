@@ -76,6 +76,24 @@ std::uint32_t CullResult::listOfPixel(std::uint32_t px, std::uint32_t py, double
     }
 }
 
+PixelListLookup::PixelListLookup(const CullResult& result) : r_(result) {
+    if (!r_.pixelList.empty()) return;
+    if (r_.algorithm == Algorithm::Clustered) {
+        slices_.emplace_back(r_.settings.slicing, r_.clusterNear, r_.clusterFar, r_.listsPerTile);
+    } else if (r_.algorithm == Algorithm::TwoPointFiveD && r_.cellLists) {
+        slices_.reserve(r_.tileDepthMin.size());
+        for (std::size_t t = 0; t < r_.tileDepthMin.size(); ++t)
+            slices_.emplace_back(r_.settings.slicing, r_.tileDepthMin[t], r_.tileDepthMax[t], r_.listsPerTile);
+    }
+}
+
+std::uint32_t PixelListLookup::operator()(std::uint32_t px, std::uint32_t py, double viewDepth) const {
+    if (slices_.empty()) return r_.listOfPixel(px, py, viewDepth);
+    const std::uint32_t tile = r_.grid.tileOfPixel(px, py);
+    const SliceLocator& slice = r_.algorithm == Algorithm::Clustered ? slices_[0] : slices_[tile];
+    return tile * r_.listsPerTile + slice(viewDepth);
+}
+
 std::pair<std::uint32_t, std::uint32_t> CullResult::tileLists(std::uint32_t tile) const {
     if (algorithm == Algorithm::All) return {0u, listCount.empty() ? 0u : 1u};
     const std::uint32_t per = std::max(listsPerTile, 1u);

@@ -155,15 +155,21 @@ void cellMasks(const CpuCull& c, CullResult& res) {
     const Algorithm algo = c.settings.algorithm;
     const std::uint32_t cells = c.settings.cells;
     res.cellMask.assign(grid.tileCount(), 0);
+    // sliceOfDepth's answers, the boundaries worked out once per range.
+    std::vector<SliceLocator> slices;
+    if (algo == Algorithm::Clustered) {
+        slices.emplace_back(c.settings.slicing, res.clusterNear, res.clusterFar, cells);
+    } else {
+        slices.reserve(grid.tileCount());
+        for (std::uint32_t t = 0; t < grid.tileCount(); ++t)
+            slices.emplace_back(c.settings.slicing, res.tileDepthMin[t], res.tileDepthMax[t], cells);
+    }
     for (std::uint32_t y = 0; y < depth.height; ++y) {
         for (std::uint32_t x = 0; x < depth.width; ++x) {
             const double v = c.viewDepth[std::size_t(y) * depth.width + x];
             if (std::isnan(v)) continue;
             const std::uint32_t t = grid.tileOfPixel(x, y);
-            const std::uint32_t k =
-                algo == Algorithm::Clustered
-                    ? sliceOfDepth(c.settings.slicing, res.clusterNear, res.clusterFar, cells, v)
-                    : sliceOfDepth(c.settings.slicing, res.tileDepthMin[t], res.tileDepthMax[t], cells, v);
+            const std::uint32_t k = slices[algo == Algorithm::Clustered ? 0 : t](v);
             res.cellMask[t] |= 1u << k;
         }
     }

@@ -200,6 +200,19 @@ std::uint32_t sliceOfDepth(Slicing s, double lo, double hi, std::uint32_t cells,
     return i;
 }
 
+SliceLocator::SliceLocator(Slicing s, double lo, double hi, std::uint32_t cells) : lo_(lo), hi_(hi), cells_(cells) {
+    if (cells <= 1 || !(hi > lo)) return;
+    inner_.reserve(cells - 1);
+    for (std::uint32_t i = 1; i < cells; ++i) inner_.push_back(sliceBoundary(s, lo, hi, cells, i));
+}
+
+std::uint32_t SliceLocator::operator()(double d) const {
+    if (cells_ <= 1 || !(hi_ > lo_) || !(d > lo_)) return 0;
+    if (d >= hi_) return cells_ - 1;
+    // Slice k starts at boundary k: the count of inner boundaries <= d.
+    return std::uint32_t(std::upper_bound(inner_.begin(), inner_.end(), d) - inner_.begin());
+}
+
 std::uint32_t sliceRangeMask(Slicing s, double lo, double hi, std::uint32_t cells, double a,
                              double b) {
     if (cells == 0) return 0;

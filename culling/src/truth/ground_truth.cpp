@@ -164,6 +164,7 @@ void countPixels(const DepthImage& depth, const Projection& proj, const ViewLigh
     const ListLimits& limits = result.limits;
     const bool limited = !limits.empty();
     Metrics& m = gt.metrics;
+    const PixelListLookup listOf(result);
     // Each pixel's lights: precomputed, or found through a uniform grid.
     std::optional<detail::LightGrid> grid;
     if (!needs) grid.emplace(lights, bmin, bmax);
@@ -221,7 +222,7 @@ void countPixels(const DepthImage& depth, const Projection& proj, const ViewLigh
                     const std::size_t pixel = std::size_t(y) * depth.width + x;
                     const double d = depth.at(x, y);
                     const double viewDepth = needs ? needs->viewDepth[pixel] : proj.viewDepthFromWindowDepth(d);
-                    const std::uint32_t l = result.listOfPixel(x, y, viewDepth);
+                    const std::uint32_t l = listOf(x, y, viewDepth);
                     if (l >= lists) throw Error("ground truth: listOfPixel gave list " + std::to_string(l));
                     const std::uint32_t t = result.grid.tileOfPixel(x, y);
                     ++a.tilePixels[t];

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <optional>
 #include <exception>
 #include <limits>
 #include <mutex>
@@ -281,13 +282,15 @@ void setShadeLists(ShadeInputs& in, const DepthImage& depth, const Projection& p
         culled = in.perPixelLists.get();
     }
     in.list.assign(std::size_t(depth.width) * depth.height, ShadeInputs::kNoList);
+    std::optional<PixelListLookup> listOf;
+    if (culled) listOf.emplace(*culled);
     forEachRowBand(depth.height, 16, [&](std::uint32_t y0, std::uint32_t y1) {
         for (std::uint32_t y = y0; y < y1; ++y)
             for (std::uint32_t x = 0; x < depth.width; ++x) {
                 if (!depth.hasGeometry(x, y)) continue;
                 const double d = depth.at(x, y);
                 in.list[std::size_t(y) * depth.width + x] =
-                    culled ? culled->listOfPixel(x, y, proj.viewDepthFromWindowDepth(d)) : 0u;
+                    listOf ? (*listOf)(x, y, proj.viewDepthFromWindowDepth(d)) : 0u;
             }
     });
 }

@@ -2,6 +2,7 @@
 // The output of a culling pass, from either backend.
 
 #include "culling/core/params.hpp"
+#include "culling/math/tile_math.hpp"
 
 #include <cstdint>
 #include <string>
@@ -149,6 +150,19 @@ struct CullResult {
     std::uint32_t zbinOf(double viewDepth) const;
     // Empty when internally consistent (sizes, offsets in range, sorted, unique).
     std::string validate(std::size_t lightCount) const;
+};
+
+// CullResult::listOfPixel for every pixel of one result: the depth slices'
+// boundaries (clustered's one range, 2.5d's per tile) worked out once, the
+// same list bit for bit. The result must outlive it.
+class PixelListLookup {
+public:
+    explicit PixelListLookup(const CullResult& result);
+    std::uint32_t operator()(std::uint32_t px, std::uint32_t py, double viewDepth) const;
+
+private:
+    const CullResult& r_;
+    std::vector<SliceLocator> slices_; // clustered: one; 2.5d with cell lists: one per tile
 };
 
 // The per-pixel lists a zbin result stands for: one list per (tile, bin)

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 namespace lc {
 
@@ -72,6 +73,22 @@ double sliceBoundary(Slicing s, double lo, double hi, std::uint32_t cells, std::
 // Slice holding view depth d, clamped to [0, cells-1]; lo == hi maps to 0.
 // Defined for every finite d (no NaN, no out-of-range cast).
 std::uint32_t sliceOfDepth(Slicing s, double lo, double hi, std::uint32_t cells, double d);
+
+// sliceOfDepth(s, lo, hi, cells, d) for many depths of one range: the inner
+// boundaries worked out once, then a search (the same slice, bit for bit:
+// sliceOfDepth's answer is defined by those boundaries). For the per-pixel
+// lookups of the ground truth, the shading inputs and the CPU backend.
+class SliceLocator {
+public:
+    SliceLocator() = default;
+    SliceLocator(Slicing s, double lo, double hi, std::uint32_t cells);
+    std::uint32_t operator()(double d) const;
+
+private:
+    double lo_ = 0, hi_ = 0;
+    std::uint32_t cells_ = 0;
+    std::vector<double> inner_; // boundaries 1 .. cells-1
+};
 // Bitmask of slices that the depth interval [a, b] overlaps (a <= b), 0 when
 // it misses [lo, hi] entirely. cells <= 32.
 std::uint32_t sliceRangeMask(Slicing s, double lo, double hi, std::uint32_t cells, double a, double b);
