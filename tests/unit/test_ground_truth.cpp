@@ -458,17 +458,27 @@ TEST(Lambert, ImageErrorIsTheContributionOfUnlistedLights) {
     EXPECT_GT(part.falseNegatives, 0u);
 }
 
-// The optimum of a granularity (DESIGN.md): for each list, the pixels that use
-// it times the lights they need together, against brute force over every
-// light and pixel, for every list rule; and E <= optimal <= W without misses.
-TEST(GroundTruthOptimum, MatchesBruteForceForEveryListRule) {
+namespace {
+
+// The atrium at 100x60 in tiles of 8 with 60 lights, a third of them spots.
+Scene atriumWithSpots() {
     Scene s = makeBuiltinScene("atrium");
     LightGenSettings g = defaultLightGen(s, 60, 9);
     g.spotFraction = 0.3;
     s.lights = generateLights(g);
     s.camera.width = 100;
     s.camera.height = 60;
-    s.camera.tileSize = 8; // bands of 8 rows, not the 16 the other metrics used
+    s.camera.tileSize = 8;
+    return s;
+}
+
+} // namespace
+
+// The optimum of a granularity (DESIGN.md): for each list, the pixels that use
+// it times the lights they need together, against brute force over every
+// light and pixel, for every list rule; and E <= optimal <= W without misses.
+TEST(GroundTruthOptimum, MatchesBruteForceForEveryListRule) {
+    const Scene s = atriumWithSpots(); // tiles of 8: bands of 8 rows, not the 16 the other metrics used
     const Projection proj(s.camera);
     const DepthImage depth = rasterizeDepthCpu(s, proj);
     const ViewLights lights = makeViewLights(s);
@@ -509,13 +519,7 @@ TEST(GroundTruthOptimum, MatchesBruteForceForEveryListRule) {
 // computeGroundTruth finds on its own, for every list rule and under limits
 // (misses by cause), and another frame's needs must be refused.
 TEST(GroundTruthNeeds, PrecomputedNeedsJudgeEveryResultAsWithout) {
-    Scene s = makeBuiltinScene("atrium");
-    LightGenSettings g = defaultLightGen(s, 60, 9);
-    g.spotFraction = 0.3;
-    s.lights = generateLights(g);
-    s.camera.width = 100;
-    s.camera.height = 60;
-    s.camera.tileSize = 8;
+    const Scene s = atriumWithSpots();
     const Projection proj(s.camera);
     const DepthImage depth = rasterizeDepthCpu(s, proj);
     const ViewLights lights = makeViewLights(s);

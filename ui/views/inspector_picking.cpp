@@ -56,38 +56,40 @@
 
 namespace lcui {
 
-void InspectorView::buildHandles(vtkInteractorStyle* style) {
-    handleRep_->SetHandleSize(40);
-    handleRep_->GetProperty()->SetColor(1, 0.45, 0.1);
-    handleRep_->GetProperty()->SetLineWidth(3);
-    handleRep_->GetSelectedProperty()->SetLineWidth(3);
-    handleRep_->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
-    handleRep_->ActiveRepresentationOff();
-    handle_->SetInteractor(interactor());
-    handle_->SetDefaultRenderer(handleLayer_);
-    handle_->SetRepresentation(handleRep_);
-    handle_->AddObserver(vtkCommand::StartInteractionEvent, this, &InspectorView::onHandleStart);
-    handle_->AddObserver(vtkCommand::InteractionEvent, this, &InspectorView::onHandleMove);
-    handle_->AddObserver(vtkCommand::EndInteractionEvent, this, &InspectorView::onHandleEnd);
-    handle_->EnabledOff();
+namespace {
 
-    radiusRep_->SetHandleSize(25);
-    radiusRep_->GetProperty()->SetColor(0.2, 1.0, 0.9);
-    radiusRep_->GetProperty()->SetLineWidth(3);
-    radiusRep_->GetSelectedProperty()->SetLineWidth(3);
-    radiusRep_->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
-    radiusRep_->ActiveRepresentationOff();
-    radiusHandle_->SetInteractor(interactor());
-    radiusHandle_->SetDefaultRenderer(handleLayer_);
-    radiusHandle_->SetRepresentation(radiusRep_);
-    radiusHandle_->AddObserver(vtkCommand::StartInteractionEvent, this, &InspectorView::onRadiusStart);
-    radiusHandle_->AddObserver(vtkCommand::InteractionEvent, this, &InspectorView::onRadiusMove);
-    radiusHandle_->AddObserver(vtkCommand::EndInteractionEvent, this, &InspectorView::onRadiusEnd);
-    radiusHandle_->EnabledOff();
+// A handle on the handle layer, its colours and size, disabled until a light
+// is selected; `start`, `move` and `end` observe its drag.
+template <class View>
+void setUpHandle(vtkHandleWidget* widget, vtkPointHandleRepresentation3D* rep, int size, const double colour[3],
+                 vtkRenderWindowInteractor* interactor, vtkRenderer* layer, View* view, void (View::*start)(),
+                 void (View::*move)(), void (View::*end)()) {
+    rep->SetHandleSize(size);
+    rep->GetProperty()->SetColor(colour[0], colour[1], colour[2]);
+    rep->GetProperty()->SetLineWidth(3);
+    rep->GetSelectedProperty()->SetLineWidth(3);
+    rep->GetSelectedProperty()->SetColor(1, 0.3, 0.2);
+    rep->ActiveRepresentationOff();
+    widget->SetInteractor(interactor);
+    widget->SetDefaultRenderer(layer);
+    widget->SetRepresentation(rep);
+    widget->AddObserver(vtkCommand::StartInteractionEvent, view, start);
+    widget->AddObserver(vtkCommand::InteractionEvent, view, move);
+    widget->AddObserver(vtkCommand::EndInteractionEvent, view, end);
+    widget->EnabledOff();
+}
+
+} // namespace
+
+void InspectorView::buildHandles(vtkInteractorStyle* style) {
+    const double position[3] = {1, 0.45, 0.1}, radius[3] = {0.2, 1.0, 0.9};
+    setUpHandle(handle_.Get(), handleRep_.Get(), 40, position, interactor(), handleLayer_.Get(), this,
+                &InspectorView::onHandleStart, &InspectorView::onHandleMove, &InspectorView::onHandleEnd);
+    setUpHandle(radiusHandle_.Get(), radiusRep_.Get(), 25, radius, interactor(), handleLayer_.Get(), this,
+                &InspectorView::onRadiusStart, &InspectorView::onRadiusMove, &InspectorView::onRadiusEnd);
     // After an orbit, the radius handle goes back to the right of the centre.
     style->AddObserver(vtkCommand::EndInteractionEvent, this, &InspectorView::placeRadiusHandle);
     spotHandles_ = std::make_unique<SpotHandles>(doc_, renderer_, interactor(), handleLayer_);
-
 }
 
 void InspectorView::onHandleStart() {
