@@ -25,14 +25,18 @@ struct Shared {
 
 // Shows the status row, waits (processing events) until `done` is ready and
 // rethrows what the work threw. `shared` outlives the wait: a job the worker
-// still holds after a cancel keeps its own reference.
+// still holds after a cancel keeps its own reference. With `thread` given, its
+// end stops the wait at once; otherwise the 50 ms poll sees it.
 void waitModal(StatusProgress* status, const QString& label, const std::shared_ptr<Shared>& shared,
-               std::future<void> done, int showAfterMs, const std::function<QString()>& liveLabel) {
+               std::future<void> done, int showAfterMs, const std::function<QString()>& liveLabel,
+               QThread* thread = nullptr) {
     const QString key = "load";
     const std::shared_ptr<lc::CancelToken> cancel = shared->cancel;
     status->begin(key, label, [cancel] { cancel->cancelled = true; }, showAfterMs);
     status->blockInput(true);
     QEventLoop loop;
+    // Connected before `done` is checked: an end after the check is queued here.
+    if (thread) QObject::connect(thread, &QThread::finished, &loop, &QEventLoop::quit);
     QTimer poll;
     QObject::connect(&poll, &QTimer::timeout, [&] {
         status->setProgress(key, shared->fraction.load(), liveLabel ? liveLabel() : QString());
@@ -66,7 +70,7 @@ void runWithProgress(StatusProgress* status, const QString& label, const Progres
     thread->start();
     std::exception_ptr error;
     try {
-        waitModal(status, label, shared, std::move(done), showAfterMs, liveLabel);
+        waitModal(status, label, shared, std::move(done), showAfterMs, liveLabel, thread);
     } catch (...) {
         error = std::current_exception();
     }
