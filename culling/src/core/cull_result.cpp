@@ -76,15 +76,22 @@ std::uint32_t CullResult::listOfPixel(std::uint32_t px, std::uint32_t py, double
     }
 }
 
-PixelListLookup::PixelListLookup(const CullResult& result) : r_(result) {
-    if (!r_.pixelList.empty()) return;
-    if (r_.algorithm == Algorithm::Clustered) {
-        slices_.emplace_back(r_.settings.slicing, r_.clusterNear, r_.clusterFar, r_.listsPerTile);
-    } else if (r_.algorithm == Algorithm::TwoPointFiveD && r_.cellLists) {
-        slices_.reserve(r_.tileDepthMin.size());
-        for (std::size_t t = 0; t < r_.tileDepthMin.size(); ++t)
-            slices_.emplace_back(r_.settings.slicing, r_.tileDepthMin[t], r_.tileDepthMax[t], r_.listsPerTile);
+std::vector<SliceLocator> cellSlices(const CullResult& r, std::uint32_t cells) {
+    std::vector<SliceLocator> slices;
+    if (r.algorithm == Algorithm::Clustered) {
+        slices.emplace_back(r.settings.slicing, r.clusterNear, r.clusterFar, cells);
+    } else if (r.algorithm == Algorithm::TwoPointFiveD) {
+        slices.reserve(r.tileDepthMin.size());
+        for (std::size_t t = 0; t < r.tileDepthMin.size(); ++t)
+            slices.emplace_back(r.settings.slicing, r.tileDepthMin[t], r.tileDepthMax[t], cells);
     }
+    return slices;
+}
+
+PixelListLookup::PixelListLookup(const CullResult& result) : r_(result) {
+    // 2.5d without cell lists has one list per tile: listOfPixel's own rule.
+    if (r_.pixelList.empty() && (r_.algorithm == Algorithm::Clustered || r_.cellLists))
+        slices_ = cellSlices(r_, r_.listsPerTile);
 }
 
 std::uint32_t PixelListLookup::operator()(std::uint32_t px, std::uint32_t py, double viewDepth) const {

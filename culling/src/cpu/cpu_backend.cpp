@@ -156,14 +156,7 @@ void cellMasks(const CpuCull& c, CullResult& res) {
     const std::uint32_t cells = c.settings.cells;
     res.cellMask.assign(grid.tileCount(), 0);
     // sliceOfDepth's answers, the boundaries worked out once per range.
-    std::vector<SliceLocator> slices;
-    if (algo == Algorithm::Clustered) {
-        slices.emplace_back(c.settings.slicing, res.clusterNear, res.clusterFar, cells);
-    } else {
-        slices.reserve(grid.tileCount());
-        for (std::uint32_t t = 0; t < grid.tileCount(); ++t)
-            slices.emplace_back(c.settings.slicing, res.tileDepthMin[t], res.tileDepthMax[t], cells);
-    }
+    const std::vector<SliceLocator> slices = cellSlices(res, cells);
     for (std::uint32_t y = 0; y < depth.height; ++y) {
         for (std::uint32_t x = 0; x < depth.width; ++x) {
             const double v = c.viewDepth[std::size_t(y) * depth.width + x];

@@ -152,6 +152,12 @@ struct CullResult {
     std::string validate(std::size_t lightCount) const;
 };
 
+// The locators of a clustered or 2.5d result's `cells` depth slices: one over
+// [clusterNear, clusterFar] for clustered, one per tile over the tile's depth
+// bounds for 2.5d (the ranges listOfPixel and the cell masks slice). Empty for
+// another algorithm.
+std::vector<SliceLocator> cellSlices(const CullResult& r, std::uint32_t cells);
+
 // CullResult::listOfPixel for every pixel of one result: the depth slices'
 // boundaries (clustered's one range, 2.5d's per tile) worked out once, the
 // same list bit for bit. The result must outlive it.
