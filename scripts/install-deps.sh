@@ -16,6 +16,9 @@ PACKAGES=(
   # Vulkan: headers, loader, lavapipe, shader compiler, validation in tests
   libvulkan-dev mesa-vulkan-drivers glslang-tools glslang-dev spirv-tools
   vulkan-validationlayers
+  # RenderDoc: the in-application capture API's header and library (run
+  # --renderdoc-capture) and its Python replay module (check --capture)
+  librenderdoc-dev librenderdoc python3-renderdoc
   # studio: Qt 5 and VTK 9 (Debian's VTK Qt module is built on Qt 5)
   qtbase5-dev libvtk9-dev libvtk9-qt-dev
   # tests and benchmarks: GoogleTest, Google Benchmark, a virtual X server

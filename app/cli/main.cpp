@@ -15,6 +15,8 @@
 // table (see docs/CLI.md). Errors print one line on stderr and exit non-zero:
 // 2 for a bad command line, 1 for anything that failed while running.
 
+#include "culling/capture/capture_frame.hpp"
+#include "culling/capture/renderdoc_capture.hpp"
 #include "culling/core/errors.hpp"
 #include "culling/diagnostics/explain.hpp"
 #include "culling/diagnostics/export.hpp"
@@ -130,6 +132,34 @@ int verdictExit(const lc::RunOutput& run) {
     return kExitMisses;
 }
 
+void printCaptureActions(const lc::CaptureInfo& info) {
+    std::size_t dispatches = 0;
+    for (const lc::CaptureAction& a : info.actions) {
+        dispatches += a.kind == "dispatch";
+        std::cout << a.event << "  " << a.kind << "  " << a.name;
+        if (a.kind == "dispatch") std::cout << " " << a.dims[0] << "x" << a.dims[1] << "x" << a.dims[2];
+        if (!a.markers.empty()) std::cout << "  [" << a.markerPath() << "]";
+        std::cout << "\n";
+    }
+    std::cout << info.actions.size() << " actions, " << dispatches << " dispatches (RenderDoc " << info.renderdoc
+              << "); lightcull capture-info " << lc::shellQuote(info.file)
+              << " --dispatch EVENT lists a dispatch's bindings\n";
+}
+
+void printCaptureBindings(const lc::CaptureInfo& info) {
+    std::cout << "event " << info.event << ": " << info.bindings.size() << " bindings\n";
+    for (const lc::CaptureBinding& b : info.bindings) {
+        std::cout << "  " << b.set << "." << b.binding << (b.element ? "[" + std::to_string(b.element) + "]" : "")
+                  << "  " << b.kind << " " << b.descriptor;
+        if (b.kind == "buffer")
+            std::cout << "  " << b.size << " bytes at offset " << b.offset << " of " << b.length;
+        else if (b.kind == "image")
+            std::cout << "  " << b.width << "x" << b.height << " " << b.format
+                      << (b.samples > 1 ? " x" + std::to_string(b.samples) + " samples" : "");
+        std::cout << "  " << b.resource << (b.variable.empty() ? "" : "  (shader: " + b.variable + ")") << "\n";
+    }
+}
+
 void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, const lc::RunOutput& run,
                   const std::string& out, const std::string& noImageErrorWhy = "--no-image-error") {
     const lc::CullResult& r = run.result;
@@ -241,10 +271,12 @@ struct SceneFlags {
                         "degrees, random directions)")
             ->type_name("F")
             ->needs(optLights);
-        std::string backendHelp = "Backend running depth and culling: ";
-        for (const std::string& b : lc::availableBackends()) backendHelp += b + " ";
-        backendHelp += "(default: vulkan where available, else cpu)";
-        cmd->add_option("--backend", backendName, backendHelp)->type_name("NAME");
+        // Named without opening a device: help text built by every command
+        // must not create a Vulkan instance (RenderDoc must load before one).
+        cmd->add_option("--backend", backendName,
+                        "Backend running depth and culling: cpu or vulkan (default: vulkan where a device opens, "
+                        "else cpu)")
+            ->type_name("NAME");
         cmd->add_option("--device", device,
                         "Vulkan device: index or name substring (default: LIGHTCULL_DEVICE, else the first discrete GPU)")
             ->type_name("D");
@@ -571,6 +603,11 @@ int main(int argc, char** argv) {
         ->required();
     lcli::CustomFlags runCustom;
     runCustom.addToRun(run);
+    std::string renderdocCapture;
+    run->add_option("--renderdoc-capture", renderdocCapture,
+                    "Also write a RenderDoc capture of the run's Vulkan work (depth pre-pass, culling, shading) to "
+                    "FILE.rdc (needs librenderdoc; docs/RENDERDOC.md)")
+        ->type_name("FILE");
 
     CLI::App* check = app.add_subcommand(
         "check", "Judge an engine's own light lists (a buffer dump or CSV) against ground truth on its depth buffer; "
@@ -579,8 +616,18 @@ int main(int argc, char** argv) {
     checkFlags.addTo(check);
     std::string checkLists, checkLayout = "fixed:64", checkRule = "tile", checkOut;
     check->add_option("--lists", checkLists, "The lists: raw little-endian 32-bit words in --layout, or .csv (list,light,...)")
-        ->type_name("FILE")
-        ->required();
+        ->type_name("FILE");
+    std::string checkCapture, checkDispatch, checkDescribe;
+    check->add_option("--capture", checkCapture,
+                      "A RenderDoc capture of the renderer's frame: lists, depth, lights and camera are read from it "
+                      "at --dispatch, as --describe says (instead of --scene and --lists; docs/RENDERDOC.md)")
+        ->type_name("FILE.rdc");
+    check->add_option("--dispatch", checkDispatch,
+                      "The culling dispatch in --capture: its event id, or text of its name or marker regions")
+        ->type_name("EVENT|NAME");
+    check->add_option("--describe", checkDescribe,
+                      "JSON description of the renderer's light struct, camera, depth and list layout in --capture")
+        ->type_name("FILE.json");
     check->add_option("--layout", checkLayout, "Layout of a raw dump: fixed:N, compact[:N] or bitmask (default fixed:64)")
         ->type_name("LAYOUT");
     check->add_option("--rule", checkRule, "Which list a pixel loops over: tile, halfz, froxel:N[:log|linear] or cells:N[:log|linear] (default tile)")
@@ -588,6 +635,14 @@ int main(int argc, char** argv) {
     lcli::CustomFlags checkDepth;
     checkDepth.addDepth(check);
     check->add_option("--out", checkOut, "Folder to write the diagnostics into")->type_name("DIR")->required();
+
+    CLI::App* captureInfo = app.add_subcommand(
+        "capture-info", "List a RenderDoc capture's dispatches and draws; with --dispatch, the bindings of one "
+                        "dispatch (set, binding, kind, size, debug names)");
+    std::string captureInfoFile, captureInfoDispatch;
+    captureInfo->add_option("capture", captureInfoFile, "The capture (.rdc)")->type_name("FILE.rdc")->required();
+    captureInfo->add_option("--dispatch", captureInfoDispatch, "A dispatch: its event id, or text of its name or markers")
+        ->type_name("EVENT|NAME");
 
     CLI::App* bench = app.add_subcommand(
         "bench", "Time the depth pre-pass and the culling pass over repeats (median/min/max), "
@@ -628,9 +683,11 @@ int main(int argc, char** argv) {
     if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "scenes" && std::string(argv[1]) != "run" &&
         std::string(argv[1]) != "bench" && std::string(argv[1]) != "report" &&
         std::string(argv[1]) != "convert" && std::string(argv[1]) != "check" &&
-        std::string(argv[1]) != "explain" && std::string(argv[1]) != "hunt")
+        std::string(argv[1]) != "explain" && std::string(argv[1]) != "hunt" &&
+        std::string(argv[1]) != "capture-info")
         return fail(2, std::string("unknown command '") + argv[1] +
-                           "' (commands: scenes, run, bench, report, convert, check, explain, hunt; see --help)");
+                           "' (commands: scenes, run, bench, report, convert, check, capture-info, explain, hunt; "
+                           "see --help)");
 
     try {
         app.parse(argc, argv);
@@ -724,7 +781,49 @@ int main(int argc, char** argv) {
             return 0;
         }
 
+        if (app.got_subcommand("capture-info")) {
+            const lc::CaptureInfo all = lc::readCaptureInfo(captureInfoFile);
+            if (captureInfoDispatch.empty()) {
+                printCaptureActions(all);
+                return 0;
+            }
+            const std::uint32_t event = lc::findDispatch(all, captureInfoDispatch);
+            printCaptureBindings(lc::readCaptureInfo(captureInfoFile, event));
+            return 0;
+        }
+
+        if (app.got_subcommand("check") && !checkCapture.empty()) {
+            if (checkFlags.hasScene() || !checkLists.empty())
+                return fail(2, "check --capture reads the lights, camera and lists from the capture: drop --scene, "
+                               "--builtin and --lists");
+            if (checkDispatch.empty()) return fail(2, "check --capture: give --dispatch EVENT|NAME (lightcull capture-info lists them)");
+            if (checkDescribe.empty())
+                return fail(2, "check --capture: give --describe FILE.json (the light struct, camera, depth and list layout)");
+            if (!checkDepth.depthFile.empty()) return fail(2, "--depth: check --capture reads the depth from the capture");
+            if (const std::string f = checkFlags.givenCullingFlag(); !f.empty())
+                return fail(2, f + ": has no effect on check --capture (the description says the tile and the list rule)");
+            if (const std::string why = outputProblem([&] { lc::checkDiagnosticsFolder(checkOut); }); !why.empty())
+                return fail(2, "--out: " + why);
+            const lc::CaptureDescription description = lc::loadCaptureDescription(checkDescribe);
+            lc::CaptureFrame frame = lc::loadCaptureFrame(checkCapture, checkDispatch, description);
+            frame.scene.origin.command = commandLine(argc, argv);
+            for (const std::string& line : frame.echo) std::cout << "read " << line << "\n";
+            lc::CustomCullReport report;
+            lc::RunOptions options;
+            options.truthOptions.imageError = false;
+            lc::RunOutput result = lc::checkCaptureFrame(frame, options, report);
+            lc::CullSettings settings;
+            settings.algorithm = result.result.algorithm;
+            lc::exportDiagnostics(frame.scene, settings, result, checkOut);
+            printSummary(frame.scene, settings, result, checkOut, "lists from a capture are not shaded");
+            lcli::printCustomReport(result, frame.scene, lc::Projection(frame.scene.camera));
+            return verdictExit(result);
+        }
+
         if (app.got_subcommand("check")) {
+            if (checkLists.empty()) return fail(2, "check: give --lists FILE (or --capture FILE.rdc)");
+            if (!checkDispatch.empty() || !checkDescribe.empty())
+                return fail(2, "--dispatch and --describe go with --capture");
             if (!checkFlags.hasScene()) return fail(2, "check: give --scene FILE or --builtin NAME (the scene the lists were culled for)");
             lc::Scene scene = checkFlags.loadScene();
             scene.origin.command = commandLine(argc, argv);
@@ -777,11 +876,28 @@ int main(int argc, char** argv) {
         if (const std::string why = outputProblem([&] { lc::checkDiagnosticsFolder(outDir); }); !why.empty())
             return fail(2, "--out: " + why);
 
+        std::unique_ptr<lc::RenderDocCapture> capture;
+        if (!renderdocCapture.empty()) {
+            if (const std::string why = outputProblem([&] { lc::checkFileTarget(renderdocCapture); }); !why.empty())
+                return fail(2, "--renderdoc-capture: " + why);
+            if (runFlags.backendName == "cpu" && runCustom.shader.empty())
+                return fail(2, "--renderdoc-capture: the cpu backend makes no Vulkan calls to capture; use --backend vulkan");
+            // Before any Vulkan instance, so RenderDoc's layer is in each.
+            capture = std::make_unique<lc::RenderDocCapture>(renderdocCapture, "lightcull " + commandLine(argc, argv));
+        }
+
         lc::Scene scene = runFlags.loadScene();
         scene.origin.command = commandLine(argc, argv);
         lc::CullSettings settings;
         runFlags.applyParams(settings, scene);
         std::unique_ptr<lc::CullBackend> backend = runFlags.openBackend();
+        if (capture && runCustom.shader.empty() && backend->name() != "vulkan")
+            return fail(1, "--renderdoc-capture: no Vulkan device opened (backend " + backend->name() +
+                               "), so there is nothing to capture");
+        if (capture && !runCustom.shader.empty())
+            capture->captureCustomShader(); // its own device, captured at its dispatch
+        else if (capture)
+            capture->start();
 
         lc::RunOptions options;
         options.truthOptions.imageError = !noImageError;
@@ -798,6 +914,12 @@ int main(int argc, char** argv) {
         lc::RunOutput result = custom ? lc::runCustomPipeline(scene, runCustom.shaderOptions(runFlags.device), *backend,
                                                               options, report, options.reuseDepth)
                                       : lc::runPipeline(scene, settings, *backend, options);
+        if (capture) {
+            capture->finish();
+            std::cerr << "RenderDoc capture written to " << renderdocCapture << " ("
+                      << (runCustom.shader.empty() ? "depth pre-pass, culling and shading" : "the shader's dispatch")
+                      << ")\n";
+        }
         if (options.reuseDepth) result.depthFrom = "depth file " + runCustom.depthFile;
         lc::exportDiagnostics(scene, settings, result, outDir);
         printSummary(scene, settings, result, outDir);

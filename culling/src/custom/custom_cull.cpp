@@ -441,9 +441,17 @@ CullResult DumpLists::makeLists(const Scene&, const DepthImage& depth, const Pro
     report_.layout = toString(layout_);
     report_.lists = toString(lists_);
     const auto lightCount = std::uint32_t(lights.size());
-    const std::string ext = fs::path(path_).extension().string();
-    const std::string bytes = detail::readWholeFile(path_);
-    if (ext == ".csv") {
+    const std::string ext = inMemory_ ? std::string() : fs::path(path_).extension().string();
+    const std::string bytes = inMemory_ ? std::string() : detail::readWholeFile(path_);
+    if (inMemory_) {
+        const std::uint64_t need = layoutWords(layout_, r.listOffset.size(), lightCount);
+        if (words_.size() < need)
+            throw InputError(path_, "", 0, std::to_string(words_.size()) + " words, but " + toString(layout_) +
+                                                " with " + std::to_string(r.listOffset.size()) + " lists (" +
+                                                toString(lists_) + ") and " + std::to_string(lightCount) +
+                                                " lights needs " + std::to_string(need));
+        decodeLists(words_, layout_, lightCount, r, report_);
+    } else if (ext == ".csv") {
         // One line per list: "list,light,light,...". Lists not named are empty.
         std::vector<std::vector<std::uint32_t>> perList(r.listOffset.size());
         std::istringstream in(bytes);
@@ -496,9 +504,9 @@ CullResult DumpLists::makeLists(const Scene&, const DepthImage& depth, const Pro
         }
         decodeLists(words, layout_, lightCount, r, report_);
     }
-    r.backend = "dump";
-    r.device = "engine lists from " + fs::path(path_).filename().string();
-    r.timingMethod = "not timed (lists read from a file)";
+    r.backend = inMemory_ ? "capture" : "dump";
+    r.device = "engine lists from " + (inMemory_ ? path_ : fs::path(path_).filename().string());
+    r.timingMethod = inMemory_ ? "not timed (lists read from a capture)" : "not timed (lists read from a file)";
     r.timings.cullMs = -1;
     r.volumeTests = 0;
     compareWithBuiltin(r, skeleton, report_);

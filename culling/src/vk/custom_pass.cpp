@@ -3,6 +3,7 @@
 // inputs docs/CUSTOM_CULLING.md fixes, dispatched one workgroup per tile with
 // robust buffer access and (by default) the validation layer on, waited for
 // with a time limit, read back and decoded into a CullResult.
+#include "culling/capture/renderdoc_capture.hpp"
 #include "culling/custom/custom_cull.hpp"
 
 #include "culling/core/errors.hpp"
@@ -433,6 +434,11 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
     st->pool = st->ctx->createDescriptorPool(bindings, 1, "custom.descriptorPool");
     VkDescriptorSet set = st->ctx->writeDescriptorSet(st->pool, st->setLayout, bindings, "custom.set");
 
+    // `run --renderdoc-capture --shader`: this device is the one captured,
+    // and the capture must end before the device is destroyed.
+    RenderDocCapture* capture = RenderDocCapture::active();
+    if (capture && !capture->capturesCustomShader()) capture = nullptr;
+    if (capture) capture->startOnInstance(st->ctx->instance());
     double wallMs = 0;
     const bool finished = st->ctx->submitAndWaitFor(
         [&](VkCommandBuffer cmd) {
@@ -460,6 +466,7 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
                           "fresh one");
     }
     report.passMs = wallMs;
+    if (capture) capture->finish();
 
     std::vector<std::uint32_t> words(outWords);
     std::memcpy(words.data(), st->out.mapped, outWords * 4);

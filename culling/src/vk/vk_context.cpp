@@ -1,8 +1,10 @@
 #include "vk/vk_context.hpp"
 
 #include "vk/validation.hpp"
+#include "culling/capture/renderdoc_capture.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -133,7 +135,10 @@ VkDebugUtilsMessengerCreateInfoEXT messengerInfo() {
     return mci;
 }
 
+std::atomic<bool> g_instanceCreated{false};
+
 VkInstance createInstance(bool& debugUtils, bool& validation, bool forceValidation) {
+    g_instanceCreated = true;
     std::uint32_t n = 0;
     LC_VK(vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr));
     std::vector<VkExtensionProperties> exts(n);
@@ -214,6 +219,7 @@ VkInstance createInstance(bool& debugUtils, bool& validation, bool forceValidati
 
 std::vector<std::string> physicalDeviceNames() {
     std::vector<std::string> out;
+    g_instanceCreated = true;
     try {
         VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
         app.apiVersion = VK_API_VERSION_1_1;
@@ -249,9 +255,15 @@ Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
             if (!create) throw DeviceError("vkCreateDebugUtilsMessengerEXT unavailable");
             LC_VK(create(instance_, &mci, nullptr, &messenger_));
         }
-        if (debugUtils_)
+        if (debugUtils_) {
             setName_ = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
                 vkGetInstanceProcAddr(instance_, "vkSetDebugUtilsObjectNameEXT"));
+            beginLabel_ = reinterpret_cast<PFN_vkCmdBeginDebugUtilsLabelEXT>(
+                vkGetInstanceProcAddr(instance_, "vkCmdBeginDebugUtilsLabelEXT"));
+            endLabel_ = reinterpret_cast<PFN_vkCmdEndDebugUtilsLabelEXT>(
+                vkGetInstanceProcAddr(instance_, "vkCmdEndDebugUtilsLabelEXT"));
+            if (!beginLabel_ || !endLabel_) beginLabel_ = nullptr, endLabel_ = nullptr;
+        }
 
         physical_ = chooseDevice(enumerateDevices(instance_), opt.device);
         vkGetPhysicalDeviceProperties(physical_, &props_);
@@ -378,6 +390,17 @@ void Context::name(VkObjectType type, std::uint64_t handle, const std::string& n
     info.objectHandle = handle;
     info.pObjectName = full.c_str();
     LC_VK(setName_(device_, &info));
+}
+
+void Context::beginLabel(VkCommandBuffer cmd, const char* label) const {
+    if (!beginLabel_) return;
+    VkDebugUtilsLabelEXT l{VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT};
+    l.pLabelName = label;
+    beginLabel_(cmd, &l);
+}
+
+void Context::endLabel(VkCommandBuffer cmd) const {
+    if (endLabel_) endLabel_(cmd);
 }
 
 std::uint32_t Context::findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags want) const {
@@ -698,7 +721,12 @@ bool Context::submitAndWaitFor(const std::function<void(VkCommandBuffer)>& recor
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     LC_VK(vkBeginCommandBuffer(cmd, &bi));
-    record(cmd);
+    {
+        // One marker region per submission, named as its command buffer.
+        const std::string label = purpose_.empty() ? n : purpose_ + "." + n;
+        LabelScope region(*this, cmd, label.c_str());
+        record(cmd);
+    }
     LC_VK(vkEndCommandBuffer(cmd));
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     si.commandBufferCount = 1;
@@ -740,3 +768,7 @@ double Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record
 }
 
 } // namespace lc::vk
+
+namespace lc {
+bool vulkanInstanceCreated() { return vk::g_instanceCreated; }
+} // namespace lc

@@ -187,6 +187,7 @@ public:
     // LIGHTCULL_VK_EMULATE_GPU=1 makes a CPU device take the GPU paths
     // (device-local buffers behind staging copies, subgroup work layout, GPU
     // timestamps) so that tests exercise them on lavapipe.
+    VkInstance instance() const { return instance_; }
     bool isCpuDevice() const { return props_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU && !emulateGpu_; }
     // The queue writes timestamps in compute and graphics (and the device
     // reports a tick period): GPU timing is possible.
@@ -200,6 +201,10 @@ public:
     template <typename T> void name(VkObjectType type, T handle, const std::string& n) const {
         name(type, reinterpret_cast<std::uint64_t>(handle), n);
     }
+    // Opens and closes a labelled region of `cmd` (a marker region in
+    // RenderDoc's event browser) when VK_EXT_debug_utils is on.
+    void beginLabel(VkCommandBuffer cmd, const char* label) const;
+    void endLabel(VkCommandBuffer cmd) const;
 
     // Where a buffer's memory lies: Host (createBuffer), HostRead
     // (createReadbackBuffer), Device (createDeviceBuffer).
@@ -287,8 +292,25 @@ private:
     bool debugUtils_ = false;
     std::string purpose_;
     PFN_vkSetDebugUtilsObjectNameEXT setName_ = nullptr;
+    PFN_vkCmdBeginDebugUtilsLabelEXT beginLabel_ = nullptr;
+    PFN_vkCmdEndDebugUtilsLabelEXT endLabel_ = nullptr;
     CommandPoolHandle commandPool_;
     FenceHandle fence_;
+};
+
+// A labelled region of a command buffer for the scope of this object.
+class LabelScope {
+public:
+    LabelScope(const Context& ctx, VkCommandBuffer cmd, const char* label) : ctx_(ctx), cmd_(cmd) {
+        ctx_.beginLabel(cmd_, label);
+    }
+    ~LabelScope() { ctx_.endLabel(cmd_); }
+    LabelScope(const LabelScope&) = delete;
+    LabelScope& operator=(const LabelScope&) = delete;
+
+private:
+    const Context& ctx_;
+    VkCommandBuffer cmd_;
 };
 
 // Names of the physical devices the loader reports (empty when none / no ICD).

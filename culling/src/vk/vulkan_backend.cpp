@@ -1054,39 +1054,47 @@ void VulkanBackend::recordFirstSubmission(VkCommandBuffer cmd, const CullPlan& p
         // workgroups (a loop over a word's lights) start before the bounds
         // pass's fill the GPU, instead of waiting for them (P1 on the H100:
         // 0.024-0.025 -> 0.022 ms).
+        LabelScope label(ctx_, cmd, "light bins");
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipes.bins);
         vkCmdDispatch(cmd, plan.binGroups.x, plan.binGroups.y, 1);
     }
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipes.bounds);
-    vkCmdDispatch(cmd, plan.boundsGroups.x, plan.boundsGroups.y, 1);
+    {
+        LabelScope label(ctx_, cmd, "tile bounds");
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipes.bounds);
+        vkCmdDispatch(cmd, plan.boundsGroups.x, plan.boundsGroups.y, 1);
+    }
     if (plan.zbin) {
         // The bins' words follow the plane bins' in one buffer: ordered
         // after light_bins, then the empty ranges before the lights.
+        LabelScope label(ctx_, cmd, "z bins");
         dispatchAfter(cmd, pipes.zbinInit, plan.zbinInitGroups);
         if (plan.lights > 0) dispatchAfter(cmd, pipes.zbin, plan.zbinGroups);
     }
     // The count pass reads the tile bounds and bins the two passes above
     // wrote (and ORs status after the bounds pass did).
-    switch (plan.strategy) {
-    case CullStrategy::Fused:
-        dispatchAfter(cmd, pipes.fused, plan.countGroups);
-        break;
-    case CullStrategy::WalkAtomicWrite:
-        dispatchAfter(cmd, pipes.count, plan.countGroups);
-        // The write pass reads the counts the count pass wrote.
-        dispatchAfter(cmd, pipes.atomicWrite, plan.writeGroups);
-        break;
-    case CullStrategy::CountPools:
-        dispatchAfter(cmd, pipes.count, plan.countGroups);
-        break;
-    case CullStrategy::CountScan:
-    case CullStrategy::CountScanWrite:
-        dispatchAfter(cmd, pipes.count, plan.countGroups);
-        // The scan reads the counts the count pass wrote.
-        dispatchAfter(cmd, pipes.scan, Groups{1, 1});
-        // The write pass reads the offsets the scan wrote.
-        if (plan.strategy == CullStrategy::CountScanWrite) dispatchAfter(cmd, pipes.write, plan.writeGroups);
-        break;
+    {
+        LabelScope label(ctx_, cmd, "light lists");
+        switch (plan.strategy) {
+        case CullStrategy::Fused:
+            dispatchAfter(cmd, pipes.fused, plan.countGroups);
+            break;
+        case CullStrategy::WalkAtomicWrite:
+            dispatchAfter(cmd, pipes.count, plan.countGroups);
+            // The write pass reads the counts the count pass wrote.
+            dispatchAfter(cmd, pipes.atomicWrite, plan.writeGroups);
+            break;
+        case CullStrategy::CountPools:
+            dispatchAfter(cmd, pipes.count, plan.countGroups);
+            break;
+        case CullStrategy::CountScan:
+        case CullStrategy::CountScanWrite:
+            dispatchAfter(cmd, pipes.count, plan.countGroups);
+            // The scan reads the counts the count pass wrote.
+            dispatchAfter(cmd, pipes.scan, Groups{1, 1});
+            // The write pass reads the offsets the scan wrote.
+            if (plan.strategy == CullStrategy::CountScanWrite) dispatchAfter(cmd, pipes.write, plan.writeGroups);
+            break;
+        }
     }
     if (run.stamps) run.stamps->end(cmd, 0);
     run.staging->recordDownloads(cmd);

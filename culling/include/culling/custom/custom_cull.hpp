@@ -152,12 +152,19 @@ class DumpLists final : public ListSource {
 public:
     DumpLists(std::string path, const LayoutSpec& layout, const ListSpec& lists, CustomCullReport& report)
         : path_(std::move(path)), layout_(layout), lists_(lists), report_(report) {}
+    // Words already read (a RenderDoc capture's buffer): `source` names them.
+    DumpLists(std::string source, std::vector<std::uint32_t> words, const LayoutSpec& layout, const ListSpec& lists,
+              CustomCullReport& report)
+        : path_(std::move(source)), words_(std::move(words)), inMemory_(true), layout_(layout), lists_(lists),
+          report_(report) {}
     CullResult makeLists(const Scene& scene, const DepthImage& depth, const Projection& proj, const TileGrid& grid,
                          const ViewLights& lights) override;
     std::shared_ptr<const CustomCullReport> report() const override;
 
 private:
     std::string path_;
+    std::vector<std::uint32_t> words_;
+    bool inMemory_ = false;
     LayoutSpec layout_;
     ListSpec lists_;
     CustomCullReport& report_;

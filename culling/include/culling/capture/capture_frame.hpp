@@ -1,0 +1,92 @@
+#pragma once
+// A renderer's culling dispatch, read from a RenderDoc capture and turned
+// into what `check` judges: the lights and camera as a Scene, the depth the
+// culling read, and the lists in a layout decodeLists reads. The renderer's
+// own light struct, camera constants and list layout are given by a short
+// JSON description (docs/RENDERDOC.md), and every field read is echoed so a
+// wrong description shows at once.
+
+#include "culling/capture/capture_reader.hpp"
+#include "culling/core/depth.hpp"
+#include "culling/custom/custom_cull.hpp"
+#include "culling/scene/scene.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace lc {
+
+// Where a value lives: a binding ("SET.BINDING" or a name) and a byte offset.
+struct CaptureField {
+    std::string binding;
+    std::uint32_t offset = 0;
+};
+
+struct CaptureDescription {
+    std::string file; // the description's file, for errors
+
+    // lights: `count` structs of `stride` bytes from the binding's range.
+    std::string lights;
+    std::uint32_t lightStride = 16;
+    std::optional<std::uint32_t> lightCount;       // a number given
+    std::optional<CaptureField> lightCountField;   // a uint32 in the capture
+    std::uint32_t positionOffset = 0, radiusOffset = 12; // vec3, float
+    bool lightsInViewSpace = true;
+    std::optional<std::uint32_t> spotAxisOffset, spotAngleOffset; // vec3, float
+    enum class AngleUnit { Radians, Degrees, Cosine } spotAngleUnit = AngleUnit::Radians;
+
+    // camera: matrices in a buffer, or the lens given.
+    std::optional<CaptureField> projection, view; // column-major mat4 (row-major with `rowMajor`)
+    bool rowMajor = false;
+    std::optional<double> fovYDeg, nearPlane, farPlane; // farPlane: +inf for infinite
+    bool reversed = false;
+
+    // depth: an image, or a float32 buffer of width x height.
+    std::string depth;
+    std::uint32_t depthWidth = 0, depthHeight = 0;
+    bool bottomUp = false; // row 0 at the bottom
+
+    // lists
+    enum class Lists { Contract, CountsIndices, Ranges, Pairs } listKind = Lists::Contract;
+    LayoutSpec layout;                // Contract: fixed:N, compact[:N], bitmask; CountsIndices: N in capacity
+    std::string listBuffer;           // Contract
+    std::string counts, indices, offsets, ranges; // the other kinds
+    ListSpec rule;
+    std::uint32_t tileSize = 16;
+};
+
+// Parses a description. Throws InputError naming the file and the JSON path
+// of a missing, mistyped, overlapping or out-of-range field.
+CaptureDescription parseCaptureDescription(const std::string& text, const std::string& file);
+CaptureDescription loadCaptureDescription(const std::string& path);
+
+// The bindings a description reads: key -> spec, for readCaptureBindings.
+std::map<std::string, std::string> captureBindingsNeeded(const CaptureDescription& d);
+
+struct CaptureFrame {
+    Scene scene;        // the capture's lights and camera (view space: the camera at the origin looking down -Z)
+    DepthImage depth;
+    std::vector<std::uint32_t> words; // the lists in `layout`
+    LayoutSpec layout;
+    ListSpec rule;
+    std::string source;               // "frame.rdc event 13"
+    std::vector<std::string> echo;    // every field read, one line each
+    std::vector<std::string> warnings;
+};
+
+// Decodes the bytes read. Throws InputError naming the capture (and the
+// binding, light or field) when a buffer is smaller than the description
+// needs or a value makes no light, camera or depth.
+CaptureFrame decodeCaptureFrame(const CaptureDescription& d, const std::map<std::string, CaptureBlob>& blobs,
+                                const std::string& capture, std::uint32_t event);
+
+// readCaptureInfo + findDispatch + readCaptureBindings + decodeCaptureFrame.
+CaptureFrame loadCaptureFrame(const std::string& capture, const std::string& dispatch,
+                              const CaptureDescription& description);
+
+// The capture's lists judged like a dump: the one pipeline with the lists
+// from the frame, on the frame's depth.
+RunOutput checkCaptureFrame(const CaptureFrame& frame, const RunOptions& runOptions, CustomCullReport& report);
+
+} // namespace lc
