@@ -415,7 +415,7 @@ std::vector<Light> decodeLights(const CaptureDescription& d, const std::map<std:
     for (std::uint64_t i = 0; i < count; ++i) {
         const std::uint64_t base = i * d.lightStride;
         Light& L = lights[i];
-        L.name = "light " + std::to_string(i);
+        L.name = "light_" + std::to_string(i); // as generated lights are named
         glm::dvec3 pos(b.f32(base + d.positionOffset), b.f32(base + d.positionOffset + 4),
                        b.f32(base + d.positionOffset + 8));
         const double radius = b.f32(base + d.radiusOffset);
