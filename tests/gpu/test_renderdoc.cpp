@@ -16,7 +16,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
+#include <sstream>
 #include <tuple>
 
 namespace fs = std::filesystem;
@@ -261,4 +263,129 @@ TEST_F(RenderDoc, WithoutRenderDocTheCommandsSayWhatToInstall) {
     EXPECT_EQ(i.code, 1);
     EXPECT_EQ(lc_test::lineCount(i.err), 1u) << i.err;
     EXPECT_NE(i.err.find("apt-get install python3-renderdoc"), std::string::npos) << i.err;
+}
+
+namespace {
+
+// list -> its lights, from the mini engine's CSV or a tiles.csv.
+std::map<std::uint32_t, std::set<std::uint32_t>> engineLists(const fs::path& csv) {
+    std::map<std::uint32_t, std::set<std::uint32_t>> out;
+    std::istringstream in(slurp(csv));
+    std::string line;
+    std::getline(in, line); // header
+    while (std::getline(in, line)) {
+        std::stringstream ss(line);
+        std::string cell;
+        std::getline(ss, cell, ',');
+        auto& l = out[std::uint32_t(std::stoul(cell))];
+        while (std::getline(ss, cell, ',')) l.insert(std::uint32_t(std::stoul(cell)));
+    }
+    return out;
+}
+
+std::map<std::uint32_t, std::set<std::uint32_t>> checkedLists(const fs::path& tilesCsv, std::uint32_t tilesX) {
+    std::map<std::uint32_t, std::set<std::uint32_t>> out;
+    std::istringstream in(slurp(tilesCsv));
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+        std::vector<std::string> f;
+        std::stringstream ss(line);
+        std::string cell;
+        while (std::getline(ss, cell, ',')) f.push_back(cell);
+        f.resize(13);
+        auto& l = out[std::uint32_t(std::stoul(f[1]) * tilesX + std::stoul(f[0]))];
+        std::stringstream lights(f[12]);
+        std::string id;
+        while (lights >> id) l.insert(std::uint32_t(std::stoul(id)));
+    }
+    return out;
+}
+
+const char* kMiniEngineDescription = R"({
+  "lights": {"binding": "LightBuffer", "stride": 32, "position": 16, "radius": 28, "space": "world",
+             "count": {"binding": "FrameConstants", "offset": 140}},
+  "camera": {"binding": "FrameConstants", "view": 0, "projection": 64, "order": "row-major"},
+  "depth": {"binding": "SceneDepth"},
+  "lists": {"layout": "counts+indices:32", "counts": "TileLightCounts", "indices": "TileLightIndices", "tile": 16}
+})";
+
+} // namespace
+
+// The issue's "done when": a renderer that is not this tool captures its
+// frame in RenderDoc; capture-info shows its culling dispatch's bindings; a
+// ten-line description of its light struct and layout gets the verdict on
+// its own lists, depth and lights, on standard and reversed-Z cameras.
+TEST_F(RenderDoc, AMinimalEnginesOwnCaptureIsJudgedFromATenLineDescription) {
+    writeText(dir.path / "engine.json", kMiniEngineDescription);
+    for (const std::string mode : {"standard", "reversed"}) {
+        SCOPED_TRACE(mode);
+        const fs::path capture = dir.path / (mode + ".rdc"), lists = dir.path / (mode + ".csv"),
+                       out = dir.path / (mode + "-check");
+        const std::string cmd = std::string(LC_MINI_ENGINE_PATH) + " '" + capture.string() + "' '" + lists.string() +
+                                "'" + (mode == "reversed" ? " --reversed" : "") + " > '" +
+                                (dir.path / "engine.log").string() + "' 2>&1";
+        ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(dir.path / "engine.log");
+
+        const CliResult info = runCli({"capture-info", capture.string(), "--dispatch", "light culling"}, dir.path);
+        ASSERT_EQ(info.code, 0) << info.err;
+        EXPECT_NE(info.out.find("0.2  image ImageSampler  250x140 D32  SceneDepth"), std::string::npos) << info.out;
+        EXPECT_NE(info.out.find("0.3  buffer ReadWriteBuffer  576 bytes at offset 0 of 576  TileLightCounts"),
+                  std::string::npos)
+            << info.out;
+
+        const CliResult c = runCli({"check", "--capture", capture.string(), "--dispatch", "Forward+ light culling",
+                                    "--describe", (dir.path / "engine.json").string(), "--out", out.string()},
+                                   dir.path);
+        ASSERT_EQ(c.code, 0) << c.out << c.err;
+        EXPECT_NE(c.out.find(mode == "reversed" ? "read camera: reversed_z, fov y 55 deg, near 0.3"
+                                                : "read camera: perspective, fov y 55 deg, near 0.3"),
+                  std::string::npos)
+            << c.out;
+        EXPECT_NE(c.out.find("read lights: 64 (read at byte 140 of set 0 binding 0"), std::string::npos) << c.out;
+        EXPECT_NE(c.out.find("custom: " + capture.string() + " event "), std::string::npos) << c.out;
+        EXPECT_NE(c.out.find("layout counts+indices:32"), std::string::npos) << c.out;
+        const json s = json::parse(slurp(out / "summary.json"));
+        EXPECT_EQ(s["metrics"]["false_negatives"], 0);
+        EXPECT_EQ(s["width"], 250);
+        EXPECT_EQ(s["tiles_x"], 16);
+        // The lists judged are the ones the engine read back.
+        const auto mine = engineLists(lists);
+        const auto judged = checkedLists(out / "tiles.csv", 16);
+        ASSERT_EQ(judged.size(), 144u);
+        std::size_t entries = 0;
+        for (const auto& [list, lights] : mine) {
+            EXPECT_EQ(judged.at(list), lights) << "list " << list;
+            entries += lights.size();
+        }
+        EXPECT_GT(entries, 100u) << "the engine's frame lists lights (a test of something)";
+    }
+}
+
+// The same engine with a bug (it tests every light with half its range):
+// the verdict names the lights it missed, in which tiles, and they are the
+// ones its lists lack.
+TEST_F(RenderDoc, AMinimalEnginesBugIsLocatedInItsOwnLists) {
+    writeText(dir.path / "engine.json", kMiniEngineDescription);
+    const fs::path capture = dir.path / "bug.rdc", lists = dir.path / "bug.csv", out = dir.path / "check";
+    const std::string cmd = std::string(LC_MINI_ENGINE_PATH) + " '" + capture.string() + "' '" + lists.string() +
+                            "' --bug > '" + (dir.path / "engine.log").string() + "' 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(dir.path / "engine.log");
+    const CliResult c = runCli({"check", "--capture", capture.string(), "--dispatch", "light culling", "--describe",
+                                (dir.path / "engine.json").string(), "--out", out.string()},
+                               dir.path);
+    ASSERT_EQ(c.code, 3) << c.out << c.err;
+    EXPECT_NE(c.err.find("lightcull: the culling fails: "), std::string::npos) << c.err;
+    const json s = json::parse(slurp(out / "summary.json"));
+    const auto fn = s["metrics"]["false_negatives"].get<std::uint64_t>();
+    ASSERT_GT(fn, 0u);
+    const auto mine = engineLists(lists);
+    std::uint64_t located = 0;
+    for (const json& m : s["custom"]["missed"]) {
+        located += m["pixels"].get<std::uint64_t>();
+        EXPECT_EQ(m["cause"], "culling_test");
+        EXPECT_EQ(mine.at(m["list"].get<std::uint32_t>()).count(m["light"].get<std::uint32_t>()), 0u)
+            << "a missed light is one the engine's list lacks";
+    }
+    EXPECT_EQ(located, fn);
 }

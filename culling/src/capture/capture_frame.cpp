@@ -634,6 +634,11 @@ CaptureFrame decodeCaptureFrame(const CaptureDescription& d, const std::map<std:
                                                                    : d.rule.slices;
     const std::uint64_t listCount = std::uint64_t(grid.tileCount()) * perTile;
     f.words = decodeListWords(d, blobs, capture, listCount, f.layout, f.echo, f.warnings);
+    using K = CaptureDescription::Lists;
+    f.layoutName = d.listKind == K::Contract        ? toString(d.layout)
+                   : d.listKind == K::CountsIndices ? "counts+indices:" + std::to_string(d.layout.capacity)
+                   : d.listKind == K::Ranges        ? "ranges"
+                                                    : "pairs";
     return f;
 }
 
@@ -652,6 +657,14 @@ RunOutput checkCaptureFrame(const CaptureFrame& frame, const RunOptions& runOpti
     o.reuseDepth = &frame.depth;
     RunOutput out = runPipeline(frame.scene, lists, nullptr, o);
     out.depthFrom = "capture " + frame.source;
+    // The layout as the description named it (decoding went through the
+    // contract's fixed or compact words).
+    report.layout = frame.layoutName;
+    if (out.custom) {
+        auto named = std::make_shared<CustomCullReport>(*out.custom);
+        named->layout = frame.layoutName;
+        out.custom = named;
+    }
     return out;
 }
 

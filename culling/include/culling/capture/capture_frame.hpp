@@ -69,6 +69,7 @@ struct CaptureFrame {
     DepthImage depth;
     std::vector<std::uint32_t> words; // the lists in `layout`
     LayoutSpec layout;
+    std::string layoutName;           // the description's: "counts+indices:32", "ranges", "fixed:64", ...
     ListSpec rule;
     std::string source;               // "frame.rdc event 13"
     std::vector<std::string> echo;    // every field read, one line each
