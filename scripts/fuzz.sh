@@ -21,7 +21,7 @@ cd "$(dirname "$0")/.."
 seconds="${LIGHTCULL_FUZZ_SECONDS:-60}"
 jobs="${LIGHTCULL_FUZZ_JOBS:-2}"
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(fuzz_gltf fuzz_camera_path fuzz_scene_json fuzz_mesh_obj fuzz_mesh_ply fuzz_mesh_off fuzz_mesh_stl)
+[ ${#targets[@]} -eq 0 ] && targets=(fuzz_capture fuzz_gltf fuzz_camera_path fuzz_scene_json fuzz_mesh_obj fuzz_mesh_ply fuzz_mesh_off fuzz_mesh_stl)
 
 bdir="${LIGHTCULL_FUZZ_BUILD_DIR:-build-fuzz}"
 export bdir
