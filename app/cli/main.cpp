@@ -880,6 +880,17 @@ int main(int argc, char** argv) {
         if (!renderdocCapture.empty()) {
             if (const std::string why = outputProblem([&] { lc::checkFileTarget(renderdocCapture); }); !why.empty())
                 return fail(2, "--renderdoc-capture: " + why);
+            // The output folder is replaced as a whole: a capture inside it
+            // would be lost (or make the next run refuse the folder).
+            namespace fs = std::filesystem;
+            const auto inside = [](const fs::path& file, const fs::path& dir) {
+                const fs::path f = fs::weakly_canonical(fs::absolute(file)), d = fs::weakly_canonical(fs::absolute(dir));
+                const auto [a, b] = std::mismatch(d.begin(), d.end(), f.begin(), f.end());
+                return a == d.end();
+            };
+            if (inside(renderdocCapture, outDir))
+                return fail(2, "--renderdoc-capture: " + renderdocCapture + " is inside --out " + outDir +
+                                   ", which each run replaces; write the capture beside it");
             if (runFlags.backendName == "cpu" && runCustom.shader.empty())
                 return fail(2, "--renderdoc-capture: the cpu backend makes no Vulkan calls to capture; use --backend vulkan");
             // Before any Vulkan instance, so RenderDoc's layer is in each.

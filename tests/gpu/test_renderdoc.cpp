@@ -194,6 +194,13 @@ TEST_F(RenderDoc, BadCapturesAndDescriptionsGetOneLine) {
                      dir.path)
                   .code,
               0);
+    // A capture inside the output folder, which each run replaces, is refused.
+    const CliResult inside = runCli({"run", "--builtin", "atrium", "--renderdoc-capture",
+                                     (dir.path / "run" / "frame.rdc").string(), "--out", (dir.path / "run").string()},
+                                    dir.path);
+    EXPECT_EQ(inside.code, 2) << inside.err;
+    EXPECT_NE(inside.err.find("is inside --out"), std::string::npos) << inside.err;
+    EXPECT_TRUE(fs::exists(dir.path / "run" / "summary.json")) << "the earlier output is untouched";
     writeText(dir.path / "good.json", contractDescription("fixed:256", "tile"));
     const auto check = [&](const std::string& cap, const std::string& dispatch, const std::string& describe) {
         fs::remove_all(dir.path / "out");
