@@ -568,7 +568,6 @@ CaptureDescription parseCaptureDescription(const std::string& text, const std::s
 CaptureDescription loadCaptureDescription(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path, "", 0, "cannot read");
-    std::ostringstream s;
     // A description is a few hundred bytes: refuse to read a huge file whole.
     std::string text(64 * 1024 + 1, '\0');
     in.read(text.data(), std::streamsize(text.size()));
