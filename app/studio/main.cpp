@@ -123,11 +123,24 @@ int main(int argc, char** argv) {
                                  "Cull as an engine does (as the Limits toolbar's Engine preset; docs/ENGINES.md), "
                                  "for the scene once it is open; --param values override it.",
                                  "NAME");
+    QCommandLineOption captureOpt("capture",
+                                  "Open a renderer's frame from a RenderDoc capture (as File > Open RenderDoc "
+                                  "capture...; with --dispatch and --describe, docs/RENDERDOC.md).",
+                                  "FILE.rdc");
+    QCommandLineOption dispatchOpt("dispatch", "The capture's culling dispatch: its event id or text of its name "
+                                               "or markers.", "EVENT|NAME");
+    QCommandLineOption describeOpt("describe", "The description of the renderer's lights, camera and lists.",
+                                   "FILE.json");
+    parser.addOptions({captureOpt, dispatchOpt, describeOpt});
     parser.addOptions({sceneOpt, builtinOpt, lightsOpt, seedOpt, shaderOpt, paramOpt, presetOpt, backendOpt, firstMissOpt, runOpt,
                        shotOpt, quitOpt, dragOpt, shadingOpt, imageModeOpt});
     parser.process(app);
-    if (parser.isSet(sceneOpt) && parser.isSet(builtinOpt)) {
-        std::fprintf(stderr, "lightcull-studio: --scene and --builtin are exclusive\n");
+    if (int(parser.isSet(sceneOpt)) + int(parser.isSet(builtinOpt)) + int(parser.isSet(captureOpt)) > 1) {
+        std::fprintf(stderr, "lightcull-studio: --scene, --builtin and --capture are exclusive\n");
+        return 2;
+    }
+    if (parser.isSet(captureOpt) != parser.isSet(dispatchOpt) || parser.isSet(captureOpt) != parser.isSet(describeOpt)) {
+        std::fprintf(stderr, "lightcull-studio: --capture, --dispatch and --describe go together\n");
         return 2;
     }
 
@@ -232,7 +245,9 @@ int main(int argc, char** argv) {
 
     // Opening a scene runs culling once (so does the default start).
     bool ok = true;
-    if (parser.isSet(sceneOpt)) ok = window.openSceneFile(parser.value(sceneOpt));
+    if (parser.isSet(captureOpt))
+        ok = window.openCapture(parser.value(captureOpt), parser.value(dispatchOpt), parser.value(describeOpt));
+    else if (parser.isSet(sceneOpt)) ok = window.openSceneFile(parser.value(sceneOpt));
     else ok = window.openBuiltin(parser.isSet(builtinOpt) ? parser.value(builtinOpt)
                                                           : QString(lc::kDefaultBuiltin));
     if (!ok && scripted) return 1;

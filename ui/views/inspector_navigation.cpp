@@ -58,7 +58,16 @@ namespace lcui {
 void InspectorView::resetCamera() {
     // Frame the meshes (not every light sphere: a generated cloud can be far
     // larger than the scene) from above and to the side of the culling camera.
-    const auto [lo, hi] = doc_->scene().bounds();
+    auto [lo, hi] = doc_->scene().bounds();
+    // A scene without meshes (a RenderDoc capture's lights): frame the
+    // lights' centres and the camera.
+    if (doc_->scene().meshes.empty() && !doc_->scene().lights.empty()) {
+        lo = hi = doc_->scene().camera.position;
+        for (const lc::PointLight& l : doc_->scene().lights) {
+            lo = glm::min(lo, l.position);
+            hi = glm::max(hi, l.position);
+        }
+    }
     const lc::Camera& c = doc_->scene().camera;
     glm::dvec3 center = 0.5 * (lo + hi);
     double diag = glm::length(hi - lo);

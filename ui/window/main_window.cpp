@@ -107,7 +107,10 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), prompts(Prompts::
     // a scene is open (settings given before it, as the studio's --param
     // are, are for its first run: a run of the empty document is no answer).
     RunState& runs = doc_->runs();
-    connect(doc_, &Document::sceneReset, this, [this] { sceneOpen_ = true; });
+    connect(doc_, &Document::sceneReset, this, [this] {
+        sceneOpen_ = true;
+        if (!openingCapture_) forgetCapture(); // another scene: not the capture's
+    });
     connect(doc_, &Document::sceneEdited, this, [this] {
         if (isLive()) runCulling(/*liveEdit=*/true);
     });
@@ -153,6 +156,7 @@ void MainWindow::wireActions() {
                                            tr("Scenes (*.json *.gltf *.glb);;Scene JSON (*.json);;glTF 2.0 (*.gltf *.glb)"));
         if (!p.isEmpty()) openSceneFile(p);
     });
+    connect(a.openCapture, &QAction::triggered, this, &MainWindow::openCaptureFromDialog);
     connect(a.import, &QAction::triggered, this, [this] {
         const QString p =
             prompts.openPath(this, tr("Import mesh"), tr("Meshes (*.obj *.ply *.off *.stl *.om *.gltf *.glb)"));
@@ -216,6 +220,11 @@ void MainWindow::wireActions() {
     });
     connect(a.builtinAlgorithm, &QAction::triggered, this, [this] { setCustomShader({}); });
     connect(a.hunt, &QAction::triggered, this, &MainWindow::huntFromDialog);
+    connect(a.captureLists, &QAction::triggered, this, [this] { setCaptureLists(true); });
+    connect(a.captureRenderDoc, &QAction::triggered, this, [this] {
+        const QString p = prompts.savePath(this, tr("Capture in RenderDoc"), tr("RenderDoc captures (*.rdc)"));
+        if (!p.isEmpty()) captureInRenderDoc(p.endsWith(".rdc", Qt::CaseInsensitive) ? p : p + ".rdc");
+    });
     // A hunt's repro opens with its miss selected once its run has the truth
     // (selectFirstMissOfRun).
     connect(this, &MainWindow::runFinished, this, [this] {
@@ -244,7 +253,7 @@ void MainWindow::wireReport() {
     connect(report, &ReportDock::finished, this, [this] { statusProgress_->end("report"); });
     connect(report, &ReportDock::cullRequested, this, [this](const QString& backend) {
         if (runTarget_->offers(backend)) setBackend(backend, doc_->runs().device());
-        if (customShader_->options())
+        if (customShader_->options() || captureLists_)
             setCustomShader({}); // runs culling
         else
             runCulling();
@@ -256,6 +265,7 @@ void MainWindow::buildMenus() {
     QMenu* file = menuBar()->addMenu(tr("&File"));
     file->addActions({a.newScene, a.open});
     recentMenu_ = file->addMenu(tr("Open &recent"));
+    file->addAction(a.openCapture);
     QMenu* builtins = file->addMenu(tr("&Built-in scene"));
     for (const auto& b : lc::builtinScenes()) {
         QAction* act = builtins->addAction(QString::fromStdString(b.name));
@@ -291,7 +301,9 @@ void MainWindow::buildMenus() {
     cull->addSeparator();
     cull->addActions({misses_->nextAction(), misses_->previousAction(), a.hunt});
     cull->addSeparator();
-    cull->addActions({a.customShader, a.builtinAlgorithm});
+    cull->addActions({a.customShader, a.builtinAlgorithm, a.captureLists});
+    cull->addSeparator();
+    cull->addAction(a.captureRenderDoc);
 }
 
 void MainWindow::buildToolbars() {
@@ -334,7 +346,8 @@ quint64 MainWindow::runCulling(bool liveEdit) {
     const RunState& runs = doc_->runs();
     const quint64 gen = service_->request(doc_->scene(), runs.settings(), runs.backend(), runs.device(), liveEdit,
                                           CameraView::needsShading(cameraView_->imageMode()),
-                                          doc_->geometryRevision(), customShader_->options());
+                                          doc_->geometryRevision(), customShader_->options(), capture_,
+                                          captureLists_);
     doc_->runs().noteRunRequested(gen);
     statusBar()->showMessage(tr("culling (run %1)...").arg(gen));
     return gen;
@@ -392,9 +405,10 @@ void MainWindow::setCullingCameraFromInspector() {
 }
 
 bool MainWindow::setCustomShader(const QString& path) {
-    const bool had = customShader_->options() != nullptr;
+    const bool had = customShader_->options() != nullptr || captureLists_;
     try {
         customShader_->set(path);
+        captureLists_ = false;
     } catch (const std::exception& e) {
         log(tr("cannot use %1: %2").arg(path, QString::fromStdString(e.what())), true);
         prompts.showError(this, tr("Custom shader"), QString::fromStdString(e.what()));
@@ -405,7 +419,8 @@ bool MainWindow::setCustomShader(const QString& path) {
                 .arg(path, QString::fromStdString(lc::toString(o->layout)),
                      QString::fromStdString(lc::toString(o->lists))));
     else if (had)
-        log(tr("culling with the built-in algorithm again"));
+        log(capture_ ? tr("culling with the built-in algorithm on the capture's depth")
+                     : tr("culling with the built-in algorithm again"));
     runCulling();
     return true;
 }

@@ -38,6 +38,7 @@ class QSplitter;
 class QTabBar;
 
 namespace lc {
+struct CaptureFrame;
 struct RunOutput;
 }
 
@@ -99,6 +100,24 @@ public:
     // to the built-in algorithm. False (logged, shown) for a bad first line.
     bool setCustomShader(const QString& path);
     QString customShaderPath() const;
+
+    // --- RenderDoc (main_window_capture.cpp; docs/RENDERDOC.md) -----------------
+    // Opens a renderer's culling dispatch: the frame's lights and camera
+    // become the scene (no meshes), its depth is the depth every run of it
+    // uses, and its lists are judged (until Culling > Built-in algorithm or
+    // Custom shader...; The capture's lists goes back). False (logged,
+    // shown) when the capture or description cannot be read; the scene being
+    // edited is then untouched.
+    bool openCapture(const QString& capture, const QString& dispatch, const QString& description);
+    bool openCaptureFrame(std::shared_ptr<const lc::CaptureFrame> frame);
+    std::shared_ptr<const lc::CaptureFrame> captureFrame() const { return capture_; }
+    bool cullsCaptureLists() const { return captureLists_; }
+    void setCaptureLists(bool on);
+    // Culling > Capture in RenderDoc...: writes `rdcPath`, a capture of the
+    // tool's own passes on this scene (`lightcull run --renderdoc-capture`
+    // with the window's settings or custom shader, on Vulkan). False (logged,
+    // shown) when it could not.
+    bool captureInRenderDoc(const QString& rdcPath);
 
     // --- file operations (return false on failure or cancel; the current
     // scene is then untouched and the error is logged and shown) -------------
@@ -172,6 +191,8 @@ protected:
 
 private:
     void huntFromDialog(); // Culling > Hunt for a miss... (main_window_hunt.cpp)
+    void openCaptureFromDialog(); // File > Open RenderDoc capture... (main_window_capture.cpp)
+    void forgetCapture();
     void wireActions();
     void wireReport();
     void buildMenus();
@@ -203,6 +224,11 @@ private:
     bool sceneOpen_ = false;         // a scene was opened (the document starts empty)
     CustomShaderSource* customShader_ = nullptr; // the user's culling shader, watched
     quint64 firstMissOfRun_ = 0; // selectFirstMissOfRun's generation; 0: none
+    // The RenderDoc capture the scene came from (null: none), whether its
+    // lists are what runs judge, and that the capture's scene is being set.
+    std::shared_ptr<const lc::CaptureFrame> capture_;
+    bool captureLists_ = false;
+    bool openingCapture_ = false;
 };
 
 } // namespace lcui

@@ -43,6 +43,13 @@ QString underTestText(const lc::CullSettings& s, const lc::CustomShaderOptions* 
 } // namespace
 
 void MainWindow::huntFromDialog() {
+    if (captureLists_) {
+        const QString why = tr("the run judges a RenderDoc capture's lists, which a hunt cannot vary: choose Culling > "
+                               "Built-in algorithm or Custom shader... first");
+        log(tr("Hunt: %1").arg(why), true);
+        prompts.showError(this, tr("Hunt for a miss"), why);
+        return;
+    }
     QSettings st;
     HuntRequest initial;
     initial.folder = st.value("hunt/folder", QDir::home().filePath("lightcull-hunt")).toString();

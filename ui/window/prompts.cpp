@@ -1,5 +1,6 @@
 #include "window/prompts.hpp"
 
+#include <QDialog>
 #include <QFileDialog>
 #include <QInputDialog>
 
@@ -28,6 +29,7 @@ Prompts Prompts::dialogs() {
         if (ok) value = v;
         return ok;
     };
+    p.execDialog = [](QDialog& d) { return d.exec(); };
     return p;
 }
 

@@ -8,6 +8,7 @@
 
 #include <functional>
 
+class QDialog;
 class QWidget;
 
 namespace lcui {
@@ -22,6 +23,8 @@ struct Prompts {
     // A number in [min, max]; false when cancelled.
     std::function<bool(QWidget*, const QString& title, const QString& label, double min, double max, double& value)>
         askNumber;
+    // A dialog of the studio's own (QDialog::exec); its result code.
+    std::function<int(QDialog&)> execDialog;
 
     // Each question as a modal dialog (QMessageBox, QFileDialog, QInputDialog).
     static Prompts dialogs();

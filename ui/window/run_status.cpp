@@ -27,6 +27,23 @@ QString allLightsNote(const lc::RunOutput& out) {
         .arg(qulonglong(u.pixelsShadedAgain));
 }
 
+// A RenderDoc capture's depth (cull_worker.hpp: CullRequest::capture).
+bool fromCapture(const lc::RunOutput& out) { return out.depthFrom.rfind("capture ", 0) == 0; }
+
+// The lists' time; a capture's lists were made by the renderer, untimed here.
+QString cullTime(const lc::RunOutput& out) {
+    if (out.result.timings.cullMs < 0) return RunStatus::tr("untimed (the renderer's lists)");
+    return RunStatus::tr("%1 ms").arg(out.result.timings.cullMs, 0, 'f', 2);
+}
+
+// Whose lists a run judged: the built-in algorithm's name, a custom shader's
+// or a RenderDoc capture's (its depth came from the capture).
+QString listSourceName(const lc::RunOutput& out, bool longForm) {
+    if (!out.custom) return QString(lc::toString(out.result.algorithm));
+    if (fromCapture(out)) return longForm ? RunStatus::tr("lists of capture") : "capture";
+    return longForm ? RunStatus::tr("custom shader") : "custom";
+}
+
 const char* const kStaleStyle = "color: white; background: #b9770e; padding: 0 4px";
 
 } // namespace
@@ -83,15 +100,16 @@ void RunStatus::finished(quint64 generation, const lc::RunOutput& out) {
                                              .arg(qulonglong(out.result.depthTrianglesDrawn))
                                              .arg(qulonglong(out.result.depthTriangles));
     // The worker keeps the last depth image while the camera and meshes stay.
-    const QString depthTime = out.depthReused ? tr("reused (camera and meshes unchanged)")
-                                              : tr("%1 ms").arg(out.result.timings.depthMs, 0, 'f', 2);
+    const QString depthTime = fromCapture(out)  ? tr("from the capture")
+                              : out.depthReused ? tr("reused (camera and meshes unchanged)")
+                                                : tr("%1 ms").arg(out.result.timings.depthMs, 0, 'f', 2);
     if (out.truthComputed) {
-        const QString line = tr("run %1: %2, %3 lights, depth %4%8, cull %5 ms, false negatives %6, efficiency %7")
+        const QString line = tr("run %1: %2, %3 lights, depth %4%8, cull %5, false negatives %6, efficiency %7")
                                  .arg(generation)
-                                 .arg(out.custom ? QStringLiteral("custom") : QString(lc::toString(out.result.algorithm)))
+                                 .arg(listSourceName(out, false))
                                  .arg(out.lights.size())
                                  .arg(depthTime)
-                                 .arg(out.result.timings.cullMs, 0, 'f', 2)
+                                 .arg(cullTime(out))
                                  .arg(m.falseNegatives)
                                  .arg(m.efficiency, 0, 'f', 4)
                                  .arg(depthTriangles);
@@ -104,7 +122,7 @@ void RunStatus::finished(quint64 generation, const lc::RunOutput& out) {
 
 void RunStatus::logCustom(const lc::RunOutput& out) {
     const lc::CustomCullReport& c = *out.custom;
-    log_->log(tr("custom shader %1 (%2, %3): overflowed lists %4, invalid indices %5, validation messages %6, "
+    log_->log(tr("%9 %1 (%2, %3): overflowed lists %4, invalid indices %5, validation messages %6, "
                  "%7 lists differ from built-in %8")
                   .arg(QString::fromStdString(c.source), QString::fromStdString(c.layout),
                        QString::fromStdString(c.lists))
@@ -112,7 +130,7 @@ void RunStatus::logCustom(const lc::RunOutput& out) {
                   .arg(c.invalidIndices)
                   .arg(c.validationMessages.size())
                   .arg(c.listsDifferingFromBuiltin)
-                  .arg(QString::fromStdString(c.builtinAlgorithm)),
+                  .arg(QString::fromStdString(c.builtinAlgorithm), listSourceName(out, true)),
               c.overflowLists > 0 || c.invalidIndices > 0 || !c.validationMessages.empty());
     for (const std::string& m : c.validationMessages) log_->log(QString::fromStdString(m), true);
 }
@@ -171,9 +189,10 @@ void RunStatus::update() {
         return;
     }
     // A run that only moved lights reuses the previous depth image (cull_worker).
-    const QString depth = run->depthReused ? tr("depth reused")
-                                           : tr("depth %1 ms").arg(run->result.timings.depthMs, 0, 'f', 2);
-    times_->setText(tr("%1 | cull %2 ms").arg(depth).arg(run->result.timings.cullMs, 0, 'f', 2));
+    const QString depth = fromCapture(*run)  ? tr("depth from the capture")
+                          : run->depthReused ? tr("depth reused")
+                                             : tr("depth %1 ms").arg(run->result.timings.depthMs, 0, 'f', 2);
+    times_->setText(tr("%1 | cull %2").arg(depth, cullTime(*run)));
     // The figures stay (they describe the run shown) but say they are old.
     const bool stale = doc_->runs().runIsStale();
     times_->setStyleSheet(stale ? kStaleStyle : "");
@@ -182,7 +201,7 @@ void RunStatus::update() {
     // A failed run (a custom shader that does not compile, settings the
     // device refuses) leaves the last good run on screen: say whose it is.
     if (failedGeneration_ > doc_->runs().runGeneration()) {
-        const QString what = run->custom ? tr("custom shader") : QString(lc::toString(run->result.algorithm));
+        const QString what = listSourceName(*run, true);
         times_->setStyleSheet(kStaleStyle);
         times_->setText(tr("run %1 failed, showing run %2 (%3): %4")
                             .arg(failedGeneration_)

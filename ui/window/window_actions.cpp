@@ -16,6 +16,8 @@ WindowActions WindowActions::create(QObject* owner, QUndoStack* undoStack) {
     WindowActions a;
     a.newScene = make(tr("&New"), "actionNew", QKeySequence::New);
     a.open = make(tr("&Open scene..."), "actionOpen", QKeySequence::Open);
+    a.openCapture = make(tr("Open Render&Doc capture..."), "actionOpenCapture");
+    a.openCapture->setStatusTip(tr("Judge the light lists of a renderer's culling dispatch in a RenderDoc capture"));
     a.import = make(tr("&Import mesh..."), "actionImport", QKeySequence(tr("Ctrl+I")));
     a.gltfCutoff = make(tr("glTF light &cut-off..."), "actionGltfCutoff");
     a.save = make(tr("&Save"), "actionSave", QKeySequence::Save);
@@ -57,6 +59,12 @@ WindowActions WindowActions::create(QObject* owner, QUndoStack* undoStack) {
     a.hunt = make(tr("&Hunt for a miss..."), "actionHunt", QKeySequence(tr("Ctrl+H")));
     a.customShader = make(tr("Custom &shader..."), "actionCustomShader");
     a.builtinAlgorithm = make(tr("&Built-in algorithm"), "actionBuiltinAlgorithm");
+    a.captureLists = make(tr("The capture's &lists"), "actionCaptureLists");
+    a.captureLists->setStatusTip(tr("Judge the lists of the RenderDoc capture the scene came from"));
+    a.captureLists->setEnabled(false);
+    a.captureRenderDoc = make(tr("Capture in Render&Doc..."), "actionCaptureRenderDoc");
+    a.captureRenderDoc->setStatusTip(
+        tr("Write a RenderDoc capture of the tool's depth pre-pass and culling of this scene"));
     return a;
 }
 

@@ -11,13 +11,13 @@ namespace lcui {
 
 struct WindowActions {
     // File
-    QAction *newScene, *open, *import, *gltfCutoff, *save, *saveAs, *exportDiagnostics, *quit;
+    QAction *newScene, *open, *openCapture, *import, *gltfCutoff, *save, *saveAs, *exportDiagnostics, *quit;
     // Edit
     QAction *undo, *redo, *addLight, *addSpotLight, *duplicate, *remove, *generate, *cameraFromView;
     // View
     QAction *tabbedViews, *resetView, *frameSelected, *lookThrough, *fitCameraImage;
     // Culling
-    QAction *run, *live, *hunt, *customShader, *builtinAlgorithm;
+    QAction *run, *live, *hunt, *customShader, *builtinAlgorithm, *captureLists, *captureRenderDoc;
 
     // The actions, owned by `owner`; undo and redo are `undo`'s.
     static WindowActions create(QObject* owner, QUndoStack* undo);

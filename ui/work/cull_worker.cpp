@@ -326,8 +326,15 @@ void CullWorker::runRequest(CullRequest req, std::shared_ptr<lc::CancelToken> ca
         // The Lambert image error (pixels x lights) is left to the shading
         // phase below, which runs only when asked (CullRequest::shade).
         options.truthOptions.imageError = false;
-        const bool reuse = sameGeometry(req);
+        const bool reuse = !req.capture && sameGeometry(req);
         if (reuse) options.reuseDepth = depth_.get();
+        if (req.capture) {
+            if (!(req.scene->camera == req.capture->scene.camera))
+                throw lc::InputError(req.capture->source, "camera", 0,
+                                     "the camera is not the capture's: its depth and lists are for the capture's "
+                                     "camera (Edit > Undo brings it back)");
+            options.reuseDepth = &req.capture->depth;
+        }
         // Rendering depth needs the meshes: a scene with them, built here
         // (worker thread) and only then.
         std::shared_ptr<const lc::Scene> runScene = req.scene;
@@ -338,7 +345,10 @@ void CullWorker::runRequest(CullRequest req, std::shared_ptr<lc::CancelToken> ca
         }
         options.groundTruth = !req.deferTruth;
         std::shared_ptr<lc::RunOutput> out;
-        if (req.custom) {
+        if (req.captureLists) {
+            lc::CustomCullReport report;
+            out = std::make_shared<lc::RunOutput>(lc::checkCaptureFrame(*req.capture, options, report, runScene.get()));
+        } else if (req.custom) {
             lc::CustomCullReport report;
             out = std::make_shared<lc::RunOutput>(
                 lc::runCustomPipeline(*runScene, *req.custom, *backend_, options, report, options.reuseDepth));
@@ -349,8 +359,13 @@ void CullWorker::runRequest(CullRequest req, std::shared_ptr<lc::CancelToken> ca
         // A reused depth names the rasteriser that drew it: a custom
         // shader or another algorithm reuses a pre-pass drawn by the
         // backend of an earlier run, and rasterisers differ at edges.
-        if (out->depthReused) out->depthFrom = "the previous run's " + depthSource_ + " (camera and meshes unchanged)";
-        if (!out->depthReused) {
+        if (req.capture) {
+            out->depthFrom = "capture " + req.capture->source;
+            depth_.reset(); // the next run without a capture draws its own
+            depthCamera_.reset();
+        } else if (out->depthReused) {
+            out->depthFrom = "the previous run's " + depthSource_ + " (camera and meshes unchanged)";
+        } else {
             depthSource_ = out->depthFrom.empty() ? "pre-pass on " + backend_->name() + " (" + backend_->deviceName() + ")"
                                                   : out->depthFrom;
             depth_ = std::make_shared<const lc::DepthImage>(out->depth);
@@ -407,9 +422,12 @@ CullService::~CullService() {
 
 quint64 CullService::request(const lc::Scene& scene, const lc::CullSettings& settings,
                              const QString& backend, const QString& device, bool deferTruth, bool shade,
-                             quint64 geometryRevision, std::shared_ptr<const lc::CustomShaderOptions> custom) {
+                             quint64 geometryRevision, std::shared_ptr<const lc::CustomShaderOptions> custom,
+                             std::shared_ptr<const lc::CaptureFrame> capture, bool captureLists) {
     CullRequest r;
     r.custom = std::move(custom);
+    r.capture = std::move(capture);
+    r.captureLists = r.capture && captureLists;
     r.generation = ++generation_;
     // Lights and camera are copied; the meshes only when their revision changed.
     auto copy = std::make_shared<lc::Scene>();

@@ -13,6 +13,7 @@
 // mode must not pile up runs); the run already in progress finishes, and the
 // document keeps the result with the highest generation number.
 
+#include "culling/capture/capture_frame.hpp"
 #include "culling/core/backend.hpp"
 #include "culling/custom/custom_cull.hpp"
 #include "culling/core/pipeline.hpp"
@@ -57,6 +58,13 @@ struct CullRequest {
     // A custom culling shader (docs/CUSTOM_CULLING.md) instead of
     // settings.algorithm; null: the built-in algorithm.
     std::shared_ptr<const lc::CustomShaderOptions> custom;
+    // A RenderDoc capture's frame (File > Open RenderDoc capture...). With
+    // `captureLists` its lists are judged (lc::checkCaptureFrame, the scene's
+    // lights for the capture's); without, the built-in algorithm or custom
+    // shader culls on the capture's depth instead of a pre-pass (the scene
+    // has no meshes to draw). Its camera must be the scene's.
+    std::shared_ptr<const lc::CaptureFrame> capture;
+    bool captureLists = false;
 };
 
 // What a job gets: the worker's backends, and a way to let waiting culling
@@ -178,7 +186,8 @@ public:
     quint64 request(const lc::Scene& scene, const lc::CullSettings& settings,
                     const QString& backend, const QString& device, bool deferTruth = false,
                     bool shade = false, quint64 geometryRevision = 0,
-                    std::shared_ptr<const lc::CustomShaderOptions> custom = nullptr);
+                    std::shared_ptr<const lc::CustomShaderOptions> custom = nullptr,
+                    std::shared_ptr<const lc::CaptureFrame> capture = nullptr, bool captureLists = false);
     // CullWorker::requestShading.
     void requestShading(quint64 generation) { worker_->requestShading(generation); }
     // CullWorker::postJob: long work on the worker's thread and backends.

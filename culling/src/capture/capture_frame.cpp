@@ -649,12 +649,16 @@ CaptureFrame loadCaptureFrame(const std::string& capture, const std::string& dis
     return decodeCaptureFrame(description, blobs, capture, event);
 }
 
-RunOutput checkCaptureFrame(const CaptureFrame& frame, const RunOptions& runOptions, CustomCullReport& report) {
+RunOutput checkCaptureFrame(const CaptureFrame& frame, const RunOptions& runOptions, CustomCullReport& report,
+                            const Scene* scene) {
+    if (scene && !(scene->camera == frame.scene.camera))
+        throw InputError(frame.source, "camera", 0,
+                         "the camera is not the capture's: its depth and lists are for the capture's camera");
     for (const std::string& w : frame.warnings) report.warnings.push_back(w);
     DumpLists lists(frame.source, frame.words, frame.layout, frame.rule, report);
     RunOptions o = runOptions;
     o.reuseDepth = &frame.depth;
-    RunOutput out = runPipeline(frame.scene, lists, nullptr, o);
+    RunOutput out = runPipeline(scene ? *scene : frame.scene, lists, nullptr, o);
     out.depthFrom = "capture " + frame.source;
     // The layout as the description named it (decoding went through the
     // contract's fixed or compact words).

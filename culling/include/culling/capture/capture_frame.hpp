@@ -87,7 +87,10 @@ CaptureFrame loadCaptureFrame(const std::string& capture, const std::string& dis
                               const CaptureDescription& description);
 
 // The capture's lists judged like a dump: the one pipeline with the lists
-// from the frame, on the frame's depth.
-RunOutput checkCaptureFrame(const CaptureFrame& frame, const RunOptions& runOptions, CustomCullReport& report);
+// from the frame, on the frame's depth. `scene` (non-null) stands for the
+// frame's: the studio's edited lights judged against the capture's lists
+// (its camera must be the frame's, or the depth is another view's).
+RunOutput checkCaptureFrame(const CaptureFrame& frame, const RunOptions& runOptions, CustomCullReport& report,
+                            const Scene* scene = nullptr);
 
 } // namespace lc
