@@ -6,6 +6,7 @@
 #include "culling/core/errors.hpp"
 #include "culling/core/pipeline.hpp"
 #include "culling/math/projection.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 
@@ -115,6 +116,9 @@ std::string decodeError(const CaptureDescription& d, const std::map<std::string,
 TEST(CaptureDescription, NamesTheJsonPathOfEachMistake) {
     EXPECT_NE(descriptionError("[1]").find("JSON object"), std::string::npos);
     EXPECT_NE(descriptionError("{").find("not JSON"), std::string::npos);
+    // A number past a double's range (nlohmann throws out_of_range, not
+    // parse_error: found by fuzz_capture).
+    EXPECT_NE(descriptionError("{\"lights\": 1" + std::string(400, '7') + "}").find("not JSON"), std::string::npos);
     const std::string noBinding = descriptionError(R"({"lights": {"stride": 16, "position": 0, "radius": 12},
         "camera": {"fov_y_deg": 60, "near": 0.1, "far": 100}, "depth": {"binding": "0.1"},
         "lists": {"layout": "fixed:8", "binding": "0.4"}})");
@@ -354,4 +358,131 @@ TEST(CaptureFrame, ListBuffersShorterThanTheGridNeedsAreRefused) {
     const CaptureFrame f = decodeCaptureFrame(d, blobs, "frame.rdc", 7);
     ASSERT_EQ(f.warnings.size(), 1u);
     EXPECT_NE(f.warnings[0].find("fixed:16 rather than fixed:8"), std::string::npos) << f.warnings[0];
+}
+
+// Z-binning as an engine stores it (lists.layout "zbin"): a light mask per
+// tile by sorted position, a 16-bit lo/hi pair per depth bin, and the sorted
+// order. The built-in zbin's own result, written in that form, reads back as
+// the same masks and bins and is judged by the same rule: no misses. Bins cut
+// short (their last light dropped) miss exactly the lights ground truth says.
+TEST(CaptureZBin, TheBuiltinZBinWrittenAsAnEngineDoesIsJudgedTheSame) {
+    Scene scene = makeBuiltinScene("atrium");
+    std::erase_if(scene.lights, [](const PointLight& l) { return l.isSpot(); });
+    scene.camera.width = 160;
+    scene.camera.height = 96;
+    CullSettings settings;
+    settings.algorithm = Algorithm::ZBin;
+    settings.bins = 64;
+    const auto cpu = makeBackend("cpu");
+    RunOptions opts;
+    opts.truthOptions.imageError = false;
+    const RunOutput run = runPipeline(scene, settings, *cpu, opts);
+    const CullResult& z = run.result;
+    ASSERT_EQ(z.algorithm, Algorithm::ZBin);
+    ASSERT_EQ(run.truth.metrics.falseNegatives, 0u);
+    const auto lights = std::uint32_t(run.lights.size());
+    ASSERT_GT(lights, 32u); // masks of more than one word
+
+    std::map<std::string, CaptureBlob> blobs;
+    std::string camera;
+    putMatrix(camera, 0, Projection(scene.camera).clipFromView());
+    blobs["camera"] = blob("buffer", camera, 0);
+    std::string lightBytes;
+    for (std::uint32_t l = 0; l < lights; ++l) {
+        const glm::dvec3 c = run.lights.centers[l];
+        put(lightBytes, 16 * l, float(c.x)), put(lightBytes, 16 * l + 4, float(c.y));
+        put(lightBytes, 16 * l + 8, float(c.z)), put(lightBytes, 16 * l + 12, float(run.lights.radii[l]));
+    }
+    blobs["lights"] = blob("buffer", lightBytes, 3);
+    blobs["depth"] = depthImage(run.depth.width, run.depth.height, run.depth.depth);
+    const std::uint32_t perTile = (lights + 31) / 32;
+    std::string masks(4 * std::size_t(z.grid.tileCount()) * perTile, '\0');
+    for (std::uint32_t t = 0; t < z.grid.tileCount(); ++t) {
+        for (std::uint32_t w = 0; w < perTile; ++w) {
+            std::uint32_t bits = 0;
+            for (std::uint32_t i = 0; i < z.listCount[t]; ++i) {
+                const std::uint32_t k = z.zbinRank[z.lightIndices[z.listOffset[t] + i]];
+                if (k / 32 == w) bits |= 1u << (k % 32);
+            }
+            put(masks, 4 * (std::size_t(t) * perTile + w), bits);
+        }
+    }
+    blobs["masks"] = blob("buffer", masks, 4);
+    auto binsOf = [&](bool cut) {
+        std::string bins;
+        for (std::size_t b = 0; b < z.zbinLo.size(); ++b) {
+            std::uint32_t lo = z.zbinLo[b], hi = z.zbinHi[b];
+            if (lo > hi) lo = 0xffff, hi = 0; // empty
+            else if (cut && hi > lo) --hi;
+            put(bins, 4 * b, lo | hi << 16);
+        }
+        return bins;
+    };
+    blobs["bins"] = blob("buffer", binsOf(false), 5);
+    std::string order;
+    for (std::uint32_t k = 0; k < lights; ++k) put(order, 4 * k, z.zbinOrder[k]);
+    blobs["order"] = blob("buffer", order, 6);
+
+    char text[600];
+    std::snprintf(text, sizeof text, R"({"lights": {"binding": "0.3", "stride": 16, "position": 0, "radius": 12},
+      "camera": {"binding": "0.0", "projection": 0}, "depth": {"binding": "0.1"},
+      "lists": {"layout": "zbin", "masks": "0.4", "bins": "0.5", "order": "0.6", "bin_format": "u16pair",
+                "bin_near": %.17g, "bin_far": %.17g}})",
+                  z.zbinNear, z.zbinFar);
+    const CaptureDescription d = parseCaptureDescription(text, "zbin.json");
+    EXPECT_EQ(captureBindingsNeeded(d).count("order"), 1u);
+    const CaptureFrame f = decodeCaptureFrame(d, blobs, "frame.rdc", 9);
+    ASSERT_TRUE(f.zbin);
+    EXPECT_EQ(f.layoutName, "zbin");
+    EXPECT_EQ(f.zbin->order, z.zbinOrder);
+    EXPECT_EQ(f.zbin->lo.size(), 64u);
+    bool echoed = false;
+    for (const std::string& e : f.echo) echoed = echoed || e.rfind("lists: zbin, 60 tile masks of ", 0) == 0;
+    EXPECT_TRUE(echoed);
+
+    CustomCullReport report;
+    const RunOutput judged = checkCaptureFrame(f, opts, report);
+    EXPECT_EQ(judged.result.algorithm, Algorithm::ZBin);
+    EXPECT_EQ(judged.result.listCount, z.listCount); // the tile masks' lights
+    EXPECT_EQ(judged.result.lightIndices, z.lightIndices);
+    ASSERT_EQ(judged.result.zbinLo.size(), z.zbinLo.size());
+    for (std::size_t b = 0; b < z.zbinLo.size(); ++b) {
+        const bool empty = z.zbinLo[b] > z.zbinHi[b];
+        EXPECT_EQ(judged.result.zbinLo[b] > judged.result.zbinHi[b], empty) << "bin " << b;
+        if (!empty) {
+            EXPECT_EQ(judged.result.zbinLo[b], z.zbinLo[b]);
+            EXPECT_EQ(judged.result.zbinHi[b], z.zbinHi[b]);
+        }
+    }
+    EXPECT_EQ(judged.truth.metrics.falseNegatives, 0u);
+    EXPECT_EQ(report.layout, "zbin");
+
+    // Each non-empty bin loses its farthest sorted light: misses, located in
+    // per-(tile, bin) lists that lack the light.
+    blobs["bins"] = blob("buffer", binsOf(true), 5);
+    const CaptureFrame cut = decodeCaptureFrame(d, blobs, "frame.rdc", 9);
+    CustomCullReport cutReport;
+    const RunOutput missed = checkCaptureFrame(cut, opts, cutReport);
+    EXPECT_GT(missed.truth.metrics.falseNegatives, 0u);
+
+    // Bad bins and orders: one line naming the binding.
+    std::string badBins = binsOf(false);
+    put(badBins, 0, 0u | (lights + 5) << 16);
+    blobs["bins"] = blob("buffer", badBins, 5);
+    EXPECT_NE(decodeError(d, blobs).find("bin 0 reaches sorted position " + std::to_string(lights + 5)),
+              std::string::npos)
+        << decodeError(d, blobs);
+    blobs["bins"] = blob("buffer", binsOf(false), 5);
+    std::string twice = order;
+    put(twice, 4, z.zbinOrder[0]);
+    blobs["order"] = blob("buffer", twice, 6);
+    EXPECT_NE(decodeError(d, blobs).find("names light " + std::to_string(z.zbinOrder[0]) + " twice"),
+              std::string::npos)
+        << decodeError(d, blobs);
+    // A zbin description must say the rule is per tile.
+    EXPECT_NE(descriptionError(R"({"lights": {"binding": "0.3", "stride": 16, "position": 0, "radius": 12},
+      "camera": {"binding": "0.0", "projection": 0}, "depth": {"binding": "0.1"},
+      "lists": {"layout": "zbin", "masks": "0.4", "bins": "0.5", "rule": "halfz"}})")
+                  .find("lists.rule"),
+              std::string::npos);
 }

@@ -91,6 +91,7 @@ private:
 
 constexpr std::uint32_t kMaxOffset = 1u << 20; // a struct or block larger than 1 MiB is a mistake
 constexpr std::uint32_t kMaxLights = 1000000;  // as the generator's limit
+constexpr std::uint32_t kMaxBins = 16384;      // as CullSettings::bins
 
 void parseLights(const Reader& r, const json& j, CaptureDescription& d) {
     const std::string p = "lights";
@@ -198,6 +199,20 @@ void parseLists(const Reader& r, const json& j, CaptureDescription& d) {
         d.offsets = r.binding(j, p, "offsets", true);
         d.counts = r.binding(j, p, "counts", false);
         d.indices = r.binding(j, p, "indices", true);
+    } else if (layout == "zbin") {
+        d.listKind = CaptureDescription::Lists::ZBin;
+        if (d.rule.kind != ListKind::Tile) r.fail(p + ".rule", "zbin's masks are per tile: the rule is tile");
+        d.layout = LayoutSpec{ListLayout::Bitmask, 0};
+        d.masks = r.binding(j, p, "masks", true);
+        d.bins = r.binding(j, p, "bins", true);
+        d.order = r.binding(j, p, "order", false);
+        d.binsU16 = r.choice(j, p, "bin_format", {"u32pair", "u16pair"}, "u32pair") == "u16pair";
+        if (r.child(j, p, "bin_count", false)) d.binCount = r.uint(j, p, "bin_count", true, 0, 1, kMaxBins);
+        d.binNear = r.number(j, p, "bin_near");
+        d.binFar = r.number(j, p, "bin_far");
+        if (d.binFar && !std::isfinite(*d.binFar)) r.fail(p + ".bin_far", "must be a finite number");
+        if (d.binNear && d.binFar && !(*d.binFar > *d.binNear))
+            r.fail(p + ".bin_far", "must be greater than bin_near");
     } else if (layout == "pairs") {
         d.listKind = CaptureDescription::Lists::Pairs;
         d.ranges = r.binding(j, p, "ranges", true);
@@ -207,7 +222,7 @@ void parseLists(const Reader& r, const json& j, CaptureDescription& d) {
         try {
             d.layout = parseLayout(layout);
         } catch (const SettingsError& e) {
-            r.fail(p + ".layout", std::string(e.what()) + "; or counts+indices:N, ranges, pairs");
+            r.fail(p + ".layout", std::string(e.what()) + "; or counts+indices:N, ranges, pairs, zbin");
         }
         d.listBuffer = r.binding(j, p, "binding", true);
     }
@@ -542,13 +557,92 @@ std::vector<std::uint32_t> decodeListWords(const CaptureDescription& d, const st
     return words;
 }
 
+// Z-binning's tile masks and bin ranges (CaptureDescription::Lists::ZBin):
+// the masks as the contract's bitmask words with bits by light index (the
+// sorted positions mapped through `order`), and the bins as ranges of sorted
+// positions.
+std::vector<std::uint32_t> decodeZBin(const CaptureDescription& d, const std::map<std::string, CaptureBlob>& blobs,
+                                      const std::string& capture, std::uint32_t tiles, std::uint32_t lights,
+                                      double binNear, double binFar, CaptureZBin& z,
+                                      std::vector<std::string>& echo) {
+    z.near = binNear;
+    z.far = binFar;
+    // The light at each sorted position.
+    z.order.resize(lights);
+    std::string orderFrom = "the light buffer's order";
+    if (!d.order.empty()) {
+        const Bytes o{&blobOf(blobs, "order"), capture, "light order"};
+        o.need(0, std::uint64_t(lights) * 4, std::to_string(lights) + " sorted light indices");
+        std::vector<bool> seen(lights, false);
+        for (std::uint32_t k = 0; k < lights; ++k) {
+            const std::uint32_t l = o.u32(std::uint64_t(k) * 4);
+            if (l >= lights || seen[l])
+                o.fail("sorted position " + std::to_string(k) + " names light " + std::to_string(l) +
+                       (l >= lights ? " of " + std::to_string(lights) : " twice") + ": not an order of the lights");
+            seen[l] = true;
+            z.order[k] = l;
+        }
+        orderFrom = "order " + o.blob->binding.where();
+    } else {
+        for (std::uint32_t k = 0; k < lights; ++k) z.order[k] = k;
+    }
+    // The bins.
+    const Bytes b{&blobOf(blobs, "bins"), capture, "depth bins"};
+    const std::uint64_t entry = d.binsU16 ? 4 : 8;
+    const std::uint64_t count = d.binCount ? *d.binCount : b.size() / entry;
+    if (count == 0) b.fail("holds no whole bin of " + std::to_string(entry) + " bytes");
+    if (count > kMaxBins)
+        b.fail("holds " + std::to_string(count) + " bins, more than the " + std::to_string(kMaxBins) +
+               " the tool's zbin takes: give bin_count");
+    b.need(0, count * entry, std::to_string(count) + " bins");
+    z.lo.resize(count);
+    z.hi.resize(count);
+    for (std::uint64_t i = 0; i < count; ++i) {
+        std::uint32_t lo = 0, hi = 0;
+        if (d.binsU16) {
+            const std::uint32_t w = b.u32(i * 4);
+            lo = w & 0xffffu, hi = w >> 16;
+            // A 16-bit range: 0xffff low half and 0 high half (or lo > hi) is empty.
+        } else {
+            lo = b.u32(i * 8), hi = b.u32(i * 8 + 4);
+        }
+        if (lo <= hi && hi >= lights)
+            b.fail("bin " + std::to_string(i) + " reaches sorted position " + std::to_string(hi) + " of " +
+                   std::to_string(lights) + " lights");
+        z.lo[i] = lo, z.hi[i] = hi;
+    }
+    // The masks: words per tile for the lights, bits by sorted position.
+    const Bytes m{&blobOf(blobs, "masks"), capture, "tile masks"};
+    const std::uint32_t perTile = (lights + 31) / 32;
+    m.need(0, std::uint64_t(tiles) * perTile * 4,
+           std::to_string(tiles) + " tiles of " + std::to_string(perTile) + " mask words");
+    std::vector<std::uint32_t> words(std::size_t(tiles) * perTile, 0u);
+    for (std::uint64_t t = 0; t < tiles; ++t)
+        for (std::uint32_t w = 0; w < perTile; ++w) {
+            std::uint32_t bits = m.u32((t * perTile + w) * 4);
+            while (bits) {
+                const std::uint32_t k = w * 32 + std::uint32_t(__builtin_ctz(bits));
+                bits &= bits - 1;
+                if (k >= lights) continue; // the last word's unused bits
+                const std::uint32_t l = z.order[k];
+                words[t * perTile + l / 32] |= 1u << (l % 32);
+            }
+        }
+    echo.push_back("lists: zbin, " + std::to_string(tiles) + " tile masks of " + std::to_string(perTile) +
+                   " words (" + m.blob->binding.where() + "), " + std::to_string(count) + " bins (" +
+                   (d.binsU16 ? "u16pair" : "u32pair") + ", " + b.blob->binding.where() + ") over view depth " +
+                   fmt(binNear) + ".." + fmt(binFar) + ", sorted by " + orderFrom + ", tile " +
+                   std::to_string(d.tileSize));
+    return words;
+}
+
 } // namespace
 
 CaptureDescription parseCaptureDescription(const std::string& text, const std::string& file) {
     json j;
     try {
         j = json::parse(text);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) { // parse_error, and out_of_range for a number past a double
         throw InputError(file, "", 0, std::string("not JSON: ") + e.what());
     }
     const Reader r(file);
@@ -582,6 +676,9 @@ std::map<std::string, std::string> captureBindingsNeeded(const CaptureDescriptio
     if (d.projection) m["camera"] = d.projection->binding;
     using K = CaptureDescription::Lists;
     if (d.listKind == K::Contract) m["lists"] = d.listBuffer;
+    if (!d.masks.empty()) m["masks"] = d.masks;
+    if (!d.bins.empty()) m["bins"] = d.bins;
+    if (!d.order.empty()) m["order"] = d.order;
     if (!d.indices.empty()) m["indices"] = d.indices;
     if (!d.counts.empty()) m["counts"] = d.counts;
     if (!d.offsets.empty()) m["offsets"] = d.offsets;
@@ -632,8 +729,21 @@ CaptureFrame decodeCaptureFrame(const CaptureDescription& d, const std::map<std:
                                   : d.rule.kind == ListKind::HalfZ ? 2
                                                                    : d.rule.slices;
     const std::uint64_t listCount = std::uint64_t(grid.tileCount()) * perTile;
-    f.words = decodeListWords(d, blobs, capture, listCount, f.layout, f.echo, f.warnings);
     using K = CaptureDescription::Lists;
+    if (d.listKind == K::ZBin) {
+        const double binNear = d.binNear.value_or(cam.nearPlane);
+        const double binFar = d.binFar.value_or(cam.farPlane);
+        if (!std::isfinite(binFar) || !(binFar > binNear))
+            throw InputError(d.file, "lists.bin_far", 0,
+                             "the camera's far plane is infinite: give the bins' far depth (bin_far)");
+        f.zbin.emplace();
+        f.words = decodeZBin(d, blobs, capture, grid.tileCount(), std::uint32_t(f.scene.lights.size()), binNear,
+                             binFar, *f.zbin, f.echo);
+        f.layout = d.layout;
+        f.layoutName = "zbin";
+        return f;
+    }
+    f.words = decodeListWords(d, blobs, capture, listCount, f.layout, f.echo, f.warnings);
     f.layoutName = d.listKind == K::Contract        ? toString(d.layout)
                    : d.listKind == K::CountsIndices ? "counts+indices:" + std::to_string(d.layout.capacity)
                    : d.listKind == K::Ranges        ? "ranges"
@@ -649,6 +759,43 @@ CaptureFrame loadCaptureFrame(const std::string& capture, const std::string& dis
     return decodeCaptureFrame(description, blobs, capture, event);
 }
 
+namespace {
+
+// A Z-binned frame's lists: its tile masks decoded as a dump, made a zbin
+// result with its bins, which ground truth and shading walk per pixel
+// (zbinPixelLists) as they do the built-in zbin's.
+class ZBinCaptureLists final : public ListSource {
+public:
+    ZBinCaptureLists(DumpLists& masks, const CaptureFrame& frame) : masks_(masks), frame_(frame) {}
+    CullResult makeLists(const Scene& scene, const DepthImage& depth, const Projection& proj, const TileGrid& grid,
+                         const ViewLights& lights) override {
+        CullResult r = masks_.makeLists(scene, depth, proj, grid, lights);
+        const CaptureZBin& z = *frame_.zbin;
+        if (z.order.size() != lights.size())
+            throw InputError(frame_.source, "", 0,
+                             "the capture's bins sort " + std::to_string(z.order.size()) + " lights, the scene has " +
+                                 std::to_string(lights.size()) + " (a zbin capture's lights cannot be added or deleted)");
+        r.algorithm = Algorithm::ZBin;
+        r.settings.algorithm = Algorithm::ZBin;
+        r.settings.bins = std::uint32_t(z.lo.size());
+        r.zbinOrder = z.order;
+        r.zbinRank.assign(z.order.size(), 0);
+        for (std::uint32_t k = 0; k < z.order.size(); ++k) r.zbinRank[z.order[k]] = k;
+        r.zbinLo = z.lo;
+        r.zbinHi = z.hi;
+        r.zbinNear = z.near;
+        r.zbinFar = z.far;
+        return r;
+    }
+    std::shared_ptr<const CustomCullReport> report() const override { return masks_.report(); }
+
+private:
+    DumpLists& masks_;
+    const CaptureFrame& frame_;
+};
+
+} // namespace
+
 RunOutput checkCaptureFrame(const CaptureFrame& frame, const RunOptions& runOptions, CustomCullReport& report,
                             const Scene* scene) {
     if (scene && !(scene->camera == frame.scene.camera))
@@ -656,9 +803,11 @@ RunOutput checkCaptureFrame(const CaptureFrame& frame, const RunOptions& runOpti
                          "the camera is not the capture's: its depth and lists are for the capture's camera");
     for (const std::string& w : frame.warnings) report.warnings.push_back(w);
     DumpLists lists(frame.source, frame.words, frame.layout, frame.rule, report);
+    ZBinCaptureLists zbin(lists, frame);
     RunOptions o = runOptions;
     o.reuseDepth = &frame.depth;
-    RunOutput out = runPipeline(scene ? *scene : frame.scene, lists, nullptr, o);
+    RunOutput out = runPipeline(scene ? *scene : frame.scene, frame.zbin ? static_cast<ListSource&>(zbin) : lists,
+                                nullptr, o);
     out.depthFrom = "capture " + frame.source;
     // The layout as the description named it (decoding went through the
     // contract's fixed or compact words).

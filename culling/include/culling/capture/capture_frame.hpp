@@ -48,10 +48,19 @@ struct CaptureDescription {
     bool bottomUp = false; // row 0 at the bottom
 
     // lists
-    enum class Lists { Contract, CountsIndices, Ranges, Pairs } listKind = Lists::Contract;
+    enum class Lists { Contract, CountsIndices, Ranges, Pairs, ZBin } listKind = Lists::Contract;
     LayoutSpec layout;                // Contract: fixed:N, compact[:N], bitmask; CountsIndices: N in capacity
     std::string listBuffer;           // Contract
     std::string counts, indices, offsets, ranges; // the other kinds
+    // ZBin (Drobot 2017): a light bit mask per tile (`masks`) and a range
+    // of sorted light positions per depth bin (`bins`, lo <= hi; lo > hi:
+    // empty), the bins linear in view depth over [binNear, binFar] (the
+    // camera's near and far unless given); `order` (optional) names the
+    // light at each sorted position, else the light buffer is in that order.
+    std::string masks, bins, order;
+    bool binsU16 = false; // lo | hi << 16 in one word; else two words
+    std::optional<std::uint32_t> binCount;
+    std::optional<double> binNear, binFar;
     ListSpec rule;
     std::uint32_t tileSize = 16;
 };
@@ -64,6 +73,12 @@ CaptureDescription loadCaptureDescription(const std::string& path);
 // The bindings a description reads: key -> spec, for readCaptureBindings.
 std::map<std::string, std::string> captureBindingsNeeded(const CaptureDescription& d);
 
+// A Z-binned frame's bins (CaptureDescription::Lists::ZBin).
+struct CaptureZBin {
+    std::vector<std::uint32_t> order, lo, hi; // order[k]: the light at sorted position k
+    double near = 0, far = 0;                 // the bins' view depth range
+};
+
 struct CaptureFrame {
     Scene scene;        // the capture's lights and camera (view space: the camera at the origin looking down -Z)
     DepthImage depth;
@@ -73,6 +88,9 @@ struct CaptureFrame {
     ListSpec rule;
     std::string source;               // "frame.rdc event 13"
     std::vector<std::string> echo;    // every field read, one line each
+    // A Z-binned frame: `words` are its tile masks (bitmask, bits by light
+    // index); a pixel's lights are its tile's within its bin's range.
+    std::optional<CaptureZBin> zbin;
     std::vector<std::string> warnings;
 };
 
