@@ -753,9 +753,8 @@ CaptureFrame decodeCaptureFrame(const CaptureDescription& d, const std::map<std:
 
 CaptureFrame loadCaptureFrame(const std::string& capture, const std::string& dispatch,
                               const CaptureDescription& description) {
-    const CaptureInfo info = readCaptureInfo(capture);
-    const std::uint32_t event = findDispatch(info, dispatch);
-    const auto blobs = readCaptureBindings(capture, event, captureBindingsNeeded(description));
+    std::uint32_t event = 0;
+    const auto blobs = readDispatchBindings(capture, dispatch, captureBindingsNeeded(description), event);
     return decodeCaptureFrame(description, blobs, capture, event);
 }
 

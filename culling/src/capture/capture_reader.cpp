@@ -255,24 +255,53 @@ std::uint32_t findDispatch(const CaptureInfo& info, const std::string& what) {
     return hits.front()->event;
 }
 
-std::map<std::string, CaptureBlob> readCaptureBindings(const std::string& capture, std::uint32_t event,
-                                                       const std::map<std::string, std::string>& specs) {
+namespace {
+
+// One replay that reads `specs` at `at` (an event id, or "dispatch:TEXT");
+// `blobs` stays empty when the helper could not resolve TEXT to one dispatch.
+json replayRead(const std::string& capture, const std::string& at, const std::map<std::string, std::string>& specs,
+                std::map<std::string, CaptureBlob>& blobs) {
     checkReadable(capture);
     TempDir tmp;
     const fs::path data = tmp.path / "data";
     fs::create_directory(data);
-    std::vector<std::string> args{"read", fs::absolute(capture).string(), std::to_string(event), data.string()};
+    std::vector<std::string> args{"read", fs::absolute(capture).string(), at, data.string()};
     for (const auto& [key, spec] : specs) args.push_back(key + "=" + spec);
-    const json reply = runReplay(fs::absolute(capture).string(), args, tmp);
-    std::map<std::string, CaptureBlob> out;
+    json reply = runReplay(fs::absolute(capture).string(), args, tmp);
     const auto read = reply.find("read");
+    if (read == reply.end()) return reply;
     for (const auto& [key, spec] : specs) {
-        if (read == reply.end() || !read->contains(key))
-            throw DeviceError(capture + ": the replay read no '" + spec + "'");
+        if (!read->contains(key)) throw DeviceError(capture + ": the replay read no '" + spec + "'");
         CaptureBlob blob;
         blob.binding = bindingFrom((*read)[key]);
         blob.bytes = readFile(data / (key + ".bin"));
-        out.emplace(key, std::move(blob));
+        blobs.emplace(key, std::move(blob));
+    }
+    return reply;
+}
+
+} // namespace
+
+std::map<std::string, CaptureBlob> readCaptureBindings(const std::string& capture, std::uint32_t event,
+                                                       const std::map<std::string, std::string>& specs) {
+    std::map<std::string, CaptureBlob> out;
+    replayRead(capture, std::to_string(event), specs, out);
+    if (out.size() != specs.size()) throw DeviceError(capture + ": the replay read nothing at event " + std::to_string(event));
+    return out;
+}
+
+std::map<std::string, CaptureBlob> readDispatchBindings(const std::string& capture, const std::string& dispatch,
+                                                        const std::map<std::string, std::string>& specs,
+                                                        std::uint32_t& event) {
+    std::map<std::string, CaptureBlob> out;
+    const json reply = replayRead(capture, "dispatch:" + dispatch, specs, out);
+    CaptureInfo info = infoFrom(capture, reply);
+    // The same rule as capture-info's: its errors (no such dispatch, several)
+    // name the dispatches; the helper resolved by it too.
+    event = findDispatch(info, dispatch);
+    if (out.size() != specs.size() || info.event != event) {
+        out.clear();
+        return readCaptureBindings(capture, event, specs);
     }
     return out;
 }

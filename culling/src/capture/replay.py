@@ -160,14 +160,35 @@ def resolve(bindings, spec, event):
     return hits[0]
 
 
+def dispatch_named(actions, what):
+    """The event of the one dispatch `what` names (an event id, or text of
+    its name or marker path), or None: the caller's findDispatch then says
+    why, from the actions."""
+    dispatches = [a for a in actions if a["kind"] == "dispatch"]
+    if what.isdigit() and len(what) < 10:
+        hits = [a for a in dispatches if a["event"] == int(what)]
+    else:
+        hits = [a for a in dispatches if what in a["name"] or what in " / ".join(a["markers"])]
+    return hits[0]["event"] if len(hits) == 1 else None
+
+
 def main(argv):
     if len(argv) < 2 or argv[0] not in ("info", "read"):
-        fail("usage: info CAPTURE [EVENT] | read CAPTURE EVENT DIR KEY=SPEC...")
+        fail("usage: info CAPTURE [EVENT] | read CAPTURE EVENT|dispatch:TEXT DIR KEY=SPEC...")
     cap, ctrl = open_capture(argv[1])
     actions = list_actions(ctrl)
     result = {"api": "Vulkan", "renderdoc": rd.GetVersionString(), "actions": actions}
     if len(argv) >= 3:
-        event = int(argv[2])
+        if argv[2].startswith("dispatch:"):
+            # The dispatch by name, resolved here: one replay reads it.
+            event = dispatch_named(actions, argv[2][len("dispatch:"):])
+            if event is None:
+                ctrl.Shutdown()
+                cap.Shutdown()
+                reply(result)
+                return
+        else:
+            event = int(argv[2])
         action = find_event(actions, event)
         if action is None:
             fail("%s has no dispatch, draw or copy at event %d" % (argv[1], event))

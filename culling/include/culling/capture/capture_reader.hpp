@@ -72,5 +72,11 @@ std::uint32_t findDispatch(const CaptureInfo& info, const std::string& what);
 // resource's or shader variable's name) after dispatch `event`.
 std::map<std::string, CaptureBlob> readCaptureBindings(const std::string& capture, std::uint32_t event,
                                                        const std::map<std::string, std::string>& specs);
+// readCaptureInfo + findDispatch + readCaptureBindings in one replay (opening
+// a large capture takes seconds): `event` gets the dispatch's event id.
+// Throws as findDispatch does when `dispatch` names none or several.
+std::map<std::string, CaptureBlob> readDispatchBindings(const std::string& capture, const std::string& dispatch,
+                                                        const std::map<std::string, std::string>& specs,
+                                                        std::uint32_t& event);
 
 } // namespace lc
