@@ -318,7 +318,13 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
     Explanation e;
     e.list = list;
     e.light = light;
-    e.algorithm = run.custom ? "custom (" + std::string(toString(r.algorithm)) + " lists)" : toString(r.algorithm);
+    // A shader's, dump's or capture's lists: whose, and which rule they
+    // follow (the skeleton's algorithm is only how their tiles are laid out).
+    if (run.custom)
+        e.algorithm = std::string(run.depthFrom.rfind("capture ", 0) == 0 ? "capture" : "custom") + " (" +
+                      (r.algorithm == Algorithm::ZBin ? std::string("zbin") : run.custom->lists) + " lists)";
+    else
+        e.algorithm = toString(r.algorithm);
     const std::uint32_t per = std::max(r.listsPerTile, 1u);
     e.tile = r.tileOfList(list);
     e.sub = per > 1 ? int(list % per) : -1;
