@@ -782,13 +782,11 @@ int main(int argc, char** argv) {
         }
 
         if (app.got_subcommand("capture-info")) {
-            const lc::CaptureInfo all = lc::readCaptureInfo(captureInfoFile);
             if (captureInfoDispatch.empty()) {
-                printCaptureActions(all);
+                printCaptureActions(lc::readCaptureInfo(captureInfoFile));
                 return 0;
             }
-            const std::uint32_t event = lc::findDispatch(all, captureInfoDispatch);
-            printCaptureBindings(lc::readCaptureInfo(captureInfoFile, event));
+            printCaptureBindings(lc::readDispatchInfo(captureInfoFile, captureInfoDispatch));
             return 0;
         }
 

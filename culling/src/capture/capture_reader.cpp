@@ -223,6 +223,17 @@ CaptureInfo readCaptureInfo(const std::string& capture, std::uint32_t event) {
     return info;
 }
 
+CaptureInfo readDispatchInfo(const std::string& capture, const std::string& what) {
+    checkReadable(capture);
+    TempDir tmp;
+    CaptureInfo info = infoFrom(capture, runReplay(fs::absolute(capture).string(),
+                                                   {"info", fs::absolute(capture).string(), "dispatch:" + what}, tmp));
+    info.file = capture;
+    // The helper resolves by findDispatch's rule; its errors come from here.
+    const std::uint32_t event = findDispatch(info, what);
+    return info.event == event ? info : readCaptureInfo(capture, event);
+}
+
 std::uint32_t findDispatch(const CaptureInfo& info, const std::string& what) {
     std::vector<const CaptureAction*> dispatches;
     for (const CaptureAction& a : info.actions)

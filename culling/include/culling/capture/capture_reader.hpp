@@ -62,6 +62,8 @@ struct CaptureBlob {
 // ran past its time limit (LIGHTCULL_REPLAY_TIMEOUT_S, default 300 s).
 CaptureInfo readCaptureInfo(const std::string& capture, std::uint32_t event = 0);
 
+// readCaptureInfo at the dispatch `what` names (findDispatch), in one replay.
+CaptureInfo readDispatchInfo(const std::string& capture, const std::string& what);
 // The event `what` names: a number (a dispatch's event id), or text found in
 // one dispatch's name or marker path ("cull", "Light culling"). Throws
 // InputError naming the file when none or several dispatches match (listing
