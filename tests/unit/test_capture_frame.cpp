@@ -116,6 +116,22 @@ std::string decodeError(const CaptureDescription& d, const std::map<std::string,
 TEST(CaptureDescription, NamesTheJsonPathOfEachMistake) {
     EXPECT_NE(descriptionError("[1]").find("JSON object"), std::string::npos);
     EXPECT_NE(descriptionError("{").find("not JSON"), std::string::npos);
+    // A misspelt optional field is refused, not left out: the spot cone,
+    // a key of another list layout, a lens beside a projection matrix.
+    const std::string base = R"("camera": {"binding": "0.0", "projection": 0}, "depth": {"binding": "0.1"})";
+    const std::string typo = descriptionError(R"({"lights": {"binding": "0.3", "stride": 32, "position": 0,
+        "radius": 12, "spot_axis": 16, "spot_angel": 28}, )" + base + R"(, "lists": {"layout": "fixed:8", "binding": "0.4"}})");
+    EXPECT_NE(typo.find("lights.spot_angel | "), std::string::npos) << typo;
+    EXPECT_NE(typo.find("unknown field (lights takes binding, stride"), std::string::npos) << typo;
+    const std::string other = descriptionError(R"({"lights": {"binding": "0.3", "stride": 16, "position": 0,
+        "radius": 12}, )" + base + R"(, "lists": {"layout": "counts+indices:8", "counts": "0.4", "indices": "0.5",
+        "binding": "0.6"}})");
+    EXPECT_NE(other.find("lists.binding | "), std::string::npos) << other;
+    EXPECT_NE(other.find("lists with layout counts+indices:8 takes"), std::string::npos) << other;
+    const std::string lens = descriptionError(R"({"lights": {"binding": "0.3", "stride": 16, "position": 0,
+        "radius": 12}, "camera": {"binding": "0.0", "projection": 0, "reversed": true}, "depth": {"binding": "0.1"},
+        "lists": {"layout": "fixed:8", "binding": "0.4"}})");
+    EXPECT_NE(lens.find("camera.reversed | "), std::string::npos) << lens;
     // A number past a double's range (nlohmann throws out_of_range, not
     // parse_error: found by fuzz_capture).
     EXPECT_NE(descriptionError("{\"lights\": 1" + std::string(400, '7') + "}").find("not JSON"), std::string::npos);

@@ -84,6 +84,19 @@ public:
         fail(join(path, key), "'" + v + "' is not one of " + known);
     }
     static std::string join(const std::string& path, const char* key) { return path.empty() ? key : path + "." + key; }
+    // A key the reader does not know is a typo, not a comment: an optional
+    // field misspelt ("spot_angel") would otherwise be left out silently.
+    void known(const json& j, const std::string& path, std::initializer_list<const char*> keys,
+               const std::string& who = {}) const {
+        for (const auto& [key, value] : j.items()) {
+            bool ok = key == "comment";
+            for (const char* k : keys) ok = ok || key == k;
+            if (ok) continue;
+            std::string list;
+            for (const char* k : keys) list += (list.empty() ? "" : ", ") + std::string(k);
+            fail(join(path, key.c_str()), "unknown field (" + (who.empty() ? path : who) + " takes " + list + ")");
+        }
+    }
 
 private:
     std::string file_;
@@ -96,10 +109,13 @@ constexpr std::uint32_t kMaxBins = 16384;      // as CullSettings::bins
 void parseLights(const Reader& r, const json& j, CaptureDescription& d) {
     const std::string p = "lights";
     if (!j.is_object()) r.fail(p, "must be an object");
+    r.known(j, p, {"binding", "stride", "count", "position", "radius", "space", "spot_axis", "spot_angle",
+                   "spot_angle_unit"});
     d.lights = r.binding(j, p, "binding", true);
     d.lightStride = r.uint(j, p, "stride", true, 16, 4, kMaxOffset);
     if (const json* c = r.child(j, p, "count", false)) {
         if (c->is_object()) {
+            r.known(*c, p + ".count", {"binding", "offset"});
             d.lightCountField = CaptureField{r.binding(*c, p + ".count", "binding", true),
                                              r.uint(*c, p + ".count", "offset", true, 0, 0, kMaxOffset)};
         } else {
@@ -142,7 +158,11 @@ void parseLights(const Reader& r, const json& j, CaptureDescription& d) {
 void parseCamera(const Reader& r, const json& j, CaptureDescription& d) {
     const std::string p = "camera";
     if (!j.is_object()) r.fail(p, "must be an object");
+    r.known(j, p, {"binding", "projection", "view", "order", "fov_y_deg", "near", "far", "reversed"});
     if (r.child(j, p, "projection", false)) {
+        for (const char* lens : {"fov_y_deg", "near", "far", "reversed"})
+            if (r.child(j, p, lens, false))
+                r.fail(Reader::join(p, lens), "not read: the projection matrix gives the lens and depth convention");
         const std::string b = r.binding(j, p, "binding", true);
         d.projection = CaptureField{b, r.uint(j, p, "projection", true, 0, 0, kMaxOffset)};
         if (r.child(j, p, "view", false)) d.view = CaptureField{b, r.uint(j, p, "view", true, 0, 0, kMaxOffset)};
@@ -168,6 +188,7 @@ void parseCamera(const Reader& r, const json& j, CaptureDescription& d) {
 void parseDepth(const Reader& r, const json& j, CaptureDescription& d) {
     const std::string p = "depth";
     if (!j.is_object()) r.fail(p, "must be an object");
+    r.known(j, p, {"binding", "rows", "width", "height"});
     d.depth = r.binding(j, p, "binding", true);
     d.bottomUp = r.choice(j, p, "rows", {"top-down", "bottom-up"}, "top-down") == "bottom-up";
     d.depthWidth = r.uint(j, p, "width", false, 0, 1, 16384);
@@ -178,6 +199,7 @@ void parseDepth(const Reader& r, const json& j, CaptureDescription& d) {
 void parseLists(const Reader& r, const json& j, CaptureDescription& d) {
     const std::string p = "lists";
     if (!j.is_object()) r.fail(p, "must be an object");
+
     const std::string layout = r.string(j, p, "layout", true);
     try {
         d.rule = parseListSpec(r.string(j, p, "rule", false, "tile"));
@@ -192,9 +214,11 @@ void parseLists(const Reader& r, const json& j, CaptureDescription& d) {
         if (n.empty() || n.find_first_not_of("0123456789") != std::string::npos || n.size() > 6 || std::stoul(n) == 0)
             r.fail(p + ".layout", "counts+indices needs the indices per list: counts+indices:N");
         d.layout = LayoutSpec{ListLayout::Fixed, std::uint32_t(std::stoul(n))};
+        r.known(j, p, {"layout", "rule", "tile", "counts", "indices"}, "lists with layout " + layout);
         d.counts = r.binding(j, p, "counts", true);
         d.indices = r.binding(j, p, "indices", true);
     } else if (layout == "ranges") {
+        r.known(j, p, {"layout", "rule", "tile", "offsets", "counts", "indices"}, "lists with layout " + layout);
         d.listKind = CaptureDescription::Lists::Ranges;
         d.offsets = r.binding(j, p, "offsets", true);
         d.counts = r.binding(j, p, "counts", false);
@@ -203,6 +227,8 @@ void parseLists(const Reader& r, const json& j, CaptureDescription& d) {
         d.listKind = CaptureDescription::Lists::ZBin;
         if (d.rule.kind != ListKind::Tile) r.fail(p + ".rule", "zbin's masks are per tile: the rule is tile");
         d.layout = LayoutSpec{ListLayout::Bitmask, 0};
+        r.known(j, p, {"layout", "rule", "tile", "masks", "bins", "order", "bin_format", "bin_count", "bin_near",
+                       "bin_far"}, "lists with layout " + layout);
         d.masks = r.binding(j, p, "masks", true);
         d.bins = r.binding(j, p, "bins", true);
         d.order = r.binding(j, p, "order", false);
@@ -215,6 +241,7 @@ void parseLists(const Reader& r, const json& j, CaptureDescription& d) {
             r.fail(p + ".bin_far", "must be greater than bin_near");
     } else if (layout == "pairs") {
         d.listKind = CaptureDescription::Lists::Pairs;
+        r.known(j, p, {"layout", "rule", "tile", "ranges", "indices"}, "lists with layout " + layout);
         d.ranges = r.binding(j, p, "ranges", true);
         d.indices = r.binding(j, p, "indices", true);
     } else {
@@ -224,6 +251,7 @@ void parseLists(const Reader& r, const json& j, CaptureDescription& d) {
         } catch (const SettingsError& e) {
             r.fail(p + ".layout", std::string(e.what()) + "; or counts+indices:N, ranges, pairs, zbin");
         }
+        r.known(j, p, {"layout", "rule", "tile", "binding"}, "lists with layout " + layout);
         d.listBuffer = r.binding(j, p, "binding", true);
     }
 }
