@@ -34,12 +34,22 @@ def fail(message):
     reply({"error": message}, 1)
 
 
+def result_text(result):
+    """RenderDoc's result as its message ("File is corrupted: ..."), not the
+    Python object's repr."""
+    text = str(result)
+    prefix = "<Result: '"
+    if text.startswith(prefix) and text.endswith("'>"):
+        text = text[len(prefix):-2]
+    return text
+
+
 def open_capture(path):
     rd.InitialiseReplay(rd.GlobalEnvironment(), [])
     cap = rd.OpenCaptureFile()
     result = cap.OpenFile(path, "", None)
     if result != rd.ResultCode.Succeeded:
-        fail(path + ": not a RenderDoc capture RenderDoc " + rd.GetVersionString() + " can open (" + str(result) + ")")
+        fail(path + ": not a RenderDoc capture RenderDoc " + rd.GetVersionString() + " can open: " + result_text(result))
     api = cap.DriverName()
     if api != "Vulkan":
         fail(path + ": a " + api + " capture; lightcull reads Vulkan captures only")
@@ -47,7 +57,7 @@ def open_capture(path):
         fail(path + ": this machine cannot replay it (" + str(cap.LocalReplaySupport()) + ")")
     result, ctrl = cap.OpenCapture(rd.ReplayOptions(), None)
     if result != rd.ResultCode.Succeeded:
-        fail(path + ": RenderDoc cannot replay it here (" + str(result) + ")")
+        fail(path + ": RenderDoc cannot replay it here: " + result_text(result))
     return cap, ctrl
 
 
