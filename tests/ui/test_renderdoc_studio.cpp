@@ -323,8 +323,6 @@ private slots:
     }
 };
 
-int main(int argc, char** argv) {
-    return lctest::runQtTest([]() -> QObject* { return new RenderDocStudioTest; }, argc, argv);
-}
+LC_STUDIO_TEST_MAIN(RenderDocStudioTest)
 
 #include "test_renderdoc_studio.moc"
