@@ -212,7 +212,7 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
         std::cout << "image error: rmse " << fmt("%.6g", m.imageRmse) << ", max " << fmt("%.6g", m.imageMaxError) << "\n";
     else
         std::cout << "image error: not computed (" << noImageErrorWhy << ")\n";
-    std::cout << "times: depth "
+    std::cout << "times (" << r.timingMethod << "): depth "
               << (run.depthReused ? "not run (" + (run.depthFrom.empty() ? std::string("depth image given") : run.depthFrom) + ")"
                                   : ms(r.timings.depthMs));
     if (r.depthTriangles) {
@@ -220,7 +220,7 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
                   << r.depthTriangles << " triangles)";
     }
     std::cout << ", cull " << ms(r.timings.cullMs)
-              << ", shade " << ms(r.timings.shadeMs) << ", ground truth " << ms(r.timings.groundTruthMs) << " (" << r.timingMethod << ")\n"
+              << ", shade " << ms(r.timings.shadeMs) << ", ground truth " << ms(r.timings.groundTruthMs) << "\n"
               << "wrote " << out << "/summary.json, tiles.csv, heatmap.png, heatmap_misses.png"
               << (run.shadedAll.empty() ? "" : ", shaded_culled.png, shaded_all.png, shaded_diff.png") << "\n";
 }
@@ -598,7 +598,7 @@ int main(int argc, char** argv) {
     bool shadedImages = false;
     run->add_flag("--shaded-images", shadedImages,
                   "Also write shaded_culled.png, shaded_all.png and shaded_diff.png (the backend's shading pass)");
-    run->add_option("--out", outDir, "Folder to write the diagnostics into (written atomically; its parent must exist)")
+    run->add_option("--out", outDir, "Folder to write the diagnostics into (written atomically; missing parent folders are made)")
         ->type_name("DIR")
         ->required();
     lcli::CustomFlags runCustom;

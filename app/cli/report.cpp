@@ -82,7 +82,7 @@ void ReportCommand::add(CLI::App& app) {
         o->type_name(p.name == "tile" || p.name == "cells" ? "N[,N...]" : "VALUE");
         paramOptions_.emplace_back(p.name, o);
     }
-    cmd_->add_option("--out", outDir_, "Folder to write into (written atomically; its parent must exist)")
+    cmd_->add_option("--out", outDir_, "Folder to write into (written atomically; missing parent folders are made)")
         ->type_name("DIR")
         ->required();
 }

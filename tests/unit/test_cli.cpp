@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include <sys/stat.h>
 #include <nlohmann/json.hpp>
 
@@ -175,7 +177,6 @@ TEST(Cli, BadCommandLinesFailWithOneLineNamingTheProblem) {
     expectCleanFailure({"run", "--builtin", "wall", "--scene", "x.json", "--out", "OUT"}, "--scene");
     expectCleanFailure({"run", "--builtin", "wall"}, "--out");
     expectCleanFailure({"run", "--out", "OUT"}, "--builtin");
-    expectCleanFailure({"run", "--builtin", "wall", "--out", "/nonexistent/parent/out"}, "/nonexistent/parent");
     expectCleanFailure({"frobnicate"}, "frobnicate", 2);
     // glTF's --camera and --min-intensity with a scene JSON would be ignored.
     {
@@ -191,6 +192,25 @@ TEST(Cli, BadCommandLinesFailWithOneLineNamingTheProblem) {
 // A view with no geometry scores as a perfect culler: the CLI says so. A
 // scene JSON without a camera frames its meshes (as a glTF does) instead of
 // looking at the origin from a fixed place.
+// The docs' `--out out/frame` in a fresh folder: missing parent folders are
+// made; a parent that is a file is refused before the run, in one line.
+TEST(Cli, OutMakesMissingParentFoldersAndRefusesAFileOnItsPath) {
+    ScratchDir s;
+    const CliResult ok = runCli({"run", "--builtin", "wall", "--width", "64", "--height", "32", "--backend", "cpu",
+                                 "--no-image-error", "--out", (s.path / "out" / "deep" / "wall").string()},
+                                s.path);
+    EXPECT_EQ(ok.code, 0) << ok.err;
+    EXPECT_TRUE(fs::exists(s.path / "out" / "deep" / "wall" / "summary.json"));
+    std::ofstream(s.path / "afile") << "x";
+    const CliResult bad = runCli({"run", "--builtin", "wall", "--width", "64", "--height", "32", "--backend", "cpu",
+                                  "--out", (s.path / "afile" / "sub" / "out").string()},
+                                 s.path);
+    EXPECT_NE(bad.code, 0);
+    EXPECT_NE(bad.err.find((s.path / "afile").string() + " is not a folder"), std::string::npos) << bad.err;
+    EXPECT_EQ(lineCount(bad.err), 1u) << bad.err;
+    EXPECT_FALSE(fs::exists(s.path / "afile" / "sub"));
+}
+
 TEST(Cli, AnEmptyViewIsSaidAndAMissingCameraFramesTheMeshes) {
     ScratchDir s;
     const std::string mesh = R"("meshes": [{"positions": [40, 0, 40, 44, 0, 40, 40, 4, 40], "indices": [0, 1, 2]}],

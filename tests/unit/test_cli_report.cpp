@@ -8,6 +8,8 @@
 #include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
+
+#include <fstream>
 #include <png.h>
 
 #include <algorithm>
@@ -102,12 +104,13 @@ TEST(CliReport, WritesCsvMarkdownAndPareto) {
 TEST(CliReport, BadInputFailsWithOneLineAndNoFolder) {
     ScratchDir tmp;
     const fs::path out = tmp.path / "rep";
+    std::ofstream(tmp.path / "afile") << "x"; // a file where a parent folder would be
     for (const std::vector<std::string>& args :
          {std::vector<std::string>{"report", "--builtin", "sky", "--algorithm", "fastest", "--out", out.string()},
           {"report", "--builtin", "sky", "--cells", "1,64", "--out", out.string()},
           {"report", "--builtin", "sky", "--backend", "nope", "--out", out.string()},
           {"report", "--out", out.string()},
-          {"report", "--builtin", "sky", "--out", (tmp.path / "no" / "rep").string()}}) {
+          {"report", "--builtin", "sky", "--out", (tmp.path / "afile" / "rep").string()}}) {
         const CliResult r = runCli(args, tmp.path);
         EXPECT_NE(r.code, 0) << args[2];
         EXPECT_EQ(lineCount(r.err), 1u) << r.err;

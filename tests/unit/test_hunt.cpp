@@ -170,7 +170,8 @@ TEST(HuntCli, NoCounterexampleExitsZeroWithCoverage) {
 TEST(HuntCli, BadFlagsExitTwo) {
     ScratchDir s;
     EXPECT_EQ(runCli({"hunt", "--backend", "cpu", "--vary", "colour", "--out", (s.path / "h").string()}, s.path).code, 2);
-    EXPECT_EQ(runCli({"hunt", "--backend", "cpu", "--out", (s.path / "no" / "such" / "h").string()}, s.path).code, 2);
+    std::ofstream(s.path / "afile") << "x"; // a file where a parent folder would be
+    EXPECT_EQ(runCli({"hunt", "--backend", "cpu", "--out", (s.path / "afile" / "such" / "h").string()}, s.path).code, 2);
     std::ofstream(s.path / "keep.txt") << "mine";
     const CliResult r = runCli({"hunt", "--backend", "cpu", "--trials", "1", "--out", s.path.string()}, s.path);
     EXPECT_EQ(r.code, 2) << r.err;

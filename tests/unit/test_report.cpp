@@ -297,7 +297,11 @@ TEST(Report, WritesCsvMarkdownAndPngAtomically) {
     std::ofstream(out / "notes.txt") << "mine";
     EXPECT_THROW(writeReport(rep, out.string()), Error);
     EXPECT_TRUE(fs::exists(out / "notes.txt"));
-    EXPECT_THROW(writeReport(rep, (tmp.path / "missing" / "rep").string()), Error);
+    // A file where a parent folder would be; a missing parent is made.
+    std::ofstream(tmp.path / "afile") << "x";
+    EXPECT_THROW(writeReport(rep, (tmp.path / "afile" / "rep").string()), Error);
+    writeReport(rep, (tmp.path / "missing" / "rep").string());
+    EXPECT_TRUE(fs::exists(tmp.path / "missing" / "rep" / "report.csv"));
     for (const auto& e : fs::directory_iterator(tmp.path))
         EXPECT_EQ(e.path().filename().string().rfind(".rep", 0), std::string::npos) << "staging left behind";
 }

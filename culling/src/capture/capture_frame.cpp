@@ -348,7 +348,9 @@ Camera cameraFromProjection(const glm::dmat4& P, const Bytes& b, std::vector<std
     } else {
         // d = A + B t
         const double A = p32, B = -p22;
-        if (B <= 0) b.fail("a reversed orthographic projection (only perspective may be reversed here)");
+        if (B <= 0)
+            b.fail("a reversed orthographic projection (only perspective may be reversed here): is "
+                   "camera.projection the projection matrix's offset, and camera.order right?");
         c.projection = ProjectionKind::Orthographic;
         c.orthoHeight = 2.0 / std::abs(p11);
         c.nearPlane = -A / B;
@@ -455,6 +457,9 @@ std::vector<Light> decodeLights(const CaptureDescription& d, const std::map<std:
     b.need(0, count * d.lightStride, std::to_string(count) + " lights of " + std::to_string(d.lightStride) + " bytes");
     const glm::dmat3 rot(viewFromWorld);
     std::vector<Light> lights(count);
+    // The first lights' position and spot axis as the buffer holds them (a
+    // user compares these with their engine's values).
+    std::vector<std::pair<glm::dvec3, glm::dvec3>> asRead;
     for (std::uint64_t i = 0; i < count; ++i) {
         const std::uint64_t base = i * d.lightStride;
         Light& L = lights[i];
@@ -466,12 +471,14 @@ std::vector<Light> decodeLights(const CaptureDescription& d, const std::map<std:
             b.fail("light " + std::to_string(i) + ": position " + fmt(pos) + " is not finite");
         if (!(radius > 0) || !std::isfinite(radius))
             b.fail("light " + std::to_string(i) + ": radius " + fmt(radius) + " is not a positive number");
+        if (i < 3) asRead.emplace_back(pos, glm::dvec3(0.0));
         if (!d.lightsInViewSpace) pos = glm::dvec3(viewFromWorld * glm::dvec4(pos, 1.0));
         L.position = pos;
         L.explicitRadius = radius;
         if (d.spotAxisOffset) {
             const std::uint64_t a = base + *d.spotAxisOffset;
             glm::dvec3 axis(b.f32(a), b.f32(a + 4), b.f32(a + 8));
+            if (i < 3) asRead.back().second = axis;
             double angle = b.f32(base + *d.spotAngleOffset);
             if (d.spotAngleUnit == CaptureDescription::AngleUnit::Radians) angle *= 180.0 / kPi;
             if (d.spotAngleUnit == CaptureDescription::AngleUnit::Cosine)
@@ -490,10 +497,12 @@ std::vector<Light> decodeLights(const CaptureDescription& d, const std::map<std:
     std::string line = "lights: " + std::to_string(count) + " (" + countFrom + "), stride " +
                        std::to_string(d.lightStride) + ", " + (d.lightsInViewSpace ? "view" : "world") + " space (" +
                        b.blob->binding.where() + ")";
+    // As read; world-space lights also as the view matrix places them.
     for (std::size_t i = 0; i < lights.size() && i < 3; ++i)
-        line += "; light " + std::to_string(i) + ": position " + fmt(lights[i].position) + " radius " +
+        line += "; light " + std::to_string(i) + ": position " + fmt(asRead[i].first) +
+                (d.lightsInViewSpace ? "" : " (view " + fmt(lights[i].position) + ")") + " radius " +
                 fmt(lights[i].explicitRadius) +
-                (lights[i].isSpot() ? " spot axis " + fmt(lights[i].direction) + " outer " +
+                (lights[i].isSpot() ? " spot axis " + fmt(asRead[i].second) + " outer " +
                                           fmt(lights[i].outerAngleDeg) + " deg"
                                     : "");
     echo.push_back(line);
@@ -517,7 +526,7 @@ std::vector<std::uint32_t> decodeListWords(const CaptureDescription& d, const st
                                std::to_string(listCount) + " lists of " + std::to_string(words / listCount) +
                                " words: is the layout fixed:" + std::to_string(words / listCount - 1) +
                                " rather than " + toString(d.layout) + "?");
-        echo.push_back("lists: " + toString(d.layout) + ", " + toString(d.rule) + ", tile " +
+        echo.push_back("lists: " + toString(d.layout) + ", rule " + toString(d.rule) + ", tile size " +
                        std::to_string(d.tileSize) + ", " + std::to_string(listCount) + " lists (" +
                        b.blob->binding.where() + ", " + std::to_string(b.size()) + " bytes)");
         return b.words();
@@ -530,12 +539,24 @@ std::vector<std::uint32_t> decodeListWords(const CaptureDescription& d, const st
         const std::uint32_t n = d.layout.capacity;
         cnt.need(0, listCount * 4, std::to_string(listCount) + " counts");
         idx.need(0, listCount * n * 4, std::to_string(listCount) + " lists of " + std::to_string(n) + " indices");
+        // Buffers sized for another grid or another N: most likely the
+        // description's tile (or rule) or N is not the renderer's.
+        const std::uint64_t countWords = cnt.size() / 4, indexWords = idx.size() / 4;
+        if (countWords > listCount)
+            warnings.push_back("the counts' binding holds " + std::to_string(countWords) + " counts, the grid " +
+                               std::to_string(listCount) + " lists (tile " + std::to_string(d.tileSize) + ", " +
+                               toString(d.rule) + "): is lists.tile (or lists.rule) the renderer's?");
+        else if (indexWords % listCount == 0 && indexWords / listCount != n)
+            warnings.push_back("the indices' binding holds " + std::to_string(indexWords) + " indices, " +
+                               std::to_string(listCount) + " lists of " + std::to_string(indexWords / listCount) +
+                               ": is the layout counts+indices:" + std::to_string(indexWords / listCount) +
+                               " rather than counts+indices:" + std::to_string(n) + "?");
         words.reserve(listCount * (n + 1));
         for (std::uint64_t l = 0; l < listCount; ++l) {
             words.push_back(cnt.u32(l * 4));
             words.insert(words.end(), indices.begin() + std::ptrdiff_t(l * n), indices.begin() + std::ptrdiff_t((l + 1) * n));
         }
-        echo.push_back("lists: counts+indices:" + std::to_string(n) + ", " + toString(d.rule) + ", tile " +
+        echo.push_back("lists: counts+indices:" + std::to_string(n) + ", rule " + toString(d.rule) + ", tile size " +
                        std::to_string(d.tileSize) + ", " + std::to_string(listCount) + " lists (counts " +
                        cnt.blob->binding.where() + ", indices " + idx.blob->binding.where() + ")");
         return words;
@@ -579,8 +600,8 @@ std::vector<std::uint32_t> decodeListWords(const CaptureDescription& d, const st
     words.push_back(std::uint32_t(std::min<std::uint64_t>(entries, 0xFFFFFFFFu)));
     for (std::uint64_t l = 0; l < listCount; ++l) words.push_back(offsets[l]), words.push_back(counts[l]);
     words.insert(words.end(), indices.begin(), indices.end());
-    echo.push_back("lists: " + std::string(d.listKind == K::Pairs ? "pairs" : "ranges") + ", " + toString(d.rule) +
-                   ", tile " + std::to_string(d.tileSize) + ", " + std::to_string(listCount) + " lists, " +
+    echo.push_back("lists: " + std::string(d.listKind == K::Pairs ? "pairs" : "ranges") + ", rule " + toString(d.rule) +
+                   ", tile size " + std::to_string(d.tileSize) + ", " + std::to_string(listCount) + " lists, " +
                    std::to_string(indices.size()) + " index slots (" + from + ", indices " + idx.blob->binding.where() + ")");
     return words;
 }
@@ -659,7 +680,7 @@ std::vector<std::uint32_t> decodeZBin(const CaptureDescription& d, const std::ma
     echo.push_back("lists: zbin, " + std::to_string(tiles) + " tile masks of " + std::to_string(perTile) +
                    " words (" + m.blob->binding.where() + "), " + std::to_string(count) + " bins (" +
                    (d.binsU16 ? "u16pair" : "u32pair") + ", " + b.blob->binding.where() + ") over view depth " +
-                   fmt(binNear) + ".." + fmt(binFar) + ", sorted by " + orderFrom + ", tile " +
+                   fmt(binNear) + ".." + fmt(binFar) + ", sorted by " + orderFrom + ", tile size " +
                    std::to_string(d.tileSize));
     return words;
 }
@@ -689,7 +710,8 @@ CaptureDescription parseCaptureDescription(const std::string& text, const std::s
 
 CaptureDescription loadCaptureDescription(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, "", 0, "cannot read");
+    std::error_code ec;
+    if (!in) throw InputError(path, "", 0, std::filesystem::exists(path, ec) ? "cannot read" : "no such file");
     // A description is a few hundred bytes: refuse to read a huge file whole.
     std::string text(64 * 1024 + 1, '\0');
     in.read(text.data(), std::streamsize(text.size()));
@@ -751,6 +773,15 @@ CaptureFrame decodeCaptureFrame(const CaptureDescription& d, const std::map<std:
     f.scene.name = std::filesystem::path(capture).stem().string();
     f.scene.camera = cam;
     f.scene.lights = decodeLights(d, blobs, capture, viewFromWorld, f.echo);
+    // One radius for every light is what an offset into a constant field
+    // reads (a colour's alpha of 1): the verdict would be about other spheres.
+    if (f.scene.lights.size() > 1 &&
+        std::all_of(f.scene.lights.begin(), f.scene.lights.end(), [&](const Light& l) {
+            return l.explicitRadius == f.scene.lights.front().explicitRadius;
+        }))
+        f.warnings.push_back("all " + std::to_string(f.scene.lights.size()) + " lights read radius " +
+                             fmt(f.scene.lights.front().explicitRadius) + ": is lights.radius (" +
+                             std::to_string(d.radiusOffset) + ") the offset of the range in your struct?");
 
     const TileGrid grid = TileGrid::make(cam.width, cam.height, cam.tileSize);
     const std::uint32_t perTile = d.rule.kind == ListKind::Tile    ? 1

@@ -206,6 +206,7 @@ CaptureInfo infoFrom(const std::string& capture, const json& reply) {
 
 void checkReadable(const std::string& capture) {
     std::error_code ec;
+    if (fs::is_directory(capture, ec)) throw InputError(capture, "", 0, "a folder, not a capture file");
     if (!fs::is_regular_file(capture, ec)) throw InputError(capture, "", 0, "no such file");
     std::ifstream in(capture, std::ios::binary);
     if (!in) throw InputError(capture, "", 0, "cannot read");

@@ -153,7 +153,14 @@ def find_event(actions, event):
     return None
 
 
-def resolve(bindings, spec, event):
+# The description's JSON path of each binding key the caller reads.
+FIELDS = {"lights": "lights.binding", "light_count": "lights.count.binding", "camera": "camera.binding",
+          "depth": "depth.binding", "lists": "lists.binding", "counts": "lists.counts", "indices": "lists.indices",
+          "offsets": "lists.offsets", "ranges": "lists.ranges", "masks": "lists.masks", "bins": "lists.bins",
+          "order": "lists.order"}
+
+
+def resolve(bindings, spec, event, key=None):
     parts = spec.split(".")
     if len(parts) == 2 and parts[0].isdigit() and parts[1].isdigit():
         hits = [b for b in bindings if b["set"] == int(parts[0]) and b["binding"] == int(parts[1])]
@@ -164,9 +171,11 @@ def resolve(bindings, spec, event):
     hits = [b for b in hits if b["element"] == 0] or hits
     if not hits:
         known = ", ".join("%d.%d %s" % (b["set"], b["binding"], b["resource"]) for b in bindings)
-        fail("event %d binds nothing named '%s' (its bindings: %s)" % (event, spec, known or "none"))
+        field = (FIELDS.get(key, key) + ": ") if key else ""
+        fail("%sevent %d binds nothing named '%s' (its bindings: %s)" % (field, event, spec, known or "none"))
     if len(hits) > 1:
-        fail("'%s' names %d bindings at event %d: give SET.BINDING" % (spec, len(hits), event))
+        field = (FIELDS.get(key, key) + ": ") if key else ""
+        fail("%s'%s' names %d bindings at event %d: give SET.BINDING" % (field, spec, len(hits), event))
     return hits[0]
 
 
@@ -209,7 +218,7 @@ def main(argv):
         read = {}
         for item in argv[4:]:
             key, spec = item.split("=", 1)
-            b = resolve(result["bindings"], spec, event)
+            b = resolve(result["bindings"], spec, event, key)
             rid = lookup_id(ctrl, b)
             if b["kind"] == "buffer":
                 data = ctrl.GetBufferData(rid, b["offset"], b["size"])

@@ -137,9 +137,14 @@ std::pair<std::filesystem::path, std::filesystem::path> checkedFolderTarget(cons
     fs::path parent = target.parent_path();
     if (parent.empty()) parent = ".";
     std::error_code ec;
-    if (!fs::is_directory(parent, ec))
-        throw Error("cannot " + action + " into " + target.string() + ": parent folder " + parent.string() +
-                    " does not exist");
+    // Missing parent folders are made when writing (as `mkdir -p`), so the
+    // docs' `--out out/frame` works in a fresh clone; the nearest one that
+    // exists must be a folder.
+    for (fs::path p = parent; !fs::is_directory(p, ec); p = p.parent_path()) {
+        if (fs::exists(fs::symlink_status(p, ec)))
+            throw Error("cannot " + action + " into " + target.string() + ": " + p.string() + " is not a folder");
+        if (!p.has_parent_path() || p.parent_path() == p) break;
+    }
     if (fs::exists(fs::symlink_status(target, ec))) {
         if (!fs::is_directory(fs::symlink_status(target, ec)))
             throw Error("cannot " + action + " into " + target.string() + ": it exists and is not a folder");
@@ -166,6 +171,10 @@ void writeFolderAtomic(const std::string& dir, const std::set<std::string>& outp
     const std::string name = target.filename().string();
     std::error_code ec;
     const bool exists = fs::exists(fs::symlink_status(target, ec));
+    fs::create_directories(parent, ec);
+    if (!fs::is_directory(parent, ec))
+        throw Error("cannot " + action + " into " + target.string() + ": cannot make its parent folder " +
+                    parent.string() + (ec ? ": " + ec.message() : std::string()));
     removeAbandonedTemporaries(parent, name);
 
     // The writer's pid in the name: a later writer removes what an

@@ -327,6 +327,8 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
         e.algorithm = toString(r.algorithm);
     const std::uint32_t per = std::max(r.listsPerTile, 1u);
     e.tile = r.tileOfList(list);
+    e.tileX = e.tile % std::max(r.grid.tilesX, 1u);
+    e.tileY = e.tile / std::max(r.grid.tilesX, 1u);
     e.sub = per > 1 ? int(list % per) : -1;
     const auto first = r.lightIndices.begin() + r.listOffset[list];
     e.listed = std::binary_search(first, first + r.listCount[list], light);
@@ -344,7 +346,7 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
 
 std::string Explanation::text(const std::string& lightName) const {
     std::string out = "light " + std::to_string(light) + (lightName.empty() ? "" : " '" + lightName + "'") + " in list " +
-                      std::to_string(list) + " (tile " + std::to_string(tile) + (sub >= 0 ? ", sub-list " + std::to_string(sub) : "") +
+                      std::to_string(list) + " (tile " + std::to_string(tileX) + "," + std::to_string(tileY) + (sub >= 0 ? ", sub-list " + std::to_string(sub) : "") +
                       "), " + algorithm + "\n";
     out += "  culling sphere: centre (" + num(sphereCenter.x) + ", " + num(sphereCenter.y) + ", " + num(sphereCenter.z) +
            ") view space, radius " + num(sphereRadius) + "; its view depth " + num(-sphereCenter.z - sphereRadius) +

@@ -790,7 +790,13 @@ std::string huntOutputProblem(const std::string& dir) {
     const fs::path p(dir);
     const fs::path parent = p.has_parent_path() ? p.parent_path() : fs::path(".");
     if (dir.empty()) return "no folder given";
-    if (!fs::is_directory(parent)) return dir + ": its parent folder does not exist";
+    // Missing parent folders are made (fs::create_directories); the nearest
+    // one that exists must be a folder.
+    std::error_code ec;
+    for (fs::path q = parent; !fs::is_directory(q, ec); q = q.parent_path()) {
+        if (fs::exists(fs::symlink_status(q, ec))) return dir + ": " + q.string() + " is not a folder";
+        if (!q.has_parent_path() || q.parent_path() == q) break;
+    }
     if (!fs::exists(p)) return {};
     if (!fs::is_directory(p)) return dir + ": is a file, not a folder";
     // A folder is reused only when a hunt wrote it (its marker file) and it

@@ -24,6 +24,7 @@ struct ExplainStep {
 
 struct Explanation {
     std::uint32_t tile = 0, list = 0, light = 0;
+    std::uint32_t tileX = 0, tileY = 0; // the tile's column and row (0,0 top-left)
     int sub = -1;              // halfz near 0 / far 1, froxel slice, cell: the sub-list of the tile; -1: none
     std::string algorithm;     // of the result ("custom ..." for a custom shader's)
     glm::dvec3 sphereCenter{0.0}; // the culling sphere the tests use (view space)
