@@ -226,6 +226,10 @@ TEST(CaptureFrame, WorldSpaceLightsAreMovedIntoViewSpaceBySpotAxisToo) {
     for (const auto& l : f.echo) echo += l + "\n";
     EXPECT_NE(echo.find("lights: 2 (the binding's 64 bytes / stride 32), stride 32, world space"), std::string::npos)
         << echo;
+    // As the buffer holds them (what RenderDoc's buffer view shows), the
+    // view-space position beside.
+    EXPECT_NE(echo.find("light 0: position (1, 2, -10) (view ("), std::string::npos) << echo;
+    EXPECT_NE(echo.find("spot axis (0, 0, -1) outer 30"), std::string::npos) << echo;
     // World-space lights without a view matrix cannot be placed.
     d.view.reset();
     EXPECT_THROW(decodeCaptureFrame(d, frameBlobs(world, view), "frame.rdc", 7), InputError);
@@ -374,6 +378,30 @@ TEST(CaptureFrame, ListBuffersShorterThanTheGridNeedsAreRefused) {
     const CaptureFrame f = decodeCaptureFrame(d, blobs, "frame.rdc", 7);
     ASSERT_EQ(f.warnings.size(), 1u);
     EXPECT_NE(f.warnings[0].find("fixed:16 rather than fixed:8"), std::string::npos) << f.warnings[0];
+
+    // counts+indices: an indices buffer for another N, a counts buffer for
+    // another grid (tile size), each named in a warning.
+    d = parseCaptureDescription(kDescription, "desc.json");
+    d.listKind = CaptureDescription::Lists::CountsIndices;
+    d.layout = LayoutSpec{ListLayout::Fixed, 8};
+    blobs = frameBlobs(cam);
+    blobs["counts"] = blob("buffer", std::string(4 * 8, '\0'), 5);
+    blobs["indices"] = blob("buffer", std::string(4 * 8 * 16, '\0'), 6);
+    const CaptureFrame n = decodeCaptureFrame(d, blobs, "frame.rdc", 7);
+    ASSERT_EQ(n.warnings.size(), 1u);
+    EXPECT_NE(n.warnings[0].find("counts+indices:16 rather than counts+indices:8"), std::string::npos) << n.warnings[0];
+    blobs["counts"] = blob("buffer", std::string(4 * 32, '\0'), 5); // a grid of 8-pixel tiles
+    const CaptureFrame t = decodeCaptureFrame(d, blobs, "frame.rdc", 7);
+    ASSERT_EQ(t.warnings.size(), 1u);
+    EXPECT_NE(t.warnings[0].find("32 counts, the grid 8 lists (tile 16"), std::string::npos) << t.warnings[0];
+
+    // Every light the same radius: the offset of a constant (a colour's alpha).
+    blobs = frameBlobs(cam);
+    std::string& lights = blobs["lights"].bytes;
+    put(lights, 12, 1.0f), put(lights, 32 + 12, 1.0f);
+    const CaptureFrame r = decodeCaptureFrame(parseCaptureDescription(kDescription, "desc.json"), blobs, "frame.rdc", 7);
+    ASSERT_EQ(r.warnings.size(), 1u);
+    EXPECT_NE(r.warnings[0].find("all 2 lights read radius 1"), std::string::npos) << r.warnings[0];
 }
 
 // Z-binning as an engine stores it (lists.layout "zbin"): a light mask per
