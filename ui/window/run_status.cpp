@@ -3,6 +3,7 @@
 #include "document/document.hpp"
 #include "widgets/message_log.hpp"
 
+#include "culling/capture/capture_frame.hpp"
 #include "culling/custom/custom_cull.hpp"
 #include "culling/scene/gltf_io.hpp"
 
@@ -27,9 +28,6 @@ QString allLightsNote(const lc::RunOutput& out) {
         .arg(qulonglong(u.pixelsShadedAgain));
 }
 
-// A RenderDoc capture's depth (cull_worker.hpp: CullRequest::capture).
-bool fromCapture(const lc::RunOutput& out) { return out.depthFrom.rfind("capture ", 0) == 0; }
-
 // The lists' time; a capture's lists were made by the renderer, untimed here.
 QString cullTime(const lc::RunOutput& out) {
     if (out.result.timings.cullMs < 0) return RunStatus::tr("untimed (the renderer's lists)");
@@ -40,7 +38,7 @@ QString cullTime(const lc::RunOutput& out) {
 // or a RenderDoc capture's (its depth came from the capture).
 QString listSourceName(const lc::RunOutput& out, bool longForm) {
     if (!out.custom) return QString(lc::toString(out.result.algorithm));
-    if (fromCapture(out)) return longForm ? RunStatus::tr("lists of capture") : "capture";
+    if (lc::captureDepth(out)) return longForm ? RunStatus::tr("lists of capture") : "capture";
     return longForm ? RunStatus::tr("custom shader") : "custom";
 }
 
@@ -100,7 +98,7 @@ void RunStatus::finished(quint64 generation, const lc::RunOutput& out) {
                                              .arg(qulonglong(out.result.depthTrianglesDrawn))
                                              .arg(qulonglong(out.result.depthTriangles));
     // The worker keeps the last depth image while the camera and meshes stay.
-    const QString depthTime = fromCapture(out)  ? tr("from the capture")
+    const QString depthTime = lc::captureDepth(out) ? tr("from the capture")
                               : out.depthReused ? tr("reused (camera and meshes unchanged)")
                                                 : tr("%1 ms").arg(out.result.timings.depthMs, 0, 'f', 2);
     if (out.truthComputed) {
@@ -189,7 +187,7 @@ void RunStatus::update() {
         return;
     }
     // A run that only moved lights reuses the previous depth image (cull_worker).
-    const QString depth = fromCapture(*run)  ? tr("depth from the capture")
+    const QString depth = lc::captureDepth(*run) ? tr("depth from the capture")
                           : run->depthReused ? tr("depth reused")
                                              : tr("depth %1 ms").arg(run->result.timings.depthMs, 0, 'f', 2);
     times_->setText(tr("%1 | cull %2").arg(depth, cullTime(*run)));

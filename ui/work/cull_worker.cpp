@@ -360,7 +360,7 @@ void CullWorker::runRequest(CullRequest req, std::shared_ptr<lc::CancelToken> ca
         // shader or another algorithm reuses a pre-pass drawn by the
         // backend of an earlier run, and rasterisers differ at edges.
         if (req.capture) {
-            out->depthFrom = "capture " + req.capture->source;
+            out->depthFrom = lc::captureDepthSource(*req.capture);
             depth_.reset(); // the next run without a capture draws its own
             depthCamera_.reset();
         } else if (out->depthReused) {

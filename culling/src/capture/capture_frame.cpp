@@ -854,6 +854,10 @@ private:
 
 } // namespace
 
+std::string captureDepthSource(const CaptureFrame& frame) { return "capture " + frame.source; }
+
+bool captureDepth(const RunOutput& run) { return run.depthFrom.rfind("capture ", 0) == 0; }
+
 RunOutput checkCaptureFrame(const CaptureFrame& frame, const RunOptions& runOptions, CustomCullReport& report,
                             const Scene* scene) {
     if (scene && !(scene->camera == frame.scene.camera))
@@ -866,7 +870,7 @@ RunOutput checkCaptureFrame(const CaptureFrame& frame, const RunOptions& runOpti
     o.reuseDepth = &frame.depth;
     RunOutput out = runPipeline(scene ? *scene : frame.scene, frame.zbin ? static_cast<ListSource&>(zbin) : lists,
                                 nullptr, o);
-    out.depthFrom = "capture " + frame.source;
+    out.depthFrom = captureDepthSource(frame);
     // The layout as the description named it (decoding went through the
     // contract's fixed or compact words).
     report.layout = frame.layoutName;

@@ -3,6 +3,7 @@
 // ground truth of the list's pixels.
 #include "culling/diagnostics/explain.hpp"
 
+#include "culling/capture/capture_frame.hpp"
 #include "culling/core/errors.hpp"
 #include "culling/cpu/fine_prune.hpp"
 #include "culling/custom/custom_cull.hpp"
@@ -321,7 +322,7 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
     // A shader's, dump's or capture's lists: whose, and which rule they
     // follow (the skeleton's algorithm is only how their tiles are laid out).
     if (run.custom)
-        e.algorithm = std::string(run.depthFrom.rfind("capture ", 0) == 0 ? "capture" : "custom") + " (" +
+        e.algorithm = std::string(captureDepth(run) ? "capture" : "custom") + " (" +
                       (r.algorithm == Algorithm::ZBin ? std::string("zbin") : run.custom->lists) + " lists)";
     else
         e.algorithm = toString(r.algorithm);

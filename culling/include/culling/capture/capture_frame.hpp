@@ -104,6 +104,12 @@ CaptureFrame decodeCaptureFrame(const CaptureDescription& d, const std::map<std:
 CaptureFrame loadCaptureFrame(const std::string& capture, const std::string& dispatch,
                               const CaptureDescription& description);
 
+// A run's depth taken from a capture: RunOutput::depthFrom says so
+// ("capture frame.rdc event 13"), and what reads a run (the studio's status,
+// Explain) asks captureDepth() instead of parsing that text.
+std::string captureDepthSource(const CaptureFrame& frame);
+bool captureDepth(const RunOutput& run);
+
 // The capture's lists judged like a dump: the one pipeline with the lists
 // from the frame, on the frame's depth. `scene` (non-null) stands for the
 // frame's: the studio's edited lights judged against the capture's lists
