@@ -77,7 +77,10 @@ void HuntCommand::add(CLI::App& app) {
         CLI::Option* o = cmd_->add_option("--" + p.name, paramValues_[p.name],
                                           p.name == "tile" ? "Tile size when the screen is not varied (default: the scene's)"
                                                            : p.help + " (default: " + p.defaultValue + ")");
-        o->type_name(p.type == lc::ParamType::Int ? "INT" : p.type == lc::ParamType::Bool ? "BOOL" : "CHOICE");
+        o->type_name(p.type == lc::ParamType::Int    ? "INT"
+                     : p.type == lc::ParamType::Bool ? "BOOL"
+                     : p.type == lc::ParamType::Real ? "REAL"
+                                                     : "CHOICE");
         paramOptions_.emplace_back(p.name, o);
     }
     {

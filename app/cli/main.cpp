@@ -81,6 +81,9 @@ std::string paramDescription(const lc::ParamSpec& p) {
         d += "}";
     } else if (p.type == lc::ParamType::Int) {
         d += " [" + std::to_string(p.minValue) + ".." + std::to_string(p.maxValue) + "]";
+    } else if (p.type == lc::ParamType::Real) {
+        d += " [" + lc::realText(p.realMin) + ".." + lc::realText(p.realMax) +
+             (p.realWord.empty() ? "" : " or " + p.realWord) + "]";
     } else {
         d += " {true|false}";
     }
@@ -255,7 +258,10 @@ struct SceneFlags {
         for (const lc::ParamSpec& p : lc::cullParams()) {
             CLI::Option* o = cmd->add_option("--" + (p.name == "tile" ? tileSizeFlag : p.name), paramValues[p.name],
                                              paramDescription(p));
-            o->type_name(p.type == lc::ParamType::Int ? "INT" : p.type == lc::ParamType::Bool ? "BOOL" : "CHOICE");
+            o->type_name(p.type == lc::ParamType::Int    ? "INT"
+                         : p.type == lc::ParamType::Bool ? "BOOL"
+                         : p.type == lc::ParamType::Real ? "REAL"
+                                                         : "CHOICE");
             paramOptions.emplace_back(p.name, o);
         }
         optPreset = cmd->add_option("--preset", presetName, presetHelp())->type_name("NAME");

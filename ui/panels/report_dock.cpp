@@ -104,6 +104,10 @@ ReportDock::ReportDock(Document* doc, CullService* service, QWidget* parent)
             addParamControl(p, p.choices, p.choices);
         else if (p.type == lc::ParamType::Bool)
             addParamControl(p, {"false", "true"}, {"false", "true"});
+        else if (p.name == "proxy-level")
+            addParamControl(p, {"0", "1", "2", "3", "4"}, {"0", "1", "2"});
+        else if (p.name == "proxy-overfit")
+            addParamControl(p, {"auto", "1", "1.1", "1.2"}, {"auto", "1"});
     }
     for (const auto& c : params_) paramRow->addWidget(c->button);
     paramRow->addStretch(1);

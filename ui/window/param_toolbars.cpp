@@ -67,11 +67,20 @@ void ParamToolbars::addParamWidgets(QToolBar* limitsBar) {
             auto* l = new QLabel(label + " ");
             l->setToolTip(tip);
             bar->addWidget(l);
-            if (p.type == lc::ParamType::Choice) {
+            if (p.type == lc::ParamType::Choice || p.type == lc::ParamType::Real) {
                 auto* combo = new QComboBox;
                 for (const auto& c : p.choices) combo->addItem(QString::fromStdString(c));
+                if (p.type == lc::ParamType::Real) {
+                    // A number typed in, or a common one picked: the word
+                    // (auto), 1 (the mesh inscribed in the light) and steps up.
+                    combo->setEditable(true);
+                    combo->setInsertPolicy(QComboBox::NoInsert);
+                    if (!p.realWord.empty()) combo->addItem(QString::fromStdString(p.realWord));
+                    for (const char* v : {"1", "1.05", "1.1", "1.2", "1.3"}) combo->addItem(v);
+                    combo->setMinimumContentsLength(5);
+                }
                 connect(combo, &QComboBox::textActivated, this,
-                        [this, name](const QString& v) { onEdited(name, v); });
+                        [this, name](const QString& v) { onEdited(name, v.trimmed()); });
                 w = combo;
             } else {
                 auto* spin = new QSpinBox;

@@ -4,6 +4,7 @@
 #include "culling/core/errors.hpp"
 
 #include <charconv>
+#include <cstdio>
 
 namespace lc {
 
@@ -13,7 +14,8 @@ constexpr std::pair<Algorithm, const char*> kAlgorithms[] = {
     {Algorithm::All, "all"},          {Algorithm::Naive, "naive"},
     {Algorithm::MinMax, "minmax"},    {Algorithm::HalfZ, "halfz"},
     {Algorithm::TwoPointFiveD, "2.5d"}, {Algorithm::Clustered, "clustered"},
-    {Algorithm::Fptl, "fptl"},        {Algorithm::ZBin, "zbin"}};
+    {Algorithm::Fptl, "fptl"},        {Algorithm::ZBin, "zbin"},
+    {Algorithm::Raster, "raster"}};
 constexpr SphereTest kTests[] = {SphereTest::Planes, SphereTest::PlanesAabb, SphereTest::Exact};
 constexpr Slicing kSlicings[] = {Slicing::Log, Slicing::Linear};
 constexpr std::pair<OverflowPolicy, const char*> kOverflow[] = {
@@ -43,7 +45,9 @@ std::vector<ParamSpec> buildTable() {
                  "minmax (tile min/max depth), halfz (two lists split at mid depth), 2.5d "
                  "(depth-cell occupancy mask), clustered (3D froxel grid), fptl (fine-pruned tiles: "
                  "minmax, then each light tested against the tile's pixels), zbin (Z-binning: a "
-                 "screen-space light mask per tile and linear view-depth bins of the depth-sorted lights)",
+                 "screen-space light mask per tile and linear view-depth bins of the depth-sorted lights), "
+                 "raster (each light's proxy mesh rasterised at one pixel per tile, then its depth range "
+                 "against the tile's min/max)",
                  "Algorithm", ""});
     t.push_back({"test", ParamType::Choice, "planes", tests, 0, 0,
                  "sphere-vs-volume test: planes (6 planes), planes+aabb (planes and the chunk's "
@@ -65,6 +69,31 @@ std::vector<ParamSpec> buildTable() {
     t.push_back({"bins", ParamType::Int, "1024", {}, 1, 16384,
                  "zbin: view-depth bins, linear from the near plane to the far plane (or the farthest "
                  "light)", "Bins", ""});
+    t.push_back({"proxy-level", ParamType::Int, "1", {}, 0, 4,
+                 "raster: subdivisions of the icosphere a point light is drawn as (0: icosahedron, 20 "
+                 "triangles; each level 4x as many)",
+                 "Proxy level", ""});
+    t.push_back({"proxy-segments", ParamType::Int, "8", {}, 3, 64,
+                 "raster: sides of the cone a spot light is drawn as", "Cone sides", ""});
+    t.push_back({"proxy-cone-angle", ParamType::Int, "60", {}, 1, 89,
+                 "raster: a spot light whose outer half-angle (degrees) is above this is drawn as its "
+                 "range sphere instead of a cone",
+                 "Cone up to", ""});
+    {
+        ParamSpec overfit{"proxy-overfit", ParamType::Real, "auto", {}, 0, 0,
+                          "raster: scale of each proxy (a sphere's about its centre, a cone's base about its "
+                          "axis); auto: the smallest that encloses the light (docs/ALGORITHMS.md), 1: the mesh "
+                          "inscribed in the light's sphere",
+                          "Overfit", ""};
+        overfit.realMin = 0.5;
+        overfit.realMax = 4.0;
+        overfit.realWord = "auto";
+        t.push_back(overfit);
+    }
+    t.push_back({"conservative", ParamType::Bool, "true", {}, 0, 1,
+                 "raster: a proxy marks every tile it overlaps (conservative rasterisation), else only "
+                 "the tiles whose centre it covers",
+                 "Conservative", ""});
     t.push_back({"tile", ParamType::Int, "16", {}, 1, 256, "tile size in pixels", "Tile", ""});
     t.push_back({"width", ParamType::Int, "1280", {}, 1, 16384, "render width in pixels", "Width", ""});
     t.push_back({"height", ParamType::Int, "720", {}, 1, 16384, "render height in pixels", "Height", ""});
@@ -96,6 +125,16 @@ std::vector<ParamSpec> buildTable() {
     return t;
 }
 
+} // namespace
+
+std::string realText(double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", x);
+    return buf;
+}
+
+namespace {
+
 long long parseInt(const ParamSpec& p, const std::string& v) {
     long long x = 0;
     const char* b = v.data();
@@ -111,6 +150,18 @@ bool parseBool(const ParamSpec& p, const std::string& v) {
     if (v == "true" || v == "1" || v == "yes" || v == "on") return true;
     if (v == "false" || v == "0" || v == "no" || v == "off") return false;
     throw SettingsError(p.name, "must be true or false, got '" + v + "'");
+}
+
+double parseReal(const ParamSpec& p, const std::string& v) {
+    if (!p.realWord.empty() && v == p.realWord) return 0.0;
+    double x = 0;
+    const char* b = v.data();
+    const char* e = v.data() + v.size();
+    auto [ptr, ec] = std::from_chars(b, e, x);
+    if (v.empty() || ec != std::errc() || ptr != e || !(x >= p.realMin && x <= p.realMax))
+        throw SettingsError(p.name, "must be a number in " + realText(p.realMin) + ".." + realText(p.realMax) +
+                                        (p.realWord.empty() ? "" : " or " + p.realWord) + ", got '" + v + "'");
+    return x;
 }
 
 std::size_t parseChoice(const ParamSpec& p, const std::string& v) {
@@ -158,6 +209,13 @@ std::string CullSettings::validate() const {
     bool knownSpot = false;
     for (auto x : kSpotTests) knownSpot |= x == spotTest;
     if (!knownSpot) return "spot-test: unknown value";
+    if (proxyLevel > 4) return "proxy-level: must be an integer in 0..4, got " + std::to_string(proxyLevel);
+    if (proxySegments < 3 || proxySegments > 64)
+        return "proxy-segments: must be an integer in 3..64, got " + std::to_string(proxySegments);
+    if (proxyConeAngle < 1 || proxyConeAngle > 89)
+        return "proxy-cone-angle: must be an integer in 1..89, got " + std::to_string(proxyConeAngle);
+    if (!(proxyOverfit == 0.0 || (proxyOverfit >= 0.5 && proxyOverfit <= 4.0)))
+        return "proxy-overfit: must be a number in 0.5..4 or auto, got " + realText(proxyOverfit);
     if (cap > 65536) return "cap: must be an integer in 0..65536, got " + std::to_string(cap);
     if (maxLights > 1000000) return "max-lights: must be an integer in 0..1000000, got " + std::to_string(maxLights);
     if (maxEntries > 100000000)
@@ -192,6 +250,11 @@ void setParam(CullSettings& s, Camera& camera, const std::string& name, const st
     else if (name == "skip-empty") s.skipEmpty = parseBool(p, value);
     else if (name == "spot-test") s.spotTest = kSpotTests[parseChoice(p, value)];
     else if (name == "bins") s.bins = std::uint32_t(parseInt(p, value));
+    else if (name == "proxy-level") s.proxyLevel = std::uint32_t(parseInt(p, value));
+    else if (name == "proxy-segments") s.proxySegments = std::uint32_t(parseInt(p, value));
+    else if (name == "proxy-cone-angle") s.proxyConeAngle = std::uint32_t(parseInt(p, value));
+    else if (name == "proxy-overfit") s.proxyOverfit = parseReal(p, value);
+    else if (name == "conservative") s.conservative = parseBool(p, value);
     else if (name == "tile") camera.tileSize = std::uint32_t(parseInt(p, value));
     else if (name == "width") camera.width = std::uint32_t(parseInt(p, value));
     else if (name == "height") camera.height = std::uint32_t(parseInt(p, value));
@@ -211,6 +274,11 @@ std::string getParam(const CullSettings& s, const Camera& camera, const std::str
     if (name == "skip-empty") return s.skipEmpty ? "true" : "false";
     if (name == "spot-test") return toString(s.spotTest);
     if (name == "bins") return std::to_string(s.bins);
+    if (name == "proxy-level") return std::to_string(s.proxyLevel);
+    if (name == "proxy-segments") return std::to_string(s.proxySegments);
+    if (name == "proxy-cone-angle") return std::to_string(s.proxyConeAngle);
+    if (name == "proxy-overfit") return s.proxyOverfit == 0.0 ? "auto" : realText(s.proxyOverfit);
+    if (name == "conservative") return s.conservative ? "true" : "false";
     if (name == "tile") return std::to_string(camera.tileSize);
     if (name == "width") return std::to_string(camera.width);
     if (name == "height") return std::to_string(camera.height);

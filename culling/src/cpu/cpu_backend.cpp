@@ -10,6 +10,7 @@
 
 #include "culling/core/errors.hpp"
 #include "culling/cpu/fine_prune.hpp"
+#include "culling/math/light_proxy.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -304,6 +305,37 @@ void cullTiles(const CpuCull& cc, CullResult& res, std::vector<std::vector<std::
     for (std::uint64_t t : rowTests) res.volumeTests += t;
 }
 
+// raster: each light's proxy (light_proxy.hpp) drawn at one pixel per tile.
+// A tile lists the light when one of the proxy's triangles covers it, the
+// tile holds geometry, and the proxy's depth extent reaches the tile's
+// min/max (widened by the tests' slack). Lights in index order, so every
+// list comes out sorted.
+void rasterTiles(const CpuCull& c, CullResult& res, std::vector<std::vector<std::uint32_t>>& lists) {
+    const TileGrid& grid = c.frame.grid;
+    const ViewLights& lights = c.lights;
+    std::vector<std::uint32_t> seen(grid.tileCount(), std::numeric_limits<std::uint32_t>::max());
+    for (std::uint32_t l = 0; l < lights.size(); ++l) {
+        const bool spot = lights.isSpot(l);
+        const LightProxy p = makeLightProxy(lights.centers[l], lights.radii[l],
+                                            spot ? lights.spotAxes[l] : glm::dvec3(0, 0, -1),
+                                            spot ? lights.spotAngles[l] : 0.0, c.settings);
+        const double slack = sphereTestSlack(p.origin, lights.radii[l] * p.overfit);
+        const double lo = p.depthMin - slack, hi = p.depthMax + slack;
+        auto mark = [&](std::uint32_t tx, std::uint32_t ty) {
+            const std::uint32_t t = grid.tileIndex(tx, ty);
+            if (seen[t] == l) return;
+            seen[t] = l;
+            if (res.tileDepthMin[t] <= res.tileDepthMax[t] && lo <= res.tileDepthMax[t] && hi >= res.tileDepthMin[t])
+                lists[t].push_back(l);
+        };
+        for (const auto& tri : p.mesh->triangles)
+            res.volumeTests += proxyTriangleTiles(c.proj, grid, {p.vertex(tri[0]), p.vertex(tri[1]), p.vertex(tri[2])},
+                                                  c.settings.conservative, mark);
+    }
+    res.coverage = c.settings.conservative ? "every tile a proxy triangle overlaps (exact, double precision)"
+                                           : "every tile whose centre a proxy triangle covers (double precision)";
+}
+
 // zbin: the lights sorted by the view depth of their culling sphere's
 // centre; per linear bin of [near, far] the range of sorted positions whose
 // depth extent (with the tests' slack) reaches it.
@@ -392,6 +424,8 @@ static CullResult cullCpu(const CullFrame& frame, const DepthImage& depth, const
     if (algo == Algorithm::All) {
         lists[0].resize(n);
         for (std::size_t l = 0; l < n; ++l) lists[0][l] = std::uint32_t(l);
+    } else if (algo == Algorithm::Raster) {
+        if (tiles > 0) rasterTiles(c, res, lists);
     } else if (tiles > 0) {
         cullTiles(c, res, lists);
     }

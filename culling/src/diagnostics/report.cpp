@@ -74,6 +74,11 @@ std::vector<std::string> sweepValues(const ParamSpec& p, const ReportOptions& o)
     };
     if (p.name == "tile") return asText(o.tileSizes);
     if (p.name == "cells") return asText(o.cellCounts);
+    // raster: the proxy's detail, and the overfit that encloses the light
+    // against the mesh inscribed in it (the misses an engine without the
+    // factor gets).
+    if (p.name == "proxy-level") return {"0", "1", "2"};
+    if (p.name == "proxy-overfit") return {"auto", "1"};
     switch (p.type) {
     case ParamType::Choice: return p.choices;
     case ParamType::Bool: return {"false", "true"};
@@ -96,6 +101,15 @@ bool paramAppliesTo(const std::string& name, Algorithm a, std::uint32_t cells, b
     if (name == "algorithm") return true;
     if (name == "width" || name == "height") return false;
     if (a == Algorithm::All) return false;
+    // raster draws proxies: no sphere or spot test; its proxy's settings
+    // (the cone's only where a spot light is drawn as one).
+    if (a == Algorithm::Raster) {
+        if (name == "test" || name == "spot-test") return false;
+        if (name == "proxy-segments" || name == "proxy-cone-angle") return sceneHasSpotLights;
+        if (name.rfind("proxy-", 0) == 0 || name == "conservative") return true;
+    } else if (name.rfind("proxy-", 0) == 0 || name == "conservative") {
+        return false;
+    }
     if (name.rfind("spot-", 0) == 0) return sceneHasSpotLights;
     if (name == "cells") return a == Algorithm::TwoPointFiveD || a == Algorithm::Clustered;
     if (name == "slicing") return (a == Algorithm::TwoPointFiveD || a == Algorithm::Clustered) && cells > 1;
@@ -981,11 +995,12 @@ void writeReport(const Report& rep, const std::string& dir) {
 }
 
 glm::dvec3 algorithmColour(Algorithm a) {
-    // Okabe-Ito's colours, then its vermillion and a grey: eight algorithms,
-    // eight colours, none of them the Pareto front's red.
-    static const glm::dvec3 k[] = {{0.0, 0.0, 0.0},    {0.90, 0.62, 0.0},  {0.34, 0.71, 0.91}, {0.0, 0.62, 0.45},
-                                   {0.80, 0.47, 0.65}, {0.0, 0.45, 0.70},  {0.84, 0.37, 0.0},  {0.55, 0.55, 0.55}};
-    static_assert(sizeof k / sizeof k[0] == std::size_t(Algorithm::ZBin) + 1, "a colour per algorithm");
+    // Okabe-Ito's colours, then its vermillion, a grey and a brown: nine
+    // algorithms, nine colours, none of them the Pareto front's red.
+    static const glm::dvec3 k[] = {{0.0, 0.0, 0.0},    {0.90, 0.62, 0.0},  {0.34, 0.71, 0.91},
+                                   {0.0, 0.62, 0.45},  {0.80, 0.47, 0.65}, {0.0, 0.45, 0.70},
+                                   {0.84, 0.37, 0.0},  {0.55, 0.55, 0.55}, {0.55, 0.35, 0.17}};
+    static_assert(sizeof k / sizeof k[0] == std::size_t(Algorithm::Raster) + 1, "a colour per algorithm");
     return k[std::min<std::size_t>(std::size_t(a), std::size(k) - 1)];
 }
 

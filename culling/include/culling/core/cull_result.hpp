@@ -107,6 +107,10 @@ struct CullResult {
     std::string backend;      // "cpu" or "vulkan"
     std::string device;       // physical device name, or the CPU's
     std::string timingMethod; // how cullMs/depthMs were taken
+    // raster: how a proxy's tiles were found (the CPU's exact overlap, the
+    // GPU's conservative rasterisation or the edges pushed out in its vertex
+    // shader, and why); empty for the other algorithms.
+    std::string coverage;
     Timings timings;
     // The depth pre-pass that made the depth this cull read (runPipeline): the
     // scene's triangles and those it rasterised (the Vulkan backend leaves out
