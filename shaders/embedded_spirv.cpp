@@ -7,6 +7,8 @@
 #include "light_bins_shuffle_comp.spv.h"
 #include "light_bins_comp.spv.h"
 #include "prefix_sum_comp.spv.h"
+#include "proxy_raster_frag.spv.h"
+#include "proxy_raster_vert.spv.h"
 #include "shade_comp.spv.h"
 #include "tile_bounds_comp.spv.h"
 #include "tile_bounds_wide_comp.spv.h"
@@ -26,5 +28,7 @@ LC_SPV(prefixSum, lc_spv_prefix_sum_comp)
 LC_SPV(finePrune, lc_spv_fine_prune_comp)
 LC_SPV(zbin, lc_spv_zbin_comp)
 LC_SPV(shade, lc_spv_shade_comp)
+LC_SPV(proxyRasterVert, lc_spv_proxy_raster_vert)
+LC_SPV(proxyRasterFrag, lc_spv_proxy_raster_frag)
 #undef LC_SPV
 } // namespace lc::spirv

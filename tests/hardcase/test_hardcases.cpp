@@ -31,7 +31,8 @@ using lc::hardcase::hardCases;
 namespace {
 
 const Algorithm kAlgorithms[] = {Algorithm::All,    Algorithm::Naive,         Algorithm::MinMax,
-                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin};
+                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin,
+                                 Algorithm::Raster};
 
 const HardCase& caseNamed(const std::string& name) {
     for (const HardCase& c : hardCases())
@@ -139,7 +140,11 @@ void expectConservativeAgreement(const CullResult& cpu, const CullResult& gpu) {
         extra += gpu.listCount[l] - (cpu.listCount[l] - lost.size());
     }
     EXPECT_EQ(missing, 0u) << "GPU lists lack " << missing << " CPU entries; first: " << firstMissing;
-    EXPECT_LE(extra, 8 + cpu.entries() / 200) << "too many extra GPU entries (" << extra << " over "
+    // raster's pushed edges reach 1/256 tile past a triangle, and a proxy
+    // past float's reach near the camera comes as its box of tiles: a few
+    // per cent more, by design (docs/ALGORITHMS.md).
+    const std::uint64_t allowed = cpu.algorithm == Algorithm::Raster ? 8 + cpu.entries() / 32 : 8 + cpu.entries() / 200;
+    EXPECT_LE(extra, allowed) << "too many extra GPU entries (" << extra << " over "
                                              << cpu.entries() << "); first: " << firstExtra;
     std::printf("[ agree    ] entries cpu %llu gpu %llu extra %llu\n", (unsigned long long)cpu.entries(),
                 (unsigned long long)gpu.entries(), (unsigned long long)extra);

@@ -22,7 +22,8 @@ using namespace lc;
 namespace {
 
 const Algorithm kAlgorithms[] = {Algorithm::All,    Algorithm::Naive,         Algorithm::MinMax,
-                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin};
+                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin,
+                                 Algorithm::Raster};
 const SpotTest kSpotTests[] = {SpotTest::ApexSphere, SpotTest::TightSphere, SpotTest::ConeSphere,
                                SpotTest::ConePlanes};
 
@@ -140,6 +141,14 @@ TEST_P(SpotHardCase, EveryAlgorithmAndSpotTest) {
         // The cone refinements never list more than the tight sphere.
         EXPECT_LE(entries(byTest[SpotTest::ConeSphere]), entries(byTest[SpotTest::TightSphere]));
         EXPECT_LE(entries(byTest[SpotTest::ConePlanes]), entries(byTest[SpotTest::TightSphere]));
+        if (algo == Algorithm::Raster) {
+            // Proxies, not spot tests: one list for all four.
+            for (SpotTest t : kSpotTests)
+                EXPECT_EQ(byTest[t].lightIndices, byTest[SpotTest::ApexSphere].lightIndices) << toString(t);
+            // A cone wholly behind the camera covers no tile.
+            if (c.name == "pointing_away") EXPECT_EQ(entries(byTest[SpotTest::ApexSphere]), 0u);
+            continue;
+        }
         if (algo == Algorithm::Fptl) {
             // The fine prune tests the cone itself at the tile's pixels,
             // whatever the spot test: one list for all four.
@@ -211,6 +220,32 @@ TEST_F(SpotVulkan, ManySpotsEveryTestIsASupersetOfTheCpu) {
                 extra += gl.size() - std::min(gl.size(), cl.size());
             }
             EXPECT_LE(extra, 8 + r.lightIndices.size() / 200);
+            EXPECT_EQ(computeGroundTruth(depth, proj, lights, gr, o).metrics.falseNegatives, 0u);
+        }
+    // raster: cones up to 89 degrees (a base 57 ranges wide), and the spots
+    // past 30 degrees drawn as spheres; coarse and fine cones.
+    for (std::uint32_t coneAngle : {30u, 89u})
+        for (std::uint32_t segments : {3u, 8u, 32u}) {
+            SCOPED_TRACE("raster cone-angle " + std::to_string(coneAngle) + " segments " + std::to_string(segments));
+            CullSettings st;
+            st.algorithm = Algorithm::Raster;
+            st.proxyConeAngle = coneAngle;
+            st.proxySegments = segments;
+            const CullResult r = cpu->cull(depth, proj, grid, lights, st);
+            const CullResult gr = gputest::vulkan().cull(depth, proj, grid, lights, st);
+            ASSERT_EQ(gr.listCount.size(), r.listCount.size());
+            std::size_t extra = 0;
+            for (std::size_t i = 0; i < r.listCount.size(); ++i) {
+                const auto cl = listOf(r, i), gl = listOf(gr, i);
+                EXPECT_TRUE(std::includes(gl.begin(), gl.end(), cl.begin(), cl.end())) << "list " << i;
+                extra += gl.size() - std::min(gl.size(), cl.size());
+            }
+            // Pushed edges reach 1/256 tile past the exact overlap and a
+            // proxy past float's reach near the camera comes as its box of
+            // tiles: a few per cent more; a cone of 89 degrees (57 ranges
+            // wide) is such a box (docs/ALGORITHMS.md).
+            if (coneAngle < 89) EXPECT_LE(extra, 8 + r.lightIndices.size() / 32);
+            EXPECT_EQ(computeGroundTruth(depth, proj, lights, r, o).metrics.falseNegatives, 0u);
             EXPECT_EQ(computeGroundTruth(depth, proj, lights, gr, o).metrics.falseNegatives, 0u);
         }
 }

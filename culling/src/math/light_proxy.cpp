@@ -141,17 +141,20 @@ std::uint64_t proxyTriangleTiles(const Projection& proj, const TileGrid& grid, c
                                  bool conservative, const std::function<void(std::uint32_t, std::uint32_t)>& covered) {
     if (grid.tilesX == 0 || grid.tilesY == 0) return 0;
     const glm::dmat4& m = proj.clipFromView();
-    // Clip space, then the part in front of the eye plane (w > 0): what the
-    // GPU's clipping keeps with the depth clip planes out of the way.
+    // Clip space, then (perspective) the part beyond the near plane: a pixel
+    // a light reaches has its geometry beyond the near plane, and the ray to
+    // it leaves the (closed) proxy beyond that geometry, so the proxy's
+    // surface beyond the near plane covers the pixel whatever lies nearer.
+    // (The Vulkan pass clips there too, as its depth clip plane.)
     std::array<glm::dvec4, 4> clip;
     std::array<glm::dvec4, 3> in;
     for (int i = 0; i < 3; ++i) in[std::size_t(i)] = m * glm::dvec4(tri[std::size_t(i)], 1.0);
-    constexpr double kEyeW = 1e-12;
+    const double kEyeW = proj.orthographic() ? -1.0 : proj.nearPlane();
     std::size_t n = 0;
     for (std::size_t i = 0; i < 3; ++i) {
         const glm::dvec4& a = in[i];
         const glm::dvec4& b = in[(i + 1) % 3];
-        const bool aIn = a.w > kEyeW, bIn = b.w > kEyeW;
+        const bool aIn = a.w >= kEyeW, bIn = b.w >= kEyeW;
         if (aIn) clip[n++] = a;
         if (aIn != bIn) clip[n++] = a + (b - a) * ((kEyeW - a.w) / (b.w - a.w));
     }

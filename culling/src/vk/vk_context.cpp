@@ -325,6 +325,29 @@ Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
         int64_ = f10.shaderInt64 == VK_TRUE;
         VkPhysicalDeviceFeatures enable10{};
         enable10.shaderInt64 = int64_ ? VK_TRUE : VK_FALSE;
+        fragmentStores_ = f10.fragmentStoresAndAtomics == VK_TRUE;
+        enable10.fragmentStoresAndAtomics = fragmentStores_ ? VK_TRUE : VK_FALSE;
+        // VK_EXT_conservative_rasterization where the device has it.
+        std::vector<const char*> deviceExtensions;
+        {
+            std::uint32_t count = 0;
+            vkEnumerateDeviceExtensionProperties(physical_, nullptr, &count, nullptr);
+            std::vector<VkExtensionProperties> exts(count);
+            vkEnumerateDeviceExtensionProperties(physical_, nullptr, &count, exts.data());
+            for (const auto& e : exts)
+                if (std::string(e.extensionName) == VK_EXT_CONSERVATIVE_RASTERIZATION_EXTENSION_NAME) conservative_ = true;
+            if (std::getenv("LIGHTCULL_VK_NO_CONSERVATIVE")) conservative_ = false;
+            if (conservative_) {
+                VkPhysicalDeviceConservativeRasterizationPropertiesEXT cp{
+                    VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_CONSERVATIVE_RASTERIZATION_PROPERTIES_EXT};
+                VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+                p2.pNext = &cp;
+                vkGetPhysicalDeviceProperties2(physical_, &p2);
+                overestimation_ = cp.primitiveOverestimationSize;
+                maxExtraOverestimation_ = cp.maxExtraPrimitiveOverestimationSize;
+                deviceExtensions.push_back(VK_EXT_CONSERVATIVE_RASTERIZATION_EXTENSION_NAME);
+            }
+        }
         if (opt.robustAccess) {
             if (!f10.robustBufferAccess)
                 throw DeviceError(std::string("Vulkan device '") + props_.deviceName + "' lacks robustBufferAccess");
@@ -340,6 +363,8 @@ Context::Context(const ContextOptions& opt) : purpose_(opt.purpose) {
         dci.queueCreateInfoCount = 1;
         dci.pQueueCreateInfos = &qci;
         dci.pEnabledFeatures = &enable10;
+        dci.enabledExtensionCount = std::uint32_t(deviceExtensions.size());
+        dci.ppEnabledExtensionNames = deviceExtensions.data();
         dci.pNext = &enable16;
         if (v13) enable16.pNext = &enable13;
         LC_VK(vkCreateDevice(physical_, &dci, nullptr, &device_));
@@ -618,13 +643,13 @@ ShaderModuleHandle Context::createShader(const std::uint32_t* words, std::size_t
 }
 
 Context::PassLayouts Context::createPassLayouts(const std::vector<VkDescriptorType>& types, const std::string& n,
-                                                std::uint32_t pushConstantBytes) const {
+                                                std::uint32_t pushConstantBytes, VkShaderStageFlags stages) const {
     std::vector<VkDescriptorSetLayoutBinding> b(types.size());
     for (std::uint32_t i = 0; i < types.size(); ++i) {
         b[i].binding = i;
         b[i].descriptorType = types[i];
         b[i].descriptorCount = 1;
-        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+        b[i].stageFlags = stages;
     }
     VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
     lci.bindingCount = std::uint32_t(b.size());
@@ -634,7 +659,7 @@ Context::PassLayouts Context::createPassLayouts(const std::vector<VkDescriptorTy
     PassLayouts out;
     out.set = DescriptorSetLayoutHandle(device_, sl);
     name(VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, sl, n + ".setLayout");
-    const VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantBytes};
+    const VkPushConstantRange push{stages, 0, pushConstantBytes};
     VkPipelineLayoutCreateInfo pci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
     pci.setLayoutCount = 1;
     pci.pSetLayouts = &sl;

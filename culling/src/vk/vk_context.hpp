@@ -181,6 +181,14 @@ public:
     // storageBuffer16BitAccess (Vulkan 1.1), enabled when the device has it:
     // the GPU culling pass writes 16-bit light indices where they fit.
     bool index16Supported() const { return index16_; }
+    // fragmentStoresAndAtomics, enabled when the device has it: the raster
+    // pass's fragment shader sets its light bits with atomics.
+    bool fragmentStoresSupported() const { return fragmentStores_; }
+    // VK_EXT_conservative_rasterization, enabled when the device has it, and
+    // its properties (the raster pass's overestimating coverage).
+    bool conservativeRasterSupported() const { return conservative_; }
+    float primitiveOverestimationSize() const { return overestimation_; }
+    float maxExtraPrimitiveOverestimationSize() const { return maxExtraOverestimation_; }
     // A CPU implementation (lavapipe): device memory is host memory, so
     // buffers stay host-visible and mapped, and compute timestamps are not
     // trusted (DESIGN.md). Elsewhere: device-local buffers, GPU timestamps.
@@ -241,7 +249,8 @@ public:
         PipelineLayoutHandle pipeline;
     };
     PassLayouts createPassLayouts(const std::vector<VkDescriptorType>& types, const std::string& name,
-                                  std::uint32_t pushConstantBytes = 0) const;
+                                  std::uint32_t pushConstantBytes = 0,
+                                  VkShaderStageFlags stages = VK_SHADER_STAGE_COMPUTE_BIT) const;
     // One binding of a descriptor set: a buffer's first `range` bytes, or
     // (image types) a sampled image.
     struct DescriptorWrite {
@@ -285,6 +294,9 @@ private:
     bool int64_ = false;
     bool shuffle_ = false;
     bool index16_ = false;
+    bool fragmentStores_ = false;
+    bool conservative_ = false;
+    float overestimation_ = 0, maxExtraOverestimation_ = 0;
     bool timestamps_ = false;
     bool emulateGpu_ = false;
     std::uint32_t timestampValidBits_ = 0;

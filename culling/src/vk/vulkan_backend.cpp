@@ -48,7 +48,9 @@
 #include "embedded_spirv.hpp"
 #include "vk/cull_plan.hpp"
 #include "vk/vk_context.hpp"
+#include "vk/raster_pass.hpp"
 #include "vk/shade_pass.hpp"
+#include "culling/math/light_proxy.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -79,6 +81,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // distance a scene cares about; the absolute term covers values near zero.
 constexpr float kRelEps = 2e-5f;
 constexpr float kAbsEps = 1e-6f;
+constexpr float kInfF = std::numeric_limits<float>::infinity();
 
 constexpr std::uint32_t kBindings = 11; // cull_common.glsl bindings 0..10
 // The largest region of one staged download copy (Staging::recordDownloads).
@@ -303,6 +306,10 @@ private:
                                const CullRun& run);
     void writeListsAgain(const CullPlan& plan, const CullPipelines& pipes, CullRun& run, const Counted& c,
                          CullResult& res);
+    // raster: minmax's tile bounds pass, then the light proxies drawn
+    // (vk/raster_pass.cpp) into per-tile light masks, decoded into lists.
+    CullResult cullRaster(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
+                          const ViewLights& lights, const CullSettings& settings);
     VkPipeline depthPipeline(bool reversed);
     VkRenderPass depthRenderPass(bool reversed);
     // The depth pre-pass's draws: one per mesh, into one vertex and one index buffer.
@@ -335,6 +342,7 @@ private:
     RenderPassHandle renderPass_[2];
     PipelineHandle depthPipeline_[2];
     std::unique_ptr<ShadePass> shadePass_;
+    std::unique_ptr<RasterPass> rasterPass_; // created on the first raster cull
     // The last rendered depth image, kept on the device for the cull that
     // follows (DepthImage::deviceCopy): its id, buffer and a sample of its
     // pixels that a cull compares before trusting the id.
@@ -1258,6 +1266,7 @@ VulkanBackend::CullReadback VulkanBackend::setUpBuffers(const CullPlan& plan, co
 CullResult VulkanBackend::cullFrame(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
                                     const ViewLights& lights, const CullSettings& settings) {
     const Algorithm algo = settings.algorithm;
+    if (algo == Algorithm::Raster) return cullRaster(frame, depth, proj, lights, settings);
     // Spot lights: the sphere tests need only the chosen sphere; the cone
     // tests (and fptl's fine prune, whatever the spot test) also upload each
     // spot's cone (binding 9).
@@ -1356,6 +1365,228 @@ CullResult VulkanBackend::cullFrame(const CullFrame& frame, const DepthImage& de
     return res;
 }
 
+
+// ---------------------------------------------------------------------------
+// raster: one submission: the tile bounds pass as minmax plans it, then the
+// render pass drawing every light's proxy (spheres, then cones: two instanced
+// draws of the unit meshes), whose fragments OR each covered tile's light
+// bit; the host turns the masks into lists.
+
+namespace {
+
+// View -> clip of the raster pass: the projection's clip matrix, then x and y
+// scaled so that a viewport of tilesX x tilesY pixels has one pixel per tile
+// (the screen's width / tile of them across: a partial edge tile is a whole
+// pixel), and z = w - nearW (perspective; orthographic: w / 2) so that only
+// the plane w = nearW clips (no far plane).
+glm::mat4 rasterClip(const Projection& proj, const TileGrid& grid, double nearW) {
+    const double sx = double(grid.width) / grid.tileSize / grid.tilesX;
+    const double sy = double(grid.height) / grid.tileSize / grid.tilesY;
+    glm::dmat4 s(1.0); // column-major: s[col][row]
+    s[0][0] = sx;
+    s[3][0] = sx - 1.0;
+    s[1][1] = sy;
+    s[3][1] = sy - 1.0;
+    glm::dmat4 m = s * proj.clipFromView();
+    for (int col = 0; col < 4; ++col) m[col][2] = proj.orthographic() ? 0.5 * m[col][3] : m[col][3];
+    if (!proj.orthographic()) m[3][2] -= nearW;
+    return glm::mat4(m);
+}
+
+} // namespace
+
+CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& depth, const Projection& proj,
+                                     const ViewLights& lights, const CullSettings& settings) {
+    if (!rasterPass_) rasterPass_ = std::make_unique<RasterPass>(ctx_);
+    const TileGrid& grid = frame.grid;
+    const std::uint32_t n = std::uint32_t(lights.size());
+    const std::uint32_t tiles = grid.tileCount();
+    const std::uint32_t words = (n + 31) / 32;
+    const std::size_t maskBytes = std::size_t(tiles) * words * 4;
+    if (maskBytes > profile_.maxStorageBufferRange)
+        throw SettingsError("algorithm", "raster needs a light bit per tile: " + std::to_string(tiles) + " tiles x " +
+                                             std::to_string(n) + " lights is " + std::to_string(maskBytes >> 20) +
+                                             " MiB of masks, more than '" + ctx_.deviceName() +
+                                             "' binds at once; use larger tiles or fewer lights");
+    CullSettings boundsSettings = settings;
+    boundsSettings.algorithm = Algorithm::MinMax;
+    CullPlanInputs planIn;
+    planIn.settings = boundsSettings;
+    planIn.grid = grid;
+    planIn.listTotal = frame.listTotal;
+    planIn.lights = n;
+    planIn.depthPixels = depth.depth.size();
+    planIn.orthographic = proj.orthographic();
+    const CullPlan plan = planCull(profile_, history_, planIn);
+
+    CullResult res;
+    res.algorithm = Algorithm::Raster;
+    res.settings = settings;
+    res.grid = grid;
+    res.listsPerTile = frame.listsPerTile;
+    std::vector<std::uint32_t> upOrder(n);
+    for (std::uint32_t l = 0; l < n; ++l) upOrder[l] = l;
+    const CullInputs in = prepareInputs(plan, frame, res, depth, proj, lights, boundsSettings, upOrder, false);
+
+    // The proxies: spheres, cones, then boxes. A proxy too large for float
+    // where it comes nearest the camera (its corners' rounding, carried to
+    // the grid, would pass 1/512 tile: a light around the camera, or one of
+    // a radius past float's range) is drawn as the box of the tiles the CPU
+    // reference's coverage of it spans, worked out here in double.
+    const glm::dmat4 clipD = proj.clipFromView();
+    const double tilesPerUnit = std::max(std::abs(clipD[0][0]) * grid.width / grid.tileSize,
+                                         std::abs(clipD[1][1]) * grid.height / grid.tileSize) * 0.5;
+    std::vector<LightProxy> proxy(n);
+    std::vector<char> boxed(n, 0);
+    std::uint32_t spheres = 0, cones = 0, boxes = 0;
+    for (std::uint32_t l = 0; l < n; ++l) {
+        const bool spot = lights.isSpot(l);
+        proxy[l] = makeLightProxy(lights.centers[l], lights.radii[l], spot ? lights.spotAxes[l] : glm::dvec3(0, 0, -1),
+                                  spot ? lights.spotAngles[l] : 0.0, settings);
+        const LightProxy& p = proxy[l];
+        const double reach = glm::length(p.origin) + lights.radii[l] * p.overfit * (p.cone ? std::max(1.0, glm::length(p.basis[0]) / lights.radii[l]) : 1.0);
+        const double perUnit = proj.orthographic() ? tilesPerUnit : tilesPerUnit / std::max(p.depthMin, proj.nearPlane());
+        const double errTiles = 5e-7 * reach * perUnit;
+        boxed[l] = !(errTiles < 1.0 / 512.0);
+        (boxed[l] ? boxes : p.cone ? cones : spheres)++;
+    }
+    std::vector<GpuProxy> proxies(n);
+    std::uint32_t nextSphere = 0, nextCone = spheres, nextBox = spheres + cones;
+    for (std::uint32_t l = 0; l < n; ++l) {
+        const LightProxy& p = proxy[l];
+        // The depth range widened past the CPU reference's slack and the
+        // bounds pass's float rounding, rounded outwards.
+        const double slack = 2.0 * sphereTestSlack(p.origin, lights.radii[l] * p.overfit) +
+                             double(kRelEps) * (std::abs(p.depthMax) + lights.radii[l] * p.overfit) + kAbsEps;
+        GpuProxy& g = proxies[boxed[l] ? nextBox++ : p.cone ? nextCone++ : nextSphere++];
+        g.basisXDepthMin = vec4(glm::vec3(p.basis[0]), std::nextafter(float(p.depthMin - slack), -kInfF));
+        g.basisYDepthMax = vec4(glm::vec3(p.basis[1]), std::nextafter(float(p.depthMax + slack), kInfF));
+        g.basisZ = vec4(glm::vec3(p.basis[2]), 0.0f);
+        g.light = uvec4(l, 0, 0, 0);
+        g.origin = vec4(glm::vec3(p.origin), 0.0f);
+        if (boxed[l]) {
+            // The tiles' centres the box keeps, in tile units (none: an empty box).
+            std::uint32_t x0 = ~0u, y0 = ~0u, x1 = 0, y1 = 0;
+            for (const auto& tri : p.mesh->triangles)
+                proxyTriangleTiles(proj, grid, {p.vertex(tri[0]), p.vertex(tri[1]), p.vertex(tri[2])},
+                                   settings.conservative, [&](std::uint32_t tx, std::uint32_t ty) {
+                                       x0 = std::min(x0, tx), x1 = std::max(x1, tx);
+                                       y0 = std::min(y0, ty), y1 = std::max(y1, ty);
+                                   });
+            g.origin = x0 > x1 ? vec4(1.0f, 1.0f, 0.0f, 0.0f)
+                               : vec4(float(x0) + 0.25f, float(y0) + 0.25f, float(x1) + 0.75f, float(y1) + 0.75f);
+            g.light.y = 1;
+        }
+    }
+    const ProxyMesh& sphereMesh = unitIcosphere(settings.proxyLevel);
+    const ProxyMesh& coneMesh = unitCone(settings.proxySegments);
+    std::vector<vec4> corners;
+    corners.reserve(3 * (sphereMesh.triangles.size() + coneMesh.triangles.size()));
+    for (const ProxyMesh* m : {&sphereMesh, &coneMesh})
+        for (const auto& t : m->triangles)
+            for (std::uint32_t k : t) corners.push_back(vec4(glm::vec3(m->vertices[k]), 1.0f));
+    const std::uint32_t sphereCorners = std::uint32_t(3 * sphereMesh.triangles.size());
+    const std::uint32_t coneCorners = std::uint32_t(3 * coneMesh.triangles.size());
+    const std::vector<RasterPass::Draw> draws = {{0, sphereCorners, 0, spheres},
+                                                 {sphereCorners, coneCorners, spheres, cones},
+                                                 {0, 3, spheres + cones, boxes}};
+
+    const RasterPass::Coverage coverage = rasterPass_->coverage(settings.conservative);
+    GpuRasterParams rp{};
+    // Clipped a hair before the near plane, where the CPU reference clips:
+    // the float pass keeps a little more, never less.
+    const double nearW = proj.orthographic() ? -1.0 : proj.nearPlane() * (1.0 - 1e-5);
+    const glm::mat4 clip = rasterClip(proj, grid, nearW);
+    for (int c = 0; c < 4; ++c) rp.clip[c] = clip[c];
+    rp.grid = uvec4(grid.tilesX, grid.tilesY, words, coverage == RasterPass::Coverage::PushedEdges ? LC_RASTER_PUSH_EDGES : 0u);
+    rp.cover = vec4(float(double(grid.width) / grid.tileSize), float(double(grid.height) / grid.tileSize),
+                    float(nearW), 0.5f + 1.0f / 256.0f);
+
+    BufferCache::Frame cacheFrame(cache_);
+    CullRun run;
+    Staging staging(cache_);
+    const CullReadback out = setUpBuffers(plan, in, depth, staging, run);
+    const CullPipelines pipes = cullPipelines(plan);
+    auto storage = [&](const char* role, std::size_t bytes, VkBufferUsageFlags extra = 0) -> const Buffer& {
+        const Buffer& b = cache_.get(role, std::max<std::size_t>(bytes, 16),
+                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | extra, BufferCache::Kind::Device);
+        run.asked[b.buffer] = std::max<std::size_t>(bytes, 16);
+        return b;
+    };
+    const Buffer& params = storage("raster.params", sizeof rp);
+    const Buffer& proxyBuf = storage("raster.proxies", proxies.size() * sizeof(GpuProxy));
+    const Buffer& meshBuf = storage("raster.mesh", corners.size() * sizeof(vec4));
+    const Buffer& masks = storage("raster.masks", maskBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    staging.upload(params, &rp, sizeof rp, "raster.params");
+    staging.upload(proxyBuf, proxies.data(), proxies.size() * sizeof(GpuProxy), "raster.proxies");
+    staging.upload(meshBuf, corners.data(), corners.size() * sizeof(vec4), "raster.mesh");
+    const auto* maskWords = static_cast<const std::uint32_t*>(staging.download(masks, maskBytes, "raster.masks"));
+    const Buffer* bound[RasterPass::kBindings] = {&params, run.tiles, &proxyBuf, &meshBuf, &masks};
+    std::vector<Context::DescriptorWrite> bindings(RasterPass::kBindings);
+    for (std::uint32_t i = 0; i < RasterPass::kBindings; ++i) {
+        bindings[i].buffer = bound[i]->buffer;
+        bindings[i].range = run.asked.at(bound[i]->buffer);
+    }
+    DescriptorPoolHandle pool = ctx_.createDescriptorPool(bindings, 1, "raster.descriptorPool");
+    const VkDescriptorSet set = ctx_.writeDescriptorSet(pool, rasterPass_->setLayout(), bindings, "raster.set");
+
+    TimestampPool stamps = profile_.gpuTimestamps() ? TimestampPool(ctx_, 1, "raster.timestamps") : TimestampPool();
+    const double wallMs = ctx_.submitAndWait(
+        [&](VkCommandBuffer cmd) {
+            if (stamps) stamps.reset(cmd);
+            vkCmdFillBuffer(cmd, masks.buffer, 0, maskBytes, 0);
+            staging.recordUploads(cmd,
+                                  VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+                                      VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+                                  VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT, true);
+            if (run.residentDepth)
+                memoryBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+            if (stamps) stamps.begin(cmd, 0);
+            {
+                LabelScope label(ctx_, cmd, "tile bounds");
+                vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, computeLayout_, 0, 1, &run.countSet, 0,
+                                        nullptr);
+                vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipes.bounds);
+                vkCmdDispatch(cmd, plan.boundsGroups.x, plan.boundsGroups.y, 1);
+            }
+            // The fragment shader reads the bounds the pass above wrote.
+            memoryBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                          VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+            {
+                LabelScope label(ctx_, cmd, "light proxies");
+                rasterPass_->record(cmd, coverage, set, grid.tilesX, grid.tilesY, draws);
+            }
+            if (stamps) stamps.end(cmd, 0);
+            // The read-back (a copy, or the host in place) reads the masks.
+            memoryBarrier(cmd, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
+                          VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_HOST_READ_BIT);
+            staging.recordDownloads(cmd);
+        },
+        "raster.commands");
+    checkStatus(out.status, ctx_.deviceName());
+
+    // Masks -> lists, in light order.
+    res.listOffset.resize(tiles);
+    res.listCount.resize(tiles);
+    for (std::uint32_t t = 0; t < tiles; ++t) {
+        res.listOffset[t] = std::uint32_t(res.lightIndices.size());
+        const std::uint32_t* m = maskWords + std::size_t(t) * words;
+        for (std::uint32_t w = 0; w < words; ++w)
+            for (std::uint32_t bits = m[w]; bits; bits &= bits - 1)
+                res.lightIndices.push_back(w * 32 + std::uint32_t(std::countr_zero(bits)));
+        res.listCount[t] = std::uint32_t(res.lightIndices.size()) - res.listOffset[t];
+    }
+    decodeTileBounds(plan, out.tb, res);
+    res.coverage = rasterPass_->describe(coverage);
+    res.backend = name();
+    res.device = deviceName();
+    res.timingMethod = timingMethod();
+    res.timings.cullMs = stamps ? stamps.milliseconds(0) : wallMs;
+    lastCullWallMs_ = wallMs;
+    return res;
+}
 } // namespace
 
 std::unique_ptr<CullBackend> makeVulkanBackend(const std::string& device) {

@@ -60,8 +60,9 @@ LightProxy makeLightProxy(const glm::dvec3& center, double radius, const glm::dv
                           const CullSettings& settings);
 
 // The tiles one triangle (view space) covers, rasterised at one pixel per
-// tile through the projection's clip matrix, the part behind the eye plane
-// clipped away. Conservative: every tile its triangle overlaps (touching
+// tile through the projection's clip matrix, the part nearer than the near
+// plane clipped away (perspective: the rest covers every pixel a light
+// reaches; docs/ALGORITHMS.md). Conservative: every tile its triangle overlaps (touching
 // counts); else the tiles whose centre it covers (edges included). A
 // triangle seen edge-on (no area on screen) covers nothing: its neighbours
 // in a closed mesh cover its edges. Calls `covered(tx, ty)` once per tile,

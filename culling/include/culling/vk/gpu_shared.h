@@ -46,6 +46,7 @@ const uint LC_ALG_25D = 4u;
 const uint LC_ALG_CLUSTERED = 5u;
 const uint LC_ALG_FPTL = 6u;
 const uint LC_ALG_ZBIN = 7u;
+const uint LC_ALG_RASTER = 8u;
 const uint LC_TEST_PLANES = 0u;
 const uint LC_TEST_PLANES_AABB = 1u;
 const uint LC_TEST_EXACT = 2u;
@@ -154,8 +155,31 @@ struct GpuTileBounds {
     uint cellMask;    // 2.5d: occupied cells; clustered: occupied slices
 };
 
+// The raster pass (shaders/proxy_raster.vert/.frag, vk/raster_pass.cpp):
+// each light's proxy mesh drawn at one pixel per tile.
+struct GpuRasterParams {
+    // View -> clip, then scaled so that the viewport of tilesX x tilesY
+    // pixels covers the grid one pixel per tile, z = w / 2 (no depth clip).
+    vec4 clip[4];          // columns
+    uvec4 grid;            // x: tilesX, y: tilesY, z: mask words per tile, w: LC_RASTER_* flags
+    vec4 cover;            // x: tilesX' (width / tile), y: tilesY', z: w below which a triangle covers the screen, w: push
+};
+const uint LC_RASTER_PUSH_EDGES = 1u; // conservative by pushing the edges out in the vertex shader
+
+// One proxy, an instance: its unit mesh placed by origin + basis * v, the
+// light it stands for and the view-depth range the tile test uses.
+struct GpuProxy {
+    vec4 origin;           // xyz: origin (view space)
+    vec4 basisXDepthMin;   // xyz: basis column x, w: depth range low
+    vec4 basisYDepthMax;   // xyz: basis column y, w: depth range high
+    vec4 basisZ;           // xyz: basis column z
+    uvec4 light;           // x: the light's index
+};
+
 #ifdef __cplusplus
 static_assert(sizeof(GpuCullParams) == 112, "GpuCullParams must match std430");
+static_assert(sizeof(GpuRasterParams) == 96, "GpuRasterParams must match std430");
+static_assert(sizeof(GpuProxy) == 80, "GpuProxy must match std430");
 static_assert(offsetof(GpuCullParams, counts) == 16, "GpuCullParams.counts offset");
 static_assert(offsetof(GpuCullParams, depth) == 32, "GpuCullParams.depth offset");
 static_assert(offsetof(GpuCullParams, lens) == 48, "GpuCullParams.lens offset");

@@ -1,0 +1,151 @@
+// The raster algorithm's graphics pipeline (raster_pass.hpp).
+#include "vk/raster_pass.hpp"
+
+#include "culling/core/errors.hpp"
+#include "embedded_spirv.hpp"
+
+#include <array>
+#include <cstdio>
+
+// Vulkan create-info structs are value-initialised as {VK_STRUCTURE_TYPE_...}:
+// the remaining members are zero on purpose.
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+
+namespace lc::vk {
+
+RasterPass::RasterPass(Context& ctx) : ctx_(ctx) {
+    if (!ctx_.fragmentStoresSupported())
+        throw DeviceError("Vulkan device '" + ctx_.deviceName() +
+                          "' lacks fragmentStoresAndAtomics, which the raster algorithm's fragment shader needs");
+    layouts_ = ctx_.createPassLayouts(std::vector<VkDescriptorType>(kBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
+                                      "raster", 0, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT);
+    const spirv::Code v = spirv::proxyRasterVert(), f = spirv::proxyRasterFrag();
+    vert_ = ctx_.createShader(v.words, v.wordCount, "shader.proxy_raster_vert");
+    frag_ = ctx_.createShader(f.words, f.wordCount, "shader.proxy_raster_frag");
+
+    // No attachments: the fragment shader's atomics are the output. The
+    // barriers around the pass are the backend's (outside the instance).
+    VkSubpassDescription sub{};
+    sub.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+    VkRenderPassCreateInfo ci{VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
+    ci.subpassCount = 1;
+    ci.pSubpasses = &sub;
+    VkRenderPass rp;
+    LC_VK(vkCreateRenderPass(ctx_.device(), &ci, nullptr, &rp));
+    ctx_.name(VK_OBJECT_TYPE_RENDER_PASS, rp, "raster.renderPass");
+    renderPass_ = RenderPassHandle(ctx_.device(), rp);
+}
+
+RasterPass::Coverage RasterPass::coverage(bool conservative) const {
+    if (!conservative) return Coverage::Centre;
+    return ctx_.conservativeRasterSupported() ? Coverage::Hardware : Coverage::PushedEdges;
+}
+
+std::string RasterPass::describe(Coverage c) const {
+    switch (c) {
+    case Coverage::Centre: return "every tile whose centre a proxy triangle covers (the device's rasteriser)";
+    case Coverage::Hardware: {
+        char extra[64];
+        std::snprintf(extra, sizeof extra, "%.4g", double(ctx_.primitiveOverestimationSize()));
+        return std::string("VK_EXT_conservative_rasterization, overestimating (the device's own ") + extra +
+               " pixel, plus 1/64)";
+    }
+    case Coverage::PushedEdges:
+        return "edges pushed out by half a tile's diagonal in the vertex shader ('" + ctx_.deviceName() +
+               "' has no VK_EXT_conservative_rasterization)";
+    }
+    return {};
+}
+
+VkPipeline RasterPass::pipeline(Coverage c) {
+    auto it = pipelines_.find(c);
+    if (it != pipelines_.end()) return it->second;
+    std::array<VkPipelineShaderStageCreateInfo, 2> stages{};
+    stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+    stages[0].module = vert_;
+    stages[0].pName = "main";
+    stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+    stages[1].module = frag_;
+    stages[1].pName = "main";
+    VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    VkPipelineInputAssemblyStateCreateInfo ia{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+    VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    vp.viewportCount = 1;
+    vp.scissorCount = 1;
+    VkPipelineRasterizationStateCreateInfo rs{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    rs.polygonMode = VK_POLYGON_MODE_FILL;
+    rs.cullMode = VK_CULL_MODE_NONE; // both faces: a proxy around the camera shows only its inside
+    rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    rs.lineWidth = 1.0f;
+    VkPipelineRasterizationConservativeStateCreateInfoEXT cons{
+        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_CONSERVATIVE_STATE_CREATE_INFO_EXT};
+    if (c == Coverage::Hardware) {
+        cons.conservativeRasterizationMode = VK_CONSERVATIVE_RASTERIZATION_MODE_OVERESTIMATE_EXT;
+        // A little more than the device's own, for the vertices' float rounding.
+        cons.extraPrimitiveOverestimationSize = std::min(1.0f / 64.0f, ctx_.maxExtraPrimitiveOverestimationSize());
+        rs.pNext = &cons;
+    }
+    VkPipelineMultisampleStateCreateInfo ms{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+    std::array<VkDynamicState, 2> dyn{VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dsi{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    dsi.dynamicStateCount = std::uint32_t(dyn.size());
+    dsi.pDynamicStates = dyn.data();
+    VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+    ci.stageCount = std::uint32_t(stages.size());
+    ci.pStages = stages.data();
+    ci.pVertexInputState = &vi;
+    ci.pInputAssemblyState = &ia;
+    ci.pViewportState = &vp;
+    ci.pRasterizationState = &rs;
+    ci.pMultisampleState = &ms;
+    ci.pDynamicState = &dsi;
+    ci.layout = layouts_.pipeline;
+    ci.renderPass = renderPass_;
+    VkPipeline p;
+    LC_VK(vkCreateGraphicsPipelines(ctx_.device(), VK_NULL_HANDLE, 1, &ci, nullptr, &p));
+    const char* names[] = {"raster.pipeline.centre", "raster.pipeline.hardware", "raster.pipeline.pushedEdges"};
+    ctx_.name(VK_OBJECT_TYPE_PIPELINE, p, names[int(c)]);
+    return pipelines_.emplace(c, PipelineHandle(ctx_.device(), p)).first->second;
+}
+
+VkFramebuffer RasterPass::framebuffer(std::uint32_t w, std::uint32_t h) {
+    if (framebuffer_ && fbSize_ == std::make_pair(w, h)) return framebuffer_;
+    framebuffer_ = FramebufferHandle();
+    VkFramebufferCreateInfo fci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+    fci.renderPass = renderPass_;
+    fci.width = w;
+    fci.height = h;
+    fci.layers = 1;
+    VkFramebuffer fb;
+    LC_VK(vkCreateFramebuffer(ctx_.device(), &fci, nullptr, &fb));
+    ctx_.name(VK_OBJECT_TYPE_FRAMEBUFFER, fb, "raster.framebuffer");
+    framebuffer_ = FramebufferHandle(ctx_.device(), fb);
+    fbSize_ = {w, h};
+    return framebuffer_;
+}
+
+void RasterPass::record(VkCommandBuffer cmd, Coverage c, VkDescriptorSet set, std::uint32_t tilesX,
+                        std::uint32_t tilesY, const std::vector<Draw>& draws) {
+    VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+    rbi.renderPass = renderPass_;
+    rbi.framebuffer = framebuffer(tilesX, tilesY);
+    rbi.renderArea = {{0, 0}, {tilesX, tilesY}};
+    const VkPipeline pipe = pipeline(c);
+    vkCmdBeginRenderPass(cmd, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layouts_.pipeline, 0, 1, &set, 0, nullptr);
+    const VkViewport viewport{0.0f, 0.0f, float(tilesX), float(tilesY), 0.0f, 1.0f};
+    const VkRect2D scissor{{0, 0}, {tilesX, tilesY}};
+    vkCmdSetViewport(cmd, 0, 1, &viewport);
+    vkCmdSetScissor(cmd, 0, 1, &scissor);
+    for (const Draw& d : draws)
+        if (d.vertexCount && d.instanceCount)
+            vkCmdDraw(cmd, d.vertexCount, d.instanceCount, d.firstVertex, d.firstInstance);
+    vkCmdEndRenderPass(cmd);
+}
+
+} // namespace lc::vk

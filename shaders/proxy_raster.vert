@@ -1,0 +1,124 @@
+#version 450
+// The raster algorithm's vertex shader (vk/raster_pass.cpp): each instance is
+// one light's proxy, its unit mesh pulled from a storage buffer three corners
+// per triangle (non-indexed), placed in view space and projected onto the
+// grid one pixel per tile.
+//
+// Conservative coverage without VK_EXT_conservative_rasterization
+// (LC_RASTER_PUSH_EDGES): every corner sees its whole triangle and moves to
+// where the triangle's edges, each pushed out by half a tile's diagonal
+// measured along its normal (0.5 (|nx| + |ny|) tiles, plus 1/256 for float
+// rounding), meet. A tile the triangle overlaps then has its centre inside
+// the pushed triangle, so the ordinary rasteriser covers it. A triangle of
+// less than 1/64 tile of area (a sliver, or far away), or one the near plane
+// cuts (w below params.cover.z; its part in front is up to four corners), is
+// drawn as a triangle around the bounding box of what is in front, grown by
+// the same amount: a superset of what it overlaps. A proxy too large for
+// float near the camera comes as a box of tiles the host worked out in double
+// (GpuProxy.light.y = 1): one triangle around it. The fragment shader then
+// keeps a tile only when its centre lies in the bounding box grown by the
+// push and passes the three pushed edges: the separating-axis test of the
+// tile's square against the triangle, as the CPU reference makes it (what
+// the pushed corners of a sharp triangle, or a box's triangle, reach beyond
+// is dropped).
+#extension GL_GOOGLE_include_directive : require
+#include "culling/vk/gpu_shared.h"
+
+layout(std430, set = 0, binding = 0) readonly buffer Params { GpuRasterParams params; };
+layout(std430, set = 0, binding = 2) readonly buffer Proxies { GpuProxy proxies[]; };
+layout(std430, set = 0, binding = 3) readonly buffer Mesh { vec4 corners[]; };
+
+layout(location = 0) flat out uint outLight;
+layout(location = 1) flat out vec2 outDepth;
+// The tiles (their centres, in tile units) a fragment may mark: the
+// triangle's bounding box grown by the push, which trims what the pushed
+// triangle or the box's triangle reaches beyond it.
+layout(location = 2) flat out vec4 outBox;
+// And the triangle's three edges pushed out (n.p + d >= 0 inside): a tile is
+// kept when its centre passes all three, the separating-axis test of the
+// tile's square against the triangle, as the CPU reference decides it.
+layout(location = 3) flat out vec3 outEdge0;
+layout(location = 4) flat out vec3 outEdge1;
+layout(location = 5) flat out vec3 outEdge2;
+
+vec4 clipOf(vec3 v) {
+    return mat4(params.clip[0], params.clip[1], params.clip[2], params.clip[3]) * vec4(v, 1.0);
+}
+
+void main() {
+    const GpuProxy p = proxies[gl_InstanceIndex];
+    outLight = p.light.x;
+    outDepth = vec2(p.basisXDepthMin.w, p.basisYDepthMax.w);
+    const mat3 basis = mat3(p.basisXDepthMin.xyz, p.basisYDepthMax.xyz, p.basisZ.xyz);
+    const uint corner = uint(gl_VertexIndex) % 3u;
+    const uint first = uint(gl_VertexIndex) - corner;
+    outBox = vec4(-1e30, -1e30, 1e30, 1e30);
+    outEdge0 = outEdge1 = outEdge2 = vec3(0.0, 0.0, 1.0);
+    if (p.light.y != 0u) {
+        // A box the host worked out (origin: the tile centres it keeps, in
+        // tile units): one triangle around it, trimmed to it.
+        outBox = p.origin;
+        const vec2 lo = p.origin.xy, size = max(p.origin.zw - p.origin.xy, vec2(0.0));
+        const vec2 box[3] = vec2[3](lo, lo + vec2(2.0 * size.x, 0.0), lo + vec2(0.0, 2.0 * size.y));
+        gl_Position = vec4(box[corner] / vec2(params.grid.xy) * 2.0 - 1.0, 0.5, 1.0);
+        return;
+    }
+    if ((params.grid.w & LC_RASTER_PUSH_EDGES) == 0u) {
+        gl_Position = clipOf(p.origin.xyz + basis * corners[gl_VertexIndex].xyz);
+        return;
+    }
+    vec4 c[3];
+    for (uint k = 0u; k < 3u; ++k) c[k] = clipOf(p.origin.xyz + basis * corners[first + k].xyz);
+    const vec2 tiles = vec2(params.grid.xy);
+    const float h = params.cover.w, nearW = params.cover.z;
+    // The triangle's part in front of the near plane (w >= nearW), on the grid.
+    vec2 q[4];
+    uint m = 0u;
+    bool clipped = false;
+    for (uint k = 0u; k < 3u; ++k) {
+        const vec4 a = c[k], b = c[(k + 1u) % 3u];
+        if (a.w >= nearW) q[m++] = (a.xy / a.w * 0.5 + 0.5) * tiles;
+        else clipped = true;
+        if ((a.w >= nearW) != (b.w >= nearW)) {
+            const vec4 x = mix(a, b, (nearW - a.w) / (b.w - a.w));
+            q[m++] = (x.xy / x.w * 0.5 + 0.5) * tiles;
+        }
+    }
+    if (m < 3u) { // all behind the near plane: nothing
+        gl_Position = vec4(0.0, 0.0, 0.5, 0.0);
+        return;
+    }
+    vec2 lo = q[0], hi = q[0];
+    for (uint k = 1u; k < m; ++k) lo = min(lo, q[k]), hi = max(hi, q[k]);
+    outBox = vec4(lo - h, hi + h);
+    const float area = (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[2].x - q[0].x) * (q[1].y - q[0].y);
+    vec2 at;
+    if (clipped || abs(area) < 1.0 / 64.0) {
+        const vec2 size = outBox.zw - outBox.xy;
+        const vec2 box[3] = vec2[3](outBox.xy, outBox.xy + vec2(2.0 * size.x, 0.0), outBox.xy + vec2(0.0, 2.0 * size.y));
+        at = box[corner];
+    } else {
+        // Counter-clockwise (area > 0): the inside is left of each edge.
+        uint me = corner;
+        if (area < 0.0) {
+            const vec2 t = q[1];
+            q[1] = q[2];
+            q[2] = t;
+            me = corner == 0u ? 0u : 3u - corner;
+        }
+        vec3 line[3]; // n.p + d >= 0 inside, d grown by the push
+        for (uint k = 0u; k < 3u; ++k) {
+            const vec2 a = q[k], b = q[(k + 1u) % 3u];
+            const vec2 n = vec2(a.y - b.y, b.x - a.x);
+            line[k] = vec3(n, -dot(n, a) + h * (abs(n.x) + abs(n.y)));
+        }
+        outEdge0 = line[0];
+        outEdge1 = line[1];
+        outEdge2 = line[2];
+        // This corner: where the pushed edges before and after it meet.
+        const vec3 l1 = line[(me + 2u) % 3u], l2 = line[me];
+        const float det = l1.x * l2.y - l1.y * l2.x;
+        at = vec2(-l1.z * l2.y + l2.z * l1.y, -l2.z * l1.x + l1.z * l2.x) / det;
+    }
+    gl_Position = vec4(at / tiles * 2.0 - 1.0, 0.5, 1.0);
+}
