@@ -92,22 +92,20 @@ void main() {
     for (uint k = 1u; k < m; ++k) lo = min(lo, q[k]), hi = max(hi, q[k]);
     outBox = vec4(lo - h, hi + h);
     const float area = (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[2].x - q[0].x) * (q[1].y - q[0].y);
-    vec2 at;
-    if (clipped || abs(area) < 1.0 / 64.0) {
-        const vec2 size = outBox.zw - outBox.xy;
-        const vec2 box[3] = vec2[3](outBox.xy, outBox.xy + vec2(2.0 * size.x, 0.0), outBox.xy + vec2(0.0, 2.0 * size.y));
-        at = box[corner];
-    } else {
-        // Counter-clockwise (area > 0): the inside is left of each edge.
-        uint me = corner;
+    // The pushed edges, counter-clockwise (the inside left of each), for the
+    // fragment shader's test; none for a clipped triangle (its part in front
+    // has up to four edges: the box alone) or one too thin to orient.
+    uint me = corner;
+    vec3 line[3];
+    const bool edges = !clipped && abs(area) > 1e-6;
+    if (edges) {
         if (area < 0.0) {
             const vec2 t = q[1];
             q[1] = q[2];
             q[2] = t;
             me = corner == 0u ? 0u : 3u - corner;
         }
-        vec3 line[3]; // n.p + d >= 0 inside, d grown by the push
-        for (uint k = 0u; k < 3u; ++k) {
+        for (uint k = 0u; k < 3u; ++k) { // n.p + d >= 0 inside, d grown by the push
             const vec2 a = q[k], b = q[(k + 1u) % 3u];
             const vec2 n = vec2(a.y - b.y, b.x - a.x);
             line[k] = vec3(n, -dot(n, a) + h * (abs(n.x) + abs(n.y)));
@@ -115,6 +113,13 @@ void main() {
         outEdge0 = line[0];
         outEdge1 = line[1];
         outEdge2 = line[2];
+    }
+    vec2 at;
+    if (!edges || abs(area) < 1.0 / 64.0) {
+        const vec2 size = outBox.zw - outBox.xy;
+        const vec2 box[3] = vec2[3](outBox.xy, outBox.xy + vec2(2.0 * size.x, 0.0), outBox.xy + vec2(0.0, 2.0 * size.y));
+        at = box[corner];
+    } else {
         // This corner: where the pushed edges before and after it meet.
         const vec3 l1 = line[(me + 2u) % 3u], l2 = line[me];
         const float det = l1.x * l2.y - l1.y * l2.x;
