@@ -2,7 +2,10 @@
 // The raster algorithm's vertex shader (vk/raster_pass.cpp): each instance is
 // one light's proxy, its unit mesh pulled from a storage buffer three corners
 // per triangle (non-indexed), placed in view space and projected onto the
-// grid one pixel per tile.
+// grid one pixel per tile. A proxy wholly beyond the near plane
+// (GpuProxy.light.z = 1) draws only the faces turned to the camera: the
+// convex proxy's front faces cover what all its faces do, for half the
+// triangles.
 //
 // Conservative coverage without VK_EXT_conservative_rasterization
 // (LC_RASTER_PUSH_EDGES): every corner sees its whole triangle and moves to
@@ -63,12 +66,24 @@ void main() {
         gl_Position = vec4(box[corner] / vec2(params.grid.xy) * 2.0 - 1.0, 0.5, 1.0);
         return;
     }
+    vec3 v[3];
+    for (uint k = 0u; k < 3u; ++k) v[k] = p.origin.xyz + basis * corners[first + k].xyz;
+    if (p.light.z != 0u) {
+        // Wholly beyond the near plane: the faces turned to the camera cover
+        // all the (convex) proxy covers; one clearly turned away is dropped.
+        const vec3 n = cross(v[1] - v[0], v[2] - v[0]);
+        const vec3 toEye = (params.grid.w & LC_RASTER_ORTHO) != 0u ? vec3(0.0, 0.0, 1.0) : -v[0];
+        if (dot(n, toEye) < -1e-4 * length(n) * length(toEye)) {
+            gl_Position = vec4(0.0, 0.0, 0.5, 0.0);
+            return;
+        }
+    }
     if ((params.grid.w & LC_RASTER_PUSH_EDGES) == 0u) {
-        gl_Position = clipOf(p.origin.xyz + basis * corners[gl_VertexIndex].xyz);
+        gl_Position = clipOf(v[corner]);
         return;
     }
     vec4 c[3];
-    for (uint k = 0u; k < 3u; ++k) c[k] = clipOf(p.origin.xyz + basis * corners[first + k].xyz);
+    for (uint k = 0u; k < 3u; ++k) c[k] = clipOf(v[k]);
     const vec2 tiles = vec2(params.grid.xy);
     const float h = params.cover.w, nearW = params.cover.z;
     // The triangle's part in front of the near plane (w >= nearW), on the grid.

@@ -22,6 +22,7 @@
 #include "culling/diagnostics/export.hpp"
 #include "culling/core/file_io.hpp"
 #include "culling/core/params.hpp"
+#include "culling/math/light_proxy.hpp"
 #include "culling/core/pipeline.hpp"
 #include "culling/core/presets.hpp"
 #include "culling/scene/scene_io.hpp"
@@ -207,6 +208,17 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
         if (m.falseNegatives)
             std::cout << "misses by cause: culling test " << m.falseNegativesCullingTest() << ", list full "
                       << m.falseNegativesListFull << ", light limit " << m.falseNegativesLightLimit << "\n";
+    }
+    if (settings.algorithm == lc::Algorithm::Raster && !r.coverage.empty()) {
+        const bool autoOverfit = settings.proxyOverfit <= 0;
+        std::cout << "proxies: icosphere level " << settings.proxyLevel << " ("
+                  << lc::unitIcosphere(settings.proxyLevel).triangles.size() << " triangles), overfit "
+                  << fmt("%.4f", autoOverfit ? lc::icosphereEnclosingOverfit(settings.proxyLevel) : settings.proxyOverfit)
+                  << "; spots up to " << settings.proxyConeAngle << " degrees: cones of " << settings.proxySegments
+                  << " sides, overfit "
+                  << fmt("%.4f", autoOverfit ? lc::coneEnclosingOverfit(settings.proxySegments) : settings.proxyOverfit)
+                  << (autoOverfit ? " (auto: each encloses its light)" : " (as set)") << "\n"
+                  << "coverage: " << r.coverage << "\n";
     }
     std::cout << "lists " << r.listCountTotal() << ", entries " << r.entries() << ", mean list "
               << fmt("%.2f", m.meanList) << ", max list " << m.maxList << ", " << m.resultBytes

@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <random>
 #include <string>
 
@@ -136,6 +137,26 @@ TEST(LightProxy, EnclosingOverfitIsTheIcosphereInradius) {
         }
         EXPECT_LT(exitDistance(m, f * 0.999, nearest), 1.0) << "level " << level;
     }
+}
+
+TEST(LightProxy, MeshesAreClosedAndWoundOutwards) {
+    // Counter-clockwise seen from outside: the Vulkan pass draws only the
+    // faces turned to the camera for a proxy wholly beyond the near plane.
+    auto check = [](const ProxyMesh& m, const glm::dvec3& inside, const std::string& what) {
+        std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+        for (const auto& t : m.triangles) {
+            const glm::dvec3 a = m.vertices[t[0]], b = m.vertices[t[1]], c = m.vertices[t[2]];
+            EXPECT_GT(glm::dot(glm::cross(b - a, c - a), (a + b + c) / 3.0 - inside), 0.0) << what;
+            for (int k = 0; k < 3; ++k) ++edges[{t[std::size_t(k)], t[std::size_t((k + 1) % 3)]}];
+        }
+        // Closed: every directed edge once, its reverse once.
+        for (const auto& [e, n] : edges) {
+            EXPECT_EQ(n, 1) << what;
+            EXPECT_EQ(edges.count({e.second, e.first}), 1u) << what;
+        }
+    };
+    for (std::uint32_t level = 0; level <= 4; ++level) check(unitIcosphere(level), {0, 0, 0}, "icosphere " + std::to_string(level));
+    for (std::uint32_t n : {3u, 8u, 64u}) check(unitCone(n), {0, 0, 0.5}, "cone " + std::to_string(n));
 }
 
 TEST(LightProxy, ConeOverfitWidensThePolygonToItsCircle) {

@@ -7,6 +7,7 @@
 #include "culling/core/errors.hpp"
 #include "culling/cpu/fine_prune.hpp"
 #include "culling/custom/custom_cull.hpp"
+#include "culling/math/light_proxy.hpp"
 #include "culling/math/spot_tests.hpp"
 #include "culling/math/tile_math.hpp"
 #include "truth/light_grid.hpp"
@@ -52,6 +53,78 @@ namespace {
 
 // The algorithm's tests of the light against the list's volume, as steps
 // with their numbers; whether all passed.
+// raster: the proxy as the reference draws it, which of its triangles
+// cover the tile (or, where none does, how near the nearest came), then its
+// depth range against the tile's.
+bool explainRaster(const RunOutput& run, const Projection& proj, Explanation& e) {
+    const CullResult& r = run.result;
+    const ViewLights& lights = run.lights;
+    const CullSettings& s = r.settings;
+    const std::uint32_t light = e.light, t = e.tile;
+    const std::uint32_t tx = t % r.grid.tilesX, ty = t / r.grid.tilesX;
+    const bool spot = lights.isSpot(light);
+    const LightProxy p = makeLightProxy(lights.centers[light], lights.radii[light],
+                                        spot ? lights.spotAxes[light] : glm::dvec3(0, 0, -1),
+                                        spot ? lights.spotAngles[light] : 0.0, s);
+    std::vector<std::uint32_t> covering;
+    // Where no triangle covers the tile: the one whose tiles come nearest
+    // (in tiles, Chebyshev), for the step's numbers; under centre sampling
+    // also a triangle that overlaps the tile without covering its centre.
+    std::uint32_t nearestTri = 0, nearestTiles = std::numeric_limits<std::uint32_t>::max();
+    std::int64_t grazing = -1;
+    for (std::uint32_t i = 0; i < p.mesh->triangles.size(); ++i) {
+        const auto& tri = p.mesh->triangles[i];
+        const std::array<glm::dvec3, 3> v = {p.vertex(tri[0]), p.vertex(tri[1]), p.vertex(tri[2])};
+        bool hit = false;
+        proxyTriangleTiles(proj, r.grid, v, s.conservative, [&](std::uint32_t x, std::uint32_t y) {
+            hit = hit || (x == tx && y == ty);
+            const std::uint32_t d = std::max(x > tx ? x - tx : tx - x, y > ty ? y - ty : ty - y);
+            if (d < nearestTiles) nearestTiles = d, nearestTri = i;
+        });
+        if (hit) covering.push_back(i);
+        if (!hit && !s.conservative && grazing < 0)
+            proxyTriangleTiles(proj, r.grid, v, true, [&](std::uint32_t x, std::uint32_t y) {
+                if (x == tx && y == ty) grazing = i;
+            });
+    }
+    const std::string mesh =
+        (p.cone ? "cone of " + std::to_string(s.proxySegments) + " sides"
+                : "icosphere level " + std::to_string(s.proxyLevel)) +
+        " (" + std::to_string(p.mesh->triangles.size()) + " triangles), overfit " + num(p.overfit) +
+        (s.proxyOverfit > 0 ? "" : " (auto: encloses the light)");
+    const std::string rule = s.conservative ? "overlaps" : "covers the centre of";
+    std::string numbers;
+    if (!covering.empty()) {
+        numbers = "triangle " + std::to_string(covering[0]) +
+                  (covering.size() > 1 ? " and " + std::to_string(covering.size() - 1) + " more" : std::string()) + " " +
+                  rule + " tile " + std::to_string(tx) + "," + std::to_string(ty);
+    } else if (grazing >= 0) {
+        numbers = "no triangle covers the centre of tile " + std::to_string(tx) + "," + std::to_string(ty) +
+                  "; triangle " + std::to_string(grazing) +
+                  " overlaps it (centre sampling: a tile a proxy only grazes is not covered; --conservative true "
+                  "covers it)";
+    } else if (nearestTiles == std::numeric_limits<std::uint32_t>::max()) {
+        numbers = "no triangle " + rule + " any tile (the proxy lies off screen or before the near plane)";
+    } else {
+        numbers = "no triangle " + rule + " tile " + std::to_string(tx) + "," + std::to_string(ty) +
+                  "; the nearest, triangle " + std::to_string(nearestTri) + ", reaches " +
+                  std::to_string(nearestTiles) + " tile" + (nearestTiles == 1 ? "" : "s") + " away" +
+                  (s.conservative ? "" : " (centre sampling: a tile it only grazes is not covered)");
+    }
+    bool ok = e.steps.emplace_back(ExplainStep{"proxy coverage: " + mesh, numbers, !covering.empty()}).passed;
+    const double slack = sphereTestSlack(p.origin, lights.radii[light] * p.overfit);
+    const double tmin = r.tileDepthMin[t], tmax = r.tileDepthMax[t];
+    const bool reaches = p.depthMin - slack <= tmax && p.depthMax + slack >= tmin;
+    ok = e.steps.emplace_back(ExplainStep{"proxy depth range",
+                                          "the proxy's depth " + num(p.depthMin) + ".." + num(p.depthMax) +
+                                              (reaches ? " reaches" : " misses") + " the tile's " + num(tmin) +
+                                              ".." + num(tmax),
+                                          reaches})
+             .passed &&
+         ok;
+    return ok;
+}
+
 bool explainTests(const RunOutput& run, const Projection& proj, const BoundingSphere& sphere, Explanation& e) {
     const CullResult& r = run.result;
     const ViewLights& lights = run.lights;
@@ -83,6 +156,7 @@ bool explainTests(const RunOutput& run, const Projection& proj, const BoundingSp
             hi = r.cameraFar;
             break;
         }
+        case Algorithm::Raster:
         case Algorithm::Fptl:
         case Algorithm::MinMax: lo = tmin, hi = tmax; break;
         case Algorithm::TwoPointFiveD:
@@ -128,6 +202,7 @@ bool explainTests(const RunOutput& run, const Projection& proj, const BoundingSp
         const FrustumChunk chunk = makeFrustumChunk(proj, rect, lo, hi);
         e.hasChunk = true;
         e.chunkCorners = chunk.corners;
+        if (r.algorithm == Algorithm::Raster) return explainRaster(run, proj, e) && ok;
         for (int k = 0; k < 6; ++k) {
             const double d = signedDistance(chunk.planes[std::size_t(k)], sphere.center);
             ok = step(chunkPlaneName(k), "signed distance " + num(d) + (d >= -rr ? " >= " : " < ") + "-r = " + num(-rr),

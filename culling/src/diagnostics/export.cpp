@@ -3,6 +3,7 @@
 // documented in docs/CLI.md.
 
 #include "culling/diagnostics/export.hpp"
+#include "culling/math/light_proxy.hpp"
 #include "culling/scene/gltf_io.hpp"
 
 #include "culling/custom/custom_cull.hpp"
@@ -260,6 +261,23 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     j["skip_empty"] = settings.skipEmpty;
     j["spot_test"] = toString(settings.spotTest);
     j["bins"] = settings.bins;
+    // raster: the proxies and how their coverage was made.
+    if (!run.custom && settings.algorithm == Algorithm::Raster) {
+        nlohmann::ordered_json p;
+        p["level"] = settings.proxyLevel;
+        p["triangles"] = unitIcosphere(settings.proxyLevel).triangles.size();
+        p["segments"] = settings.proxySegments;
+        p["cone_angle_deg"] = settings.proxyConeAngle;
+        p["overfit"] = settings.proxyOverfit > 0 ? nlohmann::ordered_json(settings.proxyOverfit)
+                                                 : nlohmann::ordered_json("auto");
+        p["sphere_overfit_applied"] = settings.proxyOverfit > 0 ? settings.proxyOverfit
+                                                                : icosphereEnclosingOverfit(settings.proxyLevel);
+        p["cone_overfit_applied"] = settings.proxyOverfit > 0 ? settings.proxyOverfit
+                                                              : coneEnclosingOverfit(settings.proxySegments);
+        p["conservative"] = settings.conservative;
+        p["coverage"] = r.coverage;
+        j["proxy"] = p;
+    }
     // Lists from a custom shader or an engine's dump were made by none of
     // the built-in settings: they are not reported as if they were.
     if (run.custom)

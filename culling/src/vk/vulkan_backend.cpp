@@ -1462,7 +1462,9 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
         g.basisXDepthMin = vec4(glm::vec3(p.basis[0]), std::nextafter(float(p.depthMin - slack), -kInfF));
         g.basisYDepthMax = vec4(glm::vec3(p.basis[1]), std::nextafter(float(p.depthMax + slack), kInfF));
         g.basisZ = vec4(glm::vec3(p.basis[2]), 0.0f);
-        g.light = uvec4(l, 0, 0, 0);
+        // Wholly beyond the near plane (a margin for float): front faces only.
+        const bool frontOnly = p.depthMin > proj.nearPlane() * 1.001 + 1e-6 * std::abs(p.depthMin);
+        g.light = uvec4(l, 0, frontOnly ? 1u : 0u, 0);
         g.origin = vec4(glm::vec3(p.origin), 0.0f);
         if (boxed[l]) {
             // The tiles' centres the box keeps, in tile units (none: an empty box).
@@ -1498,7 +1500,9 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
     const double nearW = proj.orthographic() ? -1.0 : proj.nearPlane() * (1.0 - 1e-5);
     const glm::mat4 clip = rasterClip(proj, grid, nearW);
     for (int c = 0; c < 4; ++c) rp.clip[c] = clip[c];
-    rp.grid = uvec4(grid.tilesX, grid.tilesY, words, coverage == RasterPass::Coverage::PushedEdges ? LC_RASTER_PUSH_EDGES : 0u);
+    rp.grid = uvec4(grid.tilesX, grid.tilesY, words,
+                    (coverage == RasterPass::Coverage::PushedEdges ? LC_RASTER_PUSH_EDGES : 0u) |
+                        (proj.orthographic() ? LC_RASTER_ORTHO : 0u));
     rp.cover = vec4(float(double(grid.width) / grid.tileSize), float(double(grid.height) / grid.tileSize),
                     float(nearW), 0.5f + 1.0f / 256.0f);
 

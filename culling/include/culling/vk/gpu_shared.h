@@ -165,6 +165,7 @@ struct GpuRasterParams {
     vec4 cover;            // x: tilesX' (width / tile), y: tilesY', z: w below which a triangle covers the screen, w: push
 };
 const uint LC_RASTER_PUSH_EDGES = 1u; // conservative by pushing the edges out in the vertex shader
+const uint LC_RASTER_ORTHO = 2u;      // orthographic: the eye direction is +z
 
 // One proxy, an instance: its unit mesh placed by origin + basis * v, the
 // light it stands for and the view-depth range the tile test uses.
@@ -173,7 +174,7 @@ struct GpuProxy {
     vec4 basisXDepthMin;   // xyz: basis column x, w: depth range low
     vec4 basisYDepthMax;   // xyz: basis column y, w: depth range high
     vec4 basisZ;           // xyz: basis column z
-    uvec4 light;           // x: the light's index
+    uvec4 light;           // x: the light's index, y: 1 = a box (origin: tile centres), z: 1 = front faces only
 };
 
 #ifdef __cplusplus
