@@ -11,8 +11,9 @@ TEST(Params, TableOrderAndDefaultsMatchTheStructs) {
     std::vector<std::string> names;
     for (const auto& p : t) names.push_back(p.name);
     EXPECT_EQ(names, (std::vector<std::string>{"algorithm", "test", "cells", "slicing", "skip-empty", "spot-test", "bins",
-                                               "tile", "width", "height", "cap", "max-lights", "max-entries",
-                                               "overflow-policy", "limit-keep"}));
+                                               "proxy-level", "proxy-segments", "proxy-cone-angle", "proxy-overfit",
+                                               "conservative", "tile", "width", "height", "cap", "max-lights",
+                                               "max-entries", "overflow-policy", "limit-keep"}));
     // The table's defaults are the structs' defaults.
     const CullSettings s;
     const Camera cam;
@@ -22,7 +23,7 @@ TEST(Params, TableOrderAndDefaultsMatchTheStructs) {
         EXPECT_FALSE(p.label.empty()) << p.name;
     }
     EXPECT_EQ(cullParam("algorithm").choices,
-              (std::vector<std::string>{"all", "naive", "minmax", "halfz", "2.5d", "clustered", "fptl", "zbin"}));
+              (std::vector<std::string>{"all", "naive", "minmax", "halfz", "2.5d", "clustered", "fptl", "zbin", "raster"}));
     EXPECT_EQ(cullParam("test").choices, (std::vector<std::string>{"planes", "planes+aabb", "exact"}));
     EXPECT_EQ(cullParam("cells").minValue, 1);
     EXPECT_EQ(cullParam("cells").maxValue, 32);
@@ -32,6 +33,28 @@ TEST(Params, TableOrderAndDefaultsMatchTheStructs) {
     EXPECT_EQ(cullParam("bins").minValue, 1);
     EXPECT_EQ(cullParam("bins").maxValue, 16384);
     EXPECT_THROW(cullParam("colour"), SettingsError);
+    // raster's overfit: a number in 0.5..4, or auto (0: the enclosing factor).
+    EXPECT_EQ(cullParam("proxy-overfit").type, ParamType::Real);
+    {
+        CullSettings r;
+        Camera c;
+        setParam(r, c, "proxy-overfit", "1.25");
+        EXPECT_EQ(r.proxyOverfit, 1.25);
+        EXPECT_EQ(getParam(r, c, "proxy-overfit"), "1.25");
+        setParam(r, c, "proxy-overfit", "auto");
+        EXPECT_EQ(r.proxyOverfit, 0.0);
+        EXPECT_EQ(getParam(r, c, "proxy-overfit"), "auto");
+        for (const char* bad : {"0.4", "4.5", "1,2", "", "nan", "inf", "autox"}) {
+            try {
+                setParam(r, c, "proxy-overfit", bad);
+                ADD_FAILURE() << "accepted '" << bad << "'";
+            } catch (const SettingsError& e) {
+                EXPECT_NE(std::string(e.what()).find("must be a number in 0.5..4 or auto"), std::string::npos) << e.what();
+            }
+        }
+        r.proxyOverfit = 7;
+        EXPECT_NE(r.validate().find("proxy-overfit"), std::string::npos);
+    }
     // The engine limits: off by default, on their own toolbar row.
     for (const char* n : {"cap", "max-lights", "max-entries", "overflow-policy", "limit-keep"})
         EXPECT_EQ(cullParam(n).group, "limits") << n;
@@ -58,6 +81,7 @@ TEST(Params, SetAndGetRoundTripEveryValue) {
         if (p.type == ParamType::Int)
             values = {std::to_string(p.minValue), std::to_string(p.maxValue), std::to_string((p.minValue + p.maxValue) / 2)};
         if (p.type == ParamType::Bool) values = {"false", "true"};
+        if (p.type == ParamType::Real) values = {"auto", "0.5", "4", "1.0705"};
         for (const auto& v : values) {
             setParam(s, cam, p.name, v);
             EXPECT_EQ(getParam(s, cam, p.name), v) << p.name;

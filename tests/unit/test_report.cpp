@@ -310,7 +310,7 @@ TEST(Report, WritesCsvMarkdownAndPngAtomically) {
 // no two share one (clustered, fptl and zbin did).
 TEST(Report, EveryAlgorithmHasItsOwnColour) {
     const auto names = lc::cullParam("algorithm").choices;
-    ASSERT_EQ(names.size(), 8u);
+    ASSERT_EQ(names.size(), 9u);
     for (std::size_t i = 0; i < names.size(); ++i)
         for (std::size_t j = i + 1; j < names.size(); ++j) {
             const glm::dvec3 a = lc::algorithmColour(lc::algorithmFromString(names[i]));

@@ -102,12 +102,14 @@ ReportDock::ReportDock(Document* doc, CullService* service, QWidget* parent)
             addParamControl(p, {"1", "2", "4", "8", "16", "32"}, asText(options_.cellCounts));
         else if (p.type == lc::ParamType::Choice)
             addParamControl(p, p.choices, p.choices);
+        else if (p.name == "conservative")
+            addParamControl(p, {"false", "true"}, {"true"});
         else if (p.type == lc::ParamType::Bool)
             addParamControl(p, {"false", "true"}, {"false", "true"});
         else if (p.name == "proxy-level")
             addParamControl(p, {"0", "1", "2", "3", "4"}, {"0", "1", "2"});
         else if (p.name == "proxy-overfit")
-            addParamControl(p, {"auto", "1", "1.1", "1.2"}, {"auto", "1"});
+            addParamControl(p, {"auto", "1", "1.1", "1.2"}, {"auto"});
     }
     for (const auto& c : params_) paramRow->addWidget(c->button);
     paramRow->addStretch(1);

@@ -74,11 +74,13 @@ std::vector<std::string> sweepValues(const ParamSpec& p, const ReportOptions& o)
     };
     if (p.name == "tile") return asText(o.tileSizes);
     if (p.name == "cells") return asText(o.cellCounts);
-    // raster: the proxy's detail, and the overfit that encloses the light
-    // against the mesh inscribed in it (the misses an engine without the
-    // factor gets).
+    // raster: the proxy's detail, with the overfit that encloses the light
+    // and conservative coverage; the settings that miss lights by design
+    // (--fixed proxy-overfit=1,auto or conservative=false,true) only when
+    // asked for.
     if (p.name == "proxy-level") return {"0", "1", "2"};
-    if (p.name == "proxy-overfit") return {"auto", "1"};
+    if (p.name == "proxy-overfit") return {"auto"};
+    if (p.name == "conservative") return {"true"};
     switch (p.type) {
     case ParamType::Choice: return p.choices;
     case ParamType::Bool: return {"false", "true"};
