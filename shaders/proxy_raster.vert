@@ -7,6 +7,11 @@
 // convex proxy's front faces cover what all its faces do, for half the
 // triangles.
 //
+// With VK_EXT_conservative_rasterization (LC_RASTER_TRIM alone) the corners
+// stay where they are and only the fragment shader's trim below applies: the
+// extension lets a device overestimate more than it must, and an H200 did
+// (65% more tiles than the exact overlap on the hard cases).
+//
 // Conservative coverage without VK_EXT_conservative_rasterization
 // (LC_RASTER_PUSH_EDGES): every corner sees its whole triangle and moves to
 // where the triangle's edges, each pushed out by half a tile's diagonal
@@ -78,7 +83,7 @@ void main() {
             return;
         }
     }
-    if ((params.grid.w & LC_RASTER_PUSH_EDGES) == 0u) {
+    if ((params.grid.w & (LC_RASTER_PUSH_EDGES | LC_RASTER_TRIM)) == 0u) {
         gl_Position = clipOf(v[corner]);
         return;
     }
@@ -128,6 +133,13 @@ void main() {
         outEdge0 = line[0];
         outEdge1 = line[1];
         outEdge2 = line[2];
+    }
+    if ((params.grid.w & LC_RASTER_PUSH_EDGES) == 0u) {
+        // The device's conservative rasteriser covers the triangle (it may
+        // overestimate more than it must: NVIDIA's covered tiles a sharp
+        // corner only nears); the fragment shader trims to the same test.
+        gl_Position = c[corner];
+        return;
     }
     vec2 at;
     if (!edges || abs(area) < 1.0 / 64.0) {

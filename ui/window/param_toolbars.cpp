@@ -59,6 +59,7 @@ void ParamToolbars::addParamWidgets(QToolBar* limitsBar) {
         const QString tip = QString::fromStdString(p.help);
         const QString label = QString::fromStdString(p.label.empty() ? p.name : p.label);
         QWidget* w = nullptr;
+        const bool raster = p.name.rfind("proxy-", 0) == 0 || p.name == "conservative";
         if (p.type == lc::ParamType::Bool) {
             auto* cb = new QCheckBox(label);
             connect(cb, &QCheckBox::toggled, this, [this, name](bool on) { onEdited(name, on ? "true" : "false"); });
@@ -66,7 +67,8 @@ void ParamToolbars::addParamWidgets(QToolBar* limitsBar) {
         } else {
             auto* l = new QLabel(label + " ");
             l->setToolTip(tip);
-            bar->addWidget(l);
+            QAction* labelAction = bar->addWidget(l);
+            if (raster) rasterActions_.push_back(labelAction);
             if (p.type == lc::ParamType::Choice || p.type == lc::ParamType::Real) {
                 auto* combo = new QComboBox;
                 for (const auto& c : p.choices) combo->addItem(QString::fromStdString(c));
@@ -95,12 +97,15 @@ void ParamToolbars::addParamWidgets(QToolBar* limitsBar) {
         w->setToolTip(tip);
         w->setObjectName(QString::fromStdString("param_" + name));
         widgets_[name] = w;
-        bar->addWidget(w);
+        QAction* action = bar->addWidget(w);
+        if (raster) rasterActions_.push_back(action);
     }
 }
 
 void ParamToolbars::sync() {
     syncing_ = true;
+    const bool raster = doc_->runs().settings().algorithm == lc::Algorithm::Raster;
+    for (QAction* a : rasterActions_) a->setVisible(raster);
     for (auto& [name, w] : widgets_) {
         QString v;
         try {

@@ -7,9 +7,12 @@
 // value is logged and shown back as it was.
 
 #include <QObject>
+
+class QAction;
 #include <QString>
 
 #include <map>
+#include <vector>
 #include <string>
 
 class QComboBox;
@@ -49,6 +52,9 @@ private:
     QToolBar* cullBar_ = nullptr;
     QComboBox* presetCombo_ = nullptr; // "(none)" or the preset the settings equal
     std::map<std::string, QWidget*> widgets_;
+    // raster's proxy settings (label and control): on the toolbar only while
+    // the algorithm is raster, so that they take no room from the others.
+    std::vector<QAction*> rasterActions_;
     bool syncing_ = false;
 };
 

@@ -155,9 +155,18 @@ std::vector<ReportConfig> reportConfigs(const ReportOptions& options, const std:
         const Algorithm algo = algorithmFromString(algoName);
         // Odometer over the other parameters; a parameter that does not apply
         // keeps one (its default) value and an empty column.
+        // A parameter that never applies to this algorithm (raster's proxy
+        // for the others, bins outside zbin, ...) keeps one value: the
+        // odometer would only repeat configurations (3^k times over: the
+        // studio's estimate, worked out on every edit, spent seconds so).
+        // The limits apply by their own values, whatever the algorithm.
         std::vector<std::vector<std::string>> values;
-        for (const ParamSpec* p : specs) values.push_back(p->name == "algorithm" ? std::vector<std::string>{algoName}
-                                                                                 : sweepValues(*p, options));
+        for (const ParamSpec* p : specs) {
+            std::vector<std::string> v =
+                p->name == "algorithm" ? std::vector<std::string>{algoName} : sweepValues(*p, options);
+            if (p->group != "limits" && !paramAppliesTo(p->name, algo, 32, sceneHasSpotLights)) v.resize(1);
+            values.push_back(std::move(v));
+        }
         std::vector<std::size_t> idx(specs.size(), 0);
         std::set<std::string> seen;
         for (;;) {

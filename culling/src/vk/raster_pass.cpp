@@ -48,7 +48,7 @@ std::string RasterPass::describe(Coverage c) const {
         char extra[64];
         std::snprintf(extra, sizeof extra, "%.4g", double(ctx_.primitiveOverestimationSize()));
         return std::string("VK_EXT_conservative_rasterization, overestimating (the device's own ") + extra +
-               " pixel, plus 1/64)";
+               " pixel, plus 1/64), trimmed to the exact overlap in the fragment shader";
     }
     case Coverage::PushedEdges:
         return "edges pushed out by half a tile's diagonal in the vertex shader ('" + ctx_.deviceName() +

@@ -1502,6 +1502,7 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
     for (int c = 0; c < 4; ++c) rp.clip[c] = clip[c];
     rp.grid = uvec4(grid.tilesX, grid.tilesY, words,
                     (coverage == RasterPass::Coverage::PushedEdges ? LC_RASTER_PUSH_EDGES : 0u) |
+                        (coverage != RasterPass::Coverage::Centre ? LC_RASTER_TRIM : 0u) |
                         (proj.orthographic() ? LC_RASTER_ORTHO : 0u));
     rp.cover = vec4(float(double(grid.width) / grid.tileSize), float(double(grid.height) / grid.tileSize),
                     float(nearW), 0.5f + 1.0f / 256.0f);

@@ -166,6 +166,7 @@ struct GpuRasterParams {
 };
 const uint LC_RASTER_PUSH_EDGES = 1u; // conservative by pushing the edges out in the vertex shader
 const uint LC_RASTER_ORTHO = 2u;      // orthographic: the eye direction is +z
+const uint LC_RASTER_TRIM = 4u;       // conservative: the fragment shader keeps a tile by the exact overlap test
 
 // One proxy, an instance: its unit mesh placed by origin + basis * v, the
 // light it stands for and the view-depth range the tile test uses.
