@@ -44,6 +44,13 @@ ParamToolbars::ParamToolbars(QMainWindow* window, Document* doc) : QObject(windo
     });
     limitsBar->addWidget(presetCombo_);
     limitsBar->addSeparator();
+    // raster's proxy settings on a third row, shown only while the
+    // algorithm is raster (on the first row they pushed the tile size out of
+    // sight, on the second the limits).
+    window->addToolBarBreak();
+    rasterBar_ = window->addToolBar(tr("Raster proxies"));
+    rasterBar_->setObjectName("rasterToolbar");
+    rasterBar_->setVisible(false);
     addParamWidgets(limitsBar);
     // Ctrl+Z in a culling field undoes the scene's last edit (tile, width and
     // height are camera edits), as in the properties panel.
@@ -51,15 +58,16 @@ ParamToolbars::ParamToolbars(QMainWindow* window, Document* doc) : QObject(windo
 }
 
 // A control per parameter: a check box, a combo of the choices or a spin box,
-// named "param_<name>", on the Limits row for the "limits" group.
+// named "param_<name>", on the Limits row for the "limits" group, on the
+// Raster proxies row for raster's proxy settings.
 void ParamToolbars::addParamWidgets(QToolBar* limitsBar) {
     for (const lc::ParamSpec& p : lc::cullParams()) {
-        QToolBar* bar = p.group == "limits" ? limitsBar : cullBar_;
+        const bool rasterParam = p.name.rfind("proxy-", 0) == 0 || p.name == "conservative";
+        QToolBar* bar = rasterParam ? rasterBar_ : p.group == "limits" ? limitsBar : cullBar_;
         const std::string name = p.name;
         const QString tip = QString::fromStdString(p.help);
         const QString label = QString::fromStdString(p.label.empty() ? p.name : p.label);
         QWidget* w = nullptr;
-        const bool raster = p.name.rfind("proxy-", 0) == 0 || p.name == "conservative";
         if (p.type == lc::ParamType::Bool) {
             auto* cb = new QCheckBox(label);
             connect(cb, &QCheckBox::toggled, this, [this, name](bool on) { onEdited(name, on ? "true" : "false"); });
@@ -67,8 +75,7 @@ void ParamToolbars::addParamWidgets(QToolBar* limitsBar) {
         } else {
             auto* l = new QLabel(label + " ");
             l->setToolTip(tip);
-            QAction* labelAction = bar->addWidget(l);
-            if (raster) rasterActions_.push_back(labelAction);
+            bar->addWidget(l);
             if (p.type == lc::ParamType::Choice || p.type == lc::ParamType::Real) {
                 auto* combo = new QComboBox;
                 for (const auto& c : p.choices) combo->addItem(QString::fromStdString(c));
@@ -97,15 +104,13 @@ void ParamToolbars::addParamWidgets(QToolBar* limitsBar) {
         w->setToolTip(tip);
         w->setObjectName(QString::fromStdString("param_" + name));
         widgets_[name] = w;
-        QAction* action = bar->addWidget(w);
-        if (raster) rasterActions_.push_back(action);
+        bar->addWidget(w);
     }
 }
 
 void ParamToolbars::sync() {
     syncing_ = true;
-    const bool raster = doc_->runs().settings().algorithm == lc::Algorithm::Raster;
-    for (QAction* a : rasterActions_) a->setVisible(raster);
+    rasterBar_->setVisible(doc_->runs().settings().algorithm == lc::Algorithm::Raster);
     for (auto& [name, w] : widgets_) {
         QString v;
         try {

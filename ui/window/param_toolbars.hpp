@@ -8,7 +8,6 @@
 
 #include <QObject>
 
-class QAction;
 #include <QString>
 
 #include <map>
@@ -52,9 +51,8 @@ private:
     QToolBar* cullBar_ = nullptr;
     QComboBox* presetCombo_ = nullptr; // "(none)" or the preset the settings equal
     std::map<std::string, QWidget*> widgets_;
-    // raster's proxy settings (label and control): on the toolbar only while
-    // the algorithm is raster, so that they take no room from the others.
-    std::vector<QAction*> rasterActions_;
+    // raster's proxy settings: a row shown only while the algorithm is raster.
+    QToolBar* rasterBar_ = nullptr;
     bool syncing_ = false;
 };
 
