@@ -123,3 +123,15 @@ TEST_F(VulkanRaster, RunsThroughThePipelineWithTheDepthItRendered) {
     EXPECT_GT(run.result.entries(), 0u);
     EXPECT_GT(run.truth.metrics.efficiency, 0.0);
 }
+
+TEST_F(VulkanRaster, ASceneWithoutLightsHasEmptyLists) {
+    // No light: no mask words to clear (a zero-sized fill is invalid Vulkan,
+    // which the validation layer reports), every list empty.
+    Scene scene = atrium();
+    scene.lights.clear();
+    CullSettings st;
+    st.algorithm = Algorithm::Raster;
+    const RunOutput run = runPipeline(scene, st, gputest::vulkan());
+    EXPECT_EQ(run.result.entries(), 0u);
+    EXPECT_EQ(run.result.listCount.size(), std::size_t(run.result.grid.tileCount()));
+}

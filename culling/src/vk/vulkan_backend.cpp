@@ -1539,7 +1539,7 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
     const double wallMs = ctx_.submitAndWait(
         [&](VkCommandBuffer cmd) {
             if (stamps) stamps.reset(cmd);
-            vkCmdFillBuffer(cmd, masks.buffer, 0, maskBytes, 0);
+            if (maskBytes) vkCmdFillBuffer(cmd, masks.buffer, 0, maskBytes, 0); // none without lights
             staging.recordUploads(cmd,
                                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
                                       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
