@@ -315,17 +315,12 @@ void rasterTiles(const CpuCull& c, CullResult& res, std::vector<std::vector<std:
     const ViewLights& lights = c.lights;
     std::vector<std::uint32_t> seen(grid.tileCount(), std::numeric_limits<std::uint32_t>::max());
     for (std::uint32_t l = 0; l < lights.size(); ++l) {
-        const bool spot = lights.isSpot(l);
-        const LightProxy p = makeLightProxy(lights.centers[l], lights.radii[l],
-                                            spot ? lights.spotAxes[l] : glm::dvec3(0, 0, -1),
-                                            spot ? lights.spotAngles[l] : 0.0, c.settings);
-        const double slack = sphereTestSlack(p.origin, lights.radii[l] * p.overfit);
-        const double lo = p.depthMin - slack, hi = p.depthMax + slack;
+        const LightProxy p = makeLightProxy(lights, l, c.settings);
         auto mark = [&](std::uint32_t tx, std::uint32_t ty) {
             const std::uint32_t t = grid.tileIndex(tx, ty);
             if (seen[t] == l) return;
             seen[t] = l;
-            if (res.tileDepthMin[t] <= res.tileDepthMax[t] && lo <= res.tileDepthMax[t] && hi >= res.tileDepthMin[t])
+            if (res.tileDepthMin[t] <= res.tileDepthMax[t] && p.depthReaches(res.tileDepthMin[t], res.tileDepthMax[t]))
                 lists[t].push_back(l);
         };
         for (const auto& tri : p.mesh->triangles)

@@ -62,10 +62,7 @@ bool explainRaster(const RunOutput& run, const Projection& proj, Explanation& e)
     const CullSettings& s = r.settings;
     const std::uint32_t light = e.light, t = e.tile;
     const std::uint32_t tx = t % r.grid.tilesX, ty = t / r.grid.tilesX;
-    const bool spot = lights.isSpot(light);
-    const LightProxy p = makeLightProxy(lights.centers[light], lights.radii[light],
-                                        spot ? lights.spotAxes[light] : glm::dvec3(0, 0, -1),
-                                        spot ? lights.spotAngles[light] : 0.0, s);
+    const LightProxy p = makeLightProxy(lights, light, s);
     std::vector<std::uint32_t> covering;
     // Where no triangle covers the tile: the one whose tiles come nearest
     // (in tiles, Chebyshev), for the step's numbers; under centre sampling
@@ -112,9 +109,8 @@ bool explainRaster(const RunOutput& run, const Projection& proj, Explanation& e)
                   (s.conservative ? "" : " (centre sampling: a tile it only grazes is not covered)");
     }
     bool ok = e.steps.emplace_back(ExplainStep{"proxy coverage: " + mesh, numbers, !covering.empty()}).passed;
-    const double slack = sphereTestSlack(p.origin, lights.radii[light] * p.overfit);
     const double tmin = r.tileDepthMin[t], tmax = r.tileDepthMax[t];
-    const bool reaches = p.depthMin - slack <= tmax && p.depthMax + slack >= tmin;
+    const bool reaches = p.depthReaches(tmin, tmax);
     ok = e.steps.emplace_back(ExplainStep{"proxy depth range",
                                           "the proxy's depth " + num(p.depthMin) + ".." + num(p.depthMax) +
                                               (reaches ? " reaches" : " misses") + " the tile's " + num(tmin) +

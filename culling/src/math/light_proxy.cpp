@@ -2,6 +2,8 @@
 // their enclosing overfit and one triangle's tiles.
 #include "culling/math/light_proxy.hpp"
 
+#include "culling/core/backend.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -109,6 +111,7 @@ double coneEnclosingOverfit(std::uint32_t segments) {
 LightProxy makeLightProxy(const glm::dvec3& center, double radius, const glm::dvec3& axis, double spotAngle,
                           const CullSettings& s) {
     LightProxy p;
+    p.radius = radius;
     p.cone = spotAngle > 0.0 && spotAngle <= double(s.proxyConeAngle) * kPi / 180.0;
     p.origin = center;
     if (!p.cone) {
@@ -136,6 +139,14 @@ LightProxy makeLightProxy(const glm::dvec3& center, double radius, const glm::dv
     }
     return p;
 }
+
+LightProxy makeLightProxy(const ViewLights& lights, std::size_t l, const CullSettings& settings) {
+    const bool spot = lights.isSpot(l);
+    return makeLightProxy(lights.centers[l], lights.radii[l], spot ? lights.spotAxes[l] : glm::dvec3(0, 0, -1),
+                          spot ? lights.spotAngles[l] : 0.0, settings);
+}
+
+double LightProxy::slack() const { return sphereTestSlack(origin, radius * overfit); }
 
 std::uint64_t proxyTriangleTiles(const Projection& proj, const TileGrid& grid, const std::array<glm::dvec3, 3>& tri,
                                  bool conservative, const std::function<void(std::uint32_t, std::uint32_t)>& covered) {

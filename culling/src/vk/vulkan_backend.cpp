@@ -1440,9 +1440,7 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
     std::vector<char> boxed(n, 0);
     std::uint32_t spheres = 0, cones = 0, boxes = 0;
     for (std::uint32_t l = 0; l < n; ++l) {
-        const bool spot = lights.isSpot(l);
-        proxy[l] = makeLightProxy(lights.centers[l], lights.radii[l], spot ? lights.spotAxes[l] : glm::dvec3(0, 0, -1),
-                                  spot ? lights.spotAngles[l] : 0.0, settings);
+        proxy[l] = makeLightProxy(lights, l, settings);
         const LightProxy& p = proxy[l];
         const double reach = glm::length(p.origin) + lights.radii[l] * p.overfit * (p.cone ? std::max(1.0, glm::length(p.basis[0]) / lights.radii[l]) : 1.0);
         const double perUnit = proj.orthographic() ? tilesPerUnit : tilesPerUnit / std::max(p.depthMin, proj.nearPlane());
@@ -1456,7 +1454,7 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
         const LightProxy& p = proxy[l];
         // The depth range widened past the CPU reference's slack and the
         // bounds pass's float rounding, rounded outwards.
-        const double slack = 2.0 * sphereTestSlack(p.origin, lights.radii[l] * p.overfit) +
+        const double slack = 2.0 * p.slack() +
                              double(kRelEps) * (std::abs(p.depthMax) + lights.radii[l] * p.overfit) + kAbsEps;
         GpuProxy& g = proxies[boxed[l] ? nextBox++ : p.cone ? nextCone++ : nextSphere++];
         g.basisXDepthMin = vec4(glm::vec3(p.basis[0]), std::nextafter(float(p.depthMin - slack), -kInfF));

@@ -48,16 +48,27 @@ double coneEnclosingOverfit(std::uint32_t segments);
 // circle needs coneEnclosingOverfit more).
 struct LightProxy {
     bool cone = false;
+    double radius = 0;         // the light's range
     double overfit = 1;        // as applied (auto resolved)
     glm::dvec3 origin{0.0};    // sphere: centre; cone: apex
     glm::dmat3 basis{1.0};     // columns: the unit mesh's x, y, z in view space, scaled
     double depthMin = 0, depthMax = 0; // view-depth extent of the proxy's vertices
     const ProxyMesh* mesh = nullptr;
     glm::dvec3 vertex(std::uint32_t i) const { return origin + basis * mesh->vertices[i]; }
+    // The tests' rounding slack at this proxy's size (sphereTestSlack).
+    double slack() const;
+    // The depth range, widened by the slack, reaches [depthMin, depthMax]
+    // of a tile (the CPU reference's and Explain's test).
+    bool depthReaches(double tileMin, double tileMax) const {
+        return depthMin - slack() <= tileMax && depthMax + slack() >= tileMin;
+    }
 };
 // `spotAngle` 0 for a point light; `axis` unit (ignored for a point light).
 LightProxy makeLightProxy(const glm::dvec3& center, double radius, const glm::dvec3& axis, double spotAngle,
                           const CullSettings& settings);
+// Light `l` of a frame's lights (a point light, or a spot by its axis and angle).
+struct ViewLights;
+LightProxy makeLightProxy(const ViewLights& lights, std::size_t l, const CullSettings& settings);
 
 // The tiles one triangle (view space) covers, rasterised at one pixel per
 // tile through the projection's clip matrix, the part nearer than the near
