@@ -17,14 +17,72 @@ layout(location = 2) flat in vec4 inBox; // tile centres allowed (tile units), s
 layout(location = 3) flat in vec3 inEdge0; // the pushed edges: n.centre + d >= 0 inside
 layout(location = 4) flat in vec3 inEdge1;
 layout(location = 5) flat in vec3 inEdge2;
+layout(location = 8) flat in vec3 inEdge3; // a near-cut triangle's fourth (else always passes)
+layout(location = 6) flat in vec3 inRange; // slices: the corners' depths, how the plane is given (vertex shader)
+layout(location = 7) flat in vec3 inPlane;
+layout(std430, set = 0, binding = 5) buffer Ranges { uint ranges[]; };
+
+// LC_RASTER_SLICES: the view depths this fragment's triangle spans over its
+// tile (conservative coverage: the plane at the tile's corners; centre
+// sampling: at its centre), within its corners' range, widened for float;
+// light_proxy.hpp's proxyTriangleTileDepth in double.
+vec2 tileDepthRange() {
+    vec2 r = inRange.xy;
+    if (inRange.z != 0.0) {
+        float gmin, gmax;
+        if ((params.grid.w & (LC_RASTER_PUSH_EDGES | LC_RASTER_TRIM)) != 0u) {
+            const vec2 c = floor(gl_FragCoord.xy);
+            const vec4 g = vec4(dot(inPlane, vec3(c, 1.0)), dot(inPlane, vec3(c.x + 1.0, c.y, 1.0)),
+                                dot(inPlane, vec3(c.x, c.y + 1.0, 1.0)), dot(inPlane, vec3(c + 1.0, 1.0)));
+            gmin = min(min(g.x, g.y), min(g.z, g.w));
+            gmax = max(max(g.x, g.y), max(g.z, g.w));
+        } else {
+            gmin = gmax = dot(inPlane, vec3(gl_FragCoord.xy, 1.0));
+        }
+        vec2 q = r;
+        if (inRange.z == 2.0) {
+            q = vec2(max(r.x, gmin), min(r.y, gmax));
+        } else if (gmax > 0.0) {
+            q.x = max(r.x, 1.0 / gmax);
+            if (gmin > 0.0) q.y = min(r.y, 1.0 / gmin);
+        }
+        // The plane comes from float corners: a thousandth to spare.
+        if (q.x <= q.y) r = vec2(max(r.x, q.x - 1e-3 * abs(q.x)), min(r.y, q.y + 1e-3 * abs(q.y)));
+    }
+    return vec2(r.x - (1e-5 * abs(r.x) + 1e-6), r.y + (1e-5 * abs(r.y) + 1e-6));
+}
+
+// Edge (n, d) pushed by half a tile: the rectangle's corner farthest along
+// n passes n.p + d - (|nx| + |ny|) / 2 >= 0 (a whole tile: its centre, n.c + d >= 0).
+bool keeps(vec3 e, vec2 lo, vec2 hi) {
+    const vec2 far = vec2(e.x >= 0.0 ? hi.x : lo.x, e.y >= 0.0 ? hi.y : lo.y);
+    return dot(e.xy, far) + e.z - 0.5 * (abs(e.x) + abs(e.y)) >= 0.0;
+}
 
 void main() {
-    if (any(lessThan(gl_FragCoord.xy, inBox.xy)) || any(greaterThan(gl_FragCoord.xy, inBox.zw))) return;
-    const vec3 c = vec3(gl_FragCoord.xy, 1.0);
-    if (dot(inEdge0, c) < 0.0 || dot(inEdge1, c) < 0.0 || dot(inEdge2, c) < 0.0) return;
+    // The tile as far as the screen reaches (a partial edge tile is
+    // narrower: params.cover.xy is the screen in tile units), against the
+    // box and the edges, each pushed out by half a tile and the slack
+    // (params.cover.w): the CPU reference's separating-axis test on the
+    // tile's own rectangle.
+    const vec2 lo = floor(gl_FragCoord.xy), hi = min(lo + 1.0, params.cover.xy);
+    if (any(lessThan(hi, inBox.xy + 0.5)) || any(greaterThan(lo, inBox.zw - 0.5))) return;
+    if (!keeps(inEdge0, lo, hi) || !keeps(inEdge1, lo, hi) || !keeps(inEdge2, lo, hi) || !keeps(inEdge3, lo, hi))
+        return;
     const uvec2 t = uvec2(gl_FragCoord.xy);
     if (t.x >= params.grid.x || t.y >= params.grid.y) return;
     const uint tile = t.y * params.grid.x + t.x;
+    if ((params.grid.w & LC_RASTER_SLICES) != 0u) {
+        // Clusters: no tile test here (the host applies the slices, the
+        // near and far rule and skip-empty); every covered tile keeps the
+        // depths the light's fragments span there.
+        const vec2 r = max(tileDepthRange(), vec2(0.0));
+        const uint at = 2u * (tile * params.grid.z * 32u + inLight);
+        atomicMin(ranges[at], floatBitsToUint(r.x));
+        atomicMin(ranges[at + 1u], ~floatBitsToUint(r.y));
+        atomicOr(masks[tile * params.grid.z + (inLight >> 5u)], 1u << (inLight & 31u));
+        return;
+    }
     const GpuTileBounds b = tiles[tile];
     if (!(b.depthMin <= b.depthMax) || inDepth.x > b.depthMax || inDepth.y < b.depthMin) return;
     atomicOr(masks[tile * params.grid.z + (inLight >> 5u)], 1u << (inLight & 31u));

@@ -48,6 +48,15 @@ layout(location = 2) flat out vec4 outBox;
 layout(location = 3) flat out vec3 outEdge0;
 layout(location = 4) flat out vec3 outEdge1;
 layout(location = 5) flat out vec3 outEdge2;
+layout(location = 8) flat out vec3 outEdge3; // a fourth for a triangle the near plane cuts to a quad
+// LC_RASTER_SLICES: the view depths of the triangle's corners (least,
+// greatest) and how its plane is given: z 0 none (cut by the near plane, too
+// thin, or a box), 1 1/depth, 2 depth (orthographic); outPlane: that value
+// as a x + b y + c over the grid (tile units). The fragment shader narrows
+// the corners' range to what the plane takes over its tile, as
+// light_proxy.hpp's proxyTriangleTileDepth does in double.
+layout(location = 6) flat out vec3 outRange;
+layout(location = 7) flat out vec3 outPlane;
 
 vec4 clipOf(vec3 v) {
     return mat4(params.clip[0], params.clip[1], params.clip[2], params.clip[3]) * vec4(v, 1.0);
@@ -61,10 +70,12 @@ void main() {
     const uint corner = uint(gl_VertexIndex) % 3u;
     const uint first = uint(gl_VertexIndex) - corner;
     outBox = vec4(-1e30, -1e30, 1e30, 1e30);
-    outEdge0 = outEdge1 = outEdge2 = vec3(0.0, 0.0, 1.0);
+    outEdge0 = outEdge1 = outEdge2 = outEdge3 = vec3(0.0, 0.0, 1.0);
+    outRange = vec3(p.basisXDepthMin.w, p.basisYDepthMax.w, 0.0);
+    outPlane = vec3(0.0);
     if (p.light.y != 0u) {
-        // A box the host worked out (origin: the tile centres it keeps, in
-        // tile units): one triangle around it, trimmed to it.
+        // A box the host worked out (origin, tile units: the fragment shader
+        // keeps the tiles it spans): one triangle around it, trimmed to it.
         outBox = p.origin;
         const vec2 lo = p.origin.xy, size = max(p.origin.zw - p.origin.xy, vec2(0.0));
         const vec2 box[3] = vec2[3](lo, lo + vec2(2.0 * size.x, 0.0), lo + vec2(0.0, 2.0 * size.y));
@@ -73,6 +84,29 @@ void main() {
     }
     vec3 v[3];
     for (uint k = 0u; k < 3u; ++k) v[k] = p.origin.xyz + basis * corners[first + k].xyz;
+    if ((params.grid.w & LC_RASTER_SLICES) != 0u) {
+        const bool ortho = (params.grid.w & LC_RASTER_ORTHO) != 0u;
+        vec3 d = -vec3(v[0].z, v[1].z, v[2].z);
+        outRange = vec3(min(d.x, min(d.y, d.z)), max(d.x, max(d.y, d.z)), 0.0);
+        vec2 s[3];
+        bool front = true;
+        for (uint k = 0u; k < 3u; ++k) {
+            const vec4 ck = clipOf(v[k]);
+            front = front && (ortho || ck.w >= params.cover.z);
+            s[k] = (ck.xy / ck.w * 0.5 + 0.5) * vec2(params.grid.xy);
+        }
+        const vec2 u = s[1] - s[0], w = s[2] - s[0];
+        const float det = u.x * w.y - u.y * w.x;
+        // A plane only where float fits it well: in front of the near plane
+        // and at least 1/64 tile of area (the CPU reference fits any).
+        if (front && abs(det) > 2e-4) {
+            const vec3 f = ortho ? d : 1.0 / d;
+            const float fu = f.y - f.x, fw = f.z - f.x;
+            const float a = (fu * w.y - fw * u.y) / det, b = (fw * u.x - fu * w.x) / det;
+            outPlane = vec3(a, b, f.x - a * s[0].x - b * s[0].y);
+            outRange.z = ortho ? 2.0 : 1.0;
+        }
+    }
     if (p.light.z != 0u) {
         // Wholly beyond the near plane: the faces turned to the camera cover
         // all the (convex) proxy covers; one clearly turned away is dropped.
@@ -111,28 +145,42 @@ void main() {
     vec2 lo = q[0], hi = q[0];
     for (uint k = 1u; k < m; ++k) lo = min(lo, q[k]), hi = max(hi, q[k]);
     outBox = vec4(lo - h, hi + h);
-    const float area = (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[2].x - q[0].x) * (q[1].y - q[0].y);
+    // The polygon's signed area (twice): its part in front, up to four corners.
+    float poly = 0.0;
+    for (uint k = 0u; k < m; ++k) poly += q[k].x * q[(k + 1u) % m].y - q[(k + 1u) % m].x * q[k].y;
+    const float area = clipped ? poly : (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[2].x - q[0].x) * (q[1].y - q[0].y);
     // The pushed edges, counter-clockwise (the inside left of each), for the
-    // fragment shader's test; none for a clipped triangle (its part in front
-    // has up to four edges: the box alone) or one too thin to orient.
+    // fragment shader's test: the triangle's three, or the four of what the
+    // near plane leaves of it; one too thin to orient is dropped (below).
     uint me = corner;
-    vec3 line[3];
-    const bool edges = !clipped && abs(area) > 1e-6;
+    vec3 line[4];
+    line[3] = vec3(0.0, 0.0, 1.0);
+    const bool edges = abs(area) > 1e-6;
     if (edges) {
-        if (area < 0.0) {
-            const vec2 t = q[1];
-            q[1] = q[2];
-            q[2] = t;
-            me = corner == 0u ? 0u : 3u - corner;
+        if (area < 0.0) { // reverse the corners
+            for (uint k = 0u; k < m / 2u; ++k) {
+                const vec2 t = q[k];
+                q[k] = q[m - 1u - k];
+                q[m - 1u - k] = t;
+            }
+            me = corner == 0u ? 2u : corner == 2u ? 0u : 1u;
         }
-        for (uint k = 0u; k < 3u; ++k) { // n.p + d >= 0 inside, d grown by the push
-            const vec2 a = q[k], b = q[(k + 1u) % 3u];
+        for (uint k = 0u; k < m; ++k) { // n.p + d >= 0 inside, d grown by the push
+            const vec2 a = q[k], b = q[(k + 1u) % m];
             const vec2 n = vec2(a.y - b.y, b.x - a.x);
             line[k] = vec3(n, -dot(n, a) + h * (abs(n.x) + abs(n.y)));
         }
         outEdge0 = line[0];
         outEdge1 = line[1];
         outEdge2 = line[2];
+        outEdge3 = line[3];
+    } else {
+        // Seen edge-on (the CPU reference's too: no area): a closed convex
+        // proxy's other faces cover what it would; its bounding box alone
+        // would cover tiles off the segment (an orthographic camera sees an
+        // icosphere's silhouette faces exactly edge-on).
+        gl_Position = vec4(0.0, 0.0, 0.5, 0.0);
+        return;
     }
     if ((params.grid.w & LC_RASTER_PUSH_EDGES) == 0u) {
         // The device's conservative rasteriser covers the triangle (it may
@@ -142,7 +190,7 @@ void main() {
         return;
     }
     vec2 at;
-    if (!edges || abs(area) < 1.0 / 64.0) {
+    if (clipped || abs(area) < 1.0 / 64.0) {
         const vec2 size = outBox.zw - outBox.xy;
         const vec2 box[3] = vec2[3](outBox.xy, outBox.xy + vec2(2.0 * size.x, 0.0), outBox.xy + vec2(0.0, 2.0 * size.y));
         at = box[corner];

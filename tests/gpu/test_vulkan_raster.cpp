@@ -135,3 +135,87 @@ TEST_F(VulkanRaster, ASceneWithoutLightsHasEmptyLists) {
     EXPECT_EQ(run.result.entries(), 0u);
     EXPECT_EQ(run.result.listCount.size(), std::size_t(run.result.grid.tileCount()));
 }
+
+TEST_F(VulkanRaster, ClusteredSlicesHoldTheCpuReference) {
+    // proxy-depth slices: the fragments' depth ranges (float, widened) into
+    // the host's slices; the lists hold the CPU reference's, no miss with the
+    // enclosing overfit, and the inscribed proxy's misses show on both.
+    const Scene scene = atrium();
+    for (std::uint32_t level : {0u, 1u})
+        for (double overfit : {0.0, 1.0})
+            for (Slicing slicing : {Slicing::Log, Slicing::Linear}) {
+                SCOPED_TRACE("level " + std::to_string(level) + " overfit " + std::to_string(overfit) + " " +
+                             toString(slicing));
+                CullSettings st;
+                st.algorithm = Algorithm::Raster;
+                st.proxySlices = true;
+                st.proxyLevel = level;
+                st.proxyOverfit = overfit;
+                st.slicing = slicing;
+                st.cells = 16;
+                const Compared c = compare(scene, st);
+                EXPECT_EQ(c.missing, 0u);
+                EXPECT_LE(c.extra, 8 + c.cpuEntries / 100);
+                if (overfit == 0.0) {
+                    EXPECT_EQ(c.gpuFalseNegatives, 0u);
+                } else {
+                    EXPECT_GT(c.cpuFalseNegatives, 0u);
+                    EXPECT_GT(c.gpuFalseNegatives, 0u);
+                }
+            }
+    CullSettings centre;
+    centre.algorithm = Algorithm::Raster;
+    centre.proxySlices = true;
+    centre.conservative = false;
+    const Compared c = compare(scene, centre);
+    EXPECT_LE(c.missing + c.extra, 8 + c.cpuEntries / 100) << "missing " << c.missing << " extra " << c.extra;
+}
+
+TEST_F(VulkanRaster, NearCutAndEdgeOnTrianglesCoverWhatTheCpuReferenceCovers) {
+    // An inscribed level-0 proxy (overfit 1) misses; the GPU must show the
+    // same misses, not hide them under coverage of its own. Two shapes did:
+    // triangles the near plane cuts (trimmed by their bounding box alone,
+    // now by the four edges of what is left in front) and, under an
+    // orthographic camera, faces seen exactly edge-on (drawn as their
+    // bounding box, now dropped as the CPU reference drops them: their
+    // neighbours cover their edges). Lights around the camera, across the
+    // near plane, wide spots, on a 333x197 screen (partial tiles).
+    Scene s;
+    s.camera.position = {0, 0, 0};
+    s.camera.target = {0, 0, -1};
+    s.camera.nearPlane = 0.1;
+    s.camera.farPlane = 100;
+    s.camera.fovYDeg = 90;
+    s.camera.width = 333;
+    s.camera.height = 197;
+    s.camera.tileSize = 16;
+    Mesh wall;
+    wall.positions = {-50, -50, -2, 50, -50, -2, 50, 50, -2, -50, 50, -2};
+    wall.indices = {0, 1, 2, 0, 2, 3};
+    s.meshes.push_back(wall);
+    const std::pair<glm::dvec3, double> points[] = {{{0.3, 0.2, 0.05}, 2.2},  {{0.5, 0.3, -0.08}, 2.0},
+                                                    {{-1, 0, 1}, 3.1},        {{0, 0, -0.3}, 0.25},
+                                                    {{-1.5, 0.5, -0.05}, 2.1}, {{0.8, -0.6, 0.2}, 2.4}};
+    for (const auto& [c, r] : points) {
+        PointLight l;
+        l.position = c;
+        l.explicitRadius = r;
+        s.lights.push_back(l);
+    }
+    for (bool ortho : {false, true}) {
+        SCOPED_TRACE(ortho ? "orthographic" : "perspective");
+        s.camera.projection = ortho ? ProjectionKind::Orthographic : ProjectionKind::Perspective;
+        s.camera.orthoHeight = 4;
+        for (bool slices : {false, true}) {
+            CullSettings st;
+            st.algorithm = Algorithm::Raster;
+            st.proxyLevel = 0;
+            st.proxyOverfit = 1.0;
+            st.proxySlices = slices;
+            const Compared c = compare(s, st);
+            EXPECT_EQ(c.missing, 0u);
+            EXPECT_LE(c.extra, 4 + c.cpuEntries / 100) << (slices ? "slices" : "tile");
+            EXPECT_EQ(c.gpuFalseNegatives, c.cpuFalseNegatives) << (slices ? "slices" : "tile");
+        }
+    }
+}

@@ -30,9 +30,15 @@ using lc::hardcase::hardCases;
 
 namespace {
 
-const Algorithm kAlgorithms[] = {Algorithm::All,    Algorithm::Naive,         Algorithm::MinMax,
-                                 Algorithm::HalfZ,  Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin,
-                                 Algorithm::Raster};
+// Every algorithm, and raster's clustered variant (proxy-depth slices).
+struct Variant {
+    Algorithm algorithm;
+    bool proxySlices = false;
+};
+const Variant kVariants[] = {{Algorithm::All},           {Algorithm::Naive},     {Algorithm::MinMax},
+                             {Algorithm::HalfZ},         {Algorithm::TwoPointFiveD}, {Algorithm::Clustered},
+                             {Algorithm::Fptl},          {Algorithm::ZBin},      {Algorithm::Raster},
+                             {Algorithm::Raster, true}};
 
 const HardCase& caseNamed(const std::string& name) {
     for (const HardCase& c : hardCases())
@@ -40,8 +46,9 @@ const HardCase& caseNamed(const std::string& name) {
     throw std::runtime_error("no hard case " + name);
 }
 
-std::string algorithmId(Algorithm a) {
-    std::string s = toString(a);
+std::string algorithmId(std::size_t variant) {
+    const Variant& v = kVariants[variant];
+    std::string s = std::string(toString(v.algorithm)) + (v.proxySlices ? "_slices" : "");
     std::replace(s.begin(), s.end(), '.', '_'); // "2.5d" -> "2_5d"
     return s;
 }
@@ -118,7 +125,7 @@ void expectConservativeAgreement(const CullResult& cpu, const CullResult& gpu) {
         if (ce || ge) continue;
         EXPECT_NEAR(gpu.tileDepthMin[t], cpu.tileDepthMin[t], 1e-5 * cpu.tileDepthMin[t] + 1e-6) << "tile " << t;
         EXPECT_NEAR(gpu.tileDepthMax[t], cpu.tileDepthMax[t], 1e-5 * cpu.tileDepthMax[t] + 1e-6) << "tile " << t;
-        if (cpu.algorithm == Algorithm::Clustered)
+        if (cpu.settings.clusterLists())
             EXPECT_EQ(gpu.cellMask[t] & cpu.cellMask[t], cpu.cellMask[t]) << "tile " << t;
     }
     std::uint64_t missing = 0, extra = 0;
@@ -150,16 +157,18 @@ void expectConservativeAgreement(const CullResult& cpu, const CullResult& gpu) {
                 (unsigned long long)gpu.entries(), (unsigned long long)extra);
 }
 
-using Param = std::tuple<std::string, Algorithm, std::string>;
+using Param = std::tuple<std::string, std::size_t, std::string>; // case, kVariants index, backend
 
 class HardCaseTest : public gputest::GpuTest, public ::testing::WithParamInterface<Param> {};
 
 TEST_P(HardCaseTest, Run) {
-    const auto& [caseName, algorithm, backendName] = GetParam();
+    const auto& [caseName, variant, backendName] = GetParam();
+    const Algorithm algorithm = kVariants[variant].algorithm;
     const HardCase& hc = caseNamed(caseName);
     const Scene scene = hc.make();
     CullSettings settings;
     settings.algorithm = algorithm;
+    settings.proxySlices = kVariants[variant].proxySlices;
     settings.test = hc.test;
     settings.cells = hc.cells;
     settings.slicing = hc.slicing;
@@ -227,7 +236,7 @@ std::vector<std::string> caseNames() {
 }
 
 INSTANTIATE_TEST_SUITE_P(HardCases, HardCaseTest,
-                         ::testing::Combine(::testing::ValuesIn(caseNames()), ::testing::ValuesIn(kAlgorithms),
+                         ::testing::Combine(::testing::ValuesIn(caseNames()), ::testing::Range(std::size_t(0), std::size(kVariants)),
                                             ::testing::Values(std::string("cpu"), std::string("vulkan"))),
                          [](const ::testing::TestParamInfo<Param>& info) {
                              return std::get<0>(info.param) + "__" + algorithmId(std::get<1>(info.param)) + "__" +

@@ -233,13 +233,17 @@ TEST_F(SpotVulkan, ManySpotsEveryTestIsASupersetOfTheCpu) {
         }
     // raster: cones up to 89 degrees (a base 57 ranges wide), and the spots
     // past 30 degrees drawn as spheres; coarse and fine cones.
+    // Both depth rules: the tile's min/max and clustered slices.
     for (std::uint32_t coneAngle : {30u, 89u})
-        for (std::uint32_t segments : {3u, 8u, 32u}) {
-            SCOPED_TRACE("raster cone-angle " + std::to_string(coneAngle) + " segments " + std::to_string(segments));
+        for (std::uint32_t segments : {3u, 8u, 32u})
+          for (bool slices : {false, true}) {
+            SCOPED_TRACE("raster cone-angle " + std::to_string(coneAngle) + " segments " + std::to_string(segments) +
+                         (slices ? " proxy-depth slices" : ""));
             CullSettings st;
             st.algorithm = Algorithm::Raster;
             st.proxyConeAngle = coneAngle;
             st.proxySegments = segments;
+            st.proxySlices = slices;
             const CullResult r = cpu->cull(depth, proj, grid, lights, st);
             const CullResult gr = gputest::vulkan().cull(depth, proj, grid, lights, st);
             ASSERT_EQ(gr.listCount.size(), r.listCount.size());

@@ -44,13 +44,18 @@ CullSettings minmax() {
 TEST(Explain, TestsAgreeWithTheReferenceListsForEveryAlgorithm) {
     const Scene s = smallAtrium();
     const Projection proj(s.camera);
-    for (const Algorithm a : {Algorithm::All, Algorithm::Naive, Algorithm::MinMax, Algorithm::HalfZ,
-                              Algorithm::TwoPointFiveD, Algorithm::Clustered, Algorithm::Fptl, Algorithm::ZBin,
-                              Algorithm::Raster}) {
+    // Every algorithm, and raster's clustered lists (proxy-depth slices) last.
+    const Algorithm algorithms[] = {Algorithm::All,       Algorithm::Naive, Algorithm::MinMax,
+                                    Algorithm::HalfZ,     Algorithm::TwoPointFiveD, Algorithm::Clustered,
+                                    Algorithm::Fptl,      Algorithm::ZBin,  Algorithm::Raster,
+                                    Algorithm::Raster};
+    for (std::size_t v = 0; v < std::size(algorithms); ++v) {
+        const Algorithm a = algorithms[v];
         for (const SphereTest t : {SphereTest::Planes, SphereTest::Exact}) {
             for (const SpotTest st : {SpotTest::ApexSphere, SpotTest::ConePlanes}) {
                 CullSettings cs;
                 cs.algorithm = a;
+                cs.proxySlices = v + 1 == std::size(algorithms);
                 cs.test = t;
                 cs.spotTest = st;
                 cs.cells = 8;
@@ -246,6 +251,44 @@ TEST(Explain, ARasterMissNamesTheProxyCoverage) {
     }
     EXPECT_GT(named, 0u);
     EXPECT_GT(grazed, 0u) << "no miss of centre sampling among " << named;
+}
+
+// raster with proxy-depth slices: a light the inscribed proxy misses in
+// depth (its triangles' depths over the tile end before the pixel's slice)
+// is named at the slice step, with the depths and the slices.
+TEST(Explain, ARasterSliceMissNamesTheSlices) {
+    const Scene s = smallAtrium();
+    const Projection proj(s.camera);
+    CullSettings cs;
+    cs.algorithm = Algorithm::Raster;
+    cs.proxySlices = true;
+    cs.proxyLevel = 0;
+    cs.proxyOverfit = 1.0;
+    cs.cells = 32;
+    const RunOutput run = cpuRun(s, cs);
+    ASSERT_GT(run.truth.metrics.falseNegatives, 0u) << "the case no longer misses";
+    std::uint32_t bySlice = 0, byCoverage = 0;
+    for (std::uint32_t l = 0; l < run.result.listCount.size(); ++l) {
+        if (run.truth.listFalseNegatives[l] == 0) continue;
+        for (std::uint32_t i = 0; i < run.lights.size(); ++i) {
+            const Explanation e = explainLight(run, proj, l, i);
+            if (e.listed || e.pixelsNeeding == 0) continue;
+            EXPECT_EQ(e.verdict.rfind("MISSING", 0), 0u) << e.text();
+            EXPECT_FALSE(e.testsPass) << e.text();
+            for (const ExplainStep& st : e.steps) {
+                if (st.passed) continue;
+                if (st.test.rfind("proxy depth slices (32 log of ", 0) == 0) {
+                    EXPECT_NE(st.numbers.find("the covering triangles span depths "), std::string::npos) << e.text();
+                    EXPECT_NE(st.numbers.find(", not slice " + std::to_string(l % 32)), std::string::npos) << e.text();
+                    ++bySlice;
+                }
+                byCoverage += st.test.rfind("proxy coverage", 0) == 0;
+                break;
+            }
+        }
+    }
+    EXPECT_GT(bySlice, 0u) << "no miss in depth";
+    EXPECT_GT(byCoverage, 0u) << "no miss in coverage";
 }
 
 TEST(Explain, CliPrintsTheSameExplanation) {

@@ -5,6 +5,7 @@
 // across the near plane, around the camera, on a partial edge tile.
 #include "culling/core/backend.hpp"
 #include "culling/math/light_proxy.hpp"
+#include "culling/scene/scene_io.hpp"
 #include "culling/truth/ground_truth.hpp"
 
 #include <gtest/gtest.h>
@@ -257,4 +258,144 @@ TEST(RasterCull, LightsAcrossTheNearPlaneAroundTheCameraAndOnPartialTiles) {
     EXPECT_EQ(std::count(r.lightIndices.begin(), r.lightIndices.end(), 1u), std::ptrdiff_t(r.grid.tileCount()))
         << "the light around the camera reaches the wall in every tile";
     EXPECT_FALSE(r.coverage.empty());
+}
+
+TEST(LightProxy, TileDepthRangeHoldsTheTrianglesDepthsOverTheTile) {
+    // Random triangles (some reaching behind the near plane, some steeply
+    // inclined) under a perspective and an orthographic camera, 170x100 at
+    // 16-pixel tiles (a partial last column and row): every point of a
+    // triangle over a tile it covers has its depth in the range, and the
+    // plane narrows the corners' range (it is the tight measure the slices
+    // use, not the whole triangle's).
+    for (bool ortho : {false, true}) {
+        SCOPED_TRACE(ortho ? "orthographic" : "perspective");
+        Camera cam;
+        cam.width = 170;
+        cam.height = 100;
+        cam.tileSize = 16;
+        cam.nearPlane = 0.5;
+        cam.farPlane = 100;
+        if (ortho) {
+            cam.projection = ProjectionKind::Orthographic;
+            cam.orthoHeight = 20;
+        }
+        const Projection proj(cam);
+        const TileGrid grid = TileGrid::make(cam.width, cam.height, cam.tileSize);
+        std::mt19937 rng(7);
+        std::uniform_real_distribution<double> xy(-12, 12), z(-40, 0.2);
+        std::uint64_t checked = 0, tiles = 0;
+        double narrowed = 0, corners = 0;
+        for (int n = 0; n < 300; ++n) {
+            std::array<glm::dvec3, 3> tri;
+            for (auto& v : tri) v = {xy(rng), xy(rng), z(rng)};
+            proxyTriangleTiles(proj, grid, tri, true, [&](std::uint32_t tx, std::uint32_t ty) {
+                const auto [lo, hi] = proxyTriangleTileDepth(proj, grid, tri, true, tx, ty);
+                const double vlo = std::min({-tri[0].z, -tri[1].z, -tri[2].z});
+                const double vhi = std::max({-tri[0].z, -tri[1].z, -tri[2].z});
+                ASSERT_LE(lo, hi);
+                EXPECT_GE(lo, vlo);
+                EXPECT_LE(hi, vhi);
+                ++tiles;
+                narrowed += hi - lo;
+                corners += vhi - vlo;
+                for (int i = 0; i <= 40; ++i)
+                    for (int j = 0; i + j <= 40; ++j) {
+                        const glm::dvec3 p = tri[0] + (tri[1] - tri[0]) * (i / 40.0) + (tri[2] - tri[0]) * (j / 40.0);
+                        if (-p.z < cam.nearPlane) continue; // clipped away
+                        const glm::dvec2 t = proj.pixelFromView(p) / double(cam.tileSize);
+                        if (t.x < tx || t.x > tx + 1.0 || t.y < ty || t.y > ty + 1.0) continue;
+                        const double d = -p.z, e = 1e-9 * std::abs(d) + 1e-12;
+                        EXPECT_GE(d, lo - e) << "tile " << tx << "," << ty;
+                        EXPECT_LE(d, hi + e) << "tile " << tx << "," << ty;
+                        ++checked;
+                    }
+            });
+        }
+        EXPECT_GT(checked, 10000u);
+        EXPECT_GT(tiles, 1000u);
+        EXPECT_LT(narrowed, 0.5 * corners) << "the plane narrows the corners' range";
+    }
+}
+
+namespace {
+
+// False negatives of `st` on `scene` by the pipeline's ground truth (which
+// looks clustered lists up by each pixel's slice), CPU reference.
+std::uint64_t truthFalseNegatives(const Scene& scene, const CullSettings& st, std::uint64_t* shading = nullptr) {
+    auto cpu = makeCpuBackend();
+    const Projection proj(scene.camera);
+    const DepthImage depth = cpu->renderDepth(scene, proj);
+    const ViewLights lights = makeViewLights(scene);
+    const TileGrid grid = TileGrid::make(scene.camera.width, scene.camera.height, scene.camera.tileSize);
+    const CullResult r = cpu->cull(depth, proj, grid, lights, st);
+    EXPECT_EQ(r.validate(lights.size()), "");
+    EXPECT_EQ(r.listsPerTile, st.proxySlices ? st.cells : 1u);
+    const Metrics m = computeGroundTruth(depth, proj, lights, r, {false}).metrics;
+    if (shading) *shading = m.shadingWork;
+    return m.falseNegatives;
+}
+
+} // namespace
+
+TEST(RasterCull, ClusteredSlicesMissNothingAndShadeLessThanTheTilesRange) {
+    // proxy-depth slices: each covered tile's triangles' depths mark the
+    // light's slices. With the enclosing overfit: no miss, at every level,
+    // slicing and skip-empty, and less shading than the tile's min/max rule
+    // (a tile spanning a pillar and the far wall no longer lists a light
+    // between them); the inscribed proxy misses.
+    Scene scene = makeBuiltinScene("atrium");
+    scene.camera.width = 330; // partial last column and row
+    scene.camera.height = 190;
+    for (std::uint32_t level : {0u, 1u, 2u}) {
+        CullSettings tile = raster(level, 0.0, true);
+        std::uint64_t tileWork = 0;
+        ASSERT_EQ(truthFalseNegatives(scene, tile, &tileWork), 0u);
+        for (Slicing slicing : {Slicing::Log, Slicing::Linear})
+            for (bool skipEmpty : {true, false}) {
+                SCOPED_TRACE("level " + std::to_string(level) + " " + toString(slicing) +
+                             (skipEmpty ? " skip-empty" : ""));
+                CullSettings st = tile;
+                st.proxySlices = true;
+                st.cells = 16;
+                st.slicing = slicing;
+                st.skipEmpty = skipEmpty;
+                std::uint64_t work = 0;
+                EXPECT_EQ(truthFalseNegatives(scene, st, &work), 0u);
+                EXPECT_LT(work, tileWork);
+            }
+    }
+    CullSettings inscribed = raster(0, 1.0, true);
+    inscribed.proxySlices = true;
+    EXPECT_GT(truthFalseNegatives(scene, inscribed), 0u);
+    // Centre sampling samples the depth at the tile's centre too: it misses.
+    CullSettings centre = raster(1, 0.0, false);
+    centre.proxySlices = true;
+    EXPECT_GT(truthFalseNegatives(scene, centre), 0u);
+}
+
+TEST(RasterCull, ClusteredSlicesAcrossTheNearPlaneAndAroundTheCamera) {
+    // The near-plane cases with slices: a proxy the near plane cuts starts at
+    // slice 0 (its part in front is clipped away), a camera inside a light
+    // lists it in every tile's occupied slice; one behind the camera nowhere.
+    const Scene scene = wallScene(250, 190, 16, 6.0,
+                                  {{{0.3, 0.2, -0.4}, 1.5},
+                                   {{0, 0, 0.5}, 8.0},
+                                   {{2.9, 0.5, -5.6}, 0.7},
+                                   {{0.1, -2.2, -5.5}, 0.8},
+                                   {{0, 0, 3.0}, 2.0}});
+    for (std::uint32_t level : {0u, 1u, 4u}) {
+        CullSettings st = raster(level, 0.0, true);
+        st.proxySlices = true;
+        EXPECT_EQ(truthFalseNegatives(scene, st), 0u) << "level " << level;
+    }
+    auto cpu = makeCpuBackend();
+    const Projection proj(scene.camera);
+    const DepthImage depth = cpu->renderDepth(scene, proj);
+    const ViewLights lights = makeViewLights(scene);
+    CullSettings st = raster(1, 0.0, true);
+    st.proxySlices = true;
+    const CullResult r = cpu->cull(depth, proj, TileGrid::make(250, 190, 16), lights, st);
+    EXPECT_EQ(std::count(r.lightIndices.begin(), r.lightIndices.end(), 4u), 0) << "the light behind the camera";
+    EXPECT_EQ(std::count(r.lightIndices.begin(), r.lightIndices.end(), 1u), std::ptrdiff_t(r.grid.tileCount()))
+        << "the light around the camera, once per tile: the wall's one occupied slice";
 }

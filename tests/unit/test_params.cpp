@@ -12,7 +12,7 @@ TEST(Params, TableOrderAndDefaultsMatchTheStructs) {
     for (const auto& p : t) names.push_back(p.name);
     EXPECT_EQ(names, (std::vector<std::string>{"algorithm", "test", "cells", "slicing", "skip-empty", "spot-test", "bins",
                                                "proxy-level", "proxy-segments", "proxy-cone-angle", "proxy-overfit",
-                                               "conservative", "tile", "width", "height", "cap", "max-lights",
+                                               "conservative", "proxy-depth", "tile", "width", "height", "cap", "max-lights",
                                                "max-entries", "overflow-policy", "limit-keep"}));
     // The table's defaults are the structs' defaults.
     const CullSettings s;

@@ -48,6 +48,10 @@ std::uint32_t listsPerTileOf(Algorithm algorithm, std::uint32_t cells, bool cell
     return 1;
 }
 
+std::uint32_t listsPerTileOf(const CullSettings& settings, bool cellLists) {
+    return settings.clusterLists() ? settings.cells : listsPerTileOf(settings.algorithm, settings.cells, cellLists);
+}
+
 double cameraFarDepth(const Projection& proj, const ViewLights& lights, SpotTest spotTest) {
     if (std::isfinite(proj.farPlane())) return proj.farPlane();
     double lightFar = 0.0;
@@ -72,7 +76,7 @@ CullFrame makeCullFrame(const DepthImage& depth, const Projection& proj, const T
 
     CullFrame f;
     f.grid = grid;
-    f.listsPerTile = listsPerTileOf(settings.algorithm, settings.cells);
+    f.listsPerTile = listsPerTileOf(settings);
     f.listTotal = settings.algorithm == Algorithm::All ? 1 : std::uint64_t(grid.tileCount()) * f.listsPerTile;
     f.cullSpheres.resize(lights.size());
     double lightFar = 0.0;
@@ -112,7 +116,7 @@ CullResult CullBackend::cull(const DepthImage& depth, const Projection& proj, co
     r.listsPerTile = frame.listsPerTile;
     r.cameraNear = frame.cameraNear;
     r.cameraFar = frame.cameraFar;
-    if (settings.algorithm == Algorithm::Clustered) {
+    if (settings.clusterLists()) {
         r.clusterNear = frame.clusterNear;
         r.clusterFar = frame.clusterFar;
     }

@@ -40,7 +40,7 @@ std::uint64_t CullResult::bytes() const {
     std::uint64_t b = 4 * entries() + 8 * lists;
     if (settings.maxEntries) b = 4 * std::uint64_t(settings.maxEntries) + 8 * lists;
     else if (settings.cap) b = 4 * (std::uint64_t(settings.cap) + 1) * lists;
-    if (algorithm == Algorithm::Clustered) b += 8; // clusterNear, clusterFar as float
+    if (settings.clusterLists()) b += 8; // clusterNear, clusterFar as float
     return b;
 }
 
@@ -65,6 +65,9 @@ std::uint32_t CullResult::listOfPixel(std::uint32_t px, std::uint32_t py, double
     const std::uint32_t tile = grid.tileOfPixel(px, py);
     switch (algorithm) {
     case Algorithm::HalfZ: return tile * 2 + (viewDepth <= halfzSplit[tile] ? 0u : 1u);
+    case Algorithm::Raster:
+        if (!settings.proxySlices) return tile;
+        [[fallthrough]];
     case Algorithm::Clustered:
         return tile * listsPerTile +
                sliceOfDepth(settings.slicing, clusterNear, clusterFar, listsPerTile, viewDepth);
@@ -78,7 +81,7 @@ std::uint32_t CullResult::listOfPixel(std::uint32_t px, std::uint32_t py, double
 
 std::vector<SliceLocator> cellSlices(const CullResult& r, std::uint32_t cells) {
     std::vector<SliceLocator> slices;
-    if (r.algorithm == Algorithm::Clustered) {
+    if (r.settings.clusterLists()) {
         slices.emplace_back(r.settings.slicing, r.clusterNear, r.clusterFar, cells);
     } else if (r.algorithm == Algorithm::TwoPointFiveD) {
         slices.reserve(r.tileDepthMin.size());
@@ -90,14 +93,14 @@ std::vector<SliceLocator> cellSlices(const CullResult& r, std::uint32_t cells) {
 
 PixelListLookup::PixelListLookup(const CullResult& result) : r_(result) {
     // 2.5d without cell lists has one list per tile: listOfPixel's own rule.
-    if (r_.pixelList.empty() && (r_.algorithm == Algorithm::Clustered || r_.cellLists))
+    if (r_.pixelList.empty() && (r_.settings.clusterLists() || r_.cellLists))
         slices_ = cellSlices(r_, r_.listsPerTile);
 }
 
 std::uint32_t PixelListLookup::operator()(std::uint32_t px, std::uint32_t py, double viewDepth) const {
     if (slices_.empty()) return r_.listOfPixel(px, py, viewDepth);
     const std::uint32_t tile = r_.grid.tileOfPixel(px, py);
-    const SliceLocator& slice = r_.algorithm == Algorithm::Clustered ? slices_[0] : slices_[tile];
+    const SliceLocator& slice = r_.settings.clusterLists() ? slices_[0] : slices_[tile];
     return tile * r_.listsPerTile + slice(viewDepth);
 }
 
@@ -130,7 +133,7 @@ std::uint32_t CullResult::tileOfList(std::uint32_t list) const {
 
 std::string CullResult::validate(std::size_t lightCount) const {
     const std::uint64_t tiles = grid.tileCount();
-    const std::uint32_t expectPerTile = listsPerTileOf(algorithm, settings.cells, cellLists);
+    const std::uint32_t expectPerTile = listsPerTileOf(settings, cellLists);
     if (algorithm != Algorithm::All && listsPerTile != expectPerTile)
         return "listsPerTile is " + std::to_string(listsPerTile) + ", expected " +
                std::to_string(expectPerTile);
@@ -156,8 +159,7 @@ std::string CullResult::validate(std::size_t lightCount) const {
         return "tile depth bounds hold " + std::to_string(tileDepthMin.size()) + " entries, expected " +
                std::to_string(tiles);
     if (algorithm == Algorithm::HalfZ && halfzSplit.size() != tiles) return "halfzSplit size mismatch";
-    if ((algorithm == Algorithm::TwoPointFiveD || algorithm == Algorithm::Clustered) &&
-        cellMask.size() != tiles)
+    if ((algorithm == Algorithm::TwoPointFiveD || settings.clusterLists()) && cellMask.size() != tiles)
         return "cellMask size mismatch";
     std::uint64_t total = 0;
     for (std::size_t l = 0; l < listOffset.size(); ++l) {

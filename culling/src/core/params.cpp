@@ -94,6 +94,11 @@ std::vector<ParamSpec> buildTable() {
                  "raster: a proxy marks every tile it overlaps (conservative rasterisation), else only "
                  "the tiles whose centre it covers",
                  "Conservative", ""});
+    t.push_back({"proxy-depth", ParamType::Choice, "tile", {"tile", "slices"}, 0, 0,
+                 "raster: tile (one list per tile: the proxy's depth range against the tile's min/max) or "
+                 "slices (clustered lists: cells slices of slicing, each fragment's depth marking the "
+                 "slices it spans, as Godot's depth bits)",
+                 "Depth", ""});
     t.push_back({"tile", ParamType::Int, "16", {}, 1, 256, "tile size in pixels", "Tile", ""});
     t.push_back({"width", ParamType::Int, "1280", {}, 1, 16384, "render width in pixels", "Width", ""});
     t.push_back({"height", ParamType::Int, "720", {}, 1, 16384, "render height in pixels", "Height", ""});
@@ -255,6 +260,7 @@ void setParam(CullSettings& s, Camera& camera, const std::string& name, const st
     else if (name == "proxy-cone-angle") s.proxyConeAngle = std::uint32_t(parseInt(p, value));
     else if (name == "proxy-overfit") s.proxyOverfit = parseReal(p, value);
     else if (name == "conservative") s.conservative = parseBool(p, value);
+    else if (name == "proxy-depth") s.proxySlices = parseChoice(p, value) == 1;
     else if (name == "tile") camera.tileSize = std::uint32_t(parseInt(p, value));
     else if (name == "width") camera.width = std::uint32_t(parseInt(p, value));
     else if (name == "height") camera.height = std::uint32_t(parseInt(p, value));
@@ -279,6 +285,7 @@ std::string getParam(const CullSettings& s, const Camera& camera, const std::str
     if (name == "proxy-cone-angle") return std::to_string(s.proxyConeAngle);
     if (name == "proxy-overfit") return s.proxyOverfit == 0.0 ? "auto" : realText(s.proxyOverfit);
     if (name == "conservative") return s.conservative ? "true" : "false";
+    if (name == "proxy-depth") return s.proxySlices ? "slices" : "tile";
     if (name == "tile") return std::to_string(camera.tileSize);
     if (name == "width") return std::to_string(camera.width);
     if (name == "height") return std::to_string(camera.height);

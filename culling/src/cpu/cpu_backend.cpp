@@ -153,7 +153,6 @@ void tileBounds(CpuCull& c, CullResult& res) {
 void cellMasks(const CpuCull& c, CullResult& res) {
     const DepthImage& depth = c.depth;
     const TileGrid& grid = c.frame.grid;
-    const Algorithm algo = c.settings.algorithm;
     const std::uint32_t cells = c.settings.cells;
     res.cellMask.assign(grid.tileCount(), 0);
     // sliceOfDepth's answers, the boundaries worked out once per range.
@@ -163,7 +162,7 @@ void cellMasks(const CpuCull& c, CullResult& res) {
             const double v = c.viewDepth[std::size_t(y) * depth.width + x];
             if (std::isnan(v)) continue;
             const std::uint32_t t = grid.tileOfPixel(x, y);
-            const std::uint32_t k = slices[algo == Algorithm::Clustered ? 0 : t](v);
+            const std::uint32_t k = slices[c.settings.clusterLists() ? 0 : t](v);
             res.cellMask[t] |= 1u << k;
         }
     }
@@ -316,6 +315,21 @@ void rasterTiles(const CpuCull& c, CullResult& res, std::vector<std::vector<std:
     std::vector<std::uint32_t> seen(grid.tileCount(), std::numeric_limits<std::uint32_t>::max());
     for (std::uint32_t l = 0; l < lights.size(); ++l) {
         const LightProxy p = makeLightProxy(lights, l, c.settings);
+        if (c.settings.proxySlices) {
+            // Clusters: per covered tile the depths the covering triangles
+            // span there, then the light's slices (LightProxy::sliceMask).
+            res.volumeTests += proxySliceTiles(c.proj, grid, p, c.settings.conservative,
+                                               [&](std::uint32_t t, double lo, double hi) {
+                                                   for (std::uint32_t m = p.sliceMask(c.settings, res.clusterNear,
+                                                                                      res.clusterFar, lo, hi,
+                                                                                      res.cellMask[t]);
+                                                        m; m &= m - 1)
+                                                       lists[std::size_t(t) * res.listsPerTile +
+                                                             std::uint32_t(std::countr_zero(m))]
+                                                           .push_back(l);
+                                               });
+            continue;
+        }
         auto mark = [&](std::uint32_t tx, std::uint32_t ty) {
             const std::uint32_t t = grid.tileIndex(tx, ty);
             if (seen[t] == l) return;
@@ -402,7 +416,7 @@ static CullResult cullCpu(const CullFrame& frame, const DepthImage& depth, const
         c.sphereCenter[l] = frame.cullSpheres[l].center;
         c.sphereRadius[l] = frame.cullSpheres[l].radius;
     }
-    if (algo == Algorithm::Clustered) {
+    if (settings.clusterLists()) {
         res.clusterNear = frame.clusterNear;
         res.clusterFar = frame.clusterFar;
     }
@@ -412,7 +426,7 @@ static CullResult cullCpu(const CullFrame& frame, const DepthImage& depth, const
             if (res.tileDepthMin[t] <= res.tileDepthMax[t])
                 res.halfzSplit[t] = 0.5 * (res.tileDepthMin[t] + res.tileDepthMax[t]);
     }
-    if (algo == Algorithm::TwoPointFiveD || algo == Algorithm::Clustered) cellMasks(c, res);
+    if (algo == Algorithm::TwoPointFiveD || settings.clusterLists()) cellMasks(c, res);
 
     const std::size_t listTotal = algo == Algorithm::All ? 1 : std::size_t(tiles) * res.listsPerTile;
     std::vector<std::vector<std::uint32_t>> lists(listTotal);

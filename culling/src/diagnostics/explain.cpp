@@ -13,6 +13,7 @@
 #include "truth/light_grid.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -64,21 +65,23 @@ bool explainRaster(const RunOutput& run, const Projection& proj, Explanation& e)
     const std::uint32_t tx = t % r.grid.tilesX, ty = t / r.grid.tilesX;
     const LightProxy p = makeLightProxy(lights, light, s);
     std::vector<std::uint32_t> covering;
-    // Where no triangle covers the tile: the one whose tiles come nearest
-    // (in tiles, Chebyshev), for the step's numbers; under centre sampling
-    // also a triangle that overlaps the tile without covering its centre.
-    std::uint32_t nearestTri = 0, nearestTiles = std::numeric_limits<std::uint32_t>::max();
+    // Where no triangle covers the tile: the one that comes nearest (its
+    // separation from the tile's square, in tiles: how much the proxy falls
+    // short, the measure for an overfit), for the step's numbers; under
+    // centre sampling also a triangle that overlaps the tile without
+    // covering its centre.
+    std::uint32_t nearestTri = 0;
+    double nearestGap = std::numeric_limits<double>::infinity();
     std::int64_t grazing = -1;
     for (std::uint32_t i = 0; i < p.mesh->triangles.size(); ++i) {
         const auto& tri = p.mesh->triangles[i];
         const std::array<glm::dvec3, 3> v = {p.vertex(tri[0]), p.vertex(tri[1]), p.vertex(tri[2])};
         bool hit = false;
-        proxyTriangleTiles(proj, r.grid, v, s.conservative, [&](std::uint32_t x, std::uint32_t y) {
-            hit = hit || (x == tx && y == ty);
-            const std::uint32_t d = std::max(x > tx ? x - tx : tx - x, y > ty ? y - ty : ty - y);
-            if (d < nearestTiles) nearestTiles = d, nearestTri = i;
-        });
+        proxyTriangleTiles(proj, r.grid, v, s.conservative,
+                           [&](std::uint32_t x, std::uint32_t y) { hit = hit || (x == tx && y == ty); });
         if (hit) covering.push_back(i);
+        if (const double gap = proxyTriangleTileGap(proj, r.grid, v, tx, ty); !hit && gap < nearestGap)
+            nearestGap = gap, nearestTri = i;
         if (!hit && !s.conservative && grazing < 0)
             proxyTriangleTiles(proj, r.grid, v, true, [&](std::uint32_t x, std::uint32_t y) {
                 if (x == tx && y == ty) grazing = i;
@@ -93,22 +96,63 @@ bool explainRaster(const RunOutput& run, const Projection& proj, Explanation& e)
     std::string numbers;
     if (!covering.empty()) {
         numbers = "triangle " + std::to_string(covering[0]) +
-                  (covering.size() > 1 ? " and " + std::to_string(covering.size() - 1) + " more" : std::string()) + " " +
-                  rule + " tile " + std::to_string(tx) + "," + std::to_string(ty);
+                  (covering.size() > 1 ? " (and " + std::to_string(covering.size() - 1) + " more)" : std::string()) +
+                  " " + rule + " tile " + std::to_string(tx) + "," + std::to_string(ty);
     } else if (grazing >= 0) {
         numbers = "no triangle covers the centre of tile " + std::to_string(tx) + "," + std::to_string(ty) +
                   "; triangle " + std::to_string(grazing) +
                   " overlaps it (centre sampling: a tile a proxy only grazes is not covered; --conservative true "
                   "covers it)";
-    } else if (nearestTiles == std::numeric_limits<std::uint32_t>::max()) {
-        numbers = "no triangle " + rule + " any tile (the proxy lies off screen or before the near plane)";
-    } else {
+    } else if (!std::isfinite(nearestGap)) {
         numbers = "no triangle " + rule + " tile " + std::to_string(tx) + "," + std::to_string(ty) +
-                  "; the nearest, triangle " + std::to_string(nearestTri) + ", reaches " +
-                  std::to_string(nearestTiles) + " tile" + (nearestTiles == 1 ? "" : "s") + " away" +
+                  " (the proxy lies before the near plane)";
+    } else {
+        char gap[96];
+        std::snprintf(gap, sizeof gap, "%.3g tiles (%.3g pixels)", nearestGap, nearestGap * r.grid.tileSize);
+        numbers = "no triangle " + rule + " tile " + std::to_string(tx) + "," + std::to_string(ty) +
+                  "; the nearest, triangle " + std::to_string(nearestTri) + ", falls " + gap + " short of it" +
                   (s.conservative ? "" : " (centre sampling: a tile it only grazes is not covered)");
     }
     bool ok = e.steps.emplace_back(ExplainStep{"proxy coverage: " + mesh, numbers, !covering.empty()}).passed;
+    if (s.proxySlices) {
+        // The depths the covering triangles span over the tile -> slices.
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (std::uint32_t i : covering) {
+            const auto& tri = p.mesh->triangles[i];
+            const auto [a, b] = proxyTriangleTileDepth(proj, r.grid, {p.vertex(tri[0]), p.vertex(tri[1]), p.vertex(tri[2])},
+                                                       s.conservative, tx, ty);
+            lo = std::min(lo, a), hi = std::max(hi, b);
+        }
+        if (covering.empty()) return false;
+        const std::uint32_t all = p.sliceMask(s, r.clusterNear, r.clusterFar, lo, hi, ~0u);
+        const std::uint32_t k = std::uint32_t(std::max(e.sub, 0));
+        const bool inRange = (all >> k) & 1u;
+        std::string rule;
+        if (p.depthMin - p.slack() <= r.clusterNear) rule += "; the proxy reaches the near plane: from slice 0";
+        if (p.depthMax + p.slack() >= r.clusterFar) rule += "; it reaches the far plane: to the last slice";
+        auto range = [](std::uint32_t m) {
+            if (!m) return std::string("no slice");
+            const int a = std::countr_zero(m), b = 31 - std::countl_zero(m);
+            return a == b ? "slice " + std::to_string(a) : "slices " + std::to_string(a) + ".." + std::to_string(b);
+        };
+        ok = e.steps.emplace_back(ExplainStep{"proxy depth slices (" + std::to_string(s.cells) + " " +
+                                                  toString(s.slicing) + " of " + num(r.clusterNear) + ".." +
+                                                  num(r.clusterFar) + ")",
+                                              "the covering triangles span depths " + num(lo) + ".." + num(hi) +
+                                                  " over the tile" + rule + ": " + range(all) +
+                                                  (inRange ? ", slice " : ", not slice ") + std::to_string(k),
+                                              inRange})
+                 .passed &&
+             ok;
+        if (s.skipEmpty) {
+            const bool occ = (r.cellMask[t] >> k) & 1u;
+            ok = e.steps.emplace_back(ExplainStep{"slice holds geometry (skip-empty)", occ ? "occupied" : "empty: skipped",
+                                                  occ})
+                     .passed &&
+                 ok;
+        }
+        return ok;
+    }
     const double tmin = r.tileDepthMin[t], tmax = r.tileDepthMax[t];
     const bool reaches = p.depthReaches(tmin, tmax);
     ok = e.steps.emplace_back(ExplainStep{"proxy depth range",
@@ -139,11 +183,11 @@ bool explainTests(const RunOutput& run, const Projection& proj, const BoundingSp
     bool ok = true;
     double lo = 0, hi = 0;
     const bool emptyListed = r.algorithm == Algorithm::Naive || r.algorithm == Algorithm::ZBin ||
-                             (r.algorithm == Algorithm::Clustered && !s.skipEmpty);
+                             (r.layout() == Algorithm::Clustered && !s.skipEmpty);
     if (empty && !emptyListed) {
         ok = step("tile holds geometry", "no geometry pixel: the tile gets an empty list", false);
     } else {
-        switch (r.algorithm) {
+        switch (r.layout()) {
         case Algorithm::ZBin: // the tile's mask: naive's screen-space volume
         case Algorithm::Naive: {
             // The range the pass culled over: the camera's near and far,

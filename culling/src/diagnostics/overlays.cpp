@@ -88,7 +88,7 @@ std::vector<DepthCell> tileCells(const CullResult& r, const Projection& proj, st
     const auto rect = r.grid.tileRect(tile % r.grid.tilesX, tile / r.grid.tilesX);
     const Slicing s = r.settings.slicing;
     const std::uint32_t mask = tile < r.cellMask.size() ? r.cellMask[tile] : 0u;
-    switch (r.algorithm) {
+    switch (r.layout()) {
     case Algorithm::TwoPointFiveD: {
         if (!tileHasGeometry(r, tile)) break;
         const double lo = r.tileDepthMin[tile], hi = r.tileDepthMax[tile];
@@ -139,7 +139,7 @@ std::uint32_t lightCellRange(const CullResult& r, std::uint32_t tile, const glm:
                              double radius) {
     if (tile >= r.grid.tileCount()) return 0;
     const double a = -centerView.z - radius, b = -centerView.z + radius;
-    switch (r.algorithm) {
+    switch (r.layout()) {
     case Algorithm::TwoPointFiveD:
         if (!tileHasGeometry(r, tile)) return 0;
         return sliceRangeMask(r.settings.slicing, r.tileDepthMin[tile], r.tileDepthMax[tile], r.settings.cells, a, b);
@@ -248,7 +248,7 @@ std::vector<TileLightRow> tileLightRows(const RunOutput& run, const Projection& 
     const DepthImage& depth = run.depth;
     if (tile >= r.grid.tileCount() || depth.width != r.grid.width || depth.height != r.grid.height) return rows;
     auto [first, count] = r.tileLists(tile);
-    const bool perCellLists = r.algorithm == Algorithm::HalfZ || r.algorithm == Algorithm::Clustered;
+    const bool perCellLists = r.algorithm == Algorithm::HalfZ || r.layout() == Algorithm::Clustered;
     if (cell >= 0 && perCellLists) {
         if (std::uint32_t(cell) >= count) return rows;
         first += std::uint32_t(cell);
@@ -631,7 +631,7 @@ void writeOverlaysVtm(const Scene& scene, const RunOutput& run, const std::strin
     {
         std::size_t total = 0;
         for (std::uint32_t t = 0; t < tiles; ++t) {
-            if (r.algorithm == Algorithm::Clustered) total += r.listsPerTile;
+            if (r.layout() == Algorithm::Clustered) total += r.listsPerTile;
             else if (r.algorithm == Algorithm::TwoPointFiveD && tileHasGeometry(r, t)) total += r.settings.cells;
             else if (r.algorithm == Algorithm::HalfZ && tileHasGeometry(r, t)) total += 2;
         }

@@ -81,6 +81,7 @@ std::vector<std::string> sweepValues(const ParamSpec& p, const ReportOptions& o)
     if (p.name == "proxy-level") return {"0", "1", "2"};
     if (p.name == "proxy-overfit") return {"auto"};
     if (p.name == "conservative") return {"true"};
+    if (p.name == "proxy-depth") return {"tile"};
     switch (p.type) {
     case ParamType::Choice: return p.choices;
     case ParamType::Bool: return {"false", "true"};
@@ -96,6 +97,10 @@ bool paramAppliesTo(const std::string& name, const CullSettings& s, bool sceneHa
     if (name == "overflow-policy") return s.cap || s.maxEntries;
     if (name == "limit-keep") return s.maxLights;
     if (name == "cap" || name == "max-lights" || name == "max-entries") return true;
+    // raster's clusters are slices as clustered's, only with proxy-depth slices.
+    if (s.algorithm == Algorithm::Raster && (name == "cells" || name == "slicing" || name == "skip-empty") &&
+        !s.proxySlices)
+        return false;
     return paramAppliesTo(name, s.algorithm, s.cells, sceneHasSpotLights);
 }
 
@@ -113,9 +118,11 @@ bool paramAppliesTo(const std::string& name, Algorithm a, std::uint32_t cells, b
         return false;
     }
     if (name.rfind("spot-", 0) == 0) return sceneHasSpotLights;
-    if (name == "cells") return a == Algorithm::TwoPointFiveD || a == Algorithm::Clustered;
-    if (name == "slicing") return (a == Algorithm::TwoPointFiveD || a == Algorithm::Clustered) && cells > 1;
-    if (name == "skip-empty") return a == Algorithm::Clustered;
+    // (raster's with proxy-depth slices: the settings' overload decides.)
+    const bool slices = a == Algorithm::TwoPointFiveD || a == Algorithm::Clustered || a == Algorithm::Raster;
+    if (name == "cells") return slices;
+    if (name == "slicing") return slices && cells > 1;
+    if (name == "skip-empty") return a == Algorithm::Clustered || a == Algorithm::Raster;
     if (name == "bins") return a == Algorithm::ZBin;
     return true; // tile, test, and parameters added later
 }
@@ -173,12 +180,13 @@ std::vector<ReportConfig> reportConfigs(const ReportOptions& options, const std:
             ReportConfig cfg;
             cfg.backend = backend;
             Camera cam;
-            // What decides where the others apply: the cells and the limits.
+            // What decides where the others apply: the cells, raster's depth
+            // and the limits.
             CullSettings probe;
             probe.algorithm = algo;
             for (std::size_t k = 0; k < specs.size(); ++k)
-                if (const std::string& n = specs[k]->name;
-                    n == "cells" || n == "cap" || n == "max-lights" || n == "max-entries")
+                if (const std::string& n = specs[k]->name; n == "cells" || n == "proxy-depth" || n == "cap" ||
+                                                           n == "max-lights" || n == "max-entries")
                     setParam(probe, cam, n, values[k][idx[k]]);
             for (std::size_t k = 0; k < specs.size(); ++k) {
                 const ParamSpec& p = *specs[k];
@@ -642,7 +650,7 @@ std::string presetsSection(const Report& rep) {
                  "efficiency | bytes | cull ms | to lose nothing |\n|---|---|---|---|---|---:|---:|---:|---:|---|\n";
         const CullSettings& s = r.config.settings;
         std::string set = std::string(toString(s.algorithm)) + " tile " + std::to_string(r.config.tileSize);
-        if (s.algorithm == Algorithm::Clustered || s.algorithm == Algorithm::TwoPointFiveD)
+        if (s.clusterLists() || s.algorithm == Algorithm::TwoPointFiveD)
             set += " cells " + std::to_string(s.cells) + " " + toString(s.slicing);
         if (s.algorithm == Algorithm::ZBin) set += " bins " + std::to_string(s.bins);
         if (s.cap) set += " cap " + std::to_string(s.cap);

@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <unordered_map>
 
 namespace lc {
 
@@ -148,15 +149,29 @@ LightProxy makeLightProxy(const ViewLights& lights, std::size_t l, const CullSet
 
 double LightProxy::slack() const { return sphereTestSlack(origin, radius * overfit); }
 
-std::uint64_t proxyTriangleTiles(const Projection& proj, const TileGrid& grid, const std::array<glm::dvec3, 3>& tri,
-                                 bool conservative, const std::function<void(std::uint32_t, std::uint32_t)>& covered) {
-    if (grid.tilesX == 0 || grid.tilesY == 0) return 0;
+std::uint32_t LightProxy::sliceMask(const CullSettings& settings, double clusterNear, double clusterFar, double lo,
+                                    double hi, std::uint32_t occupied) const {
+    const double e = slack();
+    double a = lo - e, b = hi + e;
+    if (depthMin - e <= clusterNear) a = std::min(a, clusterNear);
+    if (depthMax + e >= clusterFar) b = std::max(b, clusterFar);
+    std::uint32_t m = sliceRangeMask(settings.slicing, clusterNear, clusterFar, settings.cells, a, b);
+    if (settings.skipEmpty) m &= occupied;
+    return m;
+}
+
+namespace {
+
+// A proxy triangle on the grid (tile units, x in [0, width / tile] across
+// the screen), its part nearer than the near plane clipped away: a pixel a
+// light reaches has its geometry beyond the near plane, and the ray to it
+// leaves the (closed) proxy beyond that geometry, so the proxy's surface
+// beyond the near plane covers the pixel whatever lies nearer. (The Vulkan
+// pass clips there too, as its depth clip plane.) Counter-clockwise, up to
+// four corners; 0 when nothing is left or it is seen edge-on.
+std::size_t projectProxyTriangle(const Projection& proj, const TileGrid& grid, const std::array<glm::dvec3, 3>& tri,
+                                 std::array<glm::dvec2, 4>& p) {
     const glm::dmat4& m = proj.clipFromView();
-    // Clip space, then (perspective) the part beyond the near plane: a pixel
-    // a light reaches has its geometry beyond the near plane, and the ray to
-    // it leaves the (closed) proxy beyond that geometry, so the proxy's
-    // surface beyond the near plane covers the pixel whatever lies nearer.
-    // (The Vulkan pass clips there too, as its depth clip plane.)
     std::array<glm::dvec4, 4> clip;
     std::array<glm::dvec4, 3> in;
     for (int i = 0; i < 3; ++i) in[std::size_t(i)] = m * glm::dvec4(tri[std::size_t(i)], 1.0);
@@ -170,9 +185,7 @@ std::uint64_t proxyTriangleTiles(const Projection& proj, const TileGrid& grid, c
         if (aIn != bIn) clip[n++] = a + (b - a) * ((kEyeW - a.w) / (b.w - a.w));
     }
     if (n < 3) return 0;
-    // Tile units: x in [0, width / tile] across the screen.
     const double sx = double(grid.width) / grid.tileSize, sy = double(grid.height) / grid.tileSize;
-    std::array<glm::dvec2, 4> p;
     double area = 0;
     for (std::size_t i = 0; i < n; ++i)
         p[i] = {(clip[i].x / clip[i].w + 1.0) * 0.5 * sx, (clip[i].y / clip[i].w + 1.0) * 0.5 * sy};
@@ -183,6 +196,42 @@ std::uint64_t proxyTriangleTiles(const Projection& proj, const TileGrid& grid, c
     }
     if (!(std::abs(area) > 1e-12)) return 0; // edge-on (or NaN)
     if (area < 0) std::reverse(p.begin(), p.begin() + std::ptrdiff_t(n));
+    return n;
+}
+
+} // namespace
+
+double proxyTriangleTileGap(const Projection& proj, const TileGrid& grid, const std::array<glm::dvec3, 3>& tri,
+                            std::uint32_t tx, std::uint32_t ty) {
+    std::array<glm::dvec2, 4> p;
+    const std::size_t n = projectProxyTriangle(proj, grid, tri, p);
+    if (n == 0) return std::numeric_limits<double>::infinity();
+    const double sx = double(grid.width) / grid.tileSize, sy = double(grid.height) / grid.tileSize;
+    const double rx0 = tx, rx1 = std::min(double(tx) + 1.0, sx), ry0 = ty, ry1 = std::min(double(ty) + 1.0, sy);
+    double x0 = p[0].x, x1 = p[0].x, y0 = p[0].y, y1 = p[0].y;
+    for (std::size_t i = 1; i < n; ++i)
+        x0 = std::min(x0, p[i].x), x1 = std::max(x1, p[i].x), y0 = std::min(y0, p[i].y), y1 = std::max(y1, p[i].y);
+    // The widest separation along an axis of the separating-axis test: the
+    // axes x and y, and each edge's unit normal (the tile's nearest corner
+    // outside the edge by that much).
+    double gap = std::max({rx0 - x1, x0 - rx1, ry0 - y1, y0 - ry1});
+    for (std::size_t i = 0; i < n; ++i) {
+        const glm::dvec2& a = p[i];
+        const glm::dvec2& b = p[(i + 1) % n];
+        const glm::dvec2 nrm = glm::dvec2(-(b.y - a.y), b.x - a.x) / glm::length(b - a);
+        const double cx = nrm.x >= 0 ? rx1 : rx0, cy = nrm.y >= 0 ? ry1 : ry0;
+        gap = std::max(gap, -(nrm.x * (cx - a.x) + nrm.y * (cy - a.y)));
+    }
+    return gap;
+}
+
+std::uint64_t proxyTriangleTiles(const Projection& proj, const TileGrid& grid, const std::array<glm::dvec3, 3>& tri,
+                                 bool conservative, const std::function<void(std::uint32_t, std::uint32_t)>& covered) {
+    if (grid.tilesX == 0 || grid.tilesY == 0) return 0;
+    std::array<glm::dvec2, 4> p;
+    const std::size_t n = projectProxyTriangle(proj, grid, tri, p);
+    if (n == 0) return 0;
+    const double sx = double(grid.width) / grid.tileSize, sy = double(grid.height) / grid.tileSize;
     // Edge functions, >= 0 inside (counter-clockwise).
     std::array<glm::dvec3, 4> edge;
     double x0 = p[0].x, x1 = p[0].x, y0 = p[0].y, y1 = p[0].y;
@@ -223,6 +272,69 @@ std::uint64_t proxyTriangleTiles(const Projection& proj, const TileGrid& grid, c
         }
     }
     return tested;
+}
+
+std::uint64_t proxySliceTiles(const Projection& proj, const TileGrid& grid, const LightProxy& p, bool conservative,
+                              const std::function<void(std::uint32_t, double, double)>& tile) {
+    std::unordered_map<std::uint32_t, std::pair<double, double>> range;
+    std::uint64_t tested = 0;
+    for (const auto& tri : p.mesh->triangles) {
+        const std::array<glm::dvec3, 3> v = {p.vertex(tri[0]), p.vertex(tri[1]), p.vertex(tri[2])};
+        tested += proxyTriangleTiles(proj, grid, v, conservative, [&](std::uint32_t tx, std::uint32_t ty) {
+            const auto [a, b] = proxyTriangleTileDepth(proj, grid, v, conservative, tx, ty);
+            const auto [it, fresh] = range.try_emplace(grid.tileIndex(tx, ty), a, b);
+            if (!fresh) it->second = {std::min(it->second.first, a), std::max(it->second.second, b)};
+        });
+    }
+    for (const auto& [t, r] : range) tile(t, r.first, r.second);
+    return tested;
+}
+
+std::pair<double, double> proxyTriangleTileDepth(const Projection& proj, const TileGrid& grid,
+                                                 const std::array<glm::dvec3, 3>& tri, bool conservative,
+                                                 std::uint32_t tx, std::uint32_t ty) {
+    const double d[3] = {-tri[0].z, -tri[1].z, -tri[2].z};
+    const double lo = std::min({d[0], d[1], d[2]}), hi = std::max({d[0], d[1], d[2]});
+    const bool ortho = proj.orthographic();
+    if (!ortho && !(lo >= proj.nearPlane())) return {lo, hi};
+    // The plane of f (1 / depth, or depth) over the screen in tile units.
+    const glm::dmat4& m = proj.clipFromView();
+    const double sx = double(grid.width) / grid.tileSize, sy = double(grid.height) / grid.tileSize;
+    glm::dvec2 s[3];
+    double f[3];
+    for (int i = 0; i < 3; ++i) {
+        const glm::dvec4 c = m * glm::dvec4(tri[i], 1.0);
+        s[i] = {(c.x / c.w + 1.0) * 0.5 * sx, (c.y / c.w + 1.0) * 0.5 * sy};
+        f[i] = ortho ? d[i] : 1.0 / d[i];
+    }
+    const glm::dvec2 u = s[1] - s[0], v = s[2] - s[0];
+    const double det = u.x * v.y - u.y * v.x;
+    if (!(std::abs(det) > 1e-12)) return {lo, hi};
+    const double fu = f[1] - f[0], fv = f[2] - f[0];
+    const double a = (fu * v.y - fv * u.y) / det, b = (fv * u.x - fu * v.x) / det;
+    auto at = [&](double x, double y) { return f[0] + a * (x - s[0].x) + b * (y - s[0].y); };
+    auto depthOf = [&](double g) { return ortho ? g : 1.0 / g; };
+    if (!conservative) {
+        const double g = at(tx + 0.5, ty + 0.5);
+        if (!ortho && !(g > 0)) return {lo, hi};
+        const double z = std::clamp(depthOf(g), lo, hi);
+        return {z, z};
+    }
+    double gmin = at(tx, ty), gmax = gmin;
+    for (const auto& [x, y] : {std::pair<double, double>{tx + 1.0, ty}, {tx, ty + 1.0}, {tx + 1.0, ty + 1.0}}) {
+        gmin = std::min(gmin, at(x, y));
+        gmax = std::max(gmax, at(x, y));
+    }
+    double zlo = lo, zhi = hi;
+    if (ortho) {
+        zlo = std::max(lo, gmin), zhi = std::min(hi, gmax);
+    } else if (gmax > 0) {
+        // f falls as depth grows: its largest value is the nearest depth.
+        zlo = std::max(lo, 1.0 / gmax);
+        if (gmin > 0) zhi = std::min(hi, 1.0 / gmin);
+    }
+    if (!(zlo <= zhi)) return {lo, hi}; // rounding at a tile the triangle barely touches (or NaN)
+    return {zlo, zhi};
 }
 
 } // namespace lc

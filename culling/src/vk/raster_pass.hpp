@@ -15,7 +15,7 @@ namespace lc::vk {
 
 class RasterPass {
 public:
-    static constexpr std::uint32_t kBindings = 5; // params, tiles, proxies, mesh, masks
+    static constexpr std::uint32_t kBindings = 6; // params, tiles, proxies, mesh, masks, depth ranges (slices)
     explicit RasterPass(Context& ctx);
     // How the coverage is made: the device's conservative rasteriser, the
     // edges pushed out in the vertex shader (and why), or centre sampling.

@@ -1408,8 +1408,19 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
                                              std::to_string(n) + " lights is " + std::to_string(maskBytes >> 20) +
                                              " MiB of masks, more than '" + ctx_.deviceName() +
                                              "' binds at once; use larger tiles or fewer lights");
+    // proxy-depth slices: two depths per tile and light (padded to the mask's words).
+    const bool slices = settings.proxySlices;
+    const std::size_t rangeBytes = slices ? maskBytes * 64 : 0;
+    if (rangeBytes > profile_.maxStorageBufferRange)
+        throw SettingsError("proxy-depth", "raster's slices need two depths per tile and light: " +
+                                               std::to_string(tiles) + " tiles x " + std::to_string(n) + " lights is " +
+                                               std::to_string(rangeBytes >> 20) + " MiB, more than '" +
+                                               ctx_.deviceName() +
+                                               "' binds at once; use larger tiles, fewer lights or proxy-depth tile");
+    // The bounds pass: minmax's tile bounds, or with slices clustered's
+    // (its occupied slices are skip-empty's).
     CullSettings boundsSettings = settings;
-    boundsSettings.algorithm = Algorithm::MinMax;
+    boundsSettings.algorithm = slices ? Algorithm::Clustered : Algorithm::MinMax;
     CullPlanInputs planIn;
     planIn.settings = boundsSettings;
     planIn.grid = grid;
@@ -1417,6 +1428,7 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
     planIn.lights = n;
     planIn.depthPixels = depth.depth.size();
     planIn.orthographic = proj.orthographic();
+    planIn.clusterNear = slices ? frame.clusterNear : 0.0;
     const CullPlan plan = planCull(profile_, history_, planIn);
 
     CullResult res;
@@ -1424,6 +1436,10 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
     res.settings = settings;
     res.grid = grid;
     res.listsPerTile = frame.listsPerTile;
+    if (slices) {
+        res.clusterNear = frame.clusterNear;
+        res.clusterFar = frame.clusterFar;
+    }
     std::vector<std::uint32_t> upOrder(n);
     for (std::uint32_t l = 0; l < n; ++l) upOrder[l] = l;
     const CullInputs in = prepareInputs(plan, frame, res, depth, proj, lights, boundsSettings, upOrder, false);
@@ -1450,6 +1466,16 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
     }
     std::vector<GpuProxy> proxies(n);
     std::uint32_t nextSphere = 0, nextCone = spheres, nextBox = spheres + cones;
+    // A proxy drawn as a box: the tiles it covers and (proxy-depth slices)
+    // their depth ranges, worked out here in double as the CPU reference
+    // does (the box alone would list every tile of its bounding box, with the
+    // proxy's whole depth range); by light, then tile.
+    struct BoxRange {
+        std::uint32_t light, tile;
+        double lo, hi;
+        bool operator<(const BoxRange& o) const { return light != o.light ? light < o.light : tile < o.tile; }
+    };
+    std::vector<BoxRange> boxRanges;
     for (std::uint32_t l = 0; l < n; ++l) {
         const LightProxy& p = proxy[l];
         // The depth range widened past the CPU reference's slack and the
@@ -1460,21 +1486,29 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
         g.basisXDepthMin = vec4(glm::vec3(p.basis[0]), std::nextafter(float(p.depthMin - slack), -kInfF));
         g.basisYDepthMax = vec4(glm::vec3(p.basis[1]), std::nextafter(float(p.depthMax + slack), kInfF));
         g.basisZ = vec4(glm::vec3(p.basis[2]), 0.0f);
-        // Wholly beyond the near plane (a margin for float): front faces only.
-        const bool frontOnly = p.depthMin > proj.nearPlane() * 1.001 + 1e-6 * std::abs(p.depthMin);
+        // Wholly beyond the near plane (a margin for float): front faces
+        // only (slices need the far side's depths too).
+        const bool frontOnly = !slices && p.depthMin > proj.nearPlane() * 1.001 + 1e-6 * std::abs(p.depthMin);
         g.light = uvec4(l, 0, frontOnly ? 1u : 0u, 0);
         g.origin = vec4(glm::vec3(p.origin), 0.0f);
         if (boxed[l]) {
             // The tiles' centres the box keeps, in tile units (none: an empty box).
             std::uint32_t x0 = ~0u, y0 = ~0u, x1 = 0, y1 = 0;
-            for (const auto& tri : p.mesh->triangles)
-                proxyTriangleTiles(proj, grid, {p.vertex(tri[0]), p.vertex(tri[1]), p.vertex(tri[2])},
-                                   settings.conservative, [&](std::uint32_t tx, std::uint32_t ty) {
-                                       x0 = std::min(x0, tx), x1 = std::max(x1, tx);
-                                       y0 = std::min(y0, ty), y1 = std::max(y1, ty);
-                                   });
+            auto spans = [&](std::uint32_t tx, std::uint32_t ty) {
+                x0 = std::min(x0, tx), x1 = std::max(x1, tx);
+                y0 = std::min(y0, ty), y1 = std::max(y1, ty);
+            };
+            const std::size_t first = boxRanges.size();
+            proxySliceTiles(proj, grid, p, settings.conservative, [&](std::uint32_t t, double lo, double hi) {
+                spans(t % grid.tilesX, t / grid.tilesX);
+                boxRanges.push_back({l, t, lo, hi});
+            });
+            std::sort(boxRanges.begin() + std::ptrdiff_t(first), boxRanges.end());
+            // (The fragment shader keeps a tile whose rectangle reaches past
+            // x0 + 0.5 from this box's low side and past x1 + 0.5 from its
+            // high side, a partial edge tile's too.)
             g.origin = x0 > x1 ? vec4(1.0f, 1.0f, 0.0f, 0.0f)
-                               : vec4(float(x0) + 0.25f, float(y0) + 0.25f, float(x1) + 0.75f, float(y1) + 0.75f);
+                               : vec4(float(x0) - 0.49f, float(y0) - 0.49f, float(x1) + 1.49f, float(y1) + 1.49f);
             g.light.y = 1;
         }
     }
@@ -1501,7 +1535,7 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
     rp.grid = uvec4(grid.tilesX, grid.tilesY, words,
                     (coverage == RasterPass::Coverage::PushedEdges ? LC_RASTER_PUSH_EDGES : 0u) |
                         (coverage != RasterPass::Coverage::Centre ? LC_RASTER_TRIM : 0u) |
-                        (proj.orthographic() ? LC_RASTER_ORTHO : 0u));
+                        (proj.orthographic() ? LC_RASTER_ORTHO : 0u) | (slices ? LC_RASTER_SLICES : 0u));
     rp.cover = vec4(float(double(grid.width) / grid.tileSize), float(double(grid.height) / grid.tileSize),
                     float(nearW), 0.5f + 1.0f / 256.0f);
 
@@ -1520,11 +1554,14 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
     const Buffer& proxyBuf = storage("raster.proxies", proxies.size() * sizeof(GpuProxy));
     const Buffer& meshBuf = storage("raster.mesh", corners.size() * sizeof(vec4));
     const Buffer& masks = storage("raster.masks", maskBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    const Buffer& ranges = storage("raster.ranges", rangeBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     staging.upload(params, &rp, sizeof rp, "raster.params");
     staging.upload(proxyBuf, proxies.data(), proxies.size() * sizeof(GpuProxy), "raster.proxies");
     staging.upload(meshBuf, corners.data(), corners.size() * sizeof(vec4), "raster.mesh");
     const auto* maskWords = static_cast<const std::uint32_t*>(staging.download(masks, maskBytes, "raster.masks"));
-    const Buffer* bound[RasterPass::kBindings] = {&params, run.tiles, &proxyBuf, &meshBuf, &masks};
+    const auto* rangeWords =
+        slices ? static_cast<const std::uint32_t*>(staging.download(ranges, rangeBytes, "raster.ranges")) : nullptr;
+    const Buffer* bound[RasterPass::kBindings] = {&params, run.tiles, &proxyBuf, &meshBuf, &masks, &ranges};
     std::vector<Context::DescriptorWrite> bindings(RasterPass::kBindings);
     for (std::uint32_t i = 0; i < RasterPass::kBindings; ++i) {
         bindings[i].buffer = bound[i]->buffer;
@@ -1538,6 +1575,7 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
         [&](VkCommandBuffer cmd) {
             if (stamps) stamps.reset(cmd);
             if (maskBytes) vkCmdFillBuffer(cmd, masks.buffer, 0, maskBytes, 0); // none without lights
+            if (rangeBytes) vkCmdFillBuffer(cmd, ranges.buffer, 0, rangeBytes, ~0u);
             staging.recordUploads(cmd,
                                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
                                       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
@@ -1570,18 +1608,53 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
         "raster.commands");
     checkStatus(out.status, ctx_.deviceName());
 
-    // Masks -> lists, in light order.
-    res.listOffset.resize(tiles);
-    res.listCount.resize(tiles);
-    for (std::uint32_t t = 0; t < tiles; ++t) {
+    decodeTileBounds(plan, out.tb, res);
+    // A proxy drawn as a box lists only the tiles the host found it covers.
+    auto boxCovers = [&](std::uint32_t l, std::uint32_t t) -> const BoxRange* {
+        const auto it = std::lower_bound(boxRanges.begin(), boxRanges.end(), BoxRange{l, t, 0, 0});
+        return it != boxRanges.end() && it->light == l && it->tile == t ? &*it : nullptr;
+    };
+    // Masks -> lists, in light order; with slices each covered tile's depth
+    // range -> the light's slices there (LightProxy::sliceMask, as the CPU
+    // reference).
+    res.listOffset.resize(std::size_t(tiles) * res.listsPerTile);
+    res.listCount.resize(std::size_t(tiles) * res.listsPerTile);
+    std::vector<std::vector<std::uint32_t>> sliceLists(slices ? res.listsPerTile : 0);
+    for (std::uint32_t t = 0; slices && t < tiles; ++t) {
+        for (auto& s : sliceLists) s.clear();
+        const std::uint32_t* m = maskWords + std::size_t(t) * words;
+        for (std::uint32_t w = 0; w < words; ++w)
+            for (std::uint32_t bits = m[w]; bits; bits &= bits - 1) {
+                const std::uint32_t l = w * 32 + std::uint32_t(std::countr_zero(bits));
+                const std::uint32_t* r = rangeWords + 2 * (std::size_t(t) * words * 32 + l);
+                double lo = double(std::bit_cast<float>(r[0])), hi = double(std::bit_cast<float>(~r[1]));
+                if (boxed[l]) { // the host's own ranges (the box only marks the tiles they span)
+                    const BoxRange* b = boxCovers(l, t);
+                    if (!b) continue;
+                    lo = b->lo, hi = b->hi;
+                }
+                for (std::uint32_t k = proxy[l].sliceMask(settings, res.clusterNear, res.clusterFar, lo, hi,
+                                                          res.cellMask[t]);
+                     k; k &= k - 1)
+                    sliceLists[std::size_t(std::countr_zero(k))].push_back(l);
+            }
+        for (std::uint32_t k = 0; k < res.listsPerTile; ++k) {
+            const std::size_t list = std::size_t(t) * res.listsPerTile + k;
+            res.listOffset[list] = std::uint32_t(res.lightIndices.size());
+            res.listCount[list] = std::uint32_t(sliceLists[k].size());
+            res.lightIndices.insert(res.lightIndices.end(), sliceLists[k].begin(), sliceLists[k].end());
+        }
+    }
+    for (std::uint32_t t = 0; !slices && t < tiles; ++t) {
         res.listOffset[t] = std::uint32_t(res.lightIndices.size());
         const std::uint32_t* m = maskWords + std::size_t(t) * words;
         for (std::uint32_t w = 0; w < words; ++w)
-            for (std::uint32_t bits = m[w]; bits; bits &= bits - 1)
-                res.lightIndices.push_back(w * 32 + std::uint32_t(std::countr_zero(bits)));
+            for (std::uint32_t bits = m[w]; bits; bits &= bits - 1) {
+                const std::uint32_t l = w * 32 + std::uint32_t(std::countr_zero(bits));
+                if (!boxed[l] || boxCovers(l, t)) res.lightIndices.push_back(l);
+            }
         res.listCount[t] = std::uint32_t(res.lightIndices.size()) - res.listOffset[t];
     }
-    decodeTileBounds(plan, out.tb, res);
     res.coverage = rasterPass_->describe(coverage);
     res.backend = name();
     res.device = deviceName();

@@ -77,6 +77,8 @@ double cameraFarDepth(const Projection& proj, const ViewLights& lights, SpotTest
 // Lists per tile of an algorithm: halfz 2, clustered `cells` slices, 2.5d
 // with one list per cell (custom culling's cells:N) `cells`, else 1.
 std::uint32_t listsPerTileOf(Algorithm algorithm, std::uint32_t cells, bool cellLists = false);
+// The same for full settings (raster with proxy-depth slices has clusters).
+std::uint32_t listsPerTileOf(const CullSettings& settings, bool cellLists = false);
 
 // Checks a cull's inputs (settings, the depth image and the grid against the
 // camera's resolution, the lights' arrays) and builds its frame. Throws

@@ -118,6 +118,9 @@ struct CullResult {
     // depth was reused or came from elsewhere.
     std::size_t depthTriangles = 0, depthTrianglesDrawn = 0;
 
+    // The algorithm whose list layout this is: `clustered` for raster with
+    // proxy-depth slices (its lists are clusters), else the algorithm.
+    Algorithm layout() const { return settings.clusterLists() ? Algorithm::Clustered : algorithm; }
     std::uint32_t listCountTotal() const { return std::uint32_t(listCount.size()); }
     // The lists of a tile as [first, first + count); for `all`, the one list
     // every tile shares.

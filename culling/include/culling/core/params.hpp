@@ -47,6 +47,11 @@ struct CullSettings {
     std::uint32_t proxyConeAngle = 60; // spots wider than this half-angle (degrees) get the sphere proxy
     double proxyOverfit = 0;          // scale of the proxy; 0 = auto (the factor that encloses the light)
     bool conservative = true;         // coverage: any overlap of a tile (else the tile's centre)
+    // raster's depth: false = one list per tile, the proxy's depth range
+    // against the tile's min/max; true = clustered lists (`cells` slices of
+    // `slicing` over the camera's range, as `clustered`), each fragment's
+    // depth marking the slices (Godot's depth bits).
+    bool proxySlices = false;
     // Engine limits, applied to the lists the culling test made (both
     // backends, one rule: applyListLimits in core/limits.hpp); 0 = none.
     std::uint32_t cap = 0;           // entries one list keeps at most
@@ -55,6 +60,11 @@ struct CullSettings {
     OverflowPolicy overflow = OverflowPolicy::Index; // what an over-full list or buffer keeps
     LimitKeep limitKeep = LimitKeep::Index;          // which lights maxLights keeps
     bool hasLimits() const { return cap || maxLights || maxEntries; }
+    // Lists per cluster: `cells` depth slices of `slicing` over the frame's
+    // cluster range per tile (clustered, and raster with proxySlices).
+    bool clusterLists() const {
+        return algorithm == Algorithm::Clustered || (algorithm == Algorithm::Raster && proxySlices);
+    }
 
     // Empty when valid, else names the field.
     std::string validate() const;
@@ -90,7 +100,7 @@ struct ParamSpec {
 
 // Every culling parameter, in display order: algorithm, test, cells, slicing,
 // skip-empty, spot-test, bins, the raster proxy's (proxy-level, proxy-segments,
-// proxy-cone-angle, proxy-overfit, conservative), tile, width, height, then the limits: cap,
+// proxy-cone-angle, proxy-overfit, conservative, proxy-depth), tile, width, height, then the limits: cap,
 // max-lights, max-entries, overflow, limit-keep.
 const std::vector<ParamSpec>& cullParams();
 const ParamSpec& cullParam(const std::string& name); // throws SettingsError

@@ -62,6 +62,15 @@ struct LightProxy {
     bool depthReaches(double tileMin, double tileMax) const {
         return depthMin - slack() <= tileMax && depthMax + slack() >= tileMin;
     }
+    // proxy-depth slices: the slices of `settings` (cells of slicing over
+    // [clusterNear, clusterFar]) a tile lists the light in, from the depths
+    // [lo, hi] its covering triangles span there (proxyTriangleTileDepth),
+    // widened by the slack; from the first slice when the proxy reaches the
+    // near plane (its part in front is clipped away, and the camera may be
+    // inside), to the last when it reaches the far one (Godot's "touches
+    // near / far"); with skip-empty only the `occupied` slices.
+    std::uint32_t sliceMask(const CullSettings& settings, double clusterNear, double clusterFar, double lo, double hi,
+                            std::uint32_t occupied) const;
 };
 // `spotAngle` 0 for a point light; `axis` unit (ignored for a point light).
 LightProxy makeLightProxy(const glm::dvec3& center, double radius, const glm::dvec3& axis, double spotAngle,
@@ -80,5 +89,33 @@ LightProxy makeLightProxy(const ViewLights& lights, std::size_t l, const CullSet
 // returns the tiles tested.
 std::uint64_t proxyTriangleTiles(const Projection& proj, const TileGrid& grid, const std::array<glm::dvec3, 3>& tri,
                                  bool conservative, const std::function<void(std::uint32_t, std::uint32_t)>& covered);
+
+// How far (tile units) triangle `tri` falls short of overlapping tile
+// (tx, ty): the widest separation along the separating-axis test's axes (x,
+// y, the edges' normals); <= 0 where it overlaps, +inf where nothing of it
+// lies beyond the near plane. Explain's measure of a missed tile.
+double proxyTriangleTileGap(const Projection& proj, const TileGrid& grid, const std::array<glm::dvec3, 3>& tri,
+                            std::uint32_t tx, std::uint32_t ty);
+
+// raster with proxy-depth slices: the view depths (-z) triangle `tri` spans
+// over tile (tx, ty), the tile's whole square in tile units. Conservative:
+// the range of its vertices, narrowed by the range its plane takes over the
+// tile (1 / depth is affine in screen space under perspective, depth under
+// orthographic, so the extremes lie at the tile's corners); not
+// conservative: the plane's depth at the tile's centre (a rasteriser's
+// interpolated sample), clamped to the vertices' range. A triangle reaching
+// nearer than the near plane, or seen edge-on, gets its vertices' range. The
+// Vulkan pass's fragment shader works the same out in float (widened).
+std::pair<double, double> proxyTriangleTileDepth(const Projection& proj, const TileGrid& grid,
+                                                 const std::array<glm::dvec3, 3>& tri, bool conservative,
+                                                 std::uint32_t tx, std::uint32_t ty);
+
+// A whole proxy with proxy-depth slices: calls `tile(t, lo, hi)` once per
+// tile one of its triangles covers (proxyTriangleTiles), with the depths the
+// covering triangles span there (proxyTriangleTileDepth); returns the tiles
+// tested. The CPU reference's rule, and the Vulkan pass's for a proxy it
+// draws as a box.
+std::uint64_t proxySliceTiles(const Projection& proj, const TileGrid& grid, const LightProxy& proxy, bool conservative,
+                              const std::function<void(std::uint32_t, double, double)>& tile);
 
 } // namespace lc

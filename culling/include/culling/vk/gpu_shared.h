@@ -162,11 +162,15 @@ struct GpuRasterParams {
     // pixels covers the grid one pixel per tile, z = w / 2 (no depth clip).
     vec4 clip[4];          // columns
     uvec4 grid;            // x: tilesX, y: tilesY, z: mask words per tile, w: LC_RASTER_* flags
+    // (LC_RASTER_SLICES: ranges[2 (tile x 32 grid.z + light)] holds the float
+    // bits of the least depth the light's fragments span there, and + 1 the
+    // inverted bits of the greatest; both by atomicMin from all ones.)
     vec4 cover;            // x: tilesX' (width / tile), y: tilesY', z: w below which a triangle covers the screen, w: push
 };
 const uint LC_RASTER_PUSH_EDGES = 1u; // conservative by pushing the edges out in the vertex shader
 const uint LC_RASTER_ORTHO = 2u;      // orthographic: the eye direction is +z
 const uint LC_RASTER_TRIM = 4u;       // conservative: the fragment shader keeps a tile by the exact overlap test
+const uint LC_RASTER_SLICES = 8u;     // proxy-depth slices: each fragment's depth range into the tile's ranges
 
 // One proxy, an instance: its unit mesh placed by origin + basis * v, the
 // light it stands for and the view-depth range the tile test uses.
