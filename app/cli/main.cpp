@@ -20,6 +20,7 @@
 #include "culling/core/errors.hpp"
 #include "culling/diagnostics/explain.hpp"
 #include "culling/diagnostics/export.hpp"
+#include "culling/diagnostics/report.hpp"
 #include "culling/core/file_io.hpp"
 #include "culling/core/params.hpp"
 #include "culling/math/light_proxy.hpp"
@@ -122,13 +123,14 @@ int verdictExit(const lc::RunOutput& run) {
     if (!run.custom) {
         // A built-in algorithm: its misses by cause (the engine limits' drops are losses too).
         const lc::Metrics& m = run.truth.metrics;
-        std::cerr << "lightcull: the culling fails: " << fn << " false negatives (culling test "
+        std::cerr << "lightcull: the culling fails: " << fn << (fn == 1 ? " false negative" : " false negatives")
+                  << " (culling test "
                   << m.falseNegativesCullingTest() << ", list full " << m.falseNegativesListFull << ", light limit "
                   << m.falseNegativesLightLimit << "), " << run.result.limits.overflowLists.size()
                   << " over-full lists (exit " << kExitMisses << ")\n";
         return kExitMisses;
     }
-    std::cerr << "lightcull: the culling fails: " << fn << " false negatives, " << overflow << " overflowed lists, "
+    std::cerr << "lightcull: the culling fails: " << fn << (fn == 1 ? " false negative, " : " false negatives, ") << overflow << " overflowed lists, "
               << invalid << " invalid indices";
     if (duplicate) std::cerr << ", " << duplicate << " duplicate indices";
     if (validation) std::cerr << ", " << validation << " validation messages";
@@ -211,13 +213,28 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
     }
     if (settings.algorithm == lc::Algorithm::Raster && !r.coverage.empty()) {
         const bool autoOverfit = settings.proxyOverfit <= 0;
-        std::cout << "proxies: icosphere level " << settings.proxyLevel << " ("
+        // How many lights each proxy shape stands for.
+        std::size_t cones = 0, wide = 0;
+        for (std::size_t l = 0; l < run.lights.size(); ++l)
+            if (run.lights.isSpot(l))
+                (run.lights.spotAngles[l] <= settings.proxyConeAngle * M_PI / 180.0 ? cones : wide)++;
+        const std::size_t spheres = run.lights.size() - cones;
+        std::cout << "proxies: " << spheres << (spheres == 1 ? " icosphere" : " icospheres") << " of level " << settings.proxyLevel << " ("
                   << lc::unitIcosphere(settings.proxyLevel).triangles.size() << " triangles), overfit "
                   << fmt("%.4f", autoOverfit ? lc::icosphereEnclosingOverfit(settings.proxyLevel) : settings.proxyOverfit)
-                  << "; spots up to " << settings.proxyConeAngle << " degrees: cones of " << settings.proxySegments
-                  << " sides, overfit "
-                  << fmt("%.4f", autoOverfit ? lc::coneEnclosingOverfit(settings.proxySegments) : settings.proxyOverfit)
-                  << (autoOverfit ? " (auto: each encloses its light)" : " (as set)") << "\n"
+                  << (wide ? " (" + std::to_string(wide) + " of them spots wider than " +
+                                 std::to_string(settings.proxyConeAngle) + " degrees)"
+                           : std::string());
+        if (cones)
+            std::cout << "; " << cones << " spot cones of " << settings.proxySegments << " sides, overfit "
+                      << fmt("%.4f", autoOverfit ? lc::coneEnclosingOverfit(settings.proxySegments) : settings.proxyOverfit);
+        std::cout << (autoOverfit ? " (auto: each encloses its light)" : " (as set)") << "\n"
+                  << "depth: "
+                  << (settings.proxySlices ? "clusters: " + std::to_string(settings.cells) + " " +
+                                                 lc::toString(settings.slicing) + " slices, the triangles' depths over "
+                                                 "each tile"
+                                           : std::string("the proxy's depth range against each tile's min/max"))
+                  << "\n"
                   << "coverage: " << r.coverage << "\n";
     }
     std::cout << "lists " << r.listCountTotal() << ", entries " << r.entries() << ", mean list "
@@ -342,6 +359,18 @@ struct SceneFlags {
             lc::applyPreset(lc::enginePreset(presetName), settings, scene.camera, scene.lights.size(), given);
         else
             for (const auto& [name, value] : given) lc::setParam(settings, scene.camera, name, value);
+        // A flag the chosen algorithm never reads is said, not silently dropped.
+        const bool spots = std::any_of(scene.lights.begin(), scene.lights.end(),
+                                       [](const lc::PointLight& l) { return l.isSpot(); });
+        for (const auto& [name, value] : given)
+            if (name != "tile" && !lc::paramAppliesTo(name, settings, spots))
+                std::cerr << "lightcull: note: --" << name << " does not apply to "
+                          << lc::toString(settings.algorithm)
+                          << (settings.algorithm == lc::Algorithm::Raster && !settings.proxySlices &&
+                                      (name == "cells" || name == "slicing" || name == "skip-empty")
+                                  ? " with --proxy-depth tile"
+                                  : "")
+                          << " here; ignored\n";
     }
 
     std::unique_ptr<lc::CullBackend> openBackend() const {

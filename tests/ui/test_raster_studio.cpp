@@ -100,6 +100,35 @@ private slots:
         QVERIFY(lctest::waitRun(*w_, w_->runCulling(), true));
         QCOMPARE(doc()->runs().runOutput()->truth.metrics.falseNegatives, 0u);
 
+        // Depth: slices, as Godot's cluster builder: clustered lists (the
+        // cells box's slices), no misses, the cell overlay's froxels; Explain
+        // names the slice step.
+        auto* depthBox = w_->findChild<QComboBox*>("param_proxy-depth");
+        QVERIFY(depthBox && depthBox->isVisible());
+        QCOMPARE(depthBox->currentText(), QString("tile"));
+        depthBox->setCurrentIndex(depthBox->findText("slices"));
+        emit depthBox->textActivated("slices");
+        QVERIFY(doc()->runs().settings().proxySlices);
+        for (const char* bar : {"cullToolbar", "limitsToolbar", "rasterToolbar"})
+            if (auto* b = w_->findChild<QToolBar*>(bar)) QVERIFY2(!overflows(b), bar);
+        QVERIFY(lctest::waitRun(*w_, w_->runCulling(), true));
+        run = doc()->runs().runOutput();
+        QCOMPARE(run->result.listsPerTile, doc()->runs().settings().cells);
+        QCOMPARE(run->truth.metrics.falseNegatives, 0u);
+        // The inscribed proxy again, with slices: a miss, explained down to the slices.
+        overfit->lineEdit()->selectAll();
+        QTest::keyClicks(overfit->lineEdit(), "1");
+        QTest::keyClick(overfit->lineEdit(), Qt::Key_Return);
+        QVERIFY(lctest::waitRun(*w_, w_->runCulling(), true));
+        QVERIFY(doc()->runs().runOutput()->truth.metrics.falseNegatives > 0);
+        next->trigger();
+        QTRY_VERIFY(explain->findChild<QPlainTextEdit*>()->toPlainText().contains("proxy coverage"));
+        const QString sliced = explain->findChild<QPlainTextEdit*>()->toPlainText();
+        QVERIFY2(sliced.contains("MISSING"), qPrintable(sliced));
+        w_->cameraView()->renderNow();
+        QVERIFY(w_->grab().save(QString(LC_RENDER_OUT_DIR) + "/raster_slices_studio.png"));
+        overfit->setCurrentIndex(overfit->findText("auto"));
+        emit overfit->textActivated("auto");
         // A bad number is refused by name; the setting stays.
         overfit->lineEdit()->selectAll();
         QTest::keyClicks(overfit->lineEdit(), "9");

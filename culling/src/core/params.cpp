@@ -3,6 +3,7 @@
 
 #include "culling/core/errors.hpp"
 
+#include <cctype>
 #include <charconv>
 #include <cstdio>
 
@@ -151,10 +152,13 @@ long long parseInt(const ParamSpec& p, const std::string& v) {
     return x;
 }
 
-bool parseBool(const ParamSpec& p, const std::string& v) {
+bool parseBool(const ParamSpec& p, const std::string& value) {
+    // Any case: TRUE as well as true (as 1, yes and on are accepted).
+    std::string v = value;
+    for (char& c : v) c = char(std::tolower(static_cast<unsigned char>(c)));
     if (v == "true" || v == "1" || v == "yes" || v == "on") return true;
     if (v == "false" || v == "0" || v == "no" || v == "off") return false;
-    throw SettingsError(p.name, "must be true or false, got '" + v + "'");
+    throw SettingsError(p.name, "must be true or false, got '" + value + "'");
 }
 
 double parseReal(const ParamSpec& p, const std::string& v) {

@@ -113,13 +113,15 @@ std::vector<EnginePreset> buildPresets() {
                  {{"cap", 0, "r.Forward.MaxCulledLightsPerCell"}}});
     p.push_back({"godot-4",
                  "Godot 4 clustered forward",
-                 {{"algorithm", "clustered"}, {"tile", "32"}, {"cells", "32"}, {"slicing", "linear"},
-                  {"max-lights", "512"}, {"limit-keep", "index"}},
+                 {{"algorithm", "raster"}, {"proxy-depth", "slices"}, {"proxy-level", "1"}, {"proxy-segments", "32"},
+                  {"proxy-cone-angle", "60"}, {"tile", "32"}, {"cells", "32"}, {"slicing", "linear"},
+                  {"skip-empty", "false"}, {"max-lights", "512"}, {"limit-keep", "index"}},
                  nullptr,
                  "",
-                 "Godot rasterises overfit proxy meshes at a quarter resolution (modelled by the sphere test); its "
-                 "32 depth bits span 0..far (ours near..far); 512 is per element type (omni, spot), ours for all "
-                 "lights together",
+                 "Godot samples its proxies at several pixels per cluster (modelled by exact overlap; --conservative "
+                 "false is one sample per tile) and takes one depth bit per fragment (modelled by the triangle's "
+                 "depths over the tile); its 32 depth bits span 0..far (ours near..far); 512 is per element type "
+                 "(omni, spot), ours for all lights together",
                  {{"max-lights", 8192, "rendering/limits/cluster_builder/max_clustered_elements"}}});
     p.push_back({"filament",
                  "Filament froxels",

@@ -1656,6 +1656,10 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
         res.listCount[t] = std::uint32_t(res.lightIndices.size()) - res.listOffset[t];
     }
     res.coverage = rasterPass_->describe(coverage);
+    if (boxes)
+        res.coverage += "; " + std::to_string(boxes) + (boxes == 1 ? " proxy" : " proxies") +
+                        " too large for float near the camera drawn as the box of tiles the host's double-precision "
+                        "coverage found, listed only there";
     res.backend = name();
     res.device = deviceName();
     res.timingMethod = timingMethod();
