@@ -151,11 +151,25 @@ void main() {
     const float area = clipped ? poly : (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[2].x - q[0].x) * (q[1].y - q[0].y);
     // The pushed edges, counter-clockwise (the inside left of each), for the
     // fragment shader's test: the triangle's three, or the four of what the
-    // near plane leaves of it; one too thin to orient is dropped (below).
+    // near plane leaves of it; none for one seen edge-on (below).
     uint me = corner;
     vec3 line[4];
     line[3] = vec3(0.0, 0.0, 1.0);
-    const bool edges = abs(area) > 1e-6;
+    // Seen edge-on: flat to float's rounding (the CPU reference's, in double,
+    // has no area). A long one is not drawn: a closed convex proxy's other
+    // faces cover what it would, within the push's 1/256 tile (its width is
+    // below 1/512), while its bounding box would cover tiles off the segment
+    // (an orthographic camera sees an icosphere's silhouette faces exactly
+    // edge-on). A short one (a whole proxy may be that small) is drawn as
+    // its bounding box, without edges.
+    float len2 = 0.0;
+    for (uint k = 0u; k < m; ++k) len2 = max(len2, dot(q[(k + 1u) % m] - q[k], q[(k + 1u) % m] - q[k]));
+    const bool edgeOn = abs(area) <= 1e-4 * len2 && abs(area) < sqrt(len2) / 512.0;
+    if (edgeOn && len2 > 1.0 / (64.0 * 64.0)) {
+        gl_Position = vec4(0.0, 0.0, 0.5, 0.0);
+        return;
+    }
+    const bool edges = !edgeOn && abs(area) > 0.0;
     if (edges) {
         if (area < 0.0) { // reverse the corners
             for (uint k = 0u; k < m / 2u; ++k) {
@@ -174,13 +188,6 @@ void main() {
         outEdge1 = line[1];
         outEdge2 = line[2];
         outEdge3 = line[3];
-    } else {
-        // Seen edge-on (the CPU reference's too: no area): a closed convex
-        // proxy's other faces cover what it would; its bounding box alone
-        // would cover tiles off the segment (an orthographic camera sees an
-        // icosphere's silhouette faces exactly edge-on).
-        gl_Position = vec4(0.0, 0.0, 0.5, 0.0);
-        return;
     }
     if ((params.grid.w & LC_RASTER_PUSH_EDGES) == 0u) {
         // The device's conservative rasteriser covers the triangle (it may
@@ -190,7 +197,7 @@ void main() {
         return;
     }
     vec2 at;
-    if (clipped || abs(area) < 1.0 / 64.0) {
+    if (clipped || !edges || abs(area) < 1.0 / 64.0) {
         const vec2 size = outBox.zw - outBox.xy;
         const vec2 box[3] = vec2[3](outBox.xy, outBox.xy + vec2(2.0 * size.x, 0.0), outBox.xy + vec2(0.0, 2.0 * size.y));
         at = box[corner];

@@ -179,6 +179,12 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
               << run.lights.size() << " lights\n"
               << "algorithm "
               << (run.custom ? std::string("custom")
+                             : settings.algorithm == lc::Algorithm::Raster
+                                   // raster draws proxies: no sphere test; cells only with slices
+                                   ? std::string("raster") +
+                                         (settings.proxySlices ? ", cells " + std::to_string(settings.cells) +
+                                                                     ", slicing " + lc::toString(settings.slicing)
+                                                               : std::string())
                              : std::string(lc::toString(settings.algorithm)) + ", test " + lc::toString(settings.test) +
                                    (settings.algorithm == lc::Algorithm::ZBin
                                         ? ", bins " + std::to_string(settings.bins)
@@ -199,6 +205,21 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
                   << " / shading work " << m.shadingWork << ")\n"
                   << "optimum of this grid: " << fmt("%.1f", 100.0 * m.efficiencyVsOptimal) << "% (optimal work "
                   << m.optimalWork << " / shading work " << m.shadingWork << ")\n";
+    if (m.falseNegatives > 0 && !run.custom) {
+        // The first miss, culling test first, most pixels first: where to look.
+        const auto located = lc::locateFalseNegatives(run, lc::Projection(scene.camera));
+        if (!located.empty()) {
+            const lc::MissedLight& f = located.front();
+            const std::uint32_t tx = f.tile % r.grid.tilesX, ty = f.tile / r.grid.tilesX;
+            std::cout << "first miss: light " << f.light
+                      << (f.light < scene.lights.size() ? " '" + scene.lights[f.light].name + "'" : std::string())
+                      << " in tile " << tx << "," << ty << " (list " << f.list << "), " << f.pixels
+                      << (f.pixels == 1 ? " pixel needs it" : " pixels need it") << " (of " << located.size()
+                      << " missed light-list pairs" << (out.empty() ? "" : "; all in summary.json's \"missed\"")
+                      << "); why: lightcull explain with the same flags and --tile "
+                      << tx << "," << ty << " --light " << f.light << "\n";
+        }
+    }
     if (!run.custom && settings.hasLimits()) {
         // The engine limits: what they were and what they took.
         const lc::ListLimits& lim = r.limits;

@@ -439,3 +439,42 @@ TEST(Export, MissHeatmapIsRedExactlyWhereTilesMissLights) {
                                                       << "," << int(p[2]);
     }
 }
+
+// A built-in run that misses lights says which, where: summary.json's
+// "missed" names each (tile, list, light, pixels, cause), as the ground
+// truth counts them; a run without misses has an empty array.
+TEST(Export, SummaryJsonLocatesABuiltinRunsMisses) {
+    PipelineRun clean = runBuiltin("atrium", Algorithm::MinMax, 160, 96);
+    const auto c = nlohmann::json::parse(summaryJson(clean.scene, clean.settings, clean.out));
+    ASSERT_TRUE(c["missed"].is_array());
+    EXPECT_TRUE(c["missed"].empty());
+    EXPECT_EQ(c["missed_pairs"].get<std::uint64_t>(), 0u);
+
+    PipelineRun r;
+    r.scene = makeBuiltinScene("atrium");
+    r.scene.camera.width = 160;
+    r.scene.camera.height = 96;
+    r.settings.algorithm = Algorithm::Raster;
+    r.settings.proxyLevel = 0;
+    r.settings.proxyOverfit = 1.0; // inscribed: misses
+    auto backend = makeCpuBackend();
+    r.out = runPipeline(r.scene, r.settings, *backend);
+    ASSERT_GT(r.out.truth.metrics.falseNegatives, 0u);
+    const auto j = nlohmann::json::parse(summaryJson(r.scene, r.settings, r.out));
+    ASSERT_FALSE(j["missed"].empty());
+    std::uint64_t pixels = 0;
+    for (const auto& m : j["missed"]) {
+        const std::uint32_t list = m["list"].get<std::uint32_t>(), light = m["light"].get<std::uint32_t>();
+        EXPECT_EQ(m["cause"].get<std::string>(), "culling_test");
+        EXPECT_EQ(m["tile"][0].get<std::uint32_t>() + m["tile"][1].get<std::uint32_t>() * r.out.result.grid.tilesX,
+                  list);
+        EXPECT_EQ(m["light_name"].get<std::string>(), r.scene.lights[light].name);
+        // The list lacks the light.
+        const auto* b = r.out.result.lightIndices.data() + r.out.result.listOffset[list];
+        EXPECT_FALSE(std::binary_search(b, b + r.out.result.listCount[list], light));
+        pixels += m["pixels"].get<std::uint64_t>();
+    }
+    // Every missed light-pixel, when the array holds them all.
+    if (j["missed_pairs"].get<std::size_t>() == j["missed"].size())
+        EXPECT_EQ(pixels, r.out.truth.metrics.falseNegatives);
+}

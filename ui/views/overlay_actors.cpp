@@ -28,7 +28,7 @@ std::optional<std::vector<int>> InspectorOverlays::tileListLights(const Document
     // As the tile inspector's rows (lc::tileLightRows): a cell of halfz or
     // clustered has a list of its own.
     const int cell = doc.selection().selectedCell();
-    if (cell >= 0 && (r.algorithm == lc::Algorithm::HalfZ || r.algorithm == lc::Algorithm::Clustered) &&
+    if (cell >= 0 && (r.algorithm == lc::Algorithm::HalfZ || r.layout() == lc::Algorithm::Clustered) &&
         std::uint32_t(cell) < count) {
         first += std::uint32_t(cell);
         count = 1;
@@ -269,7 +269,7 @@ void InspectorOverlays::update(const Document& doc) {
         reverseLists_ = lc::listsHoldingLight(r, std::uint32_t(light));
         ChunkGeometry g;
         g.worldFromView = w;
-        const bool perCell = r.algorithm == lc::Algorithm::HalfZ || r.algorithm == lc::Algorithm::Clustered;
+        const bool perCell = r.algorithm == lc::Algorithm::HalfZ || r.layout() == lc::Algorithm::Clustered;
         if (r.algorithm != lc::Algorithm::All) {
             std::uint32_t lastTile = ~0u;
             std::vector<lc::DepthCell> tileCellsCache;

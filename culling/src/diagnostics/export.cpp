@@ -195,8 +195,35 @@ nlohmann::ordered_json limitsJson(const CullSettings& settings, const RunOutput&
 }
 
 // docs/CUSTOM_CULLING.md: what a user's culling did beside its lists.
+// Every false negative located: tile, list, light and the pixels that
+// needed it (the 1,000 with most pixels; the total is in metrics), as
+// "missed", "missed_pairs" and "missed_pairs_by_cause" of `j`.
+void addMissed(nlohmann::ordered_json& j, const Scene& scene, const RunOutput& run) {
+    const TileGrid& grid = run.result.grid;
+    const Projection proj(scene.camera);
+    nlohmann::ordered_json missed = nlohmann::ordered_json::array();
+    const std::vector<MissedLight> located = locateFalseNegatives(run, proj);
+    nlohmann::ordered_json byCause;
+    for (MissCause c : {MissCause::CullingTest, MissCause::ListFull, MissCause::InvalidIndex})
+        byCause[jsonName(c)] = std::count_if(located.begin(), located.end(),
+                                             [&](const MissedLight& m) { return m.cause == c; });
+    for (std::size_t i = 0; i < located.size() && i < 1000; ++i) {
+        const MissedLight& ml = located[i];
+        nlohmann::ordered_json e;
+        e["tile"] = {ml.tile % grid.tilesX, ml.tile / grid.tilesX};
+        e["list"] = ml.list;
+        e["light"] = ml.light;
+        e["light_name"] = ml.light < scene.lights.size() ? scene.lights[ml.light].name : std::string();
+        e["pixels"] = ml.pixels;
+        e["cause"] = jsonName(ml.cause);
+        missed.push_back(std::move(e));
+    }
+    j["missed"] = std::move(missed);
+    j["missed_pairs"] = located.size();
+    j["missed_pairs_by_cause"] = std::move(byCause);
+}
+
 nlohmann::ordered_json customJson(const Scene& scene, const RunOutput& run) {
-    const CullResult& r = run.result;
     const CustomCullReport& c = *run.custom;
     nlohmann::ordered_json cj;
     cj["source"] = c.source;
@@ -212,29 +239,7 @@ nlohmann::ordered_json customJson(const Scene& scene, const RunOutput& run) {
     cj["builtin_algorithm"] = c.builtinAlgorithm;
     cj["builtin_entries"] = c.builtinEntries;
     cj["lists_differing_from_builtin"] = c.listsDifferingFromBuiltin;
-    // Every false negative located: tile, list, light and the pixels that
-    // needed it (the 1,000 with most pixels; the total is in metrics).
-    const Projection proj(scene.camera);
-    nlohmann::ordered_json missed = nlohmann::ordered_json::array();
-    const std::vector<MissedLight> located = locateFalseNegatives(run, proj);
-    nlohmann::ordered_json byCause;
-    for (MissCause c : {MissCause::CullingTest, MissCause::ListFull, MissCause::InvalidIndex})
-        byCause[jsonName(c)] = std::count_if(located.begin(), located.end(),
-                                             [&](const MissedLight& m) { return m.cause == c; });
-    for (std::size_t i = 0; i < located.size() && i < 1000; ++i) {
-        const MissedLight& ml = located[i];
-        nlohmann::ordered_json e;
-        e["tile"] = {ml.tile % r.grid.tilesX, ml.tile / r.grid.tilesX};
-        e["list"] = ml.list;
-        e["light"] = ml.light;
-        e["light_name"] = ml.light < scene.lights.size() ? scene.lights[ml.light].name : std::string();
-        e["pixels"] = ml.pixels;
-        e["cause"] = jsonName(ml.cause);
-        missed.push_back(std::move(e));
-    }
-    cj["missed"] = std::move(missed);
-    cj["missed_pairs"] = located.size();
-    cj["missed_pairs_by_cause"] = std::move(byCause);
+    addMissed(cj, scene, run);
     return cj;
 }
 
@@ -327,6 +332,8 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
     mj["image_max_error"] =
         m.imageErrorComputed ? nlohmann::ordered_json(m.imageMaxError) : nlohmann::ordered_json(nullptr);
     j["metrics"] = mj;
+    // Which lights were missed where (a custom run has them under "custom").
+    if (!run.custom && run.truthComputed) addMissed(j, scene, run);
     if (!run.custom) j["limits"] = limitsJson(settings, run);
     if (run.custom) j["custom"] = customJson(scene, run);
     return j.dump(2) + "\n";
@@ -357,7 +364,7 @@ std::string tilesCsv(const RunOutput& run) {
                 double lo = r.tileDepthMin[t], hi = r.tileDepthMax[t];
                 if (r.algorithm == Algorithm::HalfZ && t < r.halfzSplit.size())
                     (sub == 0 ? hi : lo) = r.halfzSplit[t];
-                else if (r.algorithm == Algorithm::Clustered) {
+                else if (r.layout() == Algorithm::Clustered) {
                     lo = sliceBoundary(r.settings.slicing, r.clusterNear, r.clusterFar, per, sub);
                     hi = sliceBoundary(r.settings.slicing, r.clusterNear, r.clusterFar, per, sub + 1);
                 }

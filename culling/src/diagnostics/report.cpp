@@ -900,6 +900,13 @@ void drawPanel(Plot& p, int x0, int y0, int w, int h, const Report& rep, const s
         const glm::dvec3 c = algorithmColour(r.config.settings.algorithm);
         const bool second = !rep.backendDevices.empty() && r.config.backend != rep.backendDevices.front().first;
         if (onFront(r)) p.fill(x - 5, y - 5, x + 6, y + 6, glm::dvec3(0.85, 0.1, 0.1));
+        if (r.falseNegatives) {
+            // Misses lights: a cross, not a square (its efficiency is no
+            // score, and it never joins the front).
+            p.line(x - 4, y - 4, x + 4, y + 4, c, second ? 1 : 2);
+            p.line(x - 4, y + 4, x + 4, y - 4, c, second ? 1 : 2);
+            continue;
+        }
         if (second) { // hollow square: the second backend
             p.fill(x - 3, y - 3, x + 4, y + 4, c);
             p.fill(x - 1, y - 1, x + 2, y + 2, glm::dvec3(1.0));
@@ -978,6 +985,13 @@ RgbImage paretoImage(const Report& rep) {
     p.fill(x + 2, y + 1, x + 9, y + 8, glm::dvec3(0.3));
     p.text(x + 16, y + 1, "PARETO FRONT (LINE JOINS IT)", 1, ink);
     x = 20, y += 22;
+    if (std::any_of(rep.rows.begin(), rep.rows.end(),
+                    [](const ReportRow& r) { return r.falseNegatives && r.config.customLabel.empty(); })) {
+        p.line(x, y, x + 9, y + 9, glm::dvec3(0.3), 2);
+        p.line(x, y + 9, x + 9, y, glm::dvec3(0.3), 2);
+        p.text(x + 14, y + 1, "MISSES LIGHTS (FALSE NEGATIVES)", 1, ink);
+        x += 14 + Plot::textWidth("MISSES LIGHTS (FALSE NEGATIVES)", 1) + 24;
+    }
     for (std::size_t i = 0; i < rep.backendDevices.size(); ++i) {
         p.fill(x, y, x + 9, y + 9, glm::dvec3(0.3));
         if (i > 0) p.fill(x + 2, y + 2, x + 7, y + 7, glm::dvec3(1.0));
