@@ -98,6 +98,18 @@ Judged judge(const Scene& scene, const CullSettings& st) {
     return j;
 }
 
+// 250x190 at 16-pixel tiles (the last column and row partial), a wall at 6;
+// lights across the near plane (0), around the camera (1), on the right and
+// bottom edges (2, 3), behind the camera (4).
+Scene nearPlaneScene() {
+    return wallScene(250, 190, 16, 6.0,
+                     {{{0.3, 0.2, -0.4}, 1.5},
+                      {{0, 0, 0.5}, 8.0},
+                      {{2.9, 0.5, -5.6}, 0.7},
+                      {{0.1, -2.2, -5.5}, 0.8},
+                      {{0, 0, 3.0}, 2.0}});
+}
+
 CullSettings raster(std::uint32_t level, double overfit, bool conservative) {
     CullSettings s;
     s.algorithm = Algorithm::Raster;
@@ -236,12 +248,7 @@ TEST(RasterCull, LightsAcrossTheNearPlaneAroundTheCameraAndOnPartialTiles) {
     // 250x190 at 16-pixel tiles: the last column and row of tiles are
     // partial. Lights: across the near plane, around the camera, on the
     // right and bottom edges, behind the camera.
-    const Scene scene = wallScene(250, 190, 16, 6.0,
-                                  {{{0.3, 0.2, -0.4}, 1.5},
-                                   {{0, 0, 0.5}, 8.0},
-                                   {{2.9, 0.5, -5.6}, 0.7},
-                                   {{0.1, -2.2, -5.5}, 0.8},
-                                   {{0, 0, 3.0}, 2.0}});
+    const Scene scene = nearPlaneScene();
     for (std::uint32_t level : {0u, 1u, 4u})
         for (bool conservative : {true}) {
             const Judged j = judge(scene, raster(level, 0.0, conservative));
@@ -377,12 +384,7 @@ TEST(RasterCull, ClusteredSlicesAcrossTheNearPlaneAndAroundTheCamera) {
     // The near-plane cases with slices: a proxy the near plane cuts starts at
     // slice 0 (its part in front is clipped away), a camera inside a light
     // lists it in every tile's occupied slice; one behind the camera nowhere.
-    const Scene scene = wallScene(250, 190, 16, 6.0,
-                                  {{{0.3, 0.2, -0.4}, 1.5},
-                                   {{0, 0, 0.5}, 8.0},
-                                   {{2.9, 0.5, -5.6}, 0.7},
-                                   {{0.1, -2.2, -5.5}, 0.8},
-                                   {{0, 0, 3.0}, 2.0}});
+    const Scene scene = nearPlaneScene();
     for (std::uint32_t level : {0u, 1u, 4u}) {
         CullSettings st = raster(level, 0.0, true);
         st.proxySlices = true;
