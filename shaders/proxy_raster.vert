@@ -97,9 +97,13 @@ void main() {
         }
         const vec2 u = s[1] - s[0], w = s[2] - s[0];
         const float det = u.x * w.y - u.y * w.x;
-        // A plane only where float fits it well: in front of the near plane
-        // and at least 1/64 tile of area (the CPU reference fits any).
-        if (front && abs(det) > 2e-4) {
+        // A plane only where float fits it well (the CPU reference fits
+        // any): in front of the near plane, at least 1/10,000 tile of area,
+        // and not thin on screen (a face near the silhouette, seen almost
+        // edge-on, has a steep plane that float's rounding tilts); else
+        // the corners' range, wider and safe.
+        const float len2 = max(dot(u, u), max(dot(w, w), dot(w - u, w - u)));
+        if (front && abs(det) > 2e-4 && abs(det) > 0.01 * len2) {
             const vec3 f = ortho ? d : 1.0 / d;
             const float fu = f.y - f.x, fw = f.z - f.x;
             const float a = (fu * w.y - fw * u.y) / det, b = (fw * u.x - fu * w.x) / det;
@@ -151,23 +155,28 @@ void main() {
     const float area = clipped ? poly : (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[2].x - q[0].x) * (q[1].y - q[0].y);
     // The pushed edges, counter-clockwise (the inside left of each), for the
     // fragment shader's test: the triangle's three, or the four of what the
-    // near plane leaves of it; none for one seen edge-on (below).
+    // near plane leaves of it; a segment's two sides for one seen edge-on.
     uint me = corner;
     vec3 line[4];
     line[3] = vec3(0.0, 0.0, 1.0);
-    // Seen edge-on: flat to float's rounding (the CPU reference's, in double,
-    // has no area). A long one is not drawn: a closed convex proxy's other
-    // faces cover what it would, within the push's 1/256 tile (its width is
-    // below 1/512), while its bounding box would cover tiles off the segment
-    // (an orthographic camera sees an icosphere's silhouette faces exactly
-    // edge-on). A short one (a whole proxy may be that small) is drawn as
-    // its bounding box, without edges.
+    // Seen edge-on: flat to float's rounding, too thin to orient. It is a
+    // segment (its longest side; the third corner within 1/512 tile of it):
+    // drawn as its bounding box, trimmed by the box and by the segment's line
+    // pushed out to both sides, the separating-axis test of a segment (its
+    // bounding box alone covered tiles off it: an orthographic camera sees an
+    // icosphere's silhouette faces exactly edge-on).
     float len2 = 0.0;
-    for (uint k = 0u; k < m; ++k) len2 = max(len2, dot(q[(k + 1u) % m] - q[k], q[(k + 1u) % m] - q[k]));
+    uint longest = 0u;
+    for (uint k = 0u; k < m; ++k) {
+        const vec2 e = q[(k + 1u) % m] - q[k];
+        if (dot(e, e) > len2) len2 = dot(e, e), longest = k;
+    }
     const bool edgeOn = abs(area) <= 1e-4 * len2 && abs(area) < sqrt(len2) / 512.0;
-    if (edgeOn && len2 > 1.0 / (64.0 * 64.0)) {
-        gl_Position = vec4(0.0, 0.0, 0.5, 0.0);
-        return;
+    if (edgeOn) {
+        const vec2 a = q[longest], n = vec2(a.y - q[(longest + 1u) % m].y, q[(longest + 1u) % m].x - a.x);
+        const float push = h * (abs(n.x) + abs(n.y)) + length(n) / 512.0;
+        outEdge0 = vec3(n, -dot(n, a) + push);
+        outEdge1 = vec3(-n, dot(n, a) + push);
     }
     const bool edges = !edgeOn && abs(area) > 0.0;
     if (edges) {

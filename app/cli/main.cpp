@@ -216,8 +216,9 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
                       << " in tile " << tx << "," << ty << " (list " << f.list << "), " << f.pixels
                       << (f.pixels == 1 ? " pixel needs it" : " pixels need it") << " (of " << located.size()
                       << " missed light-list pairs" << (out.empty() ? "" : "; all in summary.json's \"missed\"")
-                      << "); why: lightcull explain with the same flags and --tile "
-                      << tx << "," << ty << " --light " << f.light << "\n";
+                      << "); why: lightcull explain with the same flags and --tile " << tx << "," << ty
+                      << (r.listsPerTile > 1 ? " --cell " + std::to_string(f.list % r.listsPerTile) : std::string())
+                      << " --light " << f.light << "\n";
         }
     }
     if (!run.custom && settings.hasLimits()) {
@@ -253,7 +254,8 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
                   << "depth: "
                   << (settings.proxySlices ? "clusters: " + std::to_string(settings.cells) + " " +
                                                  lc::toString(settings.slicing) + " slices, the triangles' depths over "
-                                                 "each tile"
+                                                 "each tile, " +
+                                                 (settings.skipEmpty ? "empty clusters skipped" : "empty clusters kept")
                                            : std::string("the proxy's depth range against each tile's min/max"))
                   << "\n"
                   << "coverage: " << r.coverage << "\n";
@@ -735,7 +737,8 @@ int main(int argc, char** argv) {
     int explainCell = -1;
     explain->add_option("--tile", explainTile, "The tile, as X,Y (0,0 is the top-left tile)")->type_name("X,Y")->required();
     explain->add_option("--cell", explainCell,
-                        "The tile's sub-list: halfz 0 near / 1 far, clustered slice, cells:N cell (default: the tile's list)")
+                        "The tile's sub-list: halfz 0 near / 1 far, clustered (and raster --proxy-depth slices) slice, cells:N cell "
+                        "(default: the tile's list)")
         ->type_name("C");
     explain->add_option("--light", explainLightText, "The light: its index or its name")->type_name("I|NAME")->required();
 

@@ -212,6 +212,11 @@ void addMissed(nlohmann::ordered_json& j, const Scene& scene, const RunOutput& r
         nlohmann::ordered_json e;
         e["tile"] = {ml.tile % grid.tilesX, ml.tile / grid.tilesX};
         e["list"] = ml.list;
+        // The list within its tile (halfz's half, a cluster's slice), as
+        // explain's --cell takes it; null where a tile has one list.
+        e["cell"] = run.result.listsPerTile > 1 && run.result.algorithm != Algorithm::All
+                        ? nlohmann::ordered_json(ml.list % run.result.listsPerTile)
+                        : nlohmann::ordered_json(nullptr);
         e["light"] = ml.light;
         e["light_name"] = ml.light < scene.lights.size() ? scene.lights[ml.light].name : std::string();
         e["pixels"] = ml.pixels;
@@ -280,6 +285,7 @@ std::string summaryJson(const Scene& scene, const CullSettings& settings, const 
         p["cone_overfit_applied"] = settings.proxyOverfit > 0 ? settings.proxyOverfit
                                                               : coneEnclosingOverfit(settings.proxySegments);
         p["conservative"] = settings.conservative;
+        p["depth"] = settings.proxySlices ? "slices" : "tile";
         p["coverage"] = r.coverage;
         j["proxy"] = p;
     }
