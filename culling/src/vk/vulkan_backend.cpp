@@ -816,41 +816,60 @@ struct Counted {
     bool poolsFitted = false;
 };
 
+// The offsets of the lists in order, added up here (atomic ranges or no
+// scan on the device). (Locals in the loop: a store to the offsets might
+// otherwise alias c's own words, and P1 / clustered's 261,120 lists paid
+// 0.3 ms for it.)
+void addUpOffsets(const CullPlan& plan, Counted& c) {
+    if (!c.hostOffs.empty() || !(plan.atomicRanges() || plan.hostScan)) return;
+    const std::uint32_t listTotal = plan.listTotal;
+    c.hostOffs.resize(std::size_t(listTotal) + 1);
+    std::uint32_t* hostOffs = c.hostOffs.data();
+    const std::uint32_t* counts = c.counts;
+    std::uint32_t at = 0; // (the total was checked to fit 32 bits)
+    for (std::uint32_t l = 0; l < listTotal; ++l) {
+        hostOffs[l] = at;
+        at += counts[l];
+    }
+    hostOffs[listTotal] = at;
+    c.offs = hostOffs;
+}
+
+// The count pass's totals. Where the host adds up the offsets, it does so
+// only when the lists' decoding needs them (addUpOffsets): the lists taken
+// from their atomic ranges are laid out with their offsets in one pass
+// (decodeRanges); walking P1 / clustered's 261,120 counts once more cost the
+// H200's host 0.3 ms.
 Counted readCounts(const CullPlan& plan, const std::uint32_t* counts, const std::uint32_t* deviceOffs,
                    const std::uint32_t* stashed) {
     Counted c;
     c.counts = counts;
-    c.offs = deviceOffs;
     const std::uint32_t listTotal = plan.listTotal;
-    std::uint64_t total64 = 0;
-    // Ranges by atomic add, or no scan on the device: the offsets of the
-    // lists in order come from here (a second submission that writes the
-    // lists scans the same counts).
-    // (Locals in the loop: a store to the offsets might otherwise alias
-    // c's own words, and P1 / clustered's 261,120 lists paid 0.3 ms for it.)
     const bool hostOffsets = plan.atomicRanges() || plan.hostScan;
-    if (hostOffsets) c.hostOffs.resize(std::size_t(listTotal) + 1);
-    std::uint32_t* hostOffs = c.hostOffs.data();
+    c.offs = hostOffsets ? nullptr : deviceOffs;
+    std::uint64_t total64 = 0;
     std::uint32_t longest = 0;
     for (std::uint32_t l = 0; l < listTotal; ++l) {
-        if (hostOffsets) hostOffs[l] = std::uint32_t(total64);
         total64 += counts[l];
         longest = std::max(longest, counts[l]);
     }
     c.longest = longest;
-    if (plan.atomicRanges()) c.rangeOffs = deviceOffs;
-    if (hostOffsets) {
-        // (A total beyond 32 bits fails the size check below.)
-        c.hostOffs[listTotal] = std::uint32_t(total64);
-        if (plan.atomicRanges() && total64 <= std::numeric_limits<std::uint32_t>::max() &&
-            total64 != deviceOffs[listTotal])
+    if (plan.atomicRanges()) {
+        c.rangeOffs = deviceOffs;
+        if (total64 <= std::numeric_limits<std::uint32_t>::max() && total64 != deviceOffs[listTotal])
             throw DeviceError("Vulkan culling's lists took " + std::to_string(deviceOffs[listTotal]) +
                               " entries of the index array for " + std::to_string(total64) + " counted");
-        c.offs = c.hostOffs.data();
     }
+    const std::uint64_t total = hostOffsets ? total64 : deviceOffs[listTotal];
+    if (total64 != total || total64 * 4 > plan.profile.maxStorageBufferRange)
+        throw DeviceError("culling produced " + std::to_string(total64) +
+                          " list entries, more than one storage buffer of this device holds (" +
+                          std::to_string(plan.profile.maxStorageBufferRange / 4) + ")");
+    c.total = std::uint32_t(total64);
     // A tile walk's pools (cull_lists.comp): whether each held its walk's
     // entries, so that the host can take the lists from there.
     bool fitted = plan.walk != 0 && stashed;
+    if (fitted) addUpOffsets(plan, c);
     const std::uint32_t* offs = c.offs;
     for (std::uint32_t t = 0; fitted && t < plan.tiles; ++t)
         for (std::uint32_t q = 0; q < plan.walkGroups; ++q) {
@@ -858,11 +877,6 @@ Counted readCounts(const CullPlan& plan, const std::uint32_t* counts, const std:
             if (offs[end] - offs[first] > (end - first) * plan.stashSlots) fitted = false;
         }
     c.poolsFitted = fitted;
-    c.total = c.offs[listTotal];
-    if (total64 != c.total || total64 * 4 > plan.profile.maxStorageBufferRange)
-        throw DeviceError("culling produced " + std::to_string(total64) +
-                          " list entries, more than one storage buffer of this device holds (" +
-                          std::to_string(plan.profile.maxStorageBufferRange / 4) + ")");
     return c;
 }
 
@@ -898,17 +912,25 @@ void decodeStash(const CullPlan& plan, const Counted& c, const std::uint32_t* st
 
 // ListsFrom::Ranges: every list was written, each at the range it took;
 // appended in list order, so no zero fill first (16-bit entries widened).
+// The counts and the offsets in order are laid out in the same pass.
 template <class Index>
 void decodeRanges(const CullPlan& plan, const Counted& c, const Index* written, CullResult& res) {
     // (Locals: the entries' stores could alias the structs' words.)
     const std::uint32_t lists = plan.listTotal, total = c.total;
     const std::uint32_t *counts = c.counts, *ranges = c.rangeOffs;
+    res.listCount.assign(counts, counts + lists);
+    res.listOffset.resize(lists);
+    std::uint32_t* offs = res.listOffset.data();
     res.lightIndices.reserve(total);
+    std::uint32_t at = 0;
     for (std::uint32_t l = 0; l < lists; ++l) {
-        if (counts[l] == 0) continue;
-        if (ranges[l] > total - counts[l])
+        const std::uint32_t n = counts[l];
+        offs[l] = at;
+        if (n == 0) continue;
+        if (ranges[l] > total - n)
             throw DeviceError("Vulkan culling placed list " + std::to_string(l) + " beyond the index array");
-        res.lightIndices.insert(res.lightIndices.end(), written + ranges[l], written + ranges[l] + counts[l]);
+        res.lightIndices.insert(res.lightIndices.end(), written + ranges[l], written + ranges[l] + n);
+        at += n;
     }
 }
 
@@ -1319,10 +1341,13 @@ CullResult VulkanBackend::cullFrame(const CullFrame& frame, const DepthImage& de
     std::uint64_t tests = 0;
     for (std::uint32_t c = 0; c < LC_TEST_COUNTERS; ++c) tests += out.status[1 + c * LC_TEST_COUNTER_STRIDE];
     res.volumeTests = (out.status[0] & LC_STATUS_TESTS_OVERFLOW) ? 0 : tests; // wrapped: not counted
-    const Counted c = readCounts(plan, out.counts, out.offs, out.stashed);
+    Counted c = readCounts(plan, out.counts, out.offs, out.stashed);
 
     lastIndexBits_ = 32; // unless the lists come from the 16-bit index array
     const ListsFrom from = plan.listsFrom(c.total, c.longest, c.poolsFitted);
+    // Every way but the ranges' needs the offsets in order.
+    const bool laidOut = from == ListsFrom::Ranges; // decodeRanges lays out the counts and offsets
+    if (!laidOut) addUpOffsets(plan, c);
     switch (from) {
     case ListsFrom::Nothing:
         break;
@@ -1349,9 +1374,10 @@ CullResult VulkanBackend::cullFrame(const CullFrame& frame, const DepthImage& de
         writeListsAgain(plan, pipes, run, c, res);
         break;
     }
-    if (plan.zbin) decodeZbin(plan, out.counts, c.offs, out.binWordsOut, settings.bins, res);
+    if (plan.zbin)
+        decodeZbin(plan, out.counts, laidOut ? res.listOffset.data() : c.offs, out.binWordsOut, settings.bins, res);
     decodeTileBounds(plan, out.tb, res);
-    if (!plan.fptl || c.total == 0) {
+    if (!laidOut && (!plan.fptl || c.total == 0)) {
         res.listCount.assign(out.counts, out.counts + listTotal);
         res.listOffset.assign(c.offs, c.offs + listTotal);
     }
