@@ -18,28 +18,6 @@
 
 const uint PRUNED = 0xffffffffu;
 
-bool pixelMayNeed(vec3 p, uint l) {
-    vec4 L = lights[l].centerRadius;
-    vec3 c = L.xyz;
-    float r = L.w;
-    bool spot = false;
-    vec3 axis = vec3(0.0);
-    float cosAngle = 0.0;
-    if (uint(spots.length()) > l && spots[l].apexRange.w > 0.0) {
-        // A spot light: its range sphere is centred on the apex.
-        c = spots[l].apexRange.xyz;
-        r = spots[l].apexRange.w;
-        axis = spots[l].axisCos.xyz;
-        cosAngle = spots[l].axisCos.w;
-        spot = true;
-    }
-    float eps = (length(c) + r) * P.cluster.z + P.cluster.w;
-    vec3 d = p - c;
-    float len = length(d);
-    if (len > r + eps) return false;
-    return !spot || dot(d, axis) >= len * cosAngle - eps;
-}
-
 void main() {
     loadParams();
     uint id = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
@@ -58,17 +36,43 @@ void main() {
         uint x0 = tx * TILE_SIZE, y0 = ty * TILE_SIZE;
         uint w = min(x0 + TILE_SIZE, P.size.x) - x0, h = min(y0 + TILE_SIZE, P.size.y) - y0;
         float W = float(P.size.x), H = float(P.size.y);
+        // The light's volume, loaded once for the walk: its range sphere and,
+        // for a spot light (its range sphere centred on the apex), its cone,
+        // both widened by eps.
+        vec4 L = lights[l].centerRadius;
+        vec3 c = L.xyz;
+        float r = L.w;
+        bool spot = false;
+        vec3 axis = vec3(0.0);
+        float cosAngle = 0.0;
+        if (uint(spots.length()) > l && spots[l].apexRange.w > 0.0) {
+            c = spots[l].apexRange.xyz;
+            r = spots[l].apexRange.w;
+            axis = spots[l].axisCos.xyz;
+            cosAngle = spots[l].axisCos.w;
+            spot = true;
+        }
+        float eps = (length(c) + r) * P.cluster.z + P.cluster.w;
+        float reach = r + eps;
         bool keep = false;
         // One flat loop over the tile's pixels (one loop, so its iterations
-        // are the only ones lavapipe counts here).
+        // are the only ones lavapipe counts here), the pixel stepped along
+        // its row: no division per pixel.
+        uint x = x0, y = y0;
         for (uint i = 0u; i < w * h && !keep; ++i) {
-            uint x = x0 + i % w, y = y0 + i / w;
             float depth = depthBuf[y * P.size.x + x];
-            if (depth == P.depth.w) continue; // clear depth: no geometry
-            float v = viewDepthOf(depth);
-            if (isnan(v) || isinf(v)) continue;
-            vec3 p = viewAt(2.0 * (float(x) + 0.5) / W - 1.0, 2.0 * (float(y) + 0.5) / H - 1.0, v);
-            keep = pixelMayNeed(p, l);
+            if (depth != P.depth.w) { // clear depth: no geometry
+                float v = viewDepthOf(depth);
+                if (!(isnan(v) || isinf(v))) {
+                    vec3 d = viewAt(2.0 * (float(x) + 0.5) / W - 1.0, 2.0 * (float(y) + 0.5) / H - 1.0, v) - c;
+                    float len = length(d);
+                    keep = len <= reach && (!spot || dot(d, axis) >= len * cosAngle - eps);
+                }
+            }
+            if (++x == x0 + w) {
+                x = x0;
+                ++y;
+            }
         }
         if (!keep) lightIndices[id] = PRUNED;
     } else {
