@@ -12,6 +12,7 @@
 #include "window/main_window.hpp"
 #include "panels/report_dock.hpp"
 
+#include "culling/core/backend.hpp"
 #include "culling/core/pipeline.hpp"
 
 #include <QComboBox>
@@ -139,6 +140,31 @@ private slots:
         if (w_) doc()->undoStack()->setClean();
         dock_ = nullptr;
         w_.reset();
+    }
+
+    // The queue label follows every scene edit, and a Live drag makes one per
+    // step: it must neither look for devices again (each look opens a Vulkan
+    // instance, tens of ms on lavapipe: the studio's drag ran at 7 Hz with
+    // it) nor miss what the count does depend on (spot lights add rows).
+    void lightEditsDoNotLookForDevicesAgain() {
+        QVERIFY(!doc()->scene().lights.empty());
+        QVERIFY(!doc()->scene().hasSpotLights());
+        const int drag = doc()->newDragId();
+        doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(0.05, 0, 0), drag);
+        const std::size_t before = dock_->queuedConfigurations();
+        const QString label = queueText();
+        const std::uint64_t opened = lc::vulkanInstancesOpened();
+        for (int i = 1; i <= 20; ++i)
+            doc()->moveLight(0, doc()->scene().lights[0].position + glm::dvec3(0.05, 0, 0), drag);
+        QCOMPARE(lc::vulkanInstancesOpened(), opened);
+        QCOMPARE(queueText(), label);
+        lc::PointLight spot = doc()->scene().lights[0];
+        spot.kind = lc::LightKind::Spot;
+        doc()->setLight(0, spot);
+        QVERIFY(doc()->scene().hasSpotLights());
+        QVERIFY2(dock_->queuedConfigurations() > before, qPrintable(queueText()));
+        QVERIFY(queueText() != label);
+        QCOMPARE(lc::vulkanInstancesOpened(), opened);
     }
 
     void runFillsTheReportAndTheProgressBar() {

@@ -129,6 +129,9 @@ private:
     lc::ReportOptions optionsFromControls() const;
     std::vector<std::string> sweptBackends() const;
     std::map<std::string, std::size_t> queuedPerBackend() const;
+    // queuedPerBackend's last answer and what it depended on.
+    mutable std::string queuedKey_;
+    mutable std::map<std::string, std::size_t> queued_;
     // What a pace was measured under (scene, size, lights, repeats).
     QString paceKey() const;
     void updateQueueLabel();

@@ -142,16 +142,36 @@ lc::ReportOptions ReportDock::optionsFromControls() const {
     return o;
 }
 
+// The backend box lists the backends found when the dock was made (finding
+// them opens a Vulkan instance: tens of milliseconds on lavapipe, which the
+// queue label paid at every step of a Live drag).
 std::vector<std::string> ReportDock::sweptBackends() const {
     if (const QString b = backendBox_->currentData().toString(); !b.isEmpty()) return {b.toStdString()};
-    return lc::availableBackends();
+    std::vector<std::string> all;
+    for (int i = 0; i < backendBox_->count(); ++i)
+        if (const QString b = backendBox_->itemData(i).toString(); !b.isEmpty()) all.push_back(b.toStdString());
+    return all;
 }
 
 std::map<std::string, std::size_t> ReportDock::queuedPerBackend() const {
     const lc::ReportOptions o = optionsFromControls();
     const bool spots = doc_->scene().hasSpotLights();
+    const std::vector<std::string> backends = sweptBackends();
+    // What the count depends on: the swept values, the backends and whether
+    // the scene has spot lights, not where its lights are. Worked out again
+    // only when one of those changes (every light edit updates the label).
+    std::string key = spots ? "spots" : "points";
+    for (const std::string& b : backends) key += "|" + b;
+    key += "|tiles";
+    for (std::uint32_t t : o.tileSizes) key += " " + std::to_string(t);
+    key += "|cells";
+    for (std::uint32_t c : o.cellCounts) key += " " + std::to_string(c);
+    for (const auto& [name, value] : o.fixed) key += "|" + name + "=" + value;
+    if (key == queuedKey_) return queued_;
     std::map<std::string, std::size_t> n;
-    for (const std::string& b : sweptBackends()) n[b] = lc::reportConfigs(o, b, spots).size();
+    for (const std::string& b : backends) n[b] = lc::reportConfigs(o, b, spots).size();
+    queuedKey_ = key;
+    queued_ = n;
     return n;
 }
 

@@ -136,9 +136,11 @@ VkDebugUtilsMessengerCreateInfoEXT messengerInfo() {
 }
 
 std::atomic<bool> g_instanceCreated{false};
+std::atomic<std::uint64_t> g_instancesOpened{0};
 
 VkInstance createInstance(bool& debugUtils, bool& validation, bool forceValidation) {
     g_instanceCreated = true;
+    ++g_instancesOpened;
     std::uint32_t n = 0;
     LC_VK(vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr));
     std::vector<VkExtensionProperties> exts(n);
@@ -220,6 +222,7 @@ VkInstance createInstance(bool& debugUtils, bool& validation, bool forceValidati
 std::vector<std::string> physicalDeviceNames() {
     std::vector<std::string> out;
     g_instanceCreated = true;
+    ++g_instancesOpened;
     try {
         VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
         app.apiVersion = VK_API_VERSION_1_1;
@@ -796,4 +799,5 @@ double Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record
 
 namespace lc {
 bool vulkanInstanceCreated() { return vk::g_instanceCreated; }
+std::uint64_t vulkanInstancesOpened() { return vk::g_instancesOpened; }
 } // namespace lc

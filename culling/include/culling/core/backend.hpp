@@ -156,6 +156,11 @@ std::unique_ptr<CullBackend> makeCpuBackend();
 // is unknown or (Vulkan) no device matches `device` (index or name substring;
 // empty: LIGHTCULL_DEVICE, else the first discrete GPU, else the first device).
 std::vector<std::string> availableBackends();
+// How many Vulkan instances this process has opened (a backend's, and one
+// each time availableBackends() or the device list looks for devices): each
+// starts the drivers, tens of milliseconds on lavapipe, so an interactive
+// path must not open one per edit.
+std::uint64_t vulkanInstancesOpened();
 std::unique_ptr<CullBackend> makeBackend(const std::string& name, const std::string& device = {});
 
 } // namespace lc
