@@ -1,7 +1,8 @@
 #version 450
 // fptl's fine prune (culling/cpu/fine_prune.hpp), run after cull_lists wrote the
 // coarse (minmax) lists into the index array:
-//   WRITE_PASS LC_PRUNE_MARK: an invocation per entry of the index array. It finds its
+//   WRITE_PASS LC_PRUNE_MARK: an invocation (LANES > 1: a subgroup, its lanes over
+//     the pixels) per entry of the index array. It finds its
 //     list (a binary search of the offsets), walks the geometry pixels of
 //     that list's tile and overwrites the entry with PRUNED when no pixel lies
 //     inside the light's volume: its range sphere and, for a spot light, its
@@ -14,6 +15,8 @@
 // Loops per invocation: at most a tile's pixels plus the search (pass 0),
 // a list's entries (pass 1); the host keeps both under lavapipe's cap.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_vote : require
 #include "cull_common.glsl"
 
 const uint PRUNED = 0xffffffffu;
@@ -24,6 +27,13 @@ void main() {
               gl_LocalInvocationIndex;
     uint lists = P.counts.z;
     if (WRITE_PASS == LC_PRUNE_MARK) {
+        // LANES > 1 (GPUs): a subgroup per entry, its lanes over the tile's
+        // pixels; else an invocation per entry.
+        uint lane = 0u;
+        if (LANES > 1u) {
+            id = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_NumSubgroups + gl_SubgroupID;
+            lane = gl_SubgroupInvocationID;
+        }
         if (id >= listOffset[lists]) return;
         // offset[lo] <= id < offset[hi]: ends on the one non-empty list holding id.
         uint lo = 0u, hi = lists;
@@ -55,6 +65,29 @@ void main() {
         float eps = (length(c) + r) * P.cluster.z + P.cluster.w;
         float reach = r + eps;
         bool keep = false;
+        if (LANES > 1u) {
+            // The subgroup steps over the tile's pixels a lane each and stops
+            // at the first pixel any lane finds inside.
+            for (uint first = 0u; first < w * h; first += LANES) {
+                uint i = first + lane;
+                if (i < w * h) {
+                    uint x = x0 + i % w, y = y0 + i / w;
+                    float depth = depthBuf[y * P.size.x + x];
+                    if (depth != P.depth.w) { // clear depth: no geometry
+                        float v = viewDepthOf(depth);
+                        if (!(isnan(v) || isinf(v))) {
+                            vec3 d = viewAt(2.0 * (float(x) + 0.5) / W - 1.0, 2.0 * (float(y) + 0.5) / H - 1.0, v) - c;
+                            float len = length(d);
+                            keep = len <= reach && (!spot || dot(d, axis) >= len * cosAngle - eps);
+                        }
+                    }
+                }
+                if (subgroupAny(keep)) break;
+            }
+            keep = subgroupAny(keep);
+            if (!keep && lane == 0u) lightIndices[id] = PRUNED;
+            return;
+        }
         // One flat loop over the tile's pixels (one loop, so its iterations
         // are the only ones lavapipe counts here), the pixel stepped along
         // its row: no division per pixel.

@@ -88,7 +88,7 @@ const char* listsFromName(ListsFrom f) {
 }
 
 Groups CullPlan::pruneGroups(std::uint32_t entries) const {
-    return groupsFor(entries, profile);
+    return groupsFor(std::uint64_t(entries) * pruneLanes(entries), profile);
 }
 
 ListsFrom CullPlan::listsFrom(std::uint32_t total, std::uint32_t longest, bool poolsFitted) const {
@@ -317,6 +317,8 @@ void planPasses(CullPlan& plan, const DeviceProfile& dev, const CullSpec& base, 
     plan.scan.lanes = plan.wideScan ? dev.subgroupSize : 1;
     plan.prune = base;
     plan.prune.writePass = LC_PRUNE_MARK;
+    plan.pruneWide = plan.prune;
+    plan.pruneWide.lanes = plan.lanes;
     plan.pack = base;
     plan.pack.writePass = LC_PRUNE_PACK;
     plan.zbinInit = base;

@@ -169,9 +169,19 @@ struct CullPlan {
     std::size_t entryBytes() const { return index16 ? 2 : 4; }
 
     // Specialisation constants per pass.
-    CullSpec bounds, bins, count, write, atomicWriteSpec, fusedSpec, scan, prune, pack, zbinInit, zbinBins;
+    // fptl's prune: an invocation per entry (prune), or on GPUs a subgroup
+    // per entry while the entries are few (pruneWide; pruneLanes).
+    CullSpec bounds, bins, count, write, atomicWriteSpec, fusedSpec, scan, prune, pruneWide, pack, zbinInit, zbinBins;
 
     Groups boundsGroups, binGroups, countGroups, writeGroups, packGroups, zbinInitGroups, zbinGroups;
+    // Lanes per entry of fptl's prune over `entries` coarse entries: the
+    // subgroup while they are at most kWidePruneEntries (too few invocations
+    // to fill a GPU otherwise), else 1 (a subgroup each did 32 times the
+    // search and loads for entries found on the first pixels).
+    static constexpr std::uint32_t kWidePruneEntries = 65536;
+    std::uint32_t pruneLanes(std::uint32_t entries) const {
+        return pruneWide.lanes > 1 && entries <= kWidePruneEntries ? pruneWide.lanes : 1;
+    }
     Groups pruneGroups(std::uint32_t entries) const;
 
     // Where the lists come from, given what the count pass found.

@@ -25,7 +25,8 @@
 //   the cull is given that image (DepthImage::deviceCopy), else uploaded.
 //   fptl adds (in the second submission, always, sized exactly: its lists
 //   are minmax's so far):
-//   5. fine_prune, an invocation per entry: the light against its tile's
+//   5. fine_prune, an invocation per entry (a subgroup on GPUs while the
+//      entries are few): the light against its tile's
 //      geometry pixels, pruned entries marked;
 //   6. fine_prune pack, an invocation per list: kept entries to the front
 //      of the list's range, the new count; the host packs the ranges.
@@ -274,7 +275,8 @@ private:
     struct CullPipelines {
         VkPipeline bounds = VK_NULL_HANDLE, bins = VK_NULL_HANDLE, count = VK_NULL_HANDLE, write = VK_NULL_HANDLE,
                    scan = VK_NULL_HANDLE, prune = VK_NULL_HANDLE, pack = VK_NULL_HANDLE, zbinInit = VK_NULL_HANDLE,
-                   zbin = VK_NULL_HANDLE, atomicWrite = VK_NULL_HANDLE, fused = VK_NULL_HANDLE;
+                   zbin = VK_NULL_HANDLE, atomicWrite = VK_NULL_HANDLE, fused = VK_NULL_HANDLE,
+                   pruneWide = VK_NULL_HANDLE;
     };
     CullPipelines cullPipelines(const CullPlan& plan);
     // One cull's buffers (the cache's, each role acquired once), the bytes
@@ -1046,6 +1048,7 @@ VulkanBackend::CullPipelines VulkanBackend::cullPipelines(const CullPlan& plan) 
     p.scan = computePipeline("prefix_sum", scanShader_, plan.scan, true);
     if (plan.fptl) {
         p.prune = computePipeline("fine_prune", pruneShader_, plan.prune, false);
+        if (plan.pruneWide.lanes > 1) p.pruneWide = computePipeline("fine_prune.wide", pruneShader_, plan.pruneWide, true);
         p.pack = computePipeline("fine_prune.pack", pruneShader_, plan.pack, false);
     }
     if (plan.zbin) {
@@ -1175,7 +1178,7 @@ void VulkanBackend::writeListsAgain(const CullPlan& plan, const CullPipelines& p
             if (plan.fptl) {
                 // The prune reads the entries the write pass wrote, and the
                 // pack the marks the prune wrote over them.
-                dispatchAfter(cmd, pipes.prune, pruneGroups);
+                dispatchAfter(cmd, plan.pruneLanes(total) > 1 ? pipes.pruneWide : pipes.prune, pruneGroups);
                 dispatchAfter(cmd, pipes.pack, plan.packGroups);
             }
             if (run.stamps) run.stamps->end(cmd, 1);
