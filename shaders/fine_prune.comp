@@ -21,6 +21,28 @@
 
 const uint PRUNED = 0xffffffffu;
 
+// The light's volume as the prune tests it: its range sphere (centre c,
+// radius r widened by eps: reach) and, for a spot, its cone.
+struct PruneVolume {
+    vec3 c;
+    float reach, eps;
+    bool spot;
+    vec3 axis;
+    float cosAngle;
+};
+
+// Whether pixel (x, y) holds geometry inside the volume.
+bool pixelInside(uint x, uint y, PruneVolume vol) {
+    float depth = depthBuf[y * P.size.x + x];
+    if (depth == P.depth.w) return false; // clear depth: no geometry
+    float v = viewDepthOf(depth);
+    if (isnan(v) || isinf(v)) return false;
+    vec3 d = viewAt(2.0 * (float(x) + 0.5) / float(P.size.x) - 1.0, 2.0 * (float(y) + 0.5) / float(P.size.y) - 1.0, v) -
+             vol.c;
+    float len = length(d);
+    return len <= vol.reach && (!vol.spot || dot(d, vol.axis) >= len * vol.cosAngle - vol.eps);
+}
+
 void main() {
     loadParams();
     uint id = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
@@ -45,43 +67,32 @@ void main() {
         uint tx = lo % P.size.z, ty = lo / P.size.z;
         uint x0 = tx * TILE_SIZE, y0 = ty * TILE_SIZE;
         uint w = min(x0 + TILE_SIZE, P.size.x) - x0, h = min(y0 + TILE_SIZE, P.size.y) - y0;
-        float W = float(P.size.x), H = float(P.size.y);
         // The light's volume, loaded once for the walk: its range sphere and,
         // for a spot light (its range sphere centred on the apex), its cone,
         // both widened by eps.
         vec4 L = lights[l].centerRadius;
-        vec3 c = L.xyz;
+        PruneVolume vol;
+        vol.c = L.xyz;
         float r = L.w;
-        bool spot = false;
-        vec3 axis = vec3(0.0);
-        float cosAngle = 0.0;
+        vol.spot = false;
+        vol.axis = vec3(0.0);
+        vol.cosAngle = 0.0;
         if (uint(spots.length()) > l && spots[l].apexRange.w > 0.0) {
-            c = spots[l].apexRange.xyz;
+            vol.c = spots[l].apexRange.xyz;
             r = spots[l].apexRange.w;
-            axis = spots[l].axisCos.xyz;
-            cosAngle = spots[l].axisCos.w;
-            spot = true;
+            vol.axis = spots[l].axisCos.xyz;
+            vol.cosAngle = spots[l].axisCos.w;
+            vol.spot = true;
         }
-        float eps = (length(c) + r) * P.cluster.z + P.cluster.w;
-        float reach = r + eps;
+        vol.eps = (length(vol.c) + r) * P.cluster.z + P.cluster.w;
+        vol.reach = r + vol.eps;
         bool keep = false;
         if (LANES > 1u) {
             // The subgroup steps over the tile's pixels a lane each and stops
             // at the first pixel any lane finds inside.
             for (uint first = 0u; first < w * h; first += LANES) {
                 uint i = first + lane;
-                if (i < w * h) {
-                    uint x = x0 + i % w, y = y0 + i / w;
-                    float depth = depthBuf[y * P.size.x + x];
-                    if (depth != P.depth.w) { // clear depth: no geometry
-                        float v = viewDepthOf(depth);
-                        if (!(isnan(v) || isinf(v))) {
-                            vec3 d = viewAt(2.0 * (float(x) + 0.5) / W - 1.0, 2.0 * (float(y) + 0.5) / H - 1.0, v) - c;
-                            float len = length(d);
-                            keep = len <= reach && (!spot || dot(d, axis) >= len * cosAngle - eps);
-                        }
-                    }
-                }
+                keep = i < w * h && pixelInside(x0 + i % w, y0 + i / w, vol);
                 if (subgroupAny(keep)) break;
             }
             keep = subgroupAny(keep);
@@ -93,15 +104,7 @@ void main() {
         // its row: no division per pixel.
         uint x = x0, y = y0;
         for (uint i = 0u; i < w * h && !keep; ++i) {
-            float depth = depthBuf[y * P.size.x + x];
-            if (depth != P.depth.w) { // clear depth: no geometry
-                float v = viewDepthOf(depth);
-                if (!(isnan(v) || isinf(v))) {
-                    vec3 d = viewAt(2.0 * (float(x) + 0.5) / W - 1.0, 2.0 * (float(y) + 0.5) / H - 1.0, v) - c;
-                    float len = length(d);
-                    keep = len <= reach && (!spot || dot(d, axis) >= len * cosAngle - eps);
-                }
-            }
+            keep = pixelInside(x, y, vol);
             if (++x == x0 + w) {
                 x = x0;
                 ++y;
