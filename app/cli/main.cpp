@@ -217,7 +217,7 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
                       << (f.pixels == 1 ? " pixel needs it" : " pixels need it") << " (of " << located.size()
                       << " missed light-list pairs" << (out.empty() ? "" : "; all in summary.json's \"missed\"")
                       << "); why: lightcull explain with the same flags and --tile " << tx << "," << ty
-                      << (r.listsPerTile > 1 ? " --cell " + std::to_string(f.list % r.listsPerTile) : std::string())
+                      << (r.cellOfList(f.list) >= 0 ? " --cell " + std::to_string(r.cellOfList(f.list)) : std::string())
                       << " --light " << f.light << "\n";
         }
     }

@@ -63,6 +63,9 @@ TEST(Explain, TestsAgreeWithTheReferenceListsForEveryAlgorithm) {
                 const CullResult& r = run.result;
                 std::uint64_t listedSeen = 0, checked = 0;
                 for (std::uint32_t l = 0; l < r.listCount.size(); l += 5) {
+                    // The tile and cell a run's first-miss hint names lead
+                    // explain back to the same list.
+                    EXPECT_EQ(r.listOf(r.tileOfList(l), r.cellOfList(l)), l) << toString(a) << " list " << l;
                     for (std::uint32_t i = 0; i < run.lights.size(); ++i) {
                         const Explanation e = explainLight(run, proj, l, i);
                         ASSERT_EQ(e.testsPass, e.listed)

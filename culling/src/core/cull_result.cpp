@@ -131,6 +131,10 @@ std::uint32_t CullResult::tileOfList(std::uint32_t list) const {
     return algorithm == Algorithm::All ? 0 : list / std::max(listsPerTile, 1u);
 }
 
+int CullResult::cellOfList(std::uint32_t list) const {
+    return algorithm == Algorithm::All || listsPerTile <= 1 ? -1 : int(list % listsPerTile);
+}
+
 std::string CullResult::validate(std::size_t lightCount) const {
     const std::uint64_t tiles = grid.tileCount();
     const std::uint32_t expectPerTile = listsPerTileOf(settings, cellLists);

@@ -214,9 +214,8 @@ void addMissed(nlohmann::ordered_json& j, const Scene& scene, const RunOutput& r
         e["list"] = ml.list;
         // The list within its tile (halfz's half, a cluster's slice), as
         // explain's --cell takes it; null where a tile has one list.
-        e["cell"] = run.result.listsPerTile > 1 && run.result.algorithm != Algorithm::All
-                        ? nlohmann::ordered_json(ml.list % run.result.listsPerTile)
-                        : nlohmann::ordered_json(nullptr);
+        const int cell = run.result.cellOfList(ml.list);
+        e["cell"] = cell >= 0 ? nlohmann::ordered_json(cell) : nlohmann::ordered_json(nullptr);
         e["light"] = ml.light;
         e["light_name"] = ml.light < scene.lights.size() ? scene.lights[ml.light].name : std::string();
         e["pixels"] = ml.pixels;

@@ -164,6 +164,9 @@ struct CullPlan {
     bool hostScan = false;   // no scan on the device: the host adds up the counts
     bool fused = false, atomicWrite = false;
     bool atomicRanges() const { return fused || atomicWrite; }
+    // The host adds up the lists' offsets in order (atomic ranges, or no
+    // scan on the device).
+    bool hostOffsets() const { return atomicRanges() || hostScan; }
     bool index16 = false;          // the fused pass writes 16-bit indices
     std::size_t firstCapacity = 1; // entries of the first index array
     std::size_t entryBytes() const { return index16 ? 2 : 4; }

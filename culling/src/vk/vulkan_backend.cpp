@@ -823,7 +823,7 @@ struct Counted {
 // otherwise alias c's own words, and P1 / clustered's 261,120 lists paid
 // 0.3 ms for it.)
 void addUpOffsets(const CullPlan& plan, Counted& c) {
-    if (!c.hostOffs.empty() || !(plan.atomicRanges() || plan.hostScan)) return;
+    if (!c.hostOffs.empty() || !plan.hostOffsets()) return;
     const std::uint32_t listTotal = plan.listTotal;
     c.hostOffs.resize(std::size_t(listTotal) + 1);
     std::uint32_t* hostOffs = c.hostOffs.data();
@@ -847,7 +847,7 @@ Counted readCounts(const CullPlan& plan, const std::uint32_t* counts, const std:
     Counted c;
     c.counts = counts;
     const std::uint32_t listTotal = plan.listTotal;
-    const bool hostOffsets = plan.atomicRanges() || plan.hostScan;
+    const bool hostOffsets = plan.hostOffsets();
     c.offs = hostOffsets ? nullptr : deviceOffs;
     std::uint64_t total64 = 0;
     std::uint32_t longest = 0;
@@ -1156,7 +1156,7 @@ void VulkanBackend::writeListsAgain(const CullPlan& plan, const CullPipelines& p
                                          *run.counts, std::size_t(listTotal) * 4, "cull.counts.packed"))
                                    : nullptr;
     const Groups pruneGroups = plan.pruneGroups(total);
-    const bool hostOffsets = plan.atomicRanges() || plan.hostScan;
+    const bool hostOffsets = plan.hostOffsets();
     run.wallMs += ctx_.submitAndWait(
         [&](VkCommandBuffer cmd) {
             // The write pass reads counts/offsets/bounds written by the previous submission.
@@ -1377,13 +1377,12 @@ CullResult VulkanBackend::cullFrame(const CullFrame& frame, const DepthImage& de
         writeListsAgain(plan, pipes, run, c, res);
         break;
     }
-    if (plan.zbin)
-        decodeZbin(plan, out.counts, laidOut ? res.listOffset.data() : c.offs, out.binWordsOut, settings.bins, res);
-    decodeTileBounds(plan, out.tb, res);
     if (!laidOut && (!plan.fptl || c.total == 0)) {
         res.listCount.assign(out.counts, out.counts + listTotal);
         res.listOffset.assign(c.offs, c.offs + listTotal);
     }
+    if (plan.zbin) decodeZbin(plan, out.counts, res.listOffset.data(), out.binWordsOut, settings.bins, res);
+    decodeTileBounds(plan, out.tb, res);
 
     res.backend = name();
     res.device = deviceName();

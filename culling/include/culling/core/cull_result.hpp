@@ -131,6 +131,9 @@ struct CullResult {
     std::uint32_t listOf(std::uint32_t tile, int sub = -1) const;
     // The tile a list belongs to (0 for `all`).
     std::uint32_t tileOfList(std::uint32_t list) const;
+    // The sub (listOf's) of a list within its tile, or -1 where a tile has
+    // one list: what explain's --cell takes.
+    int cellOfList(std::uint32_t list) const;
     std::uint64_t entries() const { return lightIndices.size(); }
     // Bytes of the light lists in the form a renderer uploads and reads while
     // shading: 4 per index and 8 per list (offset + count). halfz packs a
