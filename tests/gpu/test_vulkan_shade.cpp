@@ -262,3 +262,44 @@ TEST_F(VulkanShade, AnImagePastOneStorageBufferIsShadedInBands) {
     expectSameImage(gpu.shade(in, lights, &result), shadeCpu(in, lights, &result), in, "banded");
     EXPECT_GT(gpu.lastShadeMs(), 0.0);
 }
+
+// The pass keeps the last G-buffer it uploaded and skips the upload when it
+// is handed the same one again (a sweep shades one G-buffer with many lists).
+// Whatever it keeps, each image must be the one of the G-buffer it was
+// handed: the same G-buffer with other lists, another frame of the same size
+// (a key of sizes alone would reuse the old pixels), a copy whose pixels were
+// changed (a key of the maker's id alone would), and the first again.
+TEST_F(VulkanShade, AGBufferShadedAgainIsTheOneHandedEachTime) {
+    CullBackend& gpu = gputest::vulkan();
+    auto cpu = makeCpuBackend();
+    Scene scene = smallScene("atrium", 120, 68, 40);
+    const ViewLights lights = makeViewLights(scene);
+    const TileGrid grid = TileGrid::make(120, 68, 16);
+    const Projection proj(scene.camera);
+    const DepthImage depth = cpu->renderDepth(scene, proj);
+    CullSettings naive, clustered;
+    naive.algorithm = Algorithm::Naive;
+    clustered.algorithm = Algorithm::Clustered;
+    clustered.cells = 8;
+    const CullResult a1 = cpu->cull(depth, proj, grid, lights, naive);
+    const CullResult a2 = cpu->cull(depth, proj, grid, lights, clustered);
+    ShadeInputs a = makeShadeInputs(depth, proj, &a1);
+    expectSameImage(gpu.shade(a, lights, &a1), shadeCpu(a, lights, &a1), a, "first G-buffer");
+    setShadeLists(a, depth, proj, &a2);
+    expectSameImage(gpu.shade(a, lights, &a2), shadeCpu(a, lights, &a2), a, "the same G-buffer, other lists");
+
+    Scene turned = scene;
+    turned.camera.position = scene.camera.position + 0.35 * (scene.camera.target - scene.camera.position);
+    const Projection proj2(turned.camera);
+    const DepthImage depth2 = cpu->renderDepth(turned, proj2);
+    const ViewLights lights2 = makeViewLights(turned);
+    const CullResult b1 = cpu->cull(depth2, proj2, grid, lights2, naive);
+    const ShadeInputs b = makeShadeInputs(depth2, proj2, &b1);
+    ASSERT_NE(b.position, a.position);
+    expectSameImage(gpu.shade(b, lights2, &b1), shadeCpu(b, lights2, &b1), b, "another frame of the same size");
+
+    ShadeInputs moved = b; // the maker's id comes along with the copy
+    for (std::size_t i = 0; i < moved.position.size(); i += 3) moved.position[i + 1] += 0.25f;
+    expectSameImage(gpu.shade(moved, lights2, &b1), shadeCpu(moved, lights2, &b1), moved, "a changed copy");
+    expectSameImage(gpu.shade(a, lights, &a2), shadeCpu(a, lights, &a2), a, "the first G-buffer again");
+}

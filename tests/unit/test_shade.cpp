@@ -552,3 +552,55 @@ TEST(Shade, ImageErrorIsZeroForLightsWithARangeWhenNothingIsMissed) {
         EXPECT_GT(cut.truth.metrics.imageRmse, 1e-3 * peak) << toString(algo) << ": the cut-off's error vanished";
     }
 }
+
+// shadeCpu groups a band's pixels by list before shading. Lists close
+// together (a tile row's) are counted into place, lists spread wider than the
+// band's pixels are sorted: either way every pixel gets the sum over its own
+// list, the same as shading that pixel alone, and pixels without a list stay 0.
+TEST(Shade, EachPixelIsShadedWithItsOwnListHoweverTheBandsListsAreSpread) {
+    const Scene scene = atriumWithSpot();
+    const RunOutput run = cpuRun(scene, Algorithm::Naive);
+    const Projection proj(scene.camera);
+    const ShadeInputs base = makeShadeInputs(run.depth, proj, nullptr);
+    const std::size_t pixels = base.list.size(), lightCount = run.lights.size();
+    for (const std::uint32_t spread : {40u, 50000u}) {
+        CullResult lists;
+        lists.grid = run.result.grid;
+        for (std::uint32_t l = 0; l < spread; ++l) {
+            std::vector<std::uint32_t> own{l % std::uint32_t(lightCount), (l * 7 + 3) % std::uint32_t(lightCount),
+                                           (l * 13 + 5) % std::uint32_t(lightCount)};
+            std::sort(own.begin(), own.end());
+            own.erase(std::unique(own.begin(), own.end()), own.end());
+            lists.listOffset.push_back(std::uint32_t(lists.lightIndices.size()));
+            lists.listCount.push_back(std::uint32_t(own.size()));
+            lists.lightIndices.insert(lists.lightIndices.end(), own.begin(), own.end());
+        }
+        ShadeInputs in = base;
+        std::size_t shaded = 0;
+        for (std::size_t i = 0; i < pixels; ++i)
+            if (in.list[i] != ShadeInputs::kNoList && i % 11 != 0) {
+                in.list[i] = std::uint32_t((i * 7919) % spread);
+                ++shaded;
+            } else {
+                in.list[i] = ShadeInputs::kNoList;
+            }
+        ASSERT_GT(shaded, pixels / 4);
+        const std::vector<float> rgb = shadeCpu(in, run.lights, &lists);
+        std::size_t lit = 0;
+        for (std::size_t i = 0; i < pixels; ++i) {
+            ShadeInputs one;
+            one.width = one.height = 1;
+            one.position.assign(in.position.begin() + std::ptrdiff_t(3 * i), in.position.begin() + std::ptrdiff_t(3 * i + 3));
+            one.normal.assign(in.normal.begin() + std::ptrdiff_t(3 * i), in.normal.begin() + std::ptrdiff_t(3 * i + 3));
+            one.list = {in.list[i]};
+            const std::vector<float> alone = shadeCpu(one, run.lights, &lists);
+            for (int c = 0; c < 3; ++c) {
+                ASSERT_NEAR(rgb[3 * i + c], alone[c], 1e-6 * (std::abs(alone[c]) + 1e-6))
+                    << "pixel " << i << " list " << in.list[i] << " of " << spread;
+                if (in.list[i] == ShadeInputs::kNoList) ASSERT_EQ(rgb[3 * i + c], 0.0f);
+            }
+            lit += alone[0] + alone[1] + alone[2] > 0.0f;
+        }
+        EXPECT_GT(lit, shaded / 4) << "too few lit pixels for the comparison to mean anything";
+    }
+}

@@ -170,10 +170,15 @@ std::vector<float> ShadePass::run(const ShadeInputs& in, const ViewLights& light
 
     params.as<GpuShadeParams>()->size =
         glm::uvec4(in.width, in.height, std::uint32_t(lightCount), std::uint32_t(listTotal));
-    GpuShadePixel* px = pixelBuf.as<GpuShadePixel>();
-    for (std::size_t i = 0; i < pixels; ++i) {
-        px[i].position = glm::vec4(in.position[3 * i], in.position[3 * i + 1], in.position[3 * i + 2], 0.0f);
-        px[i].normal = glm::vec4(in.normal[3 * i], in.normal[3 * i + 1], in.normal[3 * i + 2], 0.0f);
+    const Uploaded now{in.gbufferId, in.position.data(), in.normal.data(), pixels, pixelBuf.buffer};
+    if (now.id == 0 || !(now == uploaded_)) {
+        uploaded_ = {};
+        GpuShadePixel* px = pixelBuf.as<GpuShadePixel>();
+        for (std::size_t i = 0; i < pixels; ++i) {
+            px[i].position = glm::vec4(in.position[3 * i], in.position[3 * i + 1], in.position[3 * i + 2], 0.0f);
+            px[i].normal = glm::vec4(in.normal[3 * i], in.normal[3 * i + 1], in.normal[3 * i + 2], 0.0f);
+        }
+        uploaded_ = now;
     }
     std::memcpy(listBuf.mapped, in.list.data(), pixels * 4);
     GpuShadeLight* L = lightBuf.as<GpuShadeLight>();

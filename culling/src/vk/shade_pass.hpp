@@ -30,6 +30,15 @@ private:
     ShaderModuleHandle shader_;
     std::array<PipelineHandle, 4> pipelines_; // [2 x all lights + lights in the block]
     std::uint32_t blockLights_ = 0;           // lights per uniform block (shade.comp BLOCK_LIGHTS)
+    // The G-buffer now in "shade.pixels": its maker's id, its arrays and the
+    // buffer it went to (ShadeInputs::gbufferId; id 0: nothing known).
+    struct Uploaded {
+        std::uint64_t id = 0;
+        const float *position = nullptr, *normal = nullptr;
+        std::size_t pixels = 0;
+        VkBuffer buffer = VK_NULL_HANDLE;
+        bool operator==(const Uploaded&) const = default;
+    } uploaded_;
 };
 
 } // namespace lc::vk

@@ -43,6 +43,15 @@ struct ShadeInputs {
     std::vector<float> position; // 3 per pixel
     std::vector<float> normal;   // 3 per pixel
     std::vector<std::uint32_t> list;
+    // Each geometry pixel's view depth, as Projection::viewDepthFromWindowDepth
+    // gives it (0 elsewhere): setShadeLists finds each pixel's cell from it
+    // without converting the depth again for every result.
+    std::vector<double> viewDepth;
+    // Which makeShadeInputs call made position and normal (0: made some other
+    // way). A shading pass handed the G-buffer it shaded last time, the same
+    // id and the same arrays, skips its upload (a sweep shades each G-buffer
+    // many times with different lists).
+    std::uint64_t gbufferId = 0;
     // zbin: the per-(tile, bin) lists `list` indexes (zbinPixelLists), which
     // every shading pass uses instead of the (non-null) result it is handed.
     std::shared_ptr<const CullResult> perPixelLists;
