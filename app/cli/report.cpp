@@ -12,6 +12,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -31,6 +33,15 @@ std::vector<std::string> splitCommas(const std::string& s) {
     std::stringstream in(s);
     for (std::string v; std::getline(in, v, ',');) out.push_back(v);
     return out;
+}
+
+// "about 2 min 10 s", "about 40 s", "under a second".
+std::string aboutTime(double seconds) {
+    if (!(seconds >= 1)) return "under a second";
+    const long s = std::lround(seconds);
+    if (s < 60) return "about " + std::to_string(s) + " s";
+    if (s < 3600) return "about " + std::to_string(s / 60) + " min " + std::to_string(s % 60) + " s";
+    return "about " + std::to_string(s / 3600) + " h " + std::to_string(s % 3600 / 60) + " min";
 }
 
 } // namespace
@@ -151,10 +162,29 @@ int ReportCommand::run() {
         if (!shaders_.empty()) return usage("--shader: a custom shader is not a preset; run the two reports apart");
     }
 
+    // Progress on stderr: on a terminal one line rewritten after each
+    // configuration, elsewhere (a log) a line at each tenth. What is left is
+    // estimated at the pace since the first configuration (which also opened
+    // the backend and worked out what the rows share), so the count and the
+    // first estimate come after the second configuration.
     const bool tty = ::isatty(STDERR_FILENO);
+    std::chrono::steady_clock::time_point first;
+    std::size_t tenthsShown = 0;
     const lc::Report report = lc::runReport(scene, options, [&](std::size_t done, std::size_t total,
                                                                 const std::string& label) {
-        if (tty) std::cerr << "\r[" << done << "/" << total << "] " << label << "\033[K" << std::flush;
+        const auto now = std::chrono::steady_clock::now();
+        if (done == 1) first = now;
+        const double pace = done > 1 ? std::chrono::duration<double>(now - first).count() / double(done - 1) : 0;
+        const std::string left =
+            done > 1 && done < total ? ", " + aboutTime(pace * double(total - done)) + " left" : std::string();
+        if (done == std::min<std::size_t>(2, total))
+            std::cerr << (tty ? "\r\033[K" : "") << "report: " << total << " configurations" << left << "\n";
+        if (tty) {
+            std::cerr << "\r[" << done << "/" << total << "] " << label << left << "\033[K" << std::flush;
+        } else if (done > 2 && done * 10 / total > tenthsShown) {
+            tenthsShown = done * 10 / total;
+            std::cerr << "[" << done << "/" << total << "]" << left << "\n";
+        }
     });
     if (tty) std::cerr << "\r\033[K";
     lc::writeReport(report, outDir_);

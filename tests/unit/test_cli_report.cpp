@@ -27,6 +27,12 @@ TEST(CliReport, WritesCsvMarkdownAndPareto) {
                                tmp.path);
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.out.find("9 configurations"), std::string::npos) << r.out;
+    // Progress for a log (stderr is no terminal here): the count and an
+    // estimate after the second configuration, then a line at each tenth.
+    EXPECT_EQ(r.err.rfind("report: 9 configurations, ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(" left\n"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\n[5/9], "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\n[9/9]\n"), std::string::npos) << r.err;
     const std::string csv = slurp(out / "report.csv");
     // header + 3 tests x (cells 1 + cells 4 x 2 slicings)
     ASSERT_EQ(lineCount(csv), 10u) << csv;
