@@ -941,3 +941,48 @@ TEST_F(GpuTest, ZBinBinsHoldTheReferenceBins) {
         EXPECT_EQ(computeGroundTruth(f.depth, f.proj, f.lights, gpu, o).metrics.falseNegatives, 0u);
     }
 }
+
+// A backend keeps the culling pipelines it used last, at most 64 (a report
+// sweep made hundreds, megabytes each on lavapipe): settings culled again
+// soon make none, settings whose pipelines went make them again and cull
+// the same lists, and a backend's pipelines go with it.
+TEST_F(GpuTest, CullPipelinesHeldAreTheLastUsedAndAtMost64) {
+    const VulkanPipelineCount before = vulkanCullPipelines(); // other backends' (held, unchanged here)
+    auto cpu = makeCpuBackend();
+    Scene scene = sized("atrium", 64, 36, 16);
+    scene.lights = generateLights(defaultLightGen(scene, 12, 5));
+    const gputest::Frame f(scene, cpu.get());
+    std::vector<CullSettings> all;
+    for (Algorithm algo : {Algorithm::TwoPointFiveD, Algorithm::Clustered})
+        for (std::uint32_t cells : {2u, 8u, 32u})
+            for (SphereTest test : kTests) {
+                CullSettings s;
+                s.algorithm = algo;
+                s.cells = cells;
+                s.test = test;
+                all.push_back(s);
+            }
+    {
+        std::unique_ptr<CullBackend> gpu = makeVulkanBackend("");
+        const auto made = [] { return vulkanCullPipelines().made; };
+        const auto held = [&] { return vulkanCullPipelines().held - before.held; };
+        std::vector<CullResult> first;
+        for (const CullSettings& s : all) {
+            first.push_back(gpu->cull(f.depth, f.proj, f.grid, f.lights, s));
+            ASSERT_LE(held(), 64u);
+        }
+        const std::uint64_t afterSweep = made();
+        ASSERT_GT(afterSweep - before.made, 64u) << "the sweep must make more pipelines than are kept";
+        EXPECT_EQ(held(), 64u);
+        // The last settings: their pipelines are still there.
+        EXPECT_EQ(gpu->cull(f.depth, f.proj, f.grid, f.lights, all.back()).lightIndices, first.back().lightIndices);
+        EXPECT_EQ(made(), afterSweep);
+        // The first settings: made again, the same lists.
+        const CullResult again = gpu->cull(f.depth, f.proj, f.grid, f.lights, all.front());
+        EXPECT_GT(made(), afterSweep);
+        EXPECT_EQ(again.lightIndices, first.front().lightIndices);
+        EXPECT_EQ(again.listCount, first.front().listCount);
+        EXPECT_LE(held(), 64u);
+    }
+    EXPECT_EQ(vulkanCullPipelines().held, before.held);
+}

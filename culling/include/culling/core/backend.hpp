@@ -161,6 +161,13 @@ std::vector<std::string> availableBackends();
 // starts the drivers, tens of milliseconds on lavapipe, so an interactive
 // path must not open one per edit.
 std::uint64_t vulkanInstancesOpened();
+// The culling pipelines (one per pass and specialisation) the Vulkan backends
+// of this process have made, and how many they hold now. A backend keeps the
+// 64 it used last: on lavapipe each holds megabytes of compiled code.
+struct VulkanPipelineCount {
+    std::uint64_t made = 0, held = 0;
+};
+VulkanPipelineCount vulkanCullPipelines();
 std::unique_ptr<CullBackend> makeBackend(const std::string& name, const std::string& device = {});
 
 } // namespace lc
