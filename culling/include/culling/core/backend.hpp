@@ -163,7 +163,7 @@ std::vector<std::string> availableBackends();
 std::uint64_t vulkanInstancesOpened();
 // The culling pipelines (one per pass and specialisation) the Vulkan backends
 // of this process have made, and how many they hold now. A backend keeps the
-// 64 it used last: on lavapipe each holds megabytes of compiled code.
+// 256 it used last: on lavapipe each holds megabytes of compiled code.
 struct VulkanPipelineCount {
     std::uint64_t made = 0, held = 0;
 };
