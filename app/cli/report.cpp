@@ -9,12 +9,14 @@
 #include "culling/diagnostics/report.hpp"
 #include "culling/scene/scene_io.hpp"
 
+#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -124,7 +126,13 @@ int ReportCommand::run() {
     options.repeat = repeat_;
     options.warmup = warmup_;
     for (const std::string& b : backends_)
-        for (const std::string& name : splitCommas(b)) options.backends.push_back(name);
+        for (const std::string& name : splitCommas(b)) {
+            // A misspelt name is the command line's fault (one that names a
+            // backend this machine cannot open is skipped with a note).
+            if (name != "cpu" && name != "vulkan")
+                return usage("--backend: unknown backend '" + name + "' (cpu or vulkan)");
+            options.backends.push_back(name);
+        }
     lc::CullSettings scratch;
     for (const auto& [name, opt] : paramOptions_) {
         if (!opt->count()) continue;
@@ -163,34 +171,58 @@ int ReportCommand::run() {
     }
 
     // Progress on stderr: on a terminal one line rewritten after each
-    // configuration, elsewhere (a log) a line at each tenth. What is left is
-    // estimated at the pace since the first configuration (which also opened
-    // the backend and worked out what the rows share), so the count and the
-    // first estimate come after the second configuration.
-    const bool tty = ::isatty(STDERR_FILENO);
-    std::chrono::steady_clock::time_point first;
+    // configuration (cut to the terminal's width, so it never wraps),
+    // elsewhere (a log, TERM=dumb) a line at each tenth and the last. What
+    // is left is estimated at the pace of the last tenth of the
+    // configurations done (at least one), not counting the first (which also
+    // opened the backend and worked out what the rows share): the count and
+    // the first estimate come after the second configuration, and the
+    // estimate follows a change of pace (the second backend's rows).
+    const char* term = std::getenv("TERM");
+    const bool tty = ::isatty(STDERR_FILENO) && !(term && std::string(term) == "dumb");
+    std::size_t columns = 80;
+    if (winsize ws{}; tty && ::ioctl(STDERR_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0) columns = ws.ws_col;
+    std::vector<std::chrono::steady_clock::time_point> finished; // of configuration 1, 2, ...
     std::size_t tenthsShown = 0;
-    const lc::Report report = lc::runReport(scene, options, [&](std::size_t done, std::size_t total,
-                                                                const std::string& label) {
-        const auto now = std::chrono::steady_clock::now();
-        if (done == 1) first = now;
-        const double pace = done > 1 ? std::chrono::duration<double>(now - first).count() / double(done - 1) : 0;
-        const std::string left =
-            done > 1 && done < total ? ", " + aboutTime(pace * double(total - done)) + " left" : std::string();
-        if (done == std::min<std::size_t>(2, total))
-            std::cerr << (tty ? "\r\033[K" : "") << "report: " << total << " configurations" << left << "\n";
-        if (tty) {
-            std::cerr << "\r[" << done << "/" << total << "] " << label << left << "\033[K" << std::flush;
-        } else if (done > 2 && done * 10 / total > tenthsShown) {
-            tenthsShown = done * 10 / total;
-            std::cerr << "[" << done << "/" << total << "]" << left << "\n";
-        }
-    });
-    if (tty) std::cerr << "\r\033[K";
+    const auto plural = [](std::size_t n) { return std::to_string(n) + (n == 1 ? " configuration" : " configurations"); };
+    const auto clearLine = [&] {
+        if (tty) std::cerr << "\r\033[K" << std::flush;
+    };
+    lc::Report report;
+    try {
+        report = lc::runReport(scene, options, [&](std::size_t done, std::size_t total, const std::string& label) {
+            finished.push_back(std::chrono::steady_clock::now());
+            std::string left; // ", about 1 min 5 s left"
+            if (done > 1 && done < total) {
+                const std::size_t span = std::clamp<std::size_t>(done / 10, 1, done - 1);
+                const double pace =
+                    std::chrono::duration<double>(finished[done - 1] - finished[done - 1 - span]).count() /
+                    double(span);
+                left = ", " + aboutTime(pace * double(total - done)) + " left";
+            }
+            if (done == std::min<std::size_t>(2, total)) {
+                clearLine();
+                std::cerr << "report: " << plural(total) << left << "\n";
+            }
+            const std::size_t tenths = done * 10 / total;
+            if (tty) {
+                std::string line = "[" + std::to_string(done) + "/" + std::to_string(total) + left + "] " + label;
+                if (line.size() >= columns) line.resize(columns - 1);
+                std::cerr << "\r" << line << "\033[K" << std::flush;
+            } else if (done == total || (done > 2 && tenths > tenthsShown)) {
+                std::cerr << "[" << done << "/" << total << "]" << left << "\n";
+            }
+            tenthsShown = tenths;
+        });
+    } catch (...) {
+        clearLine(); // the error's line starts on a clean line
+        throw;
+    }
+    clearLine();
     lc::writeReport(report, outDir_);
 
     std::cout << "report " << report.sceneName << ": " << report.width << "x" << report.height << ", "
-              << report.lights << " lights, " << report.rows.size() << " configurations\n";
+              << report.lights << " lights, " << plural(report.rows.size()) << "\n";
     for (const auto& [backend, device] : report.backendDevices) std::cout << "backend " << backend << ": " << device << "\n";
     for (const std::string& n : report.notes) std::cout << "note: " << n << "\n";
     std::uint64_t fnRows = 0;

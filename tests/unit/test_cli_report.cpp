@@ -33,6 +33,7 @@ TEST(CliReport, WritesCsvMarkdownAndPareto) {
     EXPECT_NE(r.err.find(" left\n"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("\n[5/9], "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("\n[9/9]\n"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 8) << r.err; // the count, then configurations 3 to 9
     const std::string csv = slurp(out / "report.csv");
     // header + 3 tests x (cells 1 + cells 4 x 2 slicings)
     ASSERT_EQ(lineCount(csv), 10u) << csv;
@@ -115,6 +116,7 @@ TEST(CliReport, BadInputFailsWithOneLineAndNoFolder) {
          {std::vector<std::string>{"report", "--builtin", "sky", "--algorithm", "fastest", "--out", out.string()},
           {"report", "--builtin", "sky", "--cells", "1,64", "--out", out.string()},
           {"report", "--builtin", "sky", "--backend", "nope", "--out", out.string()},
+          {"report", "--builtin", "sky", "--backend", "cpu", "--backend", "metal", "--out", out.string()},
           {"report", "--out", out.string()},
           {"report", "--builtin", "sky", "--out", (tmp.path / "afile" / "rep").string()}}) {
         const CliResult r = runCli(args, tmp.path);
@@ -122,5 +124,23 @@ TEST(CliReport, BadInputFailsWithOneLineAndNoFolder) {
         EXPECT_EQ(lineCount(r.err), 1u) << r.err;
         EXPECT_NE(r.err.find("lightcull: error:"), std::string::npos) << r.err;
         EXPECT_FALSE(fs::exists(out));
+    }
+}
+
+// The last progress line is always there for a log to find, from one
+// configuration on, and the count is said in the singular for one.
+TEST(CliReport, ProgressEndsWithTheTotalForAnyCount) {
+    ScratchDir tmp;
+    for (const char* tiles : {"16", "8,16"}) {
+        const fs::path out = tmp.path / (std::string("rep") + tiles);
+        const CliResult r = runCli({"report", "--builtin", "sky", "--width", "32", "--height", "16", "--lights", "2",
+                                    "--backend", "cpu", "--algorithm", "naive", "--test", "planes", "--tile", tiles,
+                                    "--repeat", "1", "--warmup", "0", "--out", out.string()},
+                                   tmp.path);
+        ASSERT_EQ(r.code, 0) << r.err;
+        const std::string n = std::string(tiles) == "16" ? "1" : "2";
+        EXPECT_EQ(r.err, "report: " + n + (n == "1" ? " configuration\n" : " configurations\n") + "[" + n + "/" +
+                             n + "]\n");
+        EXPECT_NE(r.out.find(n == "1" ? "1 configuration\n" : "2 configurations\n"), std::string::npos) << r.out;
     }
 }
