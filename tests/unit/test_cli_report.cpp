@@ -112,8 +112,13 @@ TEST(CliReport, BadInputFailsWithOneLineAndNoFolder) {
     ScratchDir tmp;
     const fs::path out = tmp.path / "rep";
     std::ofstream(tmp.path / "afile") << "x"; // a file where a parent folder would be
+    // A custom shader that does not compile: refused before the sweep (no
+    // progress line before the error), not after every built-in row.
+    std::ofstream(tmp.path / "broken.comp") << "#version 450\nthis does not compile\n";
     for (const std::vector<std::string>& args :
          {std::vector<std::string>{"report", "--builtin", "sky", "--algorithm", "fastest", "--out", out.string()},
+          {"report", "--builtin", "sky", "--width", "64", "--height", "36", "--backend", "cpu", "--algorithm",
+           "naive", "--tile", "8,16", "--shader", (tmp.path / "broken.comp").string(), "--out", out.string()},
           {"report", "--builtin", "sky", "--cells", "1,64", "--out", out.string()},
           {"report", "--builtin", "sky", "--backend", "nope", "--out", out.string()},
           {"report", "--builtin", "sky", "--backend", "cpu", "--backend", "metal", "--out", out.string()},

@@ -4,6 +4,7 @@
 #include "culling/diagnostics/report.hpp"
 
 #include "culling/core/backend.hpp"
+#include "culling/core/depth.hpp"
 #include "culling/core/presets.hpp"
 #include "culling/core/errors.hpp"
 #include "culling/core/file_io.hpp"
@@ -454,6 +455,17 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
     rep.queued = total;
     const ViewLights lights = makeViewLights(sceneIn);
     const Projection proj(sceneIn.camera);
+    // Each custom shader runs once first, on the CPU rasteriser's depth: one
+    // that does not compile, or fails on its device, fails the report before
+    // the sweep rather than after every built-in configuration.
+    if (!options.shaders.empty()) {
+        const DepthImage probe = rasterizeDepthCpu(sceneIn, proj, cancel);
+        const TileGrid grid = TileGrid::make(sceneIn.camera.width, sceneIn.camera.height, sceneIn.camera.tileSize);
+        for (const CustomShaderOptions& so : options.shaders) {
+            CustomCullReport crep;
+            runCustomShader(so, probe, proj, grid, lights, crep);
+        }
+    }
     std::size_t done = 0;
     // For the custom shaders: the depth, shading backend and all-lights image
     // of the vulkan backend (else the first that ran).
