@@ -10,6 +10,9 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <pty.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <png.h>
 
 #include <algorithm>
@@ -148,4 +151,81 @@ TEST(CliReport, ProgressEndsWithTheTotalForAnyCount) {
                              n + "]\n");
         EXPECT_NE(r.out.find(n == "1" ? "1 configuration\n" : "2 configurations\n"), std::string::npos) << r.out;
     }
+    // 20 configurations: a line at each tenth (every second one), none between.
+    const CliResult r = runCli({"report", "--builtin", "sky", "--width", "32", "--height", "16", "--lights", "2",
+                                "--backend", "cpu", "--algorithm", "2.5d", "--test", "planes", "--slicing", "log",
+                                "--tile", "16", "--cells", "1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20",
+                                "--repeat", "1", "--warmup", "0", "--out", (tmp.path / "rep20").string()},
+                               tmp.path);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(lineCount(r.err), 10u) << r.err; // the count, then 4, 6, ..., 20
+    EXPECT_EQ(r.err.find("[3/20]"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\n[20/20]\n"), std::string::npos) << r.err;
+}
+
+namespace {
+
+// The CLI with stderr on a terminal `columns` wide (stdout to a file): what
+// the terminal received. `term`: the TERM the command sees.
+std::string stderrOnTerminal(const std::vector<std::string>& args, unsigned short columns, const char* term,
+                             const fs::path& scratch) {
+    winsize ws{};
+    ws.ws_col = columns;
+    ws.ws_row = 24;
+    int master = -1, slave = -1;
+    if (::openpty(&master, &slave, nullptr, nullptr, &ws) != 0) return "openpty failed";
+    const fs::path outFile = scratch / ".tty_stdout";
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        ::close(master);
+        ::setenv("TERM", term, 1);
+        if (!std::freopen(outFile.c_str(), "w", stdout) || ::dup2(slave, STDERR_FILENO) < 0) ::_exit(126);
+        std::vector<std::string> copy = args;
+        std::string exe = LC_CLI_PATH;
+        std::vector<char*> argv{exe.data()};
+        for (auto& a : copy) argv.push_back(a.data());
+        argv.push_back(nullptr);
+        ::execv(exe.c_str(), argv.data());
+        ::_exit(127);
+    }
+    ::close(slave);
+    std::string seen;
+    char buf[4096];
+    for (ssize_t n; (n = ::read(master, buf, sizeof buf)) > 0;) seen.append(buf, std::size_t(n));
+    ::close(master);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return "exit status " + std::to_string(status) + ": " + seen;
+    return seen;
+}
+
+} // namespace
+
+// On a terminal the progress line is rewritten in place and cut to the
+// terminal's width: a line that wrapped would leave its first rows behind at
+// every rewrite (raster's labels are over 100 characters). TERM=dumb gets
+// no escape codes.
+TEST(CliReport, TerminalProgressFitsTheTerminalsWidth) {
+    ScratchDir tmp;
+    const std::vector<std::string> args{"report", "--builtin", "sky", "--width", "64", "--height", "36", "--lights",
+                                        "4", "--backend", "cpu", "--algorithm", "raster", "--tile", "16",
+                                        "--repeat", "1", "--warmup", "0", "--out", (tmp.path / "rep").string()};
+    const std::string seen = stderrOnTerminal(args, 40, "xterm", tmp.path);
+    ASSERT_NE(seen.find("[3/3"), std::string::npos) << seen;
+    std::size_t rewrites = 0;
+    for (std::size_t at = 0; at < seen.size();) {
+        std::size_t end = seen.find_first_of("\r\n", at);
+        if (end == std::string::npos) end = seen.size();
+        std::string line = seen.substr(at, end - at);
+        for (std::size_t k; (k = line.find("\033[K")) != std::string::npos;) line.erase(k, 3);
+        if (line.rfind("[", 0) == 0) { // a progress line, rewritten in place (the count line is printed once)
+            EXPECT_LT(line.size(), 40u) << "'" << line << "' would wrap on a 40-column terminal";
+            ++rewrites;
+        }
+        at = end + 1;
+    }
+    EXPECT_GE(rewrites, 3u) << seen;
+    const std::string dumb = stderrOnTerminal(args, 40, "dumb", tmp.path);
+    EXPECT_EQ(dumb.find('\033'), std::string::npos) << dumb;
+    EXPECT_NE(dumb.find("[3/3]"), std::string::npos) << dumb;
 }
