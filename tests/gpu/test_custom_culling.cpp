@@ -288,8 +288,39 @@ TEST_F(GpuTest, AHangIsATimeoutAndTheNextRunWorks) {
         // A slow shader is not called an endless loop: the limit and how to raise it.
         EXPECT_NE(std::string(e.what()).find("raise it with --timeout-ms"), std::string::npos) << e.what();
     }
+    // The hung device is abandoned, never handed to the next run: it opens one.
+    const std::uint64_t opened = customShaderDevicesOpened();
     CustomCullReport ok;
     EXPECT_EQ(runShader(s, optionsFor(kExamples + "tiled_fixed.comp"), ok).truth.metrics.falseNegatives, 0u);
+    EXPECT_EQ(customShaderDevicesOpened(), opened + 1);
+}
+
+TEST_F(GpuTest, RunsOfAShaderShareOneDeviceWithTheSameLists) {
+    // A hunt or a report runs one shader hundreds of times: a finished run
+    // leaves its device to the next run with the same device options.
+    const CustomShaderOptions o = optionsFor(kExamples + "tiled_fixed.comp");
+    CustomCullReport a, b, c;
+    const RunOutput first = runShader(atrium(96, 64), o, a);
+    const std::uint64_t opened = customShaderDevicesOpened();
+    const RunOutput second = runShader(atrium(96, 64), o, b);
+    EXPECT_EQ(customShaderDevicesOpened(), opened);
+    EXPECT_EQ(second.result.listCount, first.result.listCount);
+    EXPECT_EQ(second.result.lightIndices, first.result.lightIndices);
+    EXPECT_TRUE(b.validationMessages.empty()) << b.validationMessages.front();
+    // Another grid and light count on the same device: the lists of a run of its own.
+    const RunOutput other = runShader(atrium(250, 130, 40), o, c);
+    EXPECT_EQ(customShaderDevicesOpened(), opened);
+    EXPECT_EQ(other.truth.metrics.falseNegatives, 0u);
+    EXPECT_EQ(other.result.grid.width, 250u);
+    EXPECT_EQ(other.result.grid.height, 130u);
+    // Other device options (the layer off) are another device, kept in its place.
+    CustomShaderOptions quiet = o;
+    quiet.validation = false;
+    CustomCullReport d, e;
+    runShader(atrium(96, 64), quiet, d);
+    EXPECT_EQ(customShaderDevicesOpened(), opened + 1);
+    runShader(atrium(96, 64), quiet, e);
+    EXPECT_EQ(customShaderDevicesOpened(), opened + 1);
 }
 
 TEST_F(GpuTest, CompileErrorsNameFileAndLine) {

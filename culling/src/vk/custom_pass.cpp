@@ -21,6 +21,8 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
+#include <atomic>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -244,7 +246,58 @@ struct RunState {
     // Members die in reverse order: the context, declared first, goes last.
 };
 
+// The device a finished run leaves for the next one. A hunt or a report
+// runs one shader hundreds of times, and opening an instance and a device
+// (the validation layer's set-up with it) and closing them again was four
+// fifths of each run on lavapipe. One device is kept, for the options it was
+// opened with (the environment variables the context reads included); a run
+// takes it when its options match and gives it back only when it finished
+// (a hang abandons its device, an error closes it). Never destroyed: at exit
+// the drivers' own exit handlers may already have stopped their threads.
+class IdleDevice {
+public:
+    std::unique_ptr<vk::Context> take(const vk::ContextOptions& co) {
+        const std::string k = key(co);
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            if (ctx_ && key_ == k) return std::move(ctx_);
+        }
+        ++opened_;
+        return std::make_unique<vk::Context>(co);
+    }
+    void giveBack(std::unique_ptr<vk::Context> ctx, const vk::ContextOptions& co) {
+        std::unique_ptr<vk::Context> old; // closed outside the lock
+        std::lock_guard<std::mutex> lock(mutex_);
+        old = std::move(ctx_);
+        ctx_ = std::move(ctx);
+        key_ = key(co);
+    }
+    std::uint64_t opened() const { return opened_; }
+
+private:
+    static std::string key(const vk::ContextOptions& co) {
+        auto env = [](const char* name) {
+            const char* v = std::getenv(name);
+            return v ? std::string("=") + v : std::string("unset");
+        };
+        return co.device + '\n' + co.purpose + '\n' + char('0' + co.validation) + char('0' + co.robustAccess) + '\n' +
+               env("LIGHTCULL_DEVICE") + '\n' + env("LIGHTCULL_VALIDATION") + '\n' + env("LIGHTCULL_VK_EMULATE_GPU") +
+               '\n' + env("LIGHTCULL_VK_NO_CONSERVATIVE");
+    }
+    std::mutex mutex_;
+    std::unique_ptr<vk::Context> ctx_;
+    std::string key_;
+    std::atomic<std::uint64_t> opened_{0};
+};
+
+IdleDevice& idleDevice() {
+    static auto* kept = new IdleDevice; // NOLINT: deliberately never destroyed (see above)
+    return *kept;
+}
+
 } // namespace
+
+std::uint64_t customShaderDevicesOpened() { return idleDevice().opened(); }
 
 namespace {
 
@@ -372,7 +425,11 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
     co.purpose = "lc.custom";
     co.validation = o.validation;
     co.robustAccess = true;
-    st->ctx = std::make_unique<vk::Context>(co);
+    // A RenderDoc capture hooks the instance it is started on when it is
+    // created: such a run opens its own.
+    RenderDocCapture* capture = RenderDocCapture::active();
+    if (capture && !capture->capturesCustomShader()) capture = nullptr;
+    st->ctx = capture ? std::make_unique<vk::Context>(co) : idleDevice().take(co);
     const vk::Context& ctx = *st->ctx;
     const VkDevice dev = ctx.device();
     report.device = ctx.deviceName();
@@ -436,8 +493,6 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
 
     // `run --renderdoc-capture --shader`: this device is the one captured,
     // and the capture must end before the device is destroyed.
-    RenderDocCapture* capture = RenderDocCapture::active();
-    if (capture && !capture->capturesCustomShader()) capture = nullptr;
     if (capture) capture->startOnInstance(st->ctx->instance());
     double wallMs = 0;
     const bool finished = st->ctx->submitAndWaitFor(
@@ -470,7 +525,9 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
 
     std::vector<std::uint32_t> words(outWords);
     std::memcpy(words.data(), st->out.mapped, outWords * 4);
-    st.reset();
+    std::unique_ptr<vk::Context> finishedCtx = std::move(st->ctx);
+    st.reset(); // the run's objects, before their device goes back
+    if (!capture) idleDevice().giveBack(std::move(finishedCtx), co);
     std::vector<std::string> messages = vk::validationMessages();
     if (messages.size() > messagesBefore)
         report.validationMessages.assign(messages.begin() + std::ptrdiff_t(messagesBefore), messages.end());

@@ -128,9 +128,13 @@ void decodeLists(const std::vector<std::uint32_t>& words, const LayoutSpec& layo
 // rule of options.lists, tile bounds from the CPU reference, backend
 // "custom". Throws InputError (file:line) for compile errors, DeviceError for
 // a hang (after options.timeoutMs; the device is then abandoned and the next
-// call opens a fresh one) or any failed Vulkan call.
+// call opens a fresh one) or any failed Vulkan call (that device is closed).
 CullResult runCustomShader(const CustomShaderOptions& options, const DepthImage& depth, const Projection& proj,
                            const TileGrid& grid, const ViewLights& lights, CustomCullReport& report);
+// Vulkan devices runCustomShader opened in this process: a finished run
+// leaves its device for the next run with the same device options, so a
+// hunt or report over one shader opens one.
+std::uint64_t customShaderDevicesOpened();
 
 // A user's culling shader as a list source of the one pipeline
 // (core/pipeline.hpp): runCustomShader over the depth it is handed; what the
