@@ -289,38 +289,50 @@ TEST_F(GpuTest, AHangIsATimeoutAndTheNextRunWorks) {
         EXPECT_NE(std::string(e.what()).find("raise it with --timeout-ms"), std::string::npos) << e.what();
     }
     // The hung device is abandoned, never handed to the next run: it opens one.
-    const std::uint64_t opened = customShaderDevicesOpened();
+    const std::uint64_t opened = customShaderDevices().devicesOpened;
     CustomCullReport ok;
     EXPECT_EQ(runShader(s, optionsFor(kExamples + "tiled_fixed.comp"), ok).truth.metrics.falseNegatives, 0u);
-    EXPECT_EQ(customShaderDevicesOpened(), opened + 1);
+    EXPECT_EQ(customShaderDevices().devicesOpened, opened + 1);
 }
 
-TEST_F(GpuTest, RunsOfAShaderShareOneDeviceWithTheSameLists) {
+TEST_F(GpuTest, RunsOfAShaderShareOneDeviceAndItsPipelines) {
     // A hunt or a report runs one shader hundreds of times: a finished run
-    // leaves its device to the next run with the same device options.
+    // leaves its device, and the pipelines compiled on it, to the next run
+    // with the same device options.
     const CustomShaderOptions o = optionsFor(kExamples + "tiled_fixed.comp");
-    CustomCullReport a, b, c;
+    CustomCullReport a, b, c, d;
     const RunOutput first = runShader(atrium(96, 64), o, a);
-    const std::uint64_t opened = customShaderDevicesOpened();
+    const CustomShaderDeviceCount before = customShaderDevices();
     const RunOutput second = runShader(atrium(96, 64), o, b);
-    EXPECT_EQ(customShaderDevicesOpened(), opened);
+    EXPECT_EQ(customShaderDevices().devicesOpened, before.devicesOpened);
+    EXPECT_EQ(customShaderDevices().pipelinesMade, before.pipelinesMade);
     EXPECT_EQ(second.result.listCount, first.result.listCount);
     EXPECT_EQ(second.result.lightIndices, first.result.lightIndices);
     EXPECT_TRUE(b.validationMessages.empty()) << b.validationMessages.front();
-    // Another grid and light count on the same device: the lists of a run of its own.
-    const RunOutput other = runShader(atrium(250, 130, 40), o, c);
-    EXPECT_EQ(customShaderDevicesOpened(), opened);
-    EXPECT_EQ(other.truth.metrics.falseNegatives, 0u);
-    EXPECT_EQ(other.result.grid.width, 250u);
-    EXPECT_EQ(other.result.grid.height, 130u);
+    // Another screen, the same defines (tile size, light count, layout): the
+    // same pipeline, the lists of this screen.
+    const RunOutput wide = runShader(atrium(250, 130), o, c);
+    EXPECT_EQ(customShaderDevices().pipelinesMade, before.pipelinesMade);
+    EXPECT_EQ(wide.result.grid.width, 250u);
+    EXPECT_EQ(wide.truth.metrics.falseNegatives, 0u);
+    EXPECT_GT(wide.result.entries(), 0u);
+    // 8-pixel tiles: another TILE_SIZE, another pipeline, on the same device.
+    Scene small = atrium(250, 130, 40);
+    small.camera.tileSize = 8;
+    const RunOutput fine = runShader(small, o, d);
+    EXPECT_EQ(customShaderDevices().pipelinesMade, before.pipelinesMade + 1);
+    EXPECT_EQ(customShaderDevices().devicesOpened, before.devicesOpened);
+    EXPECT_EQ(fine.result.grid.tileSize, 8u);
+    EXPECT_EQ(fine.truth.metrics.falseNegatives, 0u);
+    EXPECT_EQ(fine.result.validate(40), "");
     // Other device options (the layer off) are another device, kept in its place.
     CustomShaderOptions quiet = o;
     quiet.validation = false;
-    CustomCullReport d, e;
-    runShader(atrium(96, 64), quiet, d);
-    EXPECT_EQ(customShaderDevicesOpened(), opened + 1);
+    CustomCullReport e, f;
     runShader(atrium(96, 64), quiet, e);
-    EXPECT_EQ(customShaderDevicesOpened(), opened + 1);
+    EXPECT_EQ(customShaderDevices().devicesOpened, before.devicesOpened + 1);
+    runShader(atrium(96, 64), quiet, f);
+    EXPECT_EQ(customShaderDevices().devicesOpened, before.devicesOpened + 1);
 }
 
 TEST_F(GpuTest, CompileErrorsNameFileAndLine) {

@@ -25,6 +25,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -231,45 +232,115 @@ void checkInterface(const std::string& path, const std::vector<std::uint32_t>& w
     }
 }
 
+// The contract's bindings (docs/CUSTOM_CULLING.md): parameters, depth
+// texture, depth buffer, lights, lists.
+const std::vector<VkDescriptorType> kBindingTypes = {
+    VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+
+// A device for user shaders and what outlives one run on it: the
+// contract's layouts and the pipelines of the shaders run on it (a device
+// compiles a pipeline from SPIR-V: lavapipe through LLVM, most of a small
+// run). A hunt's trials differ in their defines (tile size, light count,
+// layout) far less often than in their scenes.
+struct ShaderDevice {
+    std::unique_ptr<vk::Context> ctx;
+    vk::DescriptorSetLayoutHandle setLayout;
+    vk::PipelineLayoutHandle pipelineLayout;
+    struct Kept {
+        vk::ShaderModuleHandle module;
+        vk::PipelineHandle pipeline;
+        std::uint64_t lastUse = 0;
+    };
+    std::map<std::string, Kept> pipelines; // key: entry point, NUL, the SPIR-V's bytes
+    std::uint64_t uses = 0;
+    // Members die in reverse order: the context, declared first, goes last.
+
+    static constexpr std::size_t kMaxPipelines = 32;
+
+    explicit ShaderDevice(const vk::ContextOptions& co) : ctx(std::make_unique<vk::Context>(co)) {
+        auto layouts = ctx->createPassLayouts(kBindingTypes, "custom");
+        setLayout = std::move(layouts.set);
+        pipelineLayout = std::move(layouts.pipeline);
+    }
+};
+
+std::atomic<std::uint64_t> pipelinesMade{0};
+
+// The pipeline of `spirv` at `entry` on `sd`: kept from an earlier run, or
+// made now (and the one used longest ago dropped beyond kMaxPipelines).
+// Throws InputError when the device refuses it.
+VkPipeline shaderPipeline(ShaderDevice& sd, const std::vector<std::uint32_t>& spirv, const std::string& entry,
+                          const std::string& path, const std::function<std::string()>& firstMessage) {
+    std::string key = entry;
+    key.push_back('\0');
+    key.append(reinterpret_cast<const char*>(spirv.data()), spirv.size() * 4);
+    ++sd.uses;
+    if (auto it = sd.pipelines.find(key); it != sd.pipelines.end()) {
+        it->second.lastUse = sd.uses;
+        return it->second.pipeline;
+    }
+    const VkDevice dev = sd.ctx->device();
+    ShaderDevice::Kept k;
+    k.module = sd.ctx->createShader(spirv.data(), spirv.size(), "custom.shader");
+    VkComputePipelineCreateInfo cpi{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    cpi.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    cpi.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    cpi.stage.module = k.module;
+    cpi.stage.pName = entry.c_str();
+    cpi.layout = sd.pipelineLayout;
+    VkPipeline pipe;
+    const VkResult pr = vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &cpi, nullptr, &pipe);
+    if (pr != VK_SUCCESS)
+        throw InputError(path, "", 0, std::string("the device refused the pipeline (") + vk::resultName(pr) +
+                                          "): check the entry point '" + entry + "' and the bindings" + firstMessage());
+    ++pipelinesMade;
+    k.pipeline = vk::PipelineHandle(dev, pipe);
+    k.lastUse = sd.uses;
+    if (sd.pipelines.size() >= ShaderDevice::kMaxPipelines) {
+        auto oldest = sd.pipelines.begin();
+        for (auto it = sd.pipelines.begin(); it != sd.pipelines.end(); ++it)
+            if (it->second.lastUse < oldest->second.lastUse) oldest = it;
+        sd.pipelines.erase(oldest); // no run uses it: the device is this run's alone
+    }
+    return sd.pipelines.emplace(std::move(key), std::move(k)).first->second.pipeline;
+}
+
 // Everything created on the device for one run, owned together so that a
 // hang can leak all of it at once (see Context::submitAndWaitFor).
 struct RunState {
-    std::unique_ptr<vk::Context> ctx;
+    std::unique_ptr<ShaderDevice> sd;
     vk::Buffer params, depthBuf, lightBuf, out, staging;
     vk::Image depthImage;
     vk::DeviceHandle<VkSampler, vkDestroySampler> sampler;
-    vk::DescriptorSetLayoutHandle setLayout;
-    vk::PipelineLayoutHandle pipelineLayout;
-    vk::ShaderModuleHandle module;
-    vk::PipelineHandle pipeline;
     vk::DescriptorPoolHandle pool;
-    // Members die in reverse order: the context, declared first, goes last.
+    // Members die in reverse order: the device, declared first, goes last.
 };
 
 // The device a finished run leaves for the next one. A hunt or a report
 // runs one shader hundreds of times, and opening an instance and a device
-// (the validation layer's set-up with it) and closing them again was four
-// fifths of each run on lavapipe. One device is kept, for the options it was
+// (the validation layer's set-up with it) and closing them again was most
+// of each run on lavapipe. One device is kept, for the options it was
 // opened with (the environment variables the context reads included); a run
 // takes it when its options match and gives it back only when it finished
 // (a hang abandons its device, an error closes it). Never destroyed: at exit
 // the drivers' own exit handlers may already have stopped their threads.
 class IdleDevice {
 public:
-    std::unique_ptr<vk::Context> take(const vk::ContextOptions& co) {
+    std::unique_ptr<ShaderDevice> take(const vk::ContextOptions& co) {
         const std::string k = key(co);
         {
             std::lock_guard<std::mutex> lock(mutex_);
-            if (ctx_ && key_ == k) return std::move(ctx_);
+            if (sd_ && key_ == k) return std::move(sd_);
         }
         ++opened_;
-        return std::make_unique<vk::Context>(co);
+        return std::make_unique<ShaderDevice>(co);
     }
-    void giveBack(std::unique_ptr<vk::Context> ctx, const vk::ContextOptions& co) {
-        std::unique_ptr<vk::Context> old; // closed outside the lock
+    void giveBack(std::unique_ptr<ShaderDevice> sd, const vk::ContextOptions& co) {
+        std::unique_ptr<ShaderDevice> old; // closed outside the lock
         std::lock_guard<std::mutex> lock(mutex_);
-        old = std::move(ctx_);
-        ctx_ = std::move(ctx);
+        old = std::move(sd_);
+        sd_ = std::move(sd);
         key_ = key(co);
     }
     std::uint64_t opened() const { return opened_; }
@@ -285,7 +356,7 @@ private:
                '\n' + env("LIGHTCULL_VK_NO_CONSERVATIVE");
     }
     std::mutex mutex_;
-    std::unique_ptr<vk::Context> ctx_;
+    std::unique_ptr<ShaderDevice> sd_;
     std::string key_;
     std::atomic<std::uint64_t> opened_{0};
 };
@@ -297,7 +368,7 @@ IdleDevice& idleDevice() {
 
 } // namespace
 
-std::uint64_t customShaderDevicesOpened() { return idleDevice().opened(); }
+CustomShaderDeviceCount customShaderDevices() { return {idleDevice().opened(), pipelinesMade}; }
 
 namespace {
 
@@ -340,7 +411,7 @@ std::vector<std::uint32_t> shaderWords(const CustomShaderOptions& o, const TileG
 // The depth texture (binding 1), from the depth buffer through a copy.
 void uploadDepthTexture(RunState& rs, const DepthImage& depth) {
     RunState* st = &rs;
-    const vk::Context& ctx = *st->ctx;
+    const vk::Context& ctx = *st->sd->ctx;
     const VkDevice dev = ctx.device();
     st->depthImage = ctx.createImage(depth.width, depth.height, VK_FORMAT_R32_SFLOAT,
                                      VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
@@ -352,7 +423,7 @@ void uploadDepthTexture(RunState& rs, const DepthImage& depth) {
     VkSampler sampler;
     LC_VK(vkCreateSampler(dev, &sci, nullptr, &sampler));
     st->sampler = vk::DeviceHandle<VkSampler, vkDestroySampler>(dev, sampler);
-    st->ctx->submitAndWait(
+    st->sd->ctx->submitAndWait(
         [&](VkCommandBuffer cmd) {
             VkImageMemoryBarrier toDst{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
             // Hazard: the copy must not start before the image leaves UNDEFINED.
@@ -429,9 +500,8 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
     // created: such a run opens its own.
     RenderDocCapture* capture = RenderDocCapture::active();
     if (capture && !capture->capturesCustomShader()) capture = nullptr;
-    st->ctx = capture ? std::make_unique<vk::Context>(co) : idleDevice().take(co);
-    const vk::Context& ctx = *st->ctx;
-    const VkDevice dev = ctx.device();
+    st->sd = capture ? std::make_unique<ShaderDevice>(co) : idleDevice().take(co);
+    const vk::Context& ctx = *st->sd->ctx;
     report.device = ctx.deviceName();
 
     // Inputs.
@@ -458,52 +528,33 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
 
     uploadDepthTexture(*st, depth);
 
-    // Layouts, pipeline, descriptors.
-    const std::vector<VkDescriptorType> types = {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-                                                 VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                                                 VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                                                 VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
-    auto layouts = ctx.createPassLayouts(types, "custom");
-    st->setLayout = std::move(layouts.set);
-    st->pipelineLayout = std::move(layouts.pipeline);
-    st->module = ctx.createShader(spirv.data(), spirv.size(), "custom.shader");
-    VkComputePipelineCreateInfo cpi{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    cpi.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    cpi.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    cpi.stage.module = st->module;
-    cpi.stage.pName = entry.c_str();
-    cpi.layout = st->pipelineLayout;
-    VkPipeline pipe;
-    const VkResult pr = vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &cpi, nullptr, &pipe);
-    if (pr != VK_SUCCESS)
-        throw InputError(o.path, "", 0, std::string("the device refused the pipeline (") + vk::resultName(pr) +
-                                            "): check the entry point '" + entry + "' and the bindings" + firstMessage());
-    st->pipeline = vk::PipelineHandle(dev, pipe);
-
+    // Pipeline, descriptors.
+    const VkPipeline pipeline = shaderPipeline(*st->sd, spirv, entry, o.path, firstMessage);
     std::vector<vk::Context::DescriptorWrite> bindings(5);
     const VkBuffer buffers[5] = {st->params.buffer, VK_NULL_HANDLE, st->depthBuf.buffer, st->lightBuf.buffer,
                                  st->out.buffer};
     for (std::uint32_t i = 0; i < 5; ++i) {
-        bindings[i].type = types[i];
+        bindings[i].type = kBindingTypes[i];
         bindings[i].buffer = buffers[i];
     }
     bindings[1].image = {st->sampler, st->depthImage.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    st->pool = st->ctx->createDescriptorPool(bindings, 1, "custom.descriptorPool");
-    VkDescriptorSet set = st->ctx->writeDescriptorSet(st->pool, st->setLayout, bindings, "custom.set");
+    st->pool = ctx.createDescriptorPool(bindings, 1, "custom.descriptorPool");
+    VkDescriptorSet set = ctx.writeDescriptorSet(st->pool, st->sd->setLayout, bindings, "custom.set");
 
     // `run --renderdoc-capture --shader`: this device is the one captured,
     // and the capture must end before the device is destroyed.
-    if (capture) capture->startOnInstance(st->ctx->instance());
+    if (capture) capture->startOnInstance(ctx.instance());
     double wallMs = 0;
-    const bool finished = st->ctx->submitAndWaitFor(
+    const bool finished = st->sd->ctx->submitAndWaitFor(
         [&](VkCommandBuffer cmd) {
             vkCmdFillBuffer(cmd, st->out.buffer, 0, VK_WHOLE_SIZE, 0);
             // Hazard: the shader's list writes and atomics must follow the zero fill.
             vk::memoryBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                               VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, st->pipeline);
-            vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, st->pipelineLayout, 0, 1, &set, 0, nullptr);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+            vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, st->sd->pipelineLayout, 0, 1, &set, 0,
+                                    nullptr);
             vkCmdDispatch(cmd, grid.tilesX, grid.tilesY, 1);
             // Hazard: the host reads the lists only after the shader's writes.
             vk::memoryBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
@@ -525,9 +576,9 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
 
     std::vector<std::uint32_t> words(outWords);
     std::memcpy(words.data(), st->out.mapped, outWords * 4);
-    std::unique_ptr<vk::Context> finishedCtx = std::move(st->ctx);
+    std::unique_ptr<ShaderDevice> used = std::move(st->sd);
     st.reset(); // the run's objects, before their device goes back
-    if (!capture) idleDevice().giveBack(std::move(finishedCtx), co);
+    if (!capture) idleDevice().giveBack(std::move(used), co);
     std::vector<std::string> messages = vk::validationMessages();
     if (messages.size() > messagesBefore)
         report.validationMessages.assign(messages.begin() + std::ptrdiff_t(messagesBefore), messages.end());

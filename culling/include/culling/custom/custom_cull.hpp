@@ -131,10 +131,15 @@ void decodeLists(const std::vector<std::uint32_t>& words, const LayoutSpec& layo
 // call opens a fresh one) or any failed Vulkan call (that device is closed).
 CullResult runCustomShader(const CustomShaderOptions& options, const DepthImage& depth, const Projection& proj,
                            const TileGrid& grid, const ViewLights& lights, CustomCullReport& report);
-// Vulkan devices runCustomShader opened in this process: a finished run
-// leaves its device for the next run with the same device options, so a
-// hunt or report over one shader opens one.
-std::uint64_t customShaderDevicesOpened();
+// What runCustomShader made in this process: Vulkan devices, and pipelines
+// (one per distinct SPIR-V and entry point on a device). A finished run
+// leaves its device, with the last 32 pipelines made on it, to the next run
+// with the same device options: a hunt or report over one shader opens one
+// device and compiles each distinct set of defines once.
+struct CustomShaderDeviceCount {
+    std::uint64_t devicesOpened = 0, pipelinesMade = 0;
+};
+CustomShaderDeviceCount customShaderDevices();
 
 // A user's culling shader as a list source of the one pipeline
 // (core/pipeline.hpp): runCustomShader over the depth it is handed; what the
