@@ -59,6 +59,11 @@ void ReportCommand::add(CLI::App& app) {
     cmd_->add_option("--seed", seed_, "Seed of the light generator used by --lights (default: 1)")
         ->type_name("S")
         ->needs(optLights_);
+    cmd_->add_option("--spot-fraction", spotFraction_,
+                     "Fraction of the --lights that are spot lights (0..1, default 0; outer angles 15..45 degrees, "
+                     "random directions)")
+        ->type_name("F")
+        ->needs(optLights_);
     // Help text names the backends without opening a device: a device opened
     // here would be opened by every command (and before a RenderDoc capture).
     cmd_->add_option("--backend", backends_,
@@ -113,12 +118,18 @@ int ReportCommand::run() {
     if (optLights_->count()) {
         if (lights_ < 0 || lights_ > 1000000)
             throw lc::SettingsError("lights", "must be in 0..1000000, got " + std::to_string(lights_));
-        scene.lights = lc::generateLights(lc::defaultLightGen(scene, std::uint32_t(lights_), seed_));
+        lc::LightGenSettings gen = lc::defaultLightGen(scene, std::uint32_t(lights_), seed_);
+        gen.spotFraction = spotFraction_; // generateLights refuses values outside [0, 1]
+        scene.lights = lc::generateLights(gen);
     }
 
     lc::ReportOptions options;
     options.device = device_;
-    for (const std::string& sh : shaders_) {
+    for (std::size_t i = 0; i < shaders_.size(); ++i) {
+        const std::string& sh = shaders_[i];
+        for (std::size_t j = 0; j < i; ++j)
+            if (std::filesystem::path(shaders_[j]).lexically_normal() == std::filesystem::path(sh).lexically_normal())
+                return usage("--shader: " + sh + " is given twice");
         lc::CustomShaderOptions so = lc::shaderOptionsFromFile(sh);
         so.device = device_;
         options.shaders.push_back(std::move(so));
@@ -158,6 +169,8 @@ int ReportCommand::run() {
         if (std::find(options.presets.begin(), options.presets.end(), name) == options.presets.end())
             options.presets.push_back(name);
     };
+    if (allPresets_ && !presets_.empty())
+        return usage("--presets runs every preset and --preset names the ones to run: give one of the two");
     if (allPresets_)
         for (const lc::EnginePreset& p : lc::enginePresets()) addPreset(p.name);
     for (const std::string& p : presets_)

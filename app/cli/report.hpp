@@ -28,6 +28,7 @@ private:
     bool allPresets_ = false;
     long long lights_ = -1;
     unsigned long long seed_ = 1;
+    double spotFraction_ = 0.0;
     int repeat_ = 3, warmup_ = 1;
     CLI::Option* optLights_ = nullptr;
     std::map<std::string, std::string> paramValues_;

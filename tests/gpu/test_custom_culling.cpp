@@ -691,6 +691,36 @@ TEST(CustomDecode, EveryLayoutDecodesCountsOverflowAndBadIndices) {
     EXPECT_THROW(decodeLists({1, 2}, parseLayout("fixed:2"), 5, r, c), Error);
 }
 
+TEST_F(GpuTest, ReportNamesShadersOfOneFileNameByTheirPaths) {
+    // Two versions of one engine's shader, each in its own folder: two rows
+    // a reader can tell apart (both were once `custom:cull.comp ...`).
+    lc_test::ScratchDir tmp;
+    std::vector<std::string> paths;
+    for (const char* dir : {"old", "new"}) {
+        fs::create_directories(tmp.path / dir);
+        fs::copy_file(kExamples + "tiled_fixed.comp", tmp.path / dir / "cull.comp");
+        paths.push_back((tmp.path / dir / "cull.comp").string());
+    }
+    ReportOptions o;
+    o.backends = {"cpu"};
+    o.tileSizes = {16};
+    o.cellCounts = {1};
+    o.fixed["algorithm"] = "minmax";
+    o.fixed["test"] = "planes";
+    o.repeat = 1;
+    o.warmup = 0;
+    o.shaders = {optionsFor(paths[0]), optionsFor(paths[1]), optionsFor(kExamples + "tiled_fixed.comp")};
+    const Report rep = runReport(atrium(96, 64, 20), o);
+    std::vector<std::string> labels;
+    for (const ReportRow& r : rep.rows)
+        if (!r.config.customLabel.empty()) labels.push_back(r.config.customLabel);
+    ASSERT_EQ(labels.size(), 3u);
+    EXPECT_EQ(labels[0].rfind("custom:" + paths[0] + " ", 0), 0u) << labels[0];
+    EXPECT_EQ(labels[1].rfind("custom:" + paths[1] + " ", 0), 0u) << labels[1];
+    // A file name no other shader has stays short.
+    EXPECT_EQ(labels[2].rfind("custom:tiled_fixed.comp ", 0), 0u) << labels[2];
+}
+
 TEST_F(GpuTest, ReportPutsCustomShadersBesideTheBuiltinRows) {
     Scene s = atrium(330, 190, 1500); // partial edge tiles: the flawed shader drifts
     ReportOptions o;

@@ -113,6 +113,7 @@ TEST(CliReport, WritesCsvMarkdownAndPareto) {
 
 TEST(CliReport, BadInputFailsWithOneLineAndNoFolder) {
     ScratchDir tmp;
+    const std::string kShader = std::string(LC_SOURCE_DIR) + "/resources/culling-examples/tiled_fixed.comp";
     const fs::path out = tmp.path / "rep";
     std::ofstream(tmp.path / "afile") << "x"; // a file where a parent folder would be
     // A custom shader that does not compile: refused before the sweep (no
@@ -125,6 +126,10 @@ TEST(CliReport, BadInputFailsWithOneLineAndNoFolder) {
           {"report", "--builtin", "sky", "--cells", "1,64", "--out", out.string()},
           {"report", "--builtin", "sky", "--backend", "nope", "--out", out.string()},
           {"report", "--builtin", "sky", "--backend", "cpu", "--backend", "metal", "--out", out.string()},
+          {"report", "--builtin", "sky", "--presets", "--preset", "urp", "--out", out.string()},
+          {"report", "--builtin", "sky", "--shader", kShader, "--shader", kShader, "--out", out.string()},
+          {"report", "--builtin", "sky", "--spot-fraction", "0.5", "--out", out.string()},
+          {"report", "--builtin", "sky", "--lights", "4", "--spot-fraction", "2", "--out", out.string()},
           {"report", "--out", out.string()},
           {"report", "--builtin", "sky", "--out", (tmp.path / "afile" / "rep").string()}}) {
         const CliResult r = runCli(args, tmp.path);
@@ -133,6 +138,32 @@ TEST(CliReport, BadInputFailsWithOneLineAndNoFolder) {
         EXPECT_NE(r.err.find("lightcull: error:"), std::string::npos) << r.err;
         EXPECT_FALSE(fs::exists(out));
     }
+}
+
+// --spot-fraction makes some of the --lights spots, as `run`'s does: the
+// spot test is then swept. report.md counts one of a thing in the singular.
+TEST(CliReport, SpotFractionGivesSpotsAndTheSpotTestSweep) {
+    ScratchDir tmp;
+    std::size_t rows[2] = {0, 0};
+    for (int spots = 0; spots < 2; ++spots) {
+        const fs::path out = tmp.path / ("rep" + std::to_string(spots));
+        std::vector<std::string> args = {"report", "--builtin", "sky", "--width", "32", "--height", "16", "--lights",
+                                         "6", "--backend", "cpu", "--algorithm", "naive", "--test", "planes",
+                                         "--tile", "16", "--repeat", "1", "--warmup", "0", "--out", out.string()};
+        if (spots) args.insert(args.begin() + 9, {"--spot-fraction", "0.5"});
+        const CliResult r = runCli(args, tmp.path);
+        ASSERT_EQ(r.code, 0) << r.err;
+        const std::string csv = slurp(out / "report.csv");
+        rows[spots] = std::size_t(std::count(csv.begin(), csv.end(), '\n')) - 1;
+        const std::string md = slurp(out / "report.md");
+        if (!spots) {
+            EXPECT_NE(md.find("32x16, 6 lights, 1 configuration; times are of 1 run after 0 untimed."),
+                      std::string::npos)
+                << md.substr(0, 200);
+        }
+    }
+    EXPECT_EQ(rows[0], 1u);
+    EXPECT_GT(rows[1], 1u); // one row per spot test
 }
 
 // The last progress line is always there for a log to find, from one

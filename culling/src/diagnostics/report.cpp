@@ -517,7 +517,12 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             ReportRow row;
             row.config.backend = "vulkan"; // it runs on a Vulkan device: judged beside the vulkan rows
             row.config.tileSize = grid.tileSize;
-            const std::string file = std::filesystem::path(so.path).filename().string();
+            // The file's name, or the path as given where two shaders share a name.
+            std::string file = std::filesystem::path(so.path).filename().string();
+            if (std::count_if(options.shaders.begin(), options.shaders.end(), [&](const CustomShaderOptions& other) {
+                    return std::filesystem::path(other.path).filename() == std::filesystem::path(so.path).filename();
+                }) > 1)
+                file = so.path;
             row.config.params["algorithm"] = "custom:" + file;
             row.config.params["tile"] = std::to_string(grid.tileSize);
             row.config.customLabel = "custom:" + file + " " + toString(so.layout) + " " + toString(so.lists);
@@ -684,14 +689,20 @@ std::string presetsSection(const Report& rep) {
 } // namespace
 
 std::string reportMarkdown(const Report& rep) {
+    const auto count = [](std::size_t n, const char* one, const char* many) {
+        return std::to_string(n) + " " + (n == 1 ? one : many);
+    };
+    const auto configurations = [&](std::size_t n) { return count(n, "configuration", "configurations"); };
     std::string md = "# Culling report: " + rep.sceneName + "\n\n";
-    md += std::to_string(rep.width) + "x" + std::to_string(rep.height) + ", " + std::to_string(rep.lights) +
-          " lights, " + std::to_string(rep.rows.size()) + " configurations; times are medians of " +
-          std::to_string(rep.repeat) + " runs after " + std::to_string(rep.warmup) + " untimed. Total = culling pass + shading pass (the depth pre-pass, the "
+    md += std::to_string(rep.width) + "x" + std::to_string(rep.height) + ", " + count(rep.lights, "light", "lights") +
+          ", " + configurations(rep.rows.size()) + "; times are " +
+          (rep.repeat == 1 ? std::string("of 1 run") : "medians of " + std::to_string(rep.repeat) + " runs") +
+          " after " + std::to_string(rep.warmup) +
+          " untimed. Total = culling pass + shading pass (the depth pre-pass, the "
           "same for every configuration, is not included).\n\n";
     if (rep.cancelled)
-        md += "**Partial: cancelled after " + std::to_string(rep.rows.size()) + " of " + std::to_string(rep.queued) +
-              " configurations.**\n\n";
+        md += "**Partial: cancelled after " + std::to_string(rep.rows.size()) + " of " + configurations(rep.queued) +
+              ".**\n\n";
     for (std::size_t i = 0; i < rep.backendDevices.size(); ++i)
         md += "- backend `" + rep.backendDevices[i].first + "`: " + rep.backendDevices[i].second + "; timing: " +
               rep.backendTiming[i].second + "\n";
@@ -740,8 +751,8 @@ std::string reportMarkdown(const Report& rep) {
             for (const ReportRow* r : rows)
                 if (r->paretoEfficiency) front.push_back(r);
             std::sort(front.begin(), front.end(), [](auto* a, auto* b) { return a->totalMs < b->totalMs; });
-            md += "- " + backend + " Pareto front, time against efficiency (" + std::to_string(front.size()) +
-                  " configurations, fastest first):";
+            md += "- " + backend + " Pareto front, time against efficiency (" + configurations(front.size()) +
+                  ", fastest first):";
             for (std::size_t i = 0; i < front.size(); ++i) {
                 md += (i ? "; " : " ") + std::string("`") + front[i]->config.label() + "` " +
                       fmt("%.3f", front[i]->totalMs) + " ms / " + fmt("%.3f", front[i]->efficiency);
@@ -752,8 +763,7 @@ std::string reportMarkdown(const Report& rep) {
             md += ".\n";
             std::size_t errFront = 0;
             for (const ReportRow* r : rows) errFront += r->paretoError;
-            md += "- " + backend + " Pareto front, time against image error: " + std::to_string(errFront) +
-                  " configurations.";
+            md += "- " + backend + " Pareto front, time against image error: " + configurations(errFront) + ".";
             // Shading against culling: where the time goes at the two ends.
             md += " At the fastest configuration culling is " +
                   fmt("%.0f", fastest->totalMs > 0 ? 100.0 * fastest->cullMs / fastest->totalMs : 0.0) +
