@@ -44,6 +44,7 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <regex>
 #include <string>
 
 #ifndef LC_VERSION
@@ -68,6 +69,25 @@ std::string outputProblem(const std::function<void()>& check) {
         return e.what();
     }
     return {};
+}
+
+// CLI11's wording of a bad command line, said as the rest of the CLI says
+// it: the flag first, then what it takes and what it got. Messages it does
+// not recognise pass through unchanged. `command`: the subcommand, for the
+// --help it points at.
+std::string plainParseError(const std::string& what, const std::string& command) {
+    static const std::regex range(R"(^(\S+): Value (.*) not in range (\S+) to (\S+)$)");
+    static const std::regex convert(R"(^Could not convert: (\S+) = (.*)$)");
+    static const std::regex unexpected(R"(^The following arguments? (?:was|were) not expected: (.*)$)");
+    const std::string help = "lightcull" + (command.empty() ? std::string() : " " + command) + " --help";
+    std::smatch m;
+    if (std::regex_match(what, m, range))
+        return m[1].str() + ": expected a number from " + m[3].str() + " to " + m[4].str() + ", got '" + m[2].str() +
+               "'";
+    if (std::regex_match(what, m, convert)) return m[1].str() + ": '" + m[2].str() + "' is not a number";
+    if (std::regex_match(what, m, unexpected))
+        return "'" + m[1].str() + "' is not an option or argument here (see " + help + ")";
+    return what;
 }
 
 int fail(int code, const std::string& message) {
@@ -764,7 +784,8 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         if (e.get_exit_code() == 0) return app.exit(e); // --help, --version
-        return fail(2, e.what());
+        const std::vector<CLI::App*> chosen = app.get_subcommands();
+        return fail(2, plainParseError(e.what(), chosen.empty() ? std::string() : chosen.front()->get_name()));
     }
 
     try {

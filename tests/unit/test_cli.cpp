@@ -189,6 +189,27 @@ TEST(Cli, BadCommandLinesFailWithOneLineNamingTheProblem) {
     expectCleanFailure({}, "subcommand");
 }
 
+// The parser's own complaints, worded as the rest: the flag, what it takes,
+// what it got (they read "Value abc not in range 1 to 1000" and "Could not
+// convert: --lights = x").
+TEST(Cli, ParserErrorsNameTheFlagAndWhatItGot) {
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"report", "--builtin", "sky", "--repeat", "abc", "--out", "OUT"},
+         "--repeat: expected a number from 1 to 1000, got 'abc'"},
+        {{"run", "--builtin", "sky", "--lights", "x", "--out", "OUT"}, "--lights: 'x' is not a number"},
+        {{"report", "--builtin", "sky", "extra", "--out", "OUT"},
+         "'extra' is not an option or argument here (see lightcull report --help)"},
+        {{"bench", "--builtin", "sky", "--nope"},
+         "'--nope' is not an option or argument here (see lightcull bench --help)"},
+    };
+    ScratchDir s;
+    for (const auto& [args, message] : cases) {
+        const CliResult r = runCli(args, s.path);
+        EXPECT_EQ(r.code, 2) << args[0];
+        EXPECT_EQ(r.err, "lightcull: error: " + message + "\n");
+    }
+}
+
 // A view with no geometry scores as a perfect culler: the CLI says so. A
 // scene JSON without a camera frames its meshes (as a glTF does) instead of
 // looking at the origin from a fixed place.
