@@ -691,6 +691,19 @@ TEST(CustomDecode, EveryLayoutDecodesCountsOverflowAndBadIndices) {
     EXPECT_THROW(decodeLists({1, 2}, parseLayout("fixed:2"), 5, r, c), Error);
 }
 
+// A report of few rows on one backend: 16-pixel tiles, one cell, the plane
+// test, one timed run each.
+ReportOptions oneRunReport(const std::string& backend) {
+    ReportOptions o;
+    o.backends = {backend};
+    o.tileSizes = {16};
+    o.cellCounts = {1};
+    o.fixed["test"] = "planes";
+    o.repeat = 1;
+    o.warmup = 0;
+    return o;
+}
+
 TEST_F(GpuTest, ReportNamesShadersOfOneFileNameByTheirPaths) {
     // Two versions of one engine's shader, each in its own folder: two rows
     // a reader can tell apart (both were once `custom:cull.comp ...`).
@@ -701,14 +714,8 @@ TEST_F(GpuTest, ReportNamesShadersOfOneFileNameByTheirPaths) {
         fs::copy_file(kExamples + "tiled_fixed.comp", tmp.path / dir / "cull.comp");
         paths.push_back((tmp.path / dir / "cull.comp").string());
     }
-    ReportOptions o;
-    o.backends = {"cpu"};
-    o.tileSizes = {16};
-    o.cellCounts = {1};
+    ReportOptions o = oneRunReport("cpu");
     o.fixed["algorithm"] = "minmax";
-    o.fixed["test"] = "planes";
-    o.repeat = 1;
-    o.warmup = 0;
     o.shaders = {optionsFor(paths[0]), optionsFor(paths[1]), optionsFor(kExamples + "tiled_fixed.comp")};
     const Report rep = runReport(atrium(96, 64, 20), o);
     std::vector<std::string> labels;
@@ -723,14 +730,8 @@ TEST_F(GpuTest, ReportNamesShadersOfOneFileNameByTheirPaths) {
 
 TEST_F(GpuTest, ReportPutsCustomShadersBesideTheBuiltinRows) {
     Scene s = atrium(330, 190, 1500); // partial edge tiles: the flawed shader drifts
-    ReportOptions o;
-    o.backends = {"vulkan"};
-    o.tileSizes = {16};
-    o.cellCounts = {1};
-    o.fixed["test"] = "planes";
+    ReportOptions o = oneRunReport("vulkan");
     o.fixed["spot-test"] = "apex-sphere";
-    o.repeat = 1;
-    o.warmup = 0;
     o.shaders = {optionsFor(kExamples + "tiled_fixed.comp", "bitmask"),
                  optionsFor(kExamples + "flawed_tile_edges.comp", "bitmask")};
     setenv("LIGHTCULL_VALIDATION", "1", 1);
