@@ -14,7 +14,9 @@
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -253,12 +255,18 @@ int HuntCommand::run() {
     }
     const lc::HuntFailure& f = *result.failure;
     const fs::path out(outDir_);
-    const std::string verdict = lc::huntVerdictText(f, options);
+    // The verdict as written (it says so when the repro did not fail again).
+    std::ostringstream verdict;
+    verdict << std::ifstream(out / "verdict.txt").rdbuf();
     char took[32];
     std::snprintf(took, sizeof took, "%.1f", result.seconds);
+    std::string wrote;
+    for (const char* name : {"scene.json", "scene.glb", "repro.sh", "studio.sh", "summary.json", "verdict.txt", "run"})
+        if (fs::exists(out / name))
+            wrote += (wrote.empty() ? "" : ", ") + std::string(name) + (fs::is_directory(out / name) ? "/" : "");
     std::cout << "COUNTEREXAMPLE after " << f.trial + 1 << (f.trial ? " trials (" : " trial (") << took << " s):\n"
-              << verdict << "repro: " << (out / "repro.sh").string() << "  (" << command << ")\n"
-              << "wrote " << outDir_ << "/scene.json, scene.glb, repro.sh, summary.json, verdict.txt, run/\n";
+              << verdict.str() << "repro: " << (out / "repro.sh").string() << "  (" << command << ")\n"
+              << "wrote " << outDir_ << "/" << wrote << "\n";
     std::cerr << "lightcull: the culling fails the hunt: " << f.verdict.property << " (exit 3)\n";
     return 3;
 }

@@ -80,10 +80,15 @@ std::string plainParseError(const std::string& what, const std::string& command)
     static const std::regex convert(R"(^Could not convert: (\S+) = (.*)$)");
     static const std::regex unexpected(R"(^The following arguments? (?:was|were) not expected: (.*)$)");
     const std::string help = "lightcull" + (command.empty() ? std::string() : " " + command) + " --help";
+    // CLI11 prints a floating-point range's ends as 1.000000.
+    const auto number = [](const std::string& n) {
+        static const std::regex whole(R"(^(-?\d+)\.0+$)");
+        return std::regex_replace(n, whole, "$1");
+    };
     std::smatch m;
     if (std::regex_match(what, m, range))
-        return m[1].str() + ": expected a number from " + m[3].str() + " to " + m[4].str() + ", got '" + m[2].str() +
-               "'";
+        return m[1].str() + ": expected a number from " + number(m[3].str()) + " to " + number(m[4].str()) +
+               ", got '" + m[2].str() + "'";
     if (std::regex_match(what, m, convert)) return m[1].str() + ": '" + m[2].str() + "' is not a number";
     if (std::regex_match(what, m, unexpected))
         return "'" + m[1].str() + "' is not an option or argument here (see " + help + ")";

@@ -78,10 +78,15 @@ void ReportCommand::add(CLI::App& app) {
                          presetNames)
         ->type_name("NAME[,NAME...]");
     cmd_->add_flag("--presets", allPresets_, "Run every engine preset side by side instead of the sweep");
-    cmd_->add_option("--shader", shaders_,
+    CLI::Option* shaderOpt = cmd_->add_option("--shader", shaders_,
                      "A custom culling shader as one more row (repeatable; its first-line settings give layout and "
                      "lists; docs/CUSTOM_CULLING.md)")
         ->type_name("FILE");
+    cmd_->add_option("--timeout-ms", timeoutMs_,
+                     "Custom shaders: a dispatch running this long is a hang (default 10000)")
+        ->type_name("MS")
+        ->check(CLI::Range(1.0, 3600000.0))
+        ->needs(shaderOpt);
     cmd_->add_option("--repeat", repeat_, "Timed culls and shades per configuration; medians reported (default: 3)")
         ->type_name("N")
         ->check(CLI::Range(1, 1000));
@@ -127,10 +132,16 @@ int ReportCommand::run() {
     options.device = device_;
     for (std::size_t i = 0; i < shaders_.size(); ++i) {
         const std::string& sh = shaders_[i];
+        // The same file however it is reached (./, an absolute path, a link).
+        const auto same = [](const std::string& a, const std::string& b) {
+            std::error_code ec;
+            return std::filesystem::equivalent(a, b, ec) ||
+                   std::filesystem::path(a).lexically_normal() == std::filesystem::path(b).lexically_normal();
+        };
         for (std::size_t j = 0; j < i; ++j)
-            if (std::filesystem::path(shaders_[j]).lexically_normal() == std::filesystem::path(sh).lexically_normal())
-                return usage("--shader: " + sh + " is given twice");
+            if (same(shaders_[j], sh)) return usage("--shader: " + sh + " is given twice");
         lc::CustomShaderOptions so = lc::shaderOptionsFromFile(sh);
+        so.timeoutMs = timeoutMs_;
         so.device = device_;
         options.shaders.push_back(std::move(so));
     }

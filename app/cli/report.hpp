@@ -29,6 +29,7 @@ private:
     long long lights_ = -1;
     unsigned long long seed_ = 1;
     double spotFraction_ = 0.0;
+    double timeoutMs_ = 10000; // custom shaders' time limit (CustomShaderOptions)
     int repeat_ = 3, warmup_ = 1;
     CLI::Option* optLights_ = nullptr;
     std::map<std::string, std::string> paramValues_;

@@ -197,6 +197,8 @@ TEST(Cli, ParserErrorsNameTheFlagAndWhatItGot) {
         {{"report", "--builtin", "sky", "--repeat", "abc", "--out", "OUT"},
          "--repeat: expected a number from 1 to 1000, got 'abc'"},
         {{"run", "--builtin", "sky", "--lights", "x", "--out", "OUT"}, "--lights: 'x' is not a number"},
+        {{"hunt", "--shader", "x.comp", "--timeout-ms", "0", "--out", "OUT"},
+         "--timeout-ms: expected a number from 1 to 3600000, got '0'"},
         {{"report", "--builtin", "sky", "extra", "--out", "OUT"},
          "'extra' is not an option or argument here (see lightcull report --help)"},
         {{"bench", "--builtin", "sky", "--nope"},

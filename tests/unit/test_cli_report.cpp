@@ -114,6 +114,7 @@ TEST(CliReport, WritesCsvMarkdownAndPareto) {
 TEST(CliReport, BadInputFailsWithOneLineAndNoFolder) {
     ScratchDir tmp;
     const std::string kShader = std::string(LC_SOURCE_DIR) + "/resources/culling-examples/tiled_fixed.comp";
+    fs::create_symlink(kShader, tmp.path / "link.comp"); // the same file by another name
     const fs::path out = tmp.path / "rep";
     std::ofstream(tmp.path / "afile") << "x"; // a file where a parent folder would be
     // A custom shader that does not compile: refused before the sweep (no
@@ -128,6 +129,9 @@ TEST(CliReport, BadInputFailsWithOneLineAndNoFolder) {
           {"report", "--builtin", "sky", "--backend", "cpu", "--backend", "metal", "--out", out.string()},
           {"report", "--builtin", "sky", "--presets", "--preset", "urp", "--out", out.string()},
           {"report", "--builtin", "sky", "--shader", kShader, "--shader", kShader, "--out", out.string()},
+          {"report", "--builtin", "sky", "--shader", kShader, "--shader", (tmp.path / "link.comp").string(),
+           "--out", out.string()},
+          {"report", "--builtin", "sky", "--timeout-ms", "500", "--out", out.string()},
           {"report", "--builtin", "sky", "--spot-fraction", "0.5", "--out", out.string()},
           {"report", "--builtin", "sky", "--lights", "4", "--spot-fraction", "2", "--out", out.string()},
           {"report", "--out", out.string()},

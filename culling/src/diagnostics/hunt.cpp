@@ -848,6 +848,13 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
         command += " --shader " + shader + " --layout " + toString(options.shader->layout) + " --lists " +
                    toString(options.shader->lists);
         if (!options.shader->validation) command += " --no-validation";
+        // The hunt's time limit, where it is not run's default: a slow shader
+        // fails the repro as it failed the trial.
+        if (options.shader->timeoutMs != CustomShaderOptions{}.timeoutMs) {
+            std::ostringstream ms;
+            ms << options.shader->timeoutMs;
+            command += " --timeout-ms " + ms.str();
+        }
         studio += " --shader " + shader;
     } else {
         Camera scratch;
@@ -873,12 +880,24 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
         exportDiagnostics(scene, settings, run, (out / "run").string());
         fs::copy_file(out / "run" / "summary.json", out / "summary.json", fs::copy_options::overwrite_existing);
     }
-    writeFileSynced((out / "verdict.txt").string(), huntVerdictText(f, options));
+    // A failure that did not come back when the repro ran (a shader near its
+    // time limit on a loaded machine): said in the verdict and the script.
+    const std::string notAgain =
+        again.fails ? std::string()
+                    : "It did not fail when the shrunk repro ran again (a time limit depends on the machine's "
+                      "load): the repro may pass.";
+    std::string verdict = huntVerdictText(f, options);
+    if (!notAgain.empty()) {
+        while (!verdict.empty() && verdict.back() == '\n') verdict.pop_back();
+        verdict += " " + notAgain + "\n";
+    }
+    writeFileSynced((out / "verdict.txt").string(), verdict);
     writeFileSynced((out / "repro.sh").string(),
                     "#!/bin/sh\n# lightcull hunt, seed " + std::to_string(options.seed) + ", trial " +
                         std::to_string(f.trial) + ": " + oneLine(f.verdict.property) + " (verdict.txt). " +
-                        (runFailed ? "Fails (exit 1) while the error is there.\n"
-                                   : "Exits 3 while the miss is there.\n") +
+                        (!notAgain.empty() ? notAgain + "\n"
+                         : runFailed       ? "Fails (exit 1) while the error is there.\n"
+                                           : "Exits 3 while the miss is there.\n") +
                         "# Set LIGHTCULL to the binary when lightcull is not on PATH.\n"
                         "cd \"$(dirname \"$0\")\" || exit 1\n# " +
                         command + "\nexec \"${LIGHTCULL:-lightcull}\"" + command.substr(9) + "\n");
