@@ -193,6 +193,37 @@ private slots:
         QVERIFY2(!times->text().contains("failed"), qPrintable(times->text()));
     }
 
+    // git checkout and some editors delete the file and write it anew: the
+    // watch follows it back. A save (truncate, then write) is one run.
+    void deletedAndWrittenAgainIsFollowed() {
+        const QString mine = tmp_.path() + "/back.comp";
+        save(mine, readAll(kExamples + "tiled_fixed.comp"));
+        w_->prompts.openPath = [&](QWidget*, const QString&, const QString&) { return mine; };
+        quint64 before = doc()->runs().runGeneration();
+        w_->action("actionCustomShader")->trigger();
+        QString why;
+        QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
+        QCOMPARE(doc()->runs().runOutput()->truth.metrics.falseNegatives, std::uint64_t(0));
+
+        QVERIFY(QFile::remove(mine));
+        QTRY_VERIFY_WITH_TIMEOUT(w_->messageLog()->toPlainText().contains("back.comp is gone"), 5000);
+        std::string flawed = readAll(kExamples + "flawed_tile_edges.comp");
+        flawed.replace(flawed.find("fixed:256"), 9, "bitmask");
+        before = doc()->runs().runGeneration();
+        save(mine, flawed);
+        QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
+        QVERIFY(doc()->runs().runOutput()->truth.metrics.falseNegatives > 0);
+        QCOMPARE(doc()->runs().runGeneration(), before + 1);
+        QTest::qWait(800); // no second run for the same save
+        QCOMPARE(doc()->runs().runGeneration(), before + 1);
+
+        // And later saves in place are followed as before.
+        before = doc()->runs().runGeneration();
+        save(mine, readAll(kExamples + "tiled_fixed.comp"));
+        QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
+        QCOMPARE(doc()->runs().runOutput()->truth.metrics.falseNegatives, std::uint64_t(0));
+    }
+
     void badFirstLineIsRefusedAndShown() {
         const QString bad = tmp_.path() + "/bad.comp";
         save(bad, "// lightcull: --layout fixed:zero\n#version 450\nvoid main() {}\n");

@@ -3,7 +3,9 @@
 // algorithm (Culling > Custom shader...): its options read from the file's
 // first line, and the file watched, so that saving it in an editor re-reads
 // the options and asks for a run. Editors that save by replacing the file
-// are followed to the new one.
+// are followed to the new one, and a file deleted and written again (git
+// checkout, some editors) to its return; a save's burst of changes is one
+// run.
 
 #include "culling/custom/custom_cull.hpp"
 
@@ -13,6 +15,7 @@
 #include <memory>
 
 class QFileSystemWatcher;
+class QTimer;
 
 namespace lcui {
 
@@ -34,9 +37,15 @@ signals:
 
 private:
     void reload();
+    // What tells one version of the file from the next: modified and
+    // changed times and size ("" when there is no file).
+    static QString stamp(const QString& path);
 
     std::shared_ptr<const lc::CustomShaderOptions> options_;
-    QFileSystemWatcher* watcher_;
+    QFileSystemWatcher* watcher_; // the file and its folder
+    QTimer* settle_;              // a change is read once the file is quiet
+    QString stamp_;               // of the version last read
+    bool gone_ = false;           // the file was deleted and not yet back
 };
 
 } // namespace lcui
