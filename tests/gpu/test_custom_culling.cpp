@@ -22,6 +22,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <numeric>
 #include <regex>
 
 #include <unistd.h>
@@ -716,12 +717,20 @@ TEST_F(GpuTest, ReportNamesShadersOfOneFileNameByTheirPaths) {
     }
     ReportOptions o = oneRunReport("cpu");
     o.fixed["algorithm"] = "minmax";
-    o.shaders = {optionsFor(paths[0]), optionsFor(paths[1]), optionsFor(kExamples + "tiled_fixed.comp")};
+    o.shaders = {optionsFor(paths[0]), optionsFor(paths[1]), optionsFor(kExamples + "tiled_fixed.comp"),
+                 optionsFor(kData + "duplicate_light.comp")};
     const Report rep = runReport(atrium(96, 64, 20), o);
+    // A light twice in a list fails `run`: the report says it in a note.
+    ASSERT_EQ(rep.rows.back().config.customLabel.rfind("custom:duplicate_light.comp ", 0), 0u);
+    const std::string notes = std::accumulate(rep.notes.begin(), rep.notes.end(), std::string(),
+                                              [](std::string a, const std::string& b) { return a + b + "\n"; });
+    EXPECT_NE(notes.find("custom:duplicate_light.comp"), std::string::npos) << notes;
+    EXPECT_EQ(notes.find(" 0 duplicate indices"), std::string::npos) << notes;
+    EXPECT_NE(notes.find(" duplicate ind"), std::string::npos) << notes;
     std::vector<std::string> labels;
     for (const ReportRow& r : rep.rows)
         if (!r.config.customLabel.empty()) labels.push_back(r.config.customLabel);
-    ASSERT_EQ(labels.size(), 3u);
+    ASSERT_EQ(labels.size(), 4u);
     EXPECT_EQ(labels[0].rfind("custom:" + paths[0] + " ", 0), 0u) << labels[0];
     EXPECT_EQ(labels[1].rfind("custom:" + paths[1] + " ", 0), 0u) << labels[1];
     // A file name no other shader has stays short.

@@ -224,6 +224,25 @@ private slots:
         QCOMPARE(doc()->runs().runOutput()->truth.metrics.falseNegatives, std::uint64_t(0));
     }
 
+    // Lists with a light twice and an index past the light count lose no
+    // light, but `run` fails them: the status bar and the log say so.
+    void duplicateAndInvalidIndicesAreShown() {
+        const QString bad = QStringLiteral(LC_TEST_DATA_DIR) + "/custom/out_of_range.comp";
+        w_->prompts.openPath = [&](QWidget*, const QString&, const QString&) { return bad; };
+        const quint64 before = doc()->runs().runGeneration();
+        w_->action("actionCustomShader")->trigger();
+        QString why;
+        QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
+        const auto run = doc()->runs().runOutput();
+        QVERIFY(run->custom && run->custom->duplicateIndices > 0 && run->custom->invalidIndices > 0);
+        const QString fn = w_->findChild<QLabel*>("statusFalseNegatives")->text();
+        QVERIFY2(fn.contains(QString("%1 invalid indices").arg(run->custom->invalidIndices)) &&
+                     fn.contains(QString("%1 duplicate indices").arg(run->custom->duplicateIndices)),
+                 qPrintable(fn));
+        QVERIFY(w_->messageLog()->toPlainText().contains(
+            QString("duplicate indices %1").arg(run->custom->duplicateIndices)));
+    }
+
     void badFirstLineIsRefusedAndShown() {
         const QString bad = tmp_.path() + "/bad.comp";
         save(bad, "// lightcull: --layout fixed:zero\n#version 450\nvoid main() {}\n");

@@ -9,6 +9,7 @@
 
 #include <QLabel>
 #include <QStatusBar>
+#include <QStringList>
 
 #include <algorithm>
 
@@ -120,16 +121,17 @@ void RunStatus::finished(quint64 generation, const lc::RunOutput& out) {
 
 void RunStatus::logCustom(const lc::RunOutput& out) {
     const lc::CustomCullReport& c = *out.custom;
-    log_->log(tr("%9 %1 (%2, %3): overflowed lists %4, invalid indices %5, validation messages %6, "
-                 "%7 lists differ from built-in %8")
+    log_->log(tr("%9 %1 (%2, %3): overflowed lists %4, invalid indices %5, duplicate indices %10, validation "
+                 "messages %6, %7 lists differ from built-in %8")
                   .arg(QString::fromStdString(c.source), QString::fromStdString(c.layout),
                        QString::fromStdString(c.lists))
                   .arg(c.overflowLists)
                   .arg(c.invalidIndices)
                   .arg(c.validationMessages.size())
                   .arg(c.listsDifferingFromBuiltin)
-                  .arg(QString::fromStdString(c.builtinAlgorithm), listSourceName(out, true)),
-              c.overflowLists > 0 || c.invalidIndices > 0 || !c.validationMessages.empty());
+                  .arg(QString::fromStdString(c.builtinAlgorithm), listSourceName(out, true))
+                  .arg(c.duplicateIndices),
+              c.overflowLists > 0 || c.invalidIndices > 0 || c.duplicateIndices > 0 || !c.validationMessages.empty());
     for (const std::string& m : c.validationMessages) log_->log(QString::fromStdString(m), true);
 }
 
@@ -238,6 +240,17 @@ void RunStatus::updateFigures(const lc::RunOutput& run) {
                                        .arg(qulonglong(m.falseNegativesListFull))
                                        .arg(qulonglong(m.falseNegativesLightLimit)));
     fn_->setStyleSheet(m.falseNegatives > 0 ? "color: white; background: #c0392b; padding: 0 4px" : "color: #2e7d32");
+    // A custom shader's lists that hold a light twice or an index past the
+    // light count lose no light but fail `lightcull run` (exit 3): said here.
+    if (run.custom && (run.custom->duplicateIndices || run.custom->invalidIndices)) {
+        QStringList flaws;
+        if (const auto n = run.custom->invalidIndices)
+            flaws << tr("%1 invalid %2").arg(n).arg(n == 1 ? "index" : "indices");
+        if (const auto n = run.custom->duplicateIndices)
+            flaws << tr("%1 duplicate %2").arg(n).arg(n == 1 ? "index" : "indices");
+        fn_->setText(fn_->text() + " · " + flaws.join(", "));
+        if (m.falseNegatives == 0) fn_->setStyleSheet("color: white; background: #d35400; padding: 0 4px");
+    }
     // With misses efficiency is no score: lists that drop needed lights look
     // tighter than any correct list can be.
     if (m.falseNegatives > 0)

@@ -536,11 +536,21 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             }
             row.device = crep.device;
             judgeRow(row, cullMs, result, proj, lights, *shaderShade, *shaderFrame, options, cancel);
-            if (crep.overflowLists || crep.invalidIndices || !crep.validationMessages.empty())
-                rep.notes.push_back(row.config.customLabel + ": " + std::to_string(crep.overflowLists) +
-                                    " overflowed lists, " + std::to_string(crep.invalidIndices) +
-                                    " invalid indices, " + std::to_string(crep.validationMessages.size()) +
-                                    " validation messages");
+            // What `run` fails a shader for beside its misses, and the
+            // layer's first word on it (a binding of the wrong type says why).
+            if (crep.overflowLists || crep.invalidIndices || crep.duplicateIndices ||
+                !crep.validationMessages.empty()) {
+                const auto count = [](std::uint64_t n, const char* one, const char* many) {
+                    return std::to_string(n) + " " + (n == 1 ? one : many);
+                };
+                std::string note = row.config.customLabel + ": " +
+                                   count(crep.overflowLists, "overflowed list", "overflowed lists") + ", " +
+                                   count(crep.invalidIndices, "invalid index", "invalid indices") + ", " +
+                                   count(crep.duplicateIndices, "duplicate index", "duplicate indices") + ", " +
+                                   count(crep.validationMessages.size(), "validation message", "validation messages");
+                if (!crep.validationMessages.empty()) note += " (the first: " + crep.validationMessages.front() + ")";
+                rep.notes.push_back(note);
+            }
             rep.rows.push_back(std::move(row));
             ++done;
             if (progress) progress(done, total, "custom " + file);
