@@ -24,6 +24,7 @@
 #include <fstream>
 #include <numeric>
 #include <regex>
+#include <sstream>
 
 #include <unistd.h>
 
@@ -263,6 +264,27 @@ TEST_F(GpuTest, OverflowingFixedListsAreReportedNotHidden) {
     const Explanation e = explainLight(out, Projection(s.camera), missed[0].list, missed[0].light);
     EXPECT_EQ(e.verdict.rfind("MISSING", 0), 0u) << e.verdict;
     EXPECT_NE(e.verdict.find("dropped: list full, layout fixed:2"), std::string::npos) << e.verdict;
+    // The metrics split the misses the same way (they once called them all
+    // the culling test's), and tiles.csv marks the lists over-full.
+    EXPECT_EQ(out.truth.metrics.falseNegativesListFull, out.truth.metrics.falseNegatives);
+    EXPECT_EQ(out.truth.metrics.falseNegativesCullingTest(), 0u);
+    const std::string csv = tilesCsv(out);
+    std::istringstream lines(csv);
+    std::string line;
+    std::getline(lines, line); // header
+    std::uint64_t overRows = 0;
+    for (std::uint32_t l = 0; std::getline(lines, line); ++l) {
+        // tile_x,tile_y,cell,min,max,mask,count,fn,fn_list_full,fn_light_limit,overflow,...
+        std::vector<std::string> f;
+        std::istringstream cells(line);
+        for (std::string c; std::getline(cells, c, ',');) f.push_back(c);
+        ASSERT_GE(f.size(), 11u) << line;
+        const bool over = std::binary_search(rep.overflowedListIds.begin(), rep.overflowedListIds.end(), l);
+        EXPECT_EQ(f[10], over ? "1" : "0") << "list " << l;
+        EXPECT_EQ(f[8], f[7]) << "list " << l; // every miss here is the list being full
+        overRows += over;
+    }
+    EXPECT_EQ(overRows, rep.overflowLists);
 }
 
 TEST_F(GpuTest, InvalidAndDuplicateIndicesAreReportedNeverFollowed) {

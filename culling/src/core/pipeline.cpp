@@ -5,6 +5,7 @@
 #include "culling/core/pipeline.hpp"
 
 #include "culling/core/errors.hpp"
+#include "culling/custom/custom_cull.hpp" // CustomCullReport: a shader's full lists
 #include "culling/truth/shade.hpp"
 
 #include <algorithm>
@@ -371,6 +372,7 @@ void judgeRun(RunOutput& out, const Projection& proj, CullBackend& shadeBackend,
     if (options.groundTruth) {
         GroundTruthOptions truthOptions = options.truthOptions;
         truthOptions.imageError = false; // from the backend's shading pass below
+        if (out.custom) truthOptions.fullLists = &out.custom->overflowedListIds;
         const auto t0 = Clock::now();
         out.truth = computeGroundTruth(out.depth, proj, out.lights, out.result, truthOptions, cancel);
         out.truthComputed = true;

@@ -389,7 +389,12 @@ std::string tilesCsv(const RunOutput& run) {
         else
             row += ",,,";
         const auto [d0, d1] = r.limits.droppedFrom(std::uint32_t(l));
-        row += std::string(r.limits.overflowIndex(std::uint32_t(l)) >= 0 ? "1," : "0,") + std::to_string(d1 - d0) + ",";
+        // A custom shader's list over its layout's capacity is over-full too
+        // (which lights it lost is not known: dropped stays 0).
+        const bool over = r.limits.overflowIndex(std::uint32_t(l)) >= 0 ||
+                          (run.custom && std::binary_search(run.custom->overflowedListIds.begin(),
+                                                            run.custom->overflowedListIds.end(), std::uint32_t(l)));
+        row += std::string(over ? "1," : "0,") + std::to_string(d1 - d0) + ",";
         for (std::uint32_t k = 0; k < cnt; ++k) {
             if (k) row += ' ';
             row += std::to_string(r.lightIndices[off + k]);

@@ -250,13 +250,15 @@ std::shared_ptr<SweepFrame> sweepFrame(DepthImage depth, const Projection& proj,
 
 // A row after its timed culls: ground truth, `repeat` timed shades of the
 // culled lists on `shader`, and the image error against the all-lights image.
+// `fullLists`: a custom shader's lists over its layout's capacity.
 void judgeRow(ReportRow& row, const std::vector<double>& cullMs, const CullResult& result, const Projection& proj,
               const ViewLights& lights, CullBackend& shader, SweepFrame& frame, const ReportOptions& options,
-              const CancelToken* cancel) {
+              const CancelToken* cancel, const std::vector<std::uint32_t>* fullLists = nullptr) {
     const DepthImage& depth = *frame.depth;
     GroundTruthOptions gto;
     gto.imageError = false;
     gto.needs = frame.needs.get();
+    gto.fullLists = fullLists;
     const GroundTruth truth = computeGroundTruth(depth, proj, lights, result, gto, cancel);
     setShadeLists(frame.shadeIn, depth, proj, &result);
     const ShadeInputs& in = frame.shadeIn;
@@ -535,7 +537,9 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
                 if (r >= options.warmup) cullMs.push_back(crep.passMs);
             }
             row.device = crep.device;
-            judgeRow(row, cullMs, result, proj, lights, *shaderShade, *shaderFrame, options, cancel);
+            judgeRow(row, cullMs, result, proj, lights, *shaderShade, *shaderFrame, options, cancel,
+                     &crep.overflowedListIds);
+            row.overflowLists = crep.overflowLists;
             // What `run` fails a shader for beside its misses, and the
             // layer's first word on it (a binding of the wrong type says why).
             if (crep.overflowLists || crep.invalidIndices || crep.duplicateIndices ||

@@ -401,6 +401,9 @@ GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
         countPixels(depth, proj, lights, result, nullptr, bmin, bmax, workers, cancel, gt);
     }
 
+    if (opt.fullLists)
+        for (const std::uint32_t l : *opt.fullLists)
+            if (l < lists) gt.listFalseNegativesListFull[l] = gt.listFalseNegatives[l] - gt.listFalseNegativesLightLimit[l];
     for (std::size_t l = 0; l < lists; ++l) {
         m.shadingWork += gt.listShadingWork[l];
         m.exactWork += gt.listExactWork[l];

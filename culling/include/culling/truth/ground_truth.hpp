@@ -74,6 +74,10 @@ struct GroundTruthOptions {
     // computePixelNeeds of this depth image, camera and lights (or null:
     // worked out here). Another frame's is an Error.
     const PixelNeeds* needs = nullptr;
+    // Lists (ascending) that overflowed a custom shader's layout capacity:
+    // their misses are the list being full, not the culling test (as
+    // locateFalseNegatives labels them). Null or empty: none.
+    const std::vector<std::uint32_t>* fullLists = nullptr;
 };
 
 GroundTruth computeGroundTruth(const DepthImage& depth, const Projection& proj,
