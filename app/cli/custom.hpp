@@ -80,7 +80,7 @@ inline void printCustomReport(const lc::RunOutput& run, const lc::Scene& scene, 
                   << " lists differ, " << run.result.entries() << " entries vs " << c.builtinEntries << "\n";
     for (const std::string& w : c.warnings) std::cout << "  warning: " << w << "\n";
     for (std::size_t i = 0; i < c.validationMessages.size() && i < 5; ++i)
-        std::cout << "  validation: " << c.validationMessages[i].substr(0, 300) << "\n";
+        std::cout << "  validation: " << lc::validationGist(c.validationMessages[i]).substr(0, 400) << "\n";
     // The culling test's misses first: a full list is a limit, and its many
     // misses must not hide the shader's real flaw.
     const auto missed = lc::locateFalseNegatives(run, proj);

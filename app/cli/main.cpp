@@ -155,10 +155,14 @@ int verdictExit(const lc::RunOutput& run) {
                   << " over-full lists (exit " << kExitMisses << ")\n";
         return kExitMisses;
     }
-    std::cerr << "lightcull: the culling fails: " << fn << (fn == 1 ? " false negative, " : " false negatives, ") << overflow << " overflowed lists, "
-              << invalid << " invalid indices";
-    if (duplicate) std::cerr << ", " << duplicate << " duplicate indices";
-    if (validation) std::cerr << ", " << validation << " validation messages";
+    const auto count = [](std::uint64_t n, const char* one, const char* many) {
+        return std::to_string(n) + " " + (n == 1 ? one : many);
+    };
+    std::cerr << "lightcull: the culling fails: " << count(fn, "false negative", "false negatives") << ", "
+              << count(overflow, "overflowed list", "overflowed lists") << ", "
+              << count(invalid, "invalid index", "invalid indices");
+    if (duplicate) std::cerr << ", " << count(duplicate, "duplicate index", "duplicate indices");
+    if (validation) std::cerr << ", " << count(validation, "validation message", "validation messages");
     std::cerr << " (exit " << kExitMisses << ")\n";
     return kExitMisses;
 }

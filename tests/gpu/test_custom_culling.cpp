@@ -424,6 +424,16 @@ TEST_F(GpuTest, InterfaceMistakesAreOneLineErrors) {
         {"set1.comp", head + "layout(set = 1, binding = 0, std430) readonly buffer L { vec4 l[]; };\n" +
                           std::regex_replace(body, std::regex("X"), "uint(l[0].w)"),
          "", "set1.comp: declares set 1 binding 0"},
+        // The right binding, the wrong kind of resource: it would read nothing.
+        {"texture_as_buffer.comp", head + "layout(set = 0, binding = 1, std430) readonly buffer D { float d[]; };\n" +
+                                       std::regex_replace(body, std::regex("X"), "uint(d[0])"),
+         "", "texture_as_buffer.comp: declares binding 1 as a storage buffer; the contract binds a texture or sampler"},
+        {"lists_as_uniform.comp",
+         "#version 450\nlayout(local_size_x = 64) in;\n"
+         "layout(set = 0, binding = 4, std140) uniform O { uvec4 outw[4]; };\n"
+         "layout(set = 0, binding = 3, std430) buffer L { vec4 l[]; };\n"
+         "void main() { l[0].x = float(outw[0].x); }\n",
+         "", "lists_as_uniform.comp: declares binding 4 as a uniform buffer; the contract binds a storage buffer"},
         {"push.comp", head + "layout(push_constant) uniform PC { uint k; } pc;\n" +
                           std::regex_replace(body, std::regex("X"), "pc.k"),
          "", "push.comp: declares push constants"},
@@ -683,6 +693,22 @@ TEST(CustomSpecs, LayoutsListsAndFirstLineSettings) {
     EXPECT_THROW(applyShaderHeader("// lightcull: --layout bitmask\n// lightcull: --lists halfz\n", "x.comp", mention,
                                    false, false, false),
                  InputError);
+}
+
+TEST(CustomSpecs, ValidationMessagesAreCutToWhatIsWrong) {
+    const std::string layer =
+        "error: VUID-VkComputePipelineCreateInfo-layout-00703: Validation Error: [ "
+        "VUID-VkComputePipelineCreateInfo-layout-00703 ] Object 0: handle = 0x120000000012, name = "
+        "lc.custom.custom.shader, type = VK_OBJECT_TYPE_SHADER_MODULE; Object 1: handle = 0x50000000005, name = "
+        "lc.custom.custom.pipelineLayout, type = VK_OBJECT_TYPE_PIPELINE_LAYOUT; | MessageID = 0xe63c2d8b | Set 0 "
+        "Binding 1 type mismatch on descriptor slot in shader (VK_SHADER_STAGE_COMPUTE_BIT), uses type "
+        "VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER but expected VK_DESCRIPTOR_TYPE_STORAGE_BUFFER The Vulkan spec "
+        "states: layout must be consistent (https://www.khronos.org/registry/vulkan/specs/...)";
+    EXPECT_EQ(validationGist(layer),
+              "error: VUID-VkComputePipelineCreateInfo-layout-00703: Set 0 Binding 1 type mismatch on descriptor slot "
+              "in shader (VK_SHADER_STAGE_COMPUTE_BIT), uses type VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER but "
+              "expected VK_DESCRIPTOR_TYPE_STORAGE_BUFFER");
+    EXPECT_EQ(validationGist("a message of another shape"), "a message of another shape");
 }
 
 TEST(CustomDecode, EveryLayoutDecodesCountsOverflowAndBadIndices) {

@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <sstream>
 
 namespace lc {
@@ -198,6 +199,16 @@ ListSpec parseListSpec(const std::string& text) {
         throw SettingsError("lists", "'" + text + "' is not tile, halfz, froxel:N[:log|linear] or cells:N[:log|linear] (N in 1..32)");
     }
     return l;
+}
+
+std::string validationGist(const std::string& message) {
+    // "error: VUID-x: Validation Error: [ VUID-x ] Object 0: ...; | MessageID
+    // = 0x.. | what is wrong The Vulkan spec states: ..." -> "error: VUID-x:
+    // what is wrong".
+    static const std::regex layer(R"(^(.*?: )?Validation Error: .*?\| MessageID = 0x[0-9a-fA-F]+ \| (.*?)( The Vulkan spec states:.*)?$)");
+    std::smatch m;
+    if (!std::regex_match(message, m, layer)) return message;
+    return m[1].str() + m[2].str();
 }
 
 std::string toString(const ListSpec& l) {

@@ -552,7 +552,8 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
                                    count(crep.invalidIndices, "invalid index", "invalid indices") + ", " +
                                    count(crep.duplicateIndices, "duplicate index", "duplicate indices") + ", " +
                                    count(crep.validationMessages.size(), "validation message", "validation messages");
-                if (!crep.validationMessages.empty()) note += " (the first: " + crep.validationMessages.front() + ")";
+                if (!crep.validationMessages.empty())
+                    note += " (the first: " + validationGist(crep.validationMessages.front()) + ")";
                 rep.notes.push_back(note);
             }
             rep.rows.push_back(std::move(row));

@@ -31,6 +31,7 @@
 #include <memory>
 #include <mutex>
 #include <regex>
+#include <set>
 #include <sstream>
 
 namespace lc {
@@ -185,10 +186,16 @@ std::vector<std::uint32_t> loadSpirv(const std::string& path) {
 // and the DescriptorSet / Binding decorations and storage class of its
 // variables.
 void checkInterface(const std::string& path, const std::vector<std::uint32_t>& words, const std::string& entry) {
-    constexpr std::uint32_t kOpEntryPoint = 15, kOpVariable = 59, kOpDecorate = 71;
-    constexpr std::uint32_t kGLCompute = 5, kDecBinding = 33, kDecDescriptorSet = 34, kPushConstant = 9;
+    constexpr std::uint32_t kOpEntryPoint = 15, kOpTypePointer = 32, kOpVariable = 59, kOpDecorate = 71;
+    constexpr std::uint32_t kGLCompute = 5, kDecBinding = 33, kDecDescriptorSet = 34, kDecBufferBlock = 3;
+    constexpr std::uint32_t kUniformConstant = 0, kUniform = 2, kPushConstant = 9, kStorageBuffer = 12;
     std::vector<std::string> computeEntries;
     std::map<std::uint32_t, std::uint32_t> bindingOf, setOf;
+    // What each variable is: its storage class and pointer type; what each
+    // pointer points to; the structs decorated BufferBlock (a storage buffer
+    // in the Uniform class, as older GLSL compilers and HLSL emit them).
+    std::map<std::uint32_t, std::uint32_t> classOf, typeOf, pointee;
+    std::set<std::uint32_t> bufferBlocks;
     bool pushConstants = false;
     for (std::size_t i = 5; i < words.size();) {
         const std::uint32_t count = words[i] >> 16, op = words[i] & 0xFFFFu;
@@ -208,8 +215,14 @@ void checkInterface(const std::string& path, const std::vector<std::uint32_t>& w
             bindingOf[w[1]] = w[3];
         } else if (op == kOpDecorate && count >= 4 && w[2] == kDecDescriptorSet) {
             setOf[w[1]] = w[3];
-        } else if (op == kOpVariable && count >= 4 && w[3] == kPushConstant) {
-            pushConstants = true;
+        } else if (op == kOpDecorate && count >= 3 && w[2] == kDecBufferBlock) {
+            bufferBlocks.insert(w[1]);
+        } else if (op == kOpTypePointer && count >= 4) {
+            pointee[w[1]] = w[3];
+        } else if (op == kOpVariable && count >= 4) {
+            pushConstants = pushConstants || w[3] == kPushConstant;
+            typeOf[w[2]] = w[1];
+            classOf[w[2]] = w[3];
         }
         i += count;
     }
@@ -228,6 +241,24 @@ void checkInterface(const std::string& path, const std::vector<std::uint32_t>& w
         if (s != 0 || binding > 4)
             throw InputError(path, "", 0, "declares set " + std::to_string(s) + " binding " + std::to_string(binding) +
                                               ", which the contract does not bind (set 0: " + kBindings +
+                                              "; docs/CUSTOM_CULLING.md)");
+        // The kind of resource at that binding: a mismatch reads nothing
+        // (and without the validation layer says nothing).
+        const auto cls = classOf.find(id);
+        if (cls == classOf.end()) continue;
+        const auto type = typeOf.find(id);
+        const auto block = type == typeOf.end() ? pointee.end() : pointee.find(type->second);
+        const char* declared = cls->second == kUniformConstant ? "a texture or sampler"
+                               : cls->second == kStorageBuffer ? "a storage buffer"
+                               : cls->second == kUniform
+                                   ? (block != pointee.end() && bufferBlocks.count(block->second) ? "a storage buffer"
+                                                                                                  : "a uniform buffer")
+                                   : nullptr;
+        const char* expected = binding == 0 ? "a uniform buffer" : binding == 1 ? "a texture or sampler"
+                                                                                : "a storage buffer";
+        if (declared && std::string(declared) != expected)
+            throw InputError(path, "", 0, "declares binding " + std::to_string(binding) + " as " + declared +
+                                              "; the contract binds " + expected + " there (set 0: " + kBindings +
                                               "; docs/CUSTOM_CULLING.md)");
     }
 }

@@ -73,6 +73,10 @@ void applyShaderHeader(const std::string& shaderText, const std::string& path, C
 CustomShaderOptions shaderOptionsFromFile(const std::string& path, const std::string& layout = {},
                                           const std::string& lists = {}, const std::string& entry = {});
 
+// A validation layer message without the object handles and the spec's
+// quotation: severity, VUID and what is wrong (any other text as it is).
+std::string validationGist(const std::string& message);
+
 // What a custom culling (shader or dump) did beside its lists.
 struct CustomCullReport {
     std::string source;                  // the shader or dump file
