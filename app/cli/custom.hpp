@@ -77,7 +77,9 @@ inline void printCustomReport(const lc::RunOutput& run, const lc::Scene& scene, 
         std::cout << "  against built-in: " << c.builtinAlgorithm << "\n"; // "none (why)": nothing to count
     else
         std::cout << "  against built-in " << c.builtinAlgorithm << " (cpu): " << c.listsDifferingFromBuiltin
-                  << " lists differ, " << run.result.entries() << " entries vs " << c.builtinEntries << "\n";
+                  << (c.listsDifferingFromBuiltin == 1 ? " list differs, " : " lists differ, ")
+                  << run.result.entries() << (run.result.entries() == 1 ? " entry vs " : " entries vs ")
+                  << c.builtinEntries << "\n";
     for (const std::string& w : c.warnings) std::cout << "  warning: " << w << "\n";
     for (std::size_t i = 0; i < c.validationMessages.size() && i < 5; ++i)
         std::cout << "  validation: " << lc::validationGist(c.validationMessages[i]).substr(0, 400) << "\n";

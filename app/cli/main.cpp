@@ -205,7 +205,7 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
                      "cull for, and every metric is trivially perfect; check the camera\n";
     std::cout << "scene " << scene.name << ": " << r.grid.width << "x" << r.grid.height << ", tile "
               << r.grid.tileSize << " (" << r.grid.tilesX << "x" << r.grid.tilesY << " tiles), "
-              << run.lights.size() << " lights\n"
+              << run.lights.size() << (run.lights.size() == 1 ? " light\n" : " lights\n")
               << "algorithm "
               << (run.custom ? std::string("custom")
                              : settings.algorithm == lc::Algorithm::Raster
@@ -306,7 +306,9 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
     std::cout << ", cull " << ms(r.timings.cullMs)
               << ", shade " << ms(r.timings.shadeMs) << ", ground truth " << ms(r.timings.groundTruthMs) << "\n"
               << "wrote " << out << "/summary.json, tiles.csv, heatmap.png, heatmap_misses.png"
-              << (run.shadedAll.empty() ? "" : ", shaded_culled.png, shaded_all.png, shaded_diff.png") << "\n";
+              << (run.shadedAll.empty() ? "" : ", shaded_culled.png, shaded_all.png, shaded_diff.png")
+              << (std::filesystem::exists(std::filesystem::path(out) / "overlays.vtm") ? ", overlays.vtm, overlays/" : "")
+              << "\n";
 }
 
 
@@ -822,8 +824,9 @@ int main(int argc, char** argv) {
                 return fail(2, "OUT: " + why);
             const lc::Scene scene = convertIn.load();
             lc::saveSceneAny(scene, convertOut);
-            std::cout << "wrote " << convertOut << ": " << scene.triangleCount() << " triangles, " << scene.lights.size()
-                      << " lights, camera " << lc::toString(scene.camera.projection) << " " << scene.camera.width << "x"
+            std::cout << "wrote " << convertOut << ": " << scene.triangleCount()
+                      << (scene.triangleCount() == 1 ? " triangle, " : " triangles, ") << scene.lights.size()
+                      << (scene.lights.size() == 1 ? " light, camera " : " lights, camera ") << lc::toString(scene.camera.projection) << " " << scene.camera.width << "x"
                       << scene.camera.height << "\n";
             return 0;
         }

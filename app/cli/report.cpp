@@ -246,7 +246,7 @@ int ReportCommand::run() {
     lc::writeReport(report, outDir_);
 
     std::cout << "report " << report.sceneName << ": " << report.width << "x" << report.height << ", "
-              << report.lights << " lights, " << plural(report.rows.size()) << "\n";
+              << report.lights << (report.lights == 1 ? " light, " : " lights, ") << plural(report.rows.size()) << "\n";
     for (const auto& [backend, device] : report.backendDevices) std::cout << "backend " << backend << ": " << device << "\n";
     for (const std::string& n : report.notes) std::cout << "note: " << n << "\n";
     std::uint64_t fnRows = 0;

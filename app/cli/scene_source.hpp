@@ -73,8 +73,9 @@ struct SceneSource {
             std::cerr << "lightcull: warning: --min-intensity applies to no light: every light of " << sceneFile
                       << " has a range\n";
         if (lc::isGltfPath(sceneFile))
-            std::cerr << "lightcull: " << sceneFile << ": " << s.triangleCount() << " triangles, " << s.lights.size()
-                      << " lights, camera " << report.camera << "; loaded in " << std::lround(ms) << " ms\n";
+            std::cerr << "lightcull: " << sceneFile << ": " << s.triangleCount()
+                      << (s.triangleCount() == 1 ? " triangle, " : " triangles, ") << s.lights.size()
+                      << (s.lights.size() == 1 ? " light, camera " : " lights, camera ") << report.camera << "; loaded in " << std::lround(ms) << " ms\n";
         return s;
     }
 

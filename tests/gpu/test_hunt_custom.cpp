@@ -64,6 +64,13 @@ TEST(HuntCustom, FindsTheFlawedTileEdgesAndItsReproReproduces) {
     EXPECT_EQ(runReproScript(out, &reproLog), 3) << reproLog;
     const auto again = nlohmann::json::parse(slurp(out / "run" / "summary.json"));
     EXPECT_EQ(again["metrics"]["false_negatives"], summary["metrics"]["false_negatives"]);
+    // Without LIGHTCULL and with no lightcull on PATH, the script runs the
+    // lightcull that wrote it.
+    fs::remove_all(out / "run");
+    const std::string bare = "cd / && env -i PATH=/usr/bin:/bin sh '" + (out / "repro.sh").string() + "' >/dev/null 2>&1";
+    const int status = std::system(bare.c_str());
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 3) << status;
+    EXPECT_TRUE(fs::exists(out / "run" / "summary.json"));
 
     // Deterministic for a seed: the same repro again.
     const fs::path out2 = s.path / "hunt2";

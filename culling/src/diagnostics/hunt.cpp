@@ -744,7 +744,7 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
           << (l.isSpot() ? ", outer angle " + g(l.outerAngleDeg) + " degrees" : std::string()) << ")"
           << " is missing from the list of tile " << tx << "," << ty << " (list " << v.miss->list << ", cause "
           << toString(v.miss->cause) << ") where " << v.miss->pixels << (v.miss->pixels == 1 ? " geometry pixel needs it; " : " geometry pixels need it; ")
-          << v.falseNegatives << " false negatives in all";
+          << v.falseNegatives << (v.falseNegatives == 1 ? " false negative in all" : " false negatives in all");
         if (v.overflowLists || v.invalidIndices)
             o << ", " << v.overflowLists << " lists over the layout's capacity, " << v.invalidIndices
               << " invalid indices";
@@ -760,7 +760,7 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
           << v.duplicateIndices << " duplicate indices, " << v.validationMessages << " validation messages, "
           << v.overflowLists << " overflowed lists.";
     }
-    o << " Shrunk from " << f.original.lights.size() << " lights at " << f.original.camera.width << "x"
+    o << " Shrunk from " << f.original.lights.size() << (f.original.lights.size() == 1 ? " light at " : " lights at ") << f.original.camera.width << "x"
       << f.original.camera.height << " to " << s.lights.size() << " light" << (s.lights.size() == 1 ? "" : "s")
       << " at " << c.width << "x" << c.height << " (tile " << c.tileSize << ", " << toString(c.projection)
       << (isOrthographic(c.projection) ? ", height " + g(c.orthoHeight)
@@ -821,6 +821,28 @@ std::string huntNoMissText(const HuntResult& result, const HuntOptions& options)
     if (!result.path.empty()) return head + " frames of " + result.path + "\n";
     return head + " trials of seed " + std::to_string(options.seed) + " (coverage: " + result.coverage.text() + ")\n";
 }
+
+namespace {
+
+// The program `name` beside the one running (the CLI and the studio are
+// installed side by side), or empty.
+std::string besideMe(const std::string& name) {
+    std::error_code ec;
+    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+    if (ec) return {};
+    const fs::path p = self.parent_path() / name;
+    return fs::exists(p, ec) ? p.string() : std::string();
+}
+
+// What a repro script runs when its variable is unset: `name` from PATH,
+// else the one beside the program that wrote the script.
+std::string fallback(const std::string& name) {
+    const std::string mine = besideMe(name);
+    if (mine.empty()) return name;
+    return "$(command -v " + name + " || echo " + shellQuote(mine) + ")";
+}
+
+} // namespace
 
 std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options, CullBackend& backend,
                            const std::string& dir, const std::string& device) {
@@ -898,9 +920,11 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
                         (!notAgain.empty() ? notAgain + "\n"
                          : runFailed       ? "Fails (exit 1) while the error is there.\n"
                                            : "Exits 3 while the miss is there.\n") +
-                        "# Set LIGHTCULL to the binary when lightcull is not on PATH.\n"
-                        "cd \"$(dirname \"$0\")\" || exit 1\n# " +
-                        command + "\nexec \"${LIGHTCULL:-lightcull}\"" + command.substr(9) + "\n");
+                        "# Set LIGHTCULL to the binary when lightcull is not on PATH" +
+                        (besideMe("lightcull").empty() ? std::string()
+                                                       : " (else the one that wrote this runs)") +
+                        ".\ncd \"$(dirname \"$0\")\" || exit 1\n# " + command + "\nexec \"${LIGHTCULL:-" +
+                        fallback("lightcull") + "}\"" + command.substr(9) + "\n");
     // The studio reads a shader's layout and lists from its first line only.
     std::string studioNote;
     if (options.shader) {
@@ -925,7 +949,8 @@ std::string writeHuntRepro(const HuntResult& result, const HuntOptions& options,
                     "(Explain shows why).\n# Set LIGHTCULL_STUDIO to the binary when lightcull-studio is not on "
                     "PATH.\n" +
                         studioNote +
-                        "cd \"$(dirname \"$0\")\" || exit 1\nexec \"${LIGHTCULL_STUDIO:-lightcull-studio}\"" +
+                        "cd \"$(dirname \"$0\")\" || exit 1\nexec \"${LIGHTCULL_STUDIO:-" +
+                        fallback("lightcull-studio") + "}\"" +
                         studio.substr(16) + " \"$@\"\n");
     for (const char* script : {"repro.sh", "studio.sh"})
         fs::permissions(out / script, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
