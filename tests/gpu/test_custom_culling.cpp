@@ -358,6 +358,25 @@ TEST_F(GpuTest, RunsOfAShaderShareOneDeviceAndItsPipelines) {
     EXPECT_EQ(customShaderDevices().devicesOpened, before.devicesOpened + 1);
 }
 
+TEST_F(GpuTest, AKeptPipelinesValidationMessagesAreSaidAtEveryRun) {
+    // A double without the shaderFloat64 feature: the layer objects when the
+    // module is made, which a run that reuses the pipeline does not repeat.
+    lc_test::ScratchDir tmp;
+    std::string text = lc_test::slurp(kExamples + "tiled_fixed.comp");
+    text.replace(text.find("void main() {"), 13,
+                 "void main() {\n    if (double(lc.counts.x) < -1.0) lcOut[0] = 7u;");
+    const std::string path = (tmp.path / "doubles.comp").string();
+    std::ofstream(path) << text;
+    const CustomShaderOptions o = optionsFor(path);
+    CustomCullReport first, second;
+    runShader(atrium(96, 64), o, first);
+    const std::uint64_t made = customShaderDevices().pipelinesMade;
+    runShader(atrium(96, 64), o, second);
+    ASSERT_EQ(customShaderDevices().pipelinesMade, made); // the kept pipeline
+    ASSERT_FALSE(first.validationMessages.empty());
+    EXPECT_EQ(second.validationMessages, first.validationMessages);
+}
+
 TEST_F(GpuTest, CompileErrorsNameFileAndLine) {
     const Scene s = atrium(64, 64);
     CustomCullReport rep;

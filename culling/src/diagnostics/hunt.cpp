@@ -760,7 +760,8 @@ std::string huntVerdictText(const HuntFailure& f, const HuntOptions& options) {
           << v.duplicateIndices << " duplicate indices, " << v.validationMessages << " validation messages, "
           << v.overflowLists << " overflowed lists.";
     }
-    o << " Shrunk from " << f.original.lights.size() << (f.original.lights.size() == 1 ? " light at " : " lights at ") << f.original.camera.width << "x"
+    o << " Shrunk from " << f.original.lights.size() << (f.original.lights.size() == 1 ? " light at " : " lights at ")
+      << f.original.camera.width << "x"
       << f.original.camera.height << " to " << s.lights.size() << " light" << (s.lights.size() == 1 ? "" : "s")
       << " at " << c.width << "x" << c.height << " (tile " << c.tileSize << ", " << toString(c.projection)
       << (isOrthographic(c.projection) ? ", height " + g(c.orthoHeight)

@@ -282,6 +282,9 @@ struct ShaderDevice {
         vk::ShaderModuleHandle module;
         vk::PipelineHandle pipeline;
         std::uint64_t lastUse = 0;
+        // What the validation layer said while the module and pipeline were
+        // made: said again for every run that uses them.
+        std::vector<std::string> messages;
     };
     std::map<std::string, Kept> pipelines; // key: entry point, NUL, the SPIR-V's bytes
     std::uint64_t uses = 0;
@@ -300,17 +303,22 @@ std::atomic<std::uint64_t> pipelinesMade{0};
 
 // The pipeline of `spirv` at `entry` on `sd`: kept from an earlier run, or
 // made now (and the one used longest ago dropped beyond kMaxPipelines).
-// Throws InputError when the device refuses it.
+// `replayed`: a kept pipeline's validation messages from when it was made
+// (a pipeline made now puts its own in the layer's list). Throws InputError
+// when the device refuses it.
 VkPipeline shaderPipeline(ShaderDevice& sd, const std::vector<std::uint32_t>& spirv, const std::string& entry,
-                          const std::string& path, const std::function<std::string()>& firstMessage) {
+                          const std::string& path, const std::function<std::string()>& firstMessage,
+                          std::vector<std::string>& replayed) {
     std::string key = entry;
     key.push_back('\0');
     key.append(reinterpret_cast<const char*>(spirv.data()), spirv.size() * 4);
     ++sd.uses;
     if (auto it = sd.pipelines.find(key); it != sd.pipelines.end()) {
         it->second.lastUse = sd.uses;
+        replayed = it->second.messages;
         return it->second.pipeline;
     }
+    const std::size_t messagesBefore = vk::validationMessages().size();
     const VkDevice dev = sd.ctx->device();
     ShaderDevice::Kept k;
     k.module = sd.ctx->createShader(spirv.data(), spirv.size(), "custom.shader");
@@ -328,6 +336,9 @@ VkPipeline shaderPipeline(ShaderDevice& sd, const std::vector<std::uint32_t>& sp
     ++pipelinesMade;
     k.pipeline = vk::PipelineHandle(dev, pipe);
     k.lastUse = sd.uses;
+    const std::vector<std::string> messages = vk::validationMessages();
+    if (messages.size() > messagesBefore)
+        k.messages.assign(messages.begin() + std::ptrdiff_t(messagesBefore), messages.end());
     if (sd.pipelines.size() >= ShaderDevice::kMaxPipelines) {
         auto oldest = sd.pipelines.begin();
         for (auto it = sd.pipelines.begin(); it != sd.pipelines.end(); ++it)
@@ -560,7 +571,8 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
     uploadDepthTexture(*st, depth);
 
     // Pipeline, descriptors.
-    const VkPipeline pipeline = shaderPipeline(*st->sd, spirv, entry, o.path, firstMessage);
+    std::vector<std::string> replayed;
+    const VkPipeline pipeline = shaderPipeline(*st->sd, spirv, entry, o.path, firstMessage, replayed);
     std::vector<vk::Context::DescriptorWrite> bindings(5);
     const VkBuffer buffers[5] = {st->params.buffer, VK_NULL_HANDLE, st->depthBuf.buffer, st->lightBuf.buffer,
                                  st->out.buffer};
@@ -611,8 +623,10 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
     st.reset(); // the run's objects, before their device goes back
     if (!capture) idleDevice().giveBack(std::move(used), co);
     std::vector<std::string> messages = vk::validationMessages();
+    report.validationMessages = replayed;
     if (messages.size() > messagesBefore)
-        report.validationMessages.assign(messages.begin() + std::ptrdiff_t(messagesBefore), messages.end());
+        report.validationMessages.insert(report.validationMessages.end(),
+                                         messages.begin() + std::ptrdiff_t(messagesBefore), messages.end());
 
     CullResult r = skeleton;
     decodeLists(words, o.layout, lightCount, r, report);
