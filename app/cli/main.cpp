@@ -215,10 +215,14 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
                                                                      ", slicing " + lc::toString(settings.slicing)
                                                                : std::string())
                              : std::string(lc::toString(settings.algorithm)) + ", test " + lc::toString(settings.test) +
-                                   (settings.algorithm == lc::Algorithm::ZBin
-                                        ? ", bins " + std::to_string(settings.bins)
-                                        : ", cells " + std::to_string(settings.cells) + ", slicing " +
-                                              lc::toString(settings.slicing)))
+                                   // Only the settings this algorithm reads.
+                                   (settings.algorithm == lc::Algorithm::ZBin ? ", bins " + std::to_string(settings.bins)
+                                    : settings.algorithm == lc::Algorithm::TwoPointFiveD ||
+                                            settings.algorithm == lc::Algorithm::Clustered
+                                        ? ", cells " + std::to_string(settings.cells) +
+                                              (settings.cells > 1 ? ", slicing " + std::string(lc::toString(settings.slicing))
+                                                                  : std::string())
+                                        : std::string()))
               << ", backend " << r.backend << " (" << r.device << ")\n"
 ;
     // With misses, efficiency is no score: it counts only what the lists hold,

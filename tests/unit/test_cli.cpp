@@ -189,6 +189,24 @@ TEST(Cli, BadCommandLinesFailWithOneLineNamingTheProblem) {
     expectCleanFailure({}, "subcommand");
 }
 
+// run's header names the settings the algorithm reads, not every one.
+TEST(Cli, RunHeaderNamesOnlyTheSettingsTheAlgorithmReads) {
+    ScratchDir s;
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"minmax", "algorithm minmax, test planes, backend cpu"},
+        {"2.5d", "algorithm 2.5d, test planes, cells 32, slicing log, backend cpu"},
+        {"zbin", "algorithm zbin, test planes, bins 1024, backend cpu"},
+    };
+    for (const auto& [algorithm, header] : cases) {
+        const CliResult r = runCli({"run", "--builtin", "wall", "--width", "32", "--height", "24", "--backend", "cpu",
+                                    "--algorithm", algorithm, "--test", "planes", "--no-image-error", "--out",
+                                    (s.path / algorithm).string()},
+                                   s.path);
+        ASSERT_EQ(r.code, 0) << r.err;
+        EXPECT_NE(r.out.find(header), std::string::npos) << r.out;
+    }
+}
+
 // The parser's own complaints, worded as the rest: the flag, what it takes,
 // what it got (they read "Value abc not in range 1 to 1000" and "Could not
 // convert: --lights = x").
