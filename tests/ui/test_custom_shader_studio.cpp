@@ -104,6 +104,12 @@ private slots:
         QCOMPARE(run->truth.metrics.falseNegatives, std::uint64_t(0));
         QCOMPARE(QString::fromStdString(run->custom->layout), QString("fixed:256")); // its first line
         QVERIFY(w_->messageLog()->toPlainText().contains("custom shader " + mine));
+        // The built-in algorithm's settings are greyed out, saying why; the grid's stay.
+        auto* algorithm = w_->findChild<QWidget*>("param_algorithm");
+        QVERIFY(algorithm && !algorithm->isEnabled());
+        QVERIFY2(algorithm->toolTip().contains("makes the lists"), qPrintable(algorithm->toolTip()));
+        QVERIFY(w_->findChild<QWidget*>("param_tile")->isEnabled());
+        QVERIFY(!w_->findChild<QWidget*>("presetCombo")->isEnabled());
 
         // Save a flawed version: the watcher re-runs, and the misses show.
         std::string flawed = readAll(kExamples + "flawed_tile_edges.comp");
@@ -191,6 +197,8 @@ private slots:
         QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
         QVERIFY(!doc()->runs().runOutput()->custom);
         QVERIFY2(!times->text().contains("failed"), qPrintable(times->text()));
+        QVERIFY(w_->findChild<QWidget*>("param_algorithm")->isEnabled());
+        QVERIFY(!w_->findChild<QWidget*>("param_algorithm")->toolTip().contains("makes the lists"));
     }
 
     // git checkout and some editors delete the file and write it anew: the

@@ -414,6 +414,7 @@ bool MainWindow::setCustomShader(const QString& path) {
         prompts.showError(this, tr("Custom shader"), QString::fromStdString(e.what()));
         return false;
     }
+    params_->setListsFromShader(customShader_->options() ? path : QString());
     if (const auto o = customShader_->options())
         log(tr("culling with custom shader %1 (layout %2, lists %3); saving it re-runs")
                 .arg(path, QString::fromStdString(lc::toString(o->layout)),

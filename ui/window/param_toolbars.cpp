@@ -104,6 +104,7 @@ void ParamToolbars::addParamWidgets(QToolBar* limitsBar) {
         w->setToolTip(tip);
         w->setObjectName(QString::fromStdString("param_" + name));
         widgets_[name] = w;
+        tips_[name] = tip;
         bar->addWidget(w);
     }
 }
@@ -126,6 +127,18 @@ void ParamToolbars::sync() {
         lc::presetMatching(doc_->runs().settings(), doc_->scene().camera, doc_->scene().lights.size());
     presetCombo_->setCurrentIndex(matching ? presetCombo_->findData(QString::fromStdString(matching->name)) : 0);
     syncing_ = false;
+}
+
+void ParamToolbars::setListsFromShader(const QString& shader) {
+    for (auto& [name, w] : widgets_) {
+        if (name == "width" || name == "height" || name == "tile") continue;
+        w->setEnabled(shader.isEmpty());
+        w->setToolTip(shader.isEmpty() ? tips_[name]
+                                       : tr("The custom shader %1 makes the lists: this setting is the built-in "
+                                            "algorithms' (Culling > Built-in algorithm uses it again)")
+                                             .arg(shader));
+    }
+    presetCombo_->setEnabled(shader.isEmpty());
 }
 
 void ParamToolbars::applyPreset(const std::string& name) {

@@ -38,6 +38,10 @@ public:
     bool setParam(const QString& name, const QString& value);
     // An engine preset through the combo, as a user would; false for an unknown name.
     bool setPreset(const QString& name);
+    // While a custom shader makes the lists (`shader` non-empty) the settings
+    // only the built-in algorithms read are greyed out, saying why; the
+    // camera's width, height and tile size stay (the shader culls that grid).
+    void setListsFromShader(const QString& shader);
 
 signals:
     void logged(const QString& message, bool error);
@@ -51,6 +55,7 @@ private:
     QToolBar* cullBar_ = nullptr;
     QComboBox* presetCombo_ = nullptr; // "(none)" or the preset the settings equal
     std::map<std::string, QWidget*> widgets_;
+    std::map<std::string, QString> tips_; // each widget's own tool tip
     // raster's proxy settings: a row shown only while the algorithm is raster.
     QToolBar* rasterBar_ = nullptr;
     bool syncing_ = false;
