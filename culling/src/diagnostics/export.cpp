@@ -238,6 +238,19 @@ nlohmann::ordered_json customJson(const Scene& scene, const RunOutput& run) {
     cj["overflow_entries"] = c.overflowEntries;
     cj["invalid_indices"] = c.invalidIndices;
     cj["duplicate_indices"] = c.duplicateIndices;
+    // Where: the lists (and their tiles) that overflowed or held an index past
+    // the light count, the first 1,000 of each.
+    const auto where = [&](const std::vector<std::uint32_t>& lists) {
+        nlohmann::ordered_json a = nlohmann::ordered_json::array();
+        for (std::size_t k = 0; k < lists.size() && k < 1000; ++k) {
+            const std::uint32_t t = run.result.tileOfList(lists[k]);
+            const std::uint32_t tilesX = std::max(run.result.grid.tilesX, 1u);
+            a.push_back({{"list", lists[k]}, {"tile_x", t % tilesX}, {"tile_y", t / tilesX}});
+        }
+        return a;
+    };
+    cj["overflowed_lists"] = where(c.overflowedListIds);
+    cj["invalid_index_lists"] = where(c.invalidIndexListIds);
     cj["validation_messages"] = c.validationMessages;
     cj["warnings"] = c.warnings;
     cj["builtin_algorithm"] = c.builtinAlgorithm;
