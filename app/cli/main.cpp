@@ -26,6 +26,7 @@
 #include "culling/math/light_proxy.hpp"
 #include "culling/core/pipeline.hpp"
 #include "culling/core/presets.hpp"
+#include "culling/core/text.hpp"
 #include "culling/scene/scene_io.hpp"
 #include "custom.hpp"
 #include "hunt.hpp"
@@ -155,14 +156,11 @@ int verdictExit(const lc::RunOutput& run) {
                   << " over-full lists (exit " << kExitMisses << ")\n";
         return kExitMisses;
     }
-    const auto count = [](std::uint64_t n, const char* one, const char* many) {
-        return std::to_string(n) + " " + (n == 1 ? one : many);
-    };
-    std::cerr << "lightcull: the culling fails: " << count(fn, "false negative", "false negatives") << ", "
-              << count(overflow, "overflowed list", "overflowed lists") << ", "
-              << count(invalid, "invalid index", "invalid indices");
-    if (duplicate) std::cerr << ", " << count(duplicate, "duplicate index", "duplicate indices");
-    if (validation) std::cerr << ", " << count(validation, "validation message", "validation messages");
+    std::cerr << "lightcull: the culling fails: " << lc::countOf(fn, "false negative", "false negatives") << ", "
+              << lc::countOf(overflow, "overflowed list", "overflowed lists") << ", "
+              << lc::countOf(invalid, "invalid index", "invalid indices");
+    if (duplicate) std::cerr << ", " << lc::countOf(duplicate, "duplicate index", "duplicate indices");
+    if (validation) std::cerr << ", " << lc::countOf(validation, "validation message", "validation messages");
     std::cerr << " (exit " << kExitMisses << ")\n";
     return kExitMisses;
 }

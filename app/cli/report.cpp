@@ -6,6 +6,7 @@
 
 #include "culling/core/errors.hpp"
 #include "culling/core/presets.hpp"
+#include "culling/core/text.hpp"
 #include "culling/diagnostics/report.hpp"
 #include "culling/scene/scene_io.hpp"
 
@@ -130,14 +131,14 @@ int ReportCommand::run() {
 
     lc::ReportOptions options;
     options.device = device_;
+    // The same file however it is reached (./, an absolute path, a link).
+    const auto same = [](const std::string& a, const std::string& b) {
+        std::error_code ec;
+        return std::filesystem::equivalent(a, b, ec) ||
+               std::filesystem::path(a).lexically_normal() == std::filesystem::path(b).lexically_normal();
+    };
     for (std::size_t i = 0; i < shaders_.size(); ++i) {
         const std::string& sh = shaders_[i];
-        // The same file however it is reached (./, an absolute path, a link).
-        const auto same = [](const std::string& a, const std::string& b) {
-            std::error_code ec;
-            return std::filesystem::equivalent(a, b, ec) ||
-                   std::filesystem::path(a).lexically_normal() == std::filesystem::path(b).lexically_normal();
-        };
         for (std::size_t j = 0; j < i; ++j)
             if (same(shaders_[j], sh)) return usage("--shader: " + sh + " is given twice");
         lc::CustomShaderOptions so = lc::shaderOptionsFromFile(sh);
@@ -208,7 +209,7 @@ int ReportCommand::run() {
     if (winsize ws{}; tty && ::ioctl(STDERR_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0) columns = ws.ws_col;
     std::vector<std::chrono::steady_clock::time_point> finished; // of configuration 1, 2, ...
     std::size_t tenthsShown = 0;
-    const auto plural = [](std::size_t n) { return std::to_string(n) + (n == 1 ? " configuration" : " configurations"); };
+    const auto plural = [](std::size_t n) { return lc::countOf(n, "configuration", "configurations"); };
     const auto clearLine = [&] {
         if (tty) std::cerr << "\r\033[K" << std::flush;
     };

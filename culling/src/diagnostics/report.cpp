@@ -8,6 +8,7 @@
 #include "culling/core/presets.hpp"
 #include "culling/core/errors.hpp"
 #include "culling/core/file_io.hpp"
+#include "culling/core/text.hpp"
 #include "culling/truth/ground_truth.hpp"
 #include "culling/truth/shade.hpp"
 #include "diagnostics/font5x7.hpp"
@@ -544,14 +545,11 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             // layer's first word on it (a binding of the wrong type says why).
             if (crep.overflowLists || crep.invalidIndices || crep.duplicateIndices ||
                 !crep.validationMessages.empty()) {
-                const auto count = [](std::uint64_t n, const char* one, const char* many) {
-                    return std::to_string(n) + " " + (n == 1 ? one : many);
-                };
                 std::string note = row.config.customLabel + ": " +
-                                   count(crep.overflowLists, "overflowed list", "overflowed lists") + ", " +
-                                   count(crep.invalidIndices, "invalid index", "invalid indices") + ", " +
-                                   count(crep.duplicateIndices, "duplicate index", "duplicate indices") + ", " +
-                                   count(crep.validationMessages.size(), "validation message", "validation messages");
+                                   countOf(crep.overflowLists, "overflowed list", "overflowed lists") + ", " +
+                                   countOf(crep.invalidIndices, "invalid index", "invalid indices") + ", " +
+                                   countOf(crep.duplicateIndices, "duplicate index", "duplicate indices") + ", " +
+                                   countOf(crep.validationMessages.size(), "validation message", "validation messages");
                 if (!crep.validationMessages.empty())
                     note += " (the first: " + validationGist(crep.validationMessages.front()) + ")";
                 rep.notes.push_back(note);
@@ -704,12 +702,9 @@ std::string presetsSection(const Report& rep) {
 } // namespace
 
 std::string reportMarkdown(const Report& rep) {
-    const auto count = [](std::size_t n, const char* one, const char* many) {
-        return std::to_string(n) + " " + (n == 1 ? one : many);
-    };
-    const auto configurations = [&](std::size_t n) { return count(n, "configuration", "configurations"); };
+    const auto configurations = [](std::size_t n) { return countOf(n, "configuration", "configurations"); };
     std::string md = "# Culling report: " + rep.sceneName + "\n\n";
-    md += std::to_string(rep.width) + "x" + std::to_string(rep.height) + ", " + count(rep.lights, "light", "lights") +
+    md += std::to_string(rep.width) + "x" + std::to_string(rep.height) + ", " + countOf(rep.lights, "light", "lights") +
           ", " + configurations(rep.rows.size()) + "; times are " +
           (rep.repeat == 1 ? std::string("of 1 run") : "medians of " + std::to_string(rep.repeat) + " runs") +
           " after " + std::to_string(rep.warmup) +
