@@ -9,6 +9,7 @@
 #include "prefix_sum_comp.spv.h"
 #include "proxy_raster_frag.spv.h"
 #include "proxy_raster_vert.spv.h"
+#include "proxy_setup_comp.spv.h"
 #include "shade_comp.spv.h"
 #include "tile_bounds_comp.spv.h"
 #include "tile_bounds_wide_comp.spv.h"
@@ -28,6 +29,7 @@ LC_SPV(prefixSum, lc_spv_prefix_sum_comp)
 LC_SPV(finePrune, lc_spv_fine_prune_comp)
 LC_SPV(zbin, lc_spv_zbin_comp)
 LC_SPV(shade, lc_spv_shade_comp)
+LC_SPV(proxySetupComp, lc_spv_proxy_setup_comp)
 LC_SPV(proxyRasterVert, lc_spv_proxy_raster_vert)
 LC_SPV(proxyRasterFrag, lc_spv_proxy_raster_frag)
 #undef LC_SPV

@@ -13,7 +13,8 @@ struct Code {
 };
 
 Code depthVert();   // depth pre-pass vertex shader (no fragment shader)
-Code proxyRasterVert(); // raster: light proxies, vertex pulling
+Code proxySetupComp();  // raster: each proxy triangle's corners and trim, once
+Code proxyRasterVert(); // raster: the corners proxy_setup.comp worked out
 Code proxyRasterFrag(); // raster: a covered tile's light bit
 Code tileBounds();  // per-tile depth bounds, halfz split, cell / slice masks
 Code tileBoundsWide();  // the same, depth read 2 or 8 pixels a load (needs shaderInt64)

@@ -95,14 +95,22 @@ const ProxyMesh& unitCone(std::uint32_t segments) {
 }
 
 double icosphereEnclosingOverfit(std::uint32_t level) {
-    const ProxyMesh& m = unitIcosphere(level);
-    double nearest = 1.0;
-    for (const auto& t : m.triangles) {
-        const glm::dvec3 a = m.vertices[t[0]], b = m.vertices[t[1]], c = m.vertices[t[2]];
-        const glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
-        nearest = std::min(nearest, std::abs(glm::dot(n, a)));
-    }
-    return 1.0 / nearest;
+    // Once per level: every light's proxy asks (a level-4 mesh has 5,120 faces).
+    static const std::array<double, 5> overfit = [] {
+        std::array<double, 5> o{};
+        for (std::uint32_t l = 0; l < o.size(); ++l) {
+            const ProxyMesh& m = unitIcosphere(l);
+            double nearest = 1.0;
+            for (const auto& t : m.triangles) {
+                const glm::dvec3 a = m.vertices[t[0]], b = m.vertices[t[1]], c = m.vertices[t[2]];
+                const glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
+                nearest = std::min(nearest, std::abs(glm::dot(n, a)));
+            }
+            o[l] = 1.0 / nearest;
+        }
+        return o;
+    }();
+    return overfit[std::min<std::uint32_t>(level, 4)];
 }
 
 double coneEnclosingOverfit(std::uint32_t segments) {

@@ -4,6 +4,7 @@
 #include "culling/core/errors.hpp"
 #include "embedded_spirv.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 
@@ -13,13 +14,40 @@
 
 namespace lc::vk {
 
+namespace {
+// The setup pass's push constants: the batch's first triangle and its count.
+constexpr std::uint32_t kPushBytes = 8;
+constexpr VkShaderStageFlags kStages =
+    VK_SHADER_STAGE_COMPUTE_BIT | VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+constexpr std::uint32_t kSetupGroup = 64; // proxy_setup.comp's local_size_x
+
+void barrier(VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags srcAccess, VkPipelineStageFlags dst,
+             VkAccessFlags dstAccess) {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = srcAccess;
+    b.dstAccessMask = dstAccess;
+    vkCmdPipelineBarrier(cmd, src, dst, 0, 1, &b, 0, nullptr, 0, nullptr);
+}
+} // namespace
+
 RasterPass::RasterPass(Context& ctx) : ctx_(ctx) {
     if (!ctx_.fragmentStoresSupported())
         throw DeviceError("Vulkan device '" + ctx_.deviceName() +
                           "' lacks fragmentStoresAndAtomics, which the raster algorithm's fragment shader needs");
     layouts_ = ctx_.createPassLayouts(std::vector<VkDescriptorType>(kBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
-                                      "raster", 0, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT);
-    const spirv::Code v = spirv::proxyRasterVert(), f = spirv::proxyRasterFrag();
+                                      "raster", kPushBytes, kStages);
+    const spirv::Code sc = spirv::proxySetupComp(), v = spirv::proxyRasterVert(), f = spirv::proxyRasterFrag();
+    setup_ = ctx_.createShader(sc.words, sc.wordCount, "shader.proxy_setup_comp");
+    VkComputePipelineCreateInfo cci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    cci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    cci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    cci.stage.module = setup_;
+    cci.stage.pName = "main";
+    cci.layout = layouts_.pipeline;
+    VkPipeline sp;
+    LC_VK(vkCreateComputePipelines(ctx_.device(), VK_NULL_HANDLE, 1, &cci, nullptr, &sp));
+    ctx_.name(VK_OBJECT_TYPE_PIPELINE, sp, "raster.pipeline.setup");
+    setupPipeline_ = PipelineHandle(ctx_.device(), sp);
     vert_ = ctx_.createShader(v.words, v.wordCount, "shader.proxy_raster_vert");
     frag_ = ctx_.createShader(f.words, f.wordCount, "shader.proxy_raster_frag");
 
@@ -51,7 +79,7 @@ std::string RasterPass::describe(Coverage c) const {
                " pixel, plus 1/64), trimmed to the exact overlap in the fragment shader";
     }
     case Coverage::PushedEdges:
-        return "edges pushed out by half a tile's diagonal in the vertex shader ('" + ctx_.deviceName() +
+        return "edges pushed out by half a tile's diagonal before the draw ('" + ctx_.deviceName() +
                "' has no VK_EXT_conservative_rasterization)";
     }
     return {};
@@ -129,23 +157,34 @@ VkFramebuffer RasterPass::framebuffer(std::uint32_t w, std::uint32_t h) {
 }
 
 void RasterPass::record(VkCommandBuffer cmd, Coverage c, VkDescriptorSet set, std::uint32_t tilesX,
-                        std::uint32_t tilesY, const std::vector<Draw>& draws) {
+                        std::uint32_t tilesY, std::uint64_t triangles, std::uint32_t batch) {
+    const VkPipeline pipe = pipeline(c);
     VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
     rbi.renderPass = renderPass_;
     rbi.framebuffer = framebuffer(tilesX, tilesY);
     rbi.renderArea = {{0, 0}, {tilesX, tilesY}};
-    const VkPipeline pipe = pipeline(c);
-    vkCmdBeginRenderPass(cmd, &rbi, VK_SUBPASS_CONTENTS_INLINE);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layouts_.pipeline, 0, 1, &set, 0, nullptr);
     const VkViewport viewport{0.0f, 0.0f, float(tilesX), float(tilesY), 0.0f, 1.0f};
     const VkRect2D scissor{{0, 0}, {tilesX, tilesY}};
-    vkCmdSetViewport(cmd, 0, 1, &viewport);
-    vkCmdSetScissor(cmd, 0, 1, &scissor);
-    for (const Draw& d : draws)
-        if (d.vertexCount && d.instanceCount)
-            vkCmdDraw(cmd, d.vertexCount, d.instanceCount, d.firstVertex, d.firstInstance);
-    vkCmdEndRenderPass(cmd);
+    for (std::uint64_t first = 0; first < triangles; first += batch) {
+        const std::uint32_t push[2] = {std::uint32_t(first),
+                                       std::uint32_t(std::min<std::uint64_t>(batch, triangles - first))};
+        if (first) // the previous batch's draw has read the records this one overwrites
+            barrier(cmd, VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0,
+                    VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, setupPipeline_);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layouts_.pipeline, 0, 1, &set, 0, nullptr);
+        vkCmdPushConstants(cmd, layouts_.pipeline, kStages, 0, kPushBytes, push);
+        vkCmdDispatch(cmd, (push[1] + kSetupGroup - 1) / kSetupGroup, 1, 1);
+        barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+        vkCmdBeginRenderPass(cmd, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layouts_.pipeline, 0, 1, &set, 0, nullptr);
+        vkCmdSetViewport(cmd, 0, 1, &viewport);
+        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        vkCmdDraw(cmd, 3 * push[1], 1, 0, 0);
+        vkCmdEndRenderPass(cmd);
+    }
 }
 
 } // namespace lc::vk

@@ -1564,11 +1564,23 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
                 y0 = std::min(y0, ty), y1 = std::max(y1, ty);
             };
             const std::size_t first = boxRanges.size();
-            proxySliceTiles(proj, grid, p, settings.conservative, [&](std::uint32_t t, double lo, double hi) {
-                spans(t % grid.tilesX, t / grid.tilesX);
-                boxRanges.push_back({l, t, lo, hi});
-            });
+            if (slices) {
+                proxySliceTiles(proj, grid, p, settings.conservative, [&](std::uint32_t t, double lo, double hi) {
+                    spans(t % grid.tilesX, t / grid.tilesX);
+                    boxRanges.push_back({l, t, lo, hi});
+                });
+            } else { // the tiles alone (the tile test takes the proxy's whole depth range)
+                for (const auto& tri : p.mesh->triangles)
+                    proxyTriangleTiles(proj, grid, {p.vertex(tri[0]), p.vertex(tri[1]), p.vertex(tri[2])},
+                                       settings.conservative, [&](std::uint32_t tx, std::uint32_t ty) {
+                                           spans(tx, ty);
+                                           boxRanges.push_back({l, grid.tileIndex(tx, ty), 0.0, 0.0});
+                                       });
+            }
             std::sort(boxRanges.begin() + std::ptrdiff_t(first), boxRanges.end());
+            boxRanges.erase(std::unique(boxRanges.begin() + std::ptrdiff_t(first), boxRanges.end(),
+                                        [](const BoxRange& a, const BoxRange& b) { return !(a < b) && !(b < a); }),
+                            boxRanges.end());
             // (The fragment shader keeps a tile whose rectangle reaches past
             // x0 + 0.5 from this box's low side and past x1 + 0.5 from its
             // high side, a partial edge tile's too.)
@@ -1584,11 +1596,17 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
     for (const ProxyMesh* m : {&sphereMesh, &coneMesh})
         for (const auto& t : m->triangles)
             for (std::uint32_t k : t) corners.push_back(vec4(glm::vec3(m->vertices[k]), 1.0f));
-    const std::uint32_t sphereCorners = std::uint32_t(3 * sphereMesh.triangles.size());
-    const std::uint32_t coneCorners = std::uint32_t(3 * coneMesh.triangles.size());
-    const std::vector<RasterPass::Draw> draws = {{0, sphereCorners, 0, spheres},
-                                                 {sphereCorners, coneCorners, spheres, cones},
-                                                 {0, 3, spheres + cones, boxes}};
+    const std::uint32_t sphereTris = std::uint32_t(sphereMesh.triangles.size());
+    const std::uint32_t coneTris = std::uint32_t(coneMesh.triangles.size());
+    // The proxies' triangles, each set up once (proxy_setup.comp) and drawn
+    // in batches the triangles buffer holds.
+    const std::uint64_t triangles = std::uint64_t(spheres) * sphereTris + std::uint64_t(cones) * coneTris + boxes;
+    if (triangles > 0xffffffffull)
+        throw SettingsError("proxy-level", "raster's proxies have " + std::to_string(triangles) +
+                                               " triangles, more than 2^32 - 1; use a lower proxy level or fewer lights");
+    const std::uint32_t batch = std::uint32_t(std::max<std::uint64_t>(
+        1, std::min<std::uint64_t>({triangles, RasterPass::kBatchTriangles,
+                                    profile_.maxStorageBufferRange / sizeof(GpuProxyTriangle)})));
 
     const RasterPass::Coverage coverage = rasterPass_->coverage(settings.conservative);
     GpuRasterParams rp{};
@@ -1603,6 +1621,7 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
                         (proj.orthographic() ? LC_RASTER_ORTHO : 0u) | (slices ? LC_RASTER_SLICES : 0u));
     rp.cover = vec4(float(double(grid.width) / grid.tileSize), float(double(grid.height) / grid.tileSize),
                     float(nearW), 0.5f + 1.0f / 256.0f);
+    rp.setup = uvec4(sphereTris, coneTris, spheres, cones);
 
     BufferCache::Frame cacheFrame(cache_);
     CullRun run;
@@ -1620,13 +1639,15 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
     const Buffer& meshBuf = storage("raster.mesh", corners.size() * sizeof(vec4));
     const Buffer& masks = storage("raster.masks", maskBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     const Buffer& ranges = storage("raster.ranges", rangeBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    const Buffer& triangleBuf = storage("raster.triangles", std::size_t(batch) * sizeof(GpuProxyTriangle));
     staging.upload(params, &rp, sizeof rp, "raster.params");
     staging.upload(proxyBuf, proxies.data(), proxies.size() * sizeof(GpuProxy), "raster.proxies");
     staging.upload(meshBuf, corners.data(), corners.size() * sizeof(vec4), "raster.mesh");
     const auto* maskWords = static_cast<const std::uint32_t*>(staging.download(masks, maskBytes, "raster.masks"));
     const auto* rangeWords =
         slices ? static_cast<const std::uint32_t*>(staging.download(ranges, rangeBytes, "raster.ranges")) : nullptr;
-    const Buffer* bound[RasterPass::kBindings] = {&params, run.tiles, &proxyBuf, &meshBuf, &masks, &ranges};
+    const Buffer* bound[RasterPass::kBindings] = {&params,  run.tiles, &proxyBuf,    &meshBuf,
+                                                  &masks,   &ranges,   &triangleBuf};
     std::vector<Context::DescriptorWrite> bindings(RasterPass::kBindings);
     for (std::uint32_t i = 0; i < RasterPass::kBindings; ++i) {
         bindings[i].buffer = bound[i]->buffer;
@@ -1661,7 +1682,7 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
                           VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
             {
                 LabelScope label(ctx_, cmd, "light proxies");
-                rasterPass_->record(cmd, coverage, set, grid.tilesX, grid.tilesY, draws);
+                rasterPass_->record(cmd, coverage, set, grid.tilesX, grid.tilesY, triangles, batch);
             }
             if (stamps) stamps.end(cmd, 0);
             // The read-back (a copy, or the host in place) reads the masks.

@@ -155,7 +155,7 @@ struct GpuTileBounds {
     uint cellMask;    // 2.5d: occupied cells; clustered: occupied slices
 };
 
-// The raster pass (shaders/proxy_raster.vert/.frag, vk/raster_pass.cpp):
+// The raster pass (shaders/proxy_setup.comp, proxy_raster.vert/.frag, vk/raster_pass.cpp):
 // each light's proxy mesh drawn at one pixel per tile.
 struct GpuRasterParams {
     // View -> clip, then scaled so that the viewport of tilesX x tilesY
@@ -166,6 +166,9 @@ struct GpuRasterParams {
     // bits of the least depth the light's fragments span there, and + 1 the
     // inverted bits of the greatest; both by atomicMin from all ones.)
     vec4 cover;            // x: tilesX' (width / tile), y: tilesY', z: w below which a triangle covers the screen, w: push
+    // The triangles (proxy_setup.comp): x of a sphere proxy, y of a cone
+    // proxy; z spheres, w cones (the proxies, in that order, then boxes).
+    uvec4 setup;
 };
 const uint LC_RASTER_PUSH_EDGES = 1u; // conservative by pushing the edges out in the vertex shader
 const uint LC_RASTER_ORTHO = 2u;      // orthographic: the eye direction is +z
@@ -182,9 +185,23 @@ struct GpuProxy {
     uvec4 light;           // x: the light's index, y: 1 = a box (origin: tile centres), z: 1 = front faces only
 };
 
+// One proxy triangle as proxy_setup.comp works it out for the draw: its
+// corners (clip space) and the fragment shader's trim.
+struct GpuProxyTriangle {
+    vec4 corner[3];        // clip space (w = 0: dropped)
+    vec4 box;              // the tile centres allowed, tile units
+    vec4 edge[4];          // xyz: the pushed edges, n.centre + d >= 0 inside; w of 0..2: the depth plane (slices)
+    vec4 range;            // slices: x, y the corners' view depths, z how the plane is given (0 none, 1 1/depth, 2 depth)
+    float depthMin;        // the proxy's view-depth range (the tile test)
+    float depthMax;
+    uint light;            // the light's index
+    uint pad;
+};
+
 #ifdef __cplusplus
 static_assert(sizeof(GpuCullParams) == 112, "GpuCullParams must match std430");
-static_assert(sizeof(GpuRasterParams) == 96, "GpuRasterParams must match std430");
+static_assert(sizeof(GpuRasterParams) == 112, "GpuRasterParams must match std430");
+static_assert(sizeof(GpuProxyTriangle) == 160, "GpuProxyTriangle must match std430");
 static_assert(sizeof(GpuProxy) == 80, "GpuProxy must match std430");
 static_assert(offsetof(GpuCullParams, counts) == 16, "GpuCullParams.counts offset");
 static_assert(offsetof(GpuCullParams, depth) == 32, "GpuCullParams.depth offset");
