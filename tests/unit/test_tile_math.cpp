@@ -224,7 +224,8 @@ TEST(Names, TestAndSlicingStrings) {
 
 // SliceLocator answers as sliceOfDepth does, bit for bit: at every boundary,
 // one ulp either side, random depths, out of range, NaN and degenerate ranges
-// (the ground truth and the shading inputs look up every pixel through it).
+// (the ground truth and the shading inputs look up every pixel through it);
+// its range masks are sliceRangeMask's.
 TEST(Slicing, LocatorAnswersAsSliceOfDepth) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -246,6 +247,14 @@ TEST(Slicing, LocatorAnswersAsSliceOfDepth) {
                     ASSERT_EQ(locate(d), sliceOfDepth(s, lo, hi, cells, d))
                         << toString(s) << " cells " << cells << " [" << lo << ", " << hi << "] d " << d;
                     ++checked;
+                }
+                // Its range masks (the raster slices' decode) are sliceRangeMask's.
+                for (std::size_t k = 0; k + 1 < depths.size(); ++k) {
+                    const double a = std::min(depths[k], depths[k + 1]), b = std::max(depths[k], depths[k + 1]);
+                    for (auto [x, y] : {std::pair{a, b}, std::pair{depths[k], depths[k + 1]}, std::pair{a, a}})
+                        ASSERT_EQ(locate.rangeMask(x, y), sliceRangeMask(s, lo, hi, cells, x, y))
+                            << toString(s) << " cells " << cells << " [" << lo << ", " << hi << "] [" << x << ", "
+                            << y << "]";
                 }
             }
     EXPECT_GT(checked, 10000u);

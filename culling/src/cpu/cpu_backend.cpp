@@ -313,6 +313,8 @@ void rasterTiles(const CpuCull& c, CullResult& res, std::vector<std::vector<std:
     const TileGrid& grid = c.frame.grid;
     const ViewLights& lights = c.lights;
     std::vector<std::uint32_t> seen(grid.tileCount(), std::numeric_limits<std::uint32_t>::max());
+    const SliceLocator clusterSlices(c.settings.slicing, res.clusterNear, res.clusterFar,
+                                     std::min<std::uint32_t>(c.settings.cells, 32));
     for (std::uint32_t l = 0; l < lights.size(); ++l) {
         const LightProxy p = makeLightProxy(lights, l, c.settings);
         if (c.settings.proxySlices) {
@@ -320,8 +322,8 @@ void rasterTiles(const CpuCull& c, CullResult& res, std::vector<std::vector<std:
             // span there, then the light's slices (LightProxy::sliceMask).
             res.volumeTests += proxySliceTiles(c.proj, grid, p, c.settings.conservative,
                                                [&](std::uint32_t t, double lo, double hi) {
-                                                   for (std::uint32_t m = p.sliceMask(c.settings, res.clusterNear,
-                                                                                      res.clusterFar, lo, hi,
+                                                   for (std::uint32_t m = p.sliceMask(clusterSlices,
+                                                                                      c.settings.skipEmpty, lo, hi,
                                                                                       res.cellMask[t]);
                                                         m; m &= m - 1)
                                                        lists[std::size_t(t) * res.listsPerTile +

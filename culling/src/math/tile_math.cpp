@@ -200,7 +200,8 @@ std::uint32_t sliceOfDepth(Slicing s, double lo, double hi, std::uint32_t cells,
     return i;
 }
 
-SliceLocator::SliceLocator(Slicing s, double lo, double hi, std::uint32_t cells) : lo_(lo), hi_(hi), cells_(cells) {
+SliceLocator::SliceLocator(Slicing s, double lo, double hi, std::uint32_t cells)
+    : s_(s), lo_(lo), hi_(hi), cells_(cells) {
     if (cells <= 1 || !(hi > lo)) return;
     inner_.reserve(cells - 1);
     for (std::uint32_t i = 1; i < cells; ++i) inner_.push_back(sliceBoundary(s, lo, hi, cells, i));
@@ -213,19 +214,30 @@ std::uint32_t SliceLocator::operator()(double d) const {
     return std::uint32_t(std::upper_bound(inner_.begin(), inner_.end(), d) - inner_.begin());
 }
 
-std::uint32_t sliceRangeMask(Slicing s, double lo, double hi, std::uint32_t cells, double a,
-                             double b) {
+namespace {
+// [a, b] clipped to [lo, hi] -> the slices from a's to b's (slice(d): the slice of d).
+template <class Slice>
+std::uint32_t rangeMaskOf(double lo, double hi, std::uint32_t cells, double a, double b, const Slice& slice) {
     if (cells == 0) return 0;
-    cells = std::min<std::uint32_t>(cells, 32);
     if (!(b >= lo) || !(a <= hi)) return 0; // misses [lo, hi] (or NaN)
     // Clip to [lo, hi] first: an interval reaching behind the near plane starts at lo.
-    a = std::max(a, lo);
-    b = std::min(b, hi);
-    const std::uint32_t ka = sliceOfDepth(s, lo, hi, cells, a);
-    const std::uint32_t kb = sliceOfDepth(s, lo, hi, cells, b);
+    const std::uint32_t ka = slice(std::max(a, lo));
+    const std::uint32_t kb = slice(std::min(b, hi));
     const std::uint64_t upTo = (std::uint64_t(1) << (kb + 1)) - 1;
     const std::uint64_t below = (std::uint64_t(1) << ka) - 1;
     return std::uint32_t(upTo & ~below);
+}
+} // namespace
+
+std::uint32_t sliceRangeMask(Slicing s, double lo, double hi, std::uint32_t cells, double a,
+                             double b) {
+    cells = std::min<std::uint32_t>(cells, 32);
+    return rangeMaskOf(lo, hi, cells, a, b, [&](double d) { return sliceOfDepth(s, lo, hi, cells, d); });
+}
+
+std::uint32_t SliceLocator::rangeMask(double a, double b) const {
+    if (cells_ > 32) return sliceRangeMask(s_, lo_, hi_, cells_, a, b); // over 32 slices: another range
+    return rangeMaskOf(lo_, hi_, cells_, a, b, *this);
 }
 
 } // namespace lc

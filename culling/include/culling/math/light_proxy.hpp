@@ -13,6 +13,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace lc {
@@ -71,6 +72,13 @@ struct LightProxy {
     // near / far"); with skip-empty only the `occupied` slices.
     std::uint32_t sliceMask(const CullSettings& settings, double clusterNear, double clusterFar, double lo, double hi,
                             std::uint32_t occupied) const;
+    // The same over the slices a locator holds (its boundaries worked out
+    // once for every light and tile), skipping empty slices when `skipEmpty`.
+    std::uint32_t sliceMask(const SliceLocator& slices, bool skipEmpty, double lo, double hi,
+                            std::uint32_t occupied) const;
+    // [lo, hi] as both widen it: by the slack, and to the near / far end
+    // the proxy reaches.
+    std::pair<double, double> sliceRange(double clusterNear, double clusterFar, double lo, double hi) const;
 };
 // `spotAngle` 0 for a point light; `axis` unit (ignored for a point light).
 LightProxy makeLightProxy(const glm::dvec3& center, double radius, const glm::dvec3& axis, double spotAngle,

@@ -83,8 +83,13 @@ public:
     SliceLocator() = default;
     SliceLocator(Slicing s, double lo, double hi, std::uint32_t cells);
     std::uint32_t operator()(double d) const;
+    // sliceRangeMask(s, lo, hi, cells, a, b), bit for bit.
+    std::uint32_t rangeMask(double a, double b) const;
+    double lo() const { return lo_; }
+    double hi() const { return hi_; }
 
 private:
+    Slicing s_ = Slicing::Linear;
     double lo_ = 0, hi_ = 0;
     std::uint32_t cells_ = 0;
     std::vector<double> inner_; // boundaries 1 .. cells-1
