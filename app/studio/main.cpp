@@ -243,7 +243,10 @@ int main(int argc, char** argv) {
         }
     }
 
-    // Opening a scene runs culling once (so does the default start).
+    // The scene opens without a run: --lights, --preset and --shader below
+    // change what it culls, and the first run is theirs (a custom shader's
+    // start would otherwise cull with the built-in algorithm first).
+    window.runOnOpen = false;
     bool ok = true;
     if (parser.isSet(captureOpt))
         ok = window.openCapture(parser.value(captureOpt), parser.value(dispatchOpt), parser.value(describeOpt));
@@ -264,7 +267,6 @@ int main(int argc, char** argv) {
         window.log(QString("the scene's lights replaced by %1 generated ones (--lights, seed %2)")
                        .arg(lightCount)
                        .arg(seed));
-        window.runCulling();
     }
     if (ok && parser.isSet(presetOpt)) {
         // The preset's grid and limits depend on the scene's camera and
@@ -272,12 +274,12 @@ int main(int argc, char** argv) {
         window.setPresetFromUi(parser.value(presetOpt));
         for (const QString& nv : parser.values(paramOpt))
             window.setParamFromUi(nv.left(nv.indexOf('=')), nv.mid(nv.indexOf('=') + 1));
-        window.runCulling();
     }
+    // (A shader it takes runs culling with it.)
     if (ok && parser.isSet(shaderOpt) && !window.setCustomShader(parser.value(shaderOpt)) && scripted) return 1;
-    const quint64 generation = window.cullService()->lastGeneration();
-    const bool wantRun = generation > 0 || parser.isSet(runOpt) || parser.isSet(firstMissOpt);
-    if (wantRun && generation == 0) window.runCulling();
+    window.runOnOpen = true;
+    const bool wantRun = ok || parser.isSet(runOpt) || parser.isSet(firstMissOpt);
+    if (wantRun && window.cullService()->lastGeneration() == 0) window.runCulling();
     if (ok && parser.isSet(firstMissOpt)) {
         window.selectFirstMissOfRun(window.cullService()->lastGeneration());
         if (scripted) // the miss selected, for a script's log

@@ -230,6 +230,23 @@ private slots:
         save(mine, readAll(kExamples + "tiled_fixed.comp"));
         QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
         QCOMPARE(doc()->runs().runOutput()->truth.metrics.falseNegatives, std::uint64_t(0));
+
+        // Saved with a settings line it cannot use: nothing runs, and the
+        // status bar says the figures are the earlier version's until a
+        // good save.
+        before = doc()->runs().runGeneration();
+        std::string badLine = readAll(kExamples + "tiled_fixed.comp");
+        badLine.replace(badLine.find("fixed:256"), 9, "fixed:zero");
+        save(mine, badLine);
+        QTRY_VERIFY_WITH_TIMEOUT(w_->messageLog()->toPlainText().contains("fixed:zero"), 5000);
+        auto* times = w_->findChild<QLabel*>("statusTimes");
+        QVERIFY2(times->text().startsWith(QString("back.comp refused, showing run %1 (custom shader)").arg(before)),
+                 qPrintable(times->text()));
+        QVERIFY2(times->toolTip().contains("fixed:zero"), qPrintable(times->toolTip()));
+        QCOMPARE(doc()->runs().runGeneration(), before);
+        save(mine, readAll(kExamples + "tiled_fixed.comp"));
+        QVERIFY2(waitRunAfter(before, &why), qPrintable(why));
+        QVERIFY2(!times->text().contains("refused"), qPrintable(times->text()));
     }
 
     // Lists with a light twice and an index past the light count lose no

@@ -290,7 +290,7 @@ private slots:
         // sqrt(80 / 0.01) = 89 m, wider than the atrium: warned.
         const auto* cutLabel = w_->findChild<QLabel*>("statusCutoff");
         QVERIFY(cutLabel);
-        QVERIFY2(cutLabel->text().contains("cut-off 0.01 lux (1 lights)"), qPrintable(cutLabel->text()));
+        QVERIFY2(cutLabel->text().contains("cut-off 0.01 lux (1 light)"), qPrintable(cutLabel->text()));
         QVERIFY(!lc::cutoffCoverageWarning(doc()->scene()).empty());
         const int steps = doc()->undoStack()->count();
 
@@ -303,7 +303,7 @@ private slots:
         QVERIFY(std::abs(doc()->scene().lights[0].radius() - std::sqrt(40.0)) < 1e-12); // sqrt(80 / 2)
         QCOMPARE(doc()->scene().lights[1].radius(), 1.5);
         QVERIFY2(cutLabel->text().contains("cut-off 2 lux"), qPrintable(cutLabel->text()));
-        QVERIFY(w_->messageLog()->toPlainText().contains("radii of 1 lights without a range re-derived"));
+        QVERIFY(w_->messageLog()->toPlainText().contains("radii of 1 light without a range re-derived"));
         QVERIFY(lc::cutoffCoverageWarning(doc()->scene()).empty());
 
         doc()->undoStack()->undo();

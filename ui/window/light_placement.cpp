@@ -2,6 +2,7 @@
 
 #include "document/document.hpp"
 #include "views/inspector_view.hpp"
+#include "widgets/count_text.hpp"
 #include "widgets/message_log.hpp"
 #include "window/prompts.hpp"
 #include "work/progress_task.hpp"
@@ -83,8 +84,8 @@ bool LightPlacement::generate(const lc::LightGenSettings& g) {
         return false;
     }
     nameUniquely(doc_->scene().lights, lights);
-    doc_->addLights(lights, tr("Generate %1 lights").arg(lights.size()), /*select=*/false);
-    log_->log(tr("generated %1 lights (seed %2)").arg(lights.size()).arg(g.seed));
+    doc_->addLights(lights, tr("Generate %1").arg(countOf(lights.size(), "light", "lights")), /*select=*/false);
+    log_->log(tr("generated %1 (seed %2)").arg(countOf(lights.size(), "light", "lights")).arg(g.seed));
     return true;
 }
 

@@ -10,6 +10,7 @@
 #include "views/camera_view.hpp"
 #include "views/inspector_view.hpp"
 #include "views/vtk_adapters.hpp"
+#include "widgets/count_text.hpp"
 #include "widgets/message_log.hpp"
 #include "widgets/status_progress.hpp"
 #include "window/diagnostics_export.hpp"
@@ -85,6 +86,8 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), prompts(Prompts::
         statusBar()->showMessage(why, 10000);
     });
     connect(customShader_, &CustomShaderSource::changed, this, [this] { runCulling(); });
+    connect(customShader_, &CustomShaderSource::refusalChanged, this,
+            [this](const QString& why) { runStatus_->setShaderRefused(customShader_->path(), why); });
     connect(customShader_, &CustomShaderSource::logged, this, &MainWindow::log);
     files_->setRecentMenu(recentMenu_);
     connect(files_, &SceneFiles::logged, this, &MainWindow::log);
@@ -382,11 +385,11 @@ bool MainWindow::saveAs(const QString& path) { return files_->saveAs(path); }
 
 void MainWindow::afterSceneOpened(const QString& what) {
     const auto& s = doc_->scene();
-    log(tr("opened %1: %2 meshes, %3 triangles, %4 lights")
+    log(tr("opened %1: %2, %3, %4")
             .arg(what)
-            .arg(s.meshes.size())
-            .arg(s.triangleCount())
-            .arg(s.lights.size()));
+            .arg(countOf(s.meshes.size(), "mesh", "meshes"))
+            .arg(countOf(s.triangleCount(), "triangle", "triangles"))
+            .arg(countOf(s.lights.size(), "light", "lights")));
     // With Live on, the new scene's sceneEdited has asked for its run already.
     if (runOnOpen && !isLive()) runCulling();
 }
@@ -437,10 +440,10 @@ void MainWindow::setGltfMinIntensity(double lux) {
     // setting does what it says on the scene in front of the user.
     const int n = doc_->setGltfCutoff(lux);
     if (n > 0) {
-        log(tr("glTF light cut-off I_min = %1 lux: radii of %2 lights without a range re-derived (Ctrl+Z undoes), "
+        log(tr("glTF light cut-off I_min = %1 lux: radii of %2 without a range re-derived (Ctrl+Z undoes), "
                "and for the next glTF opened")
                 .arg(lux)
-                .arg(n));
+                .arg(countOf(std::uint64_t(n), "light", "lights")));
         if (const std::string w = lc::cutoffCoverageWarning(doc_->scene()); !w.empty()) warn(QString::fromStdString(w));
     } else {
         log(tr("glTF light cut-off I_min = %1 lux (for the next glTF opened; the open scene has no glTF light "

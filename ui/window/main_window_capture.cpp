@@ -11,6 +11,7 @@
 #include "document/document.hpp"
 #include "document/run_state.hpp"
 #include "panels/capture_dialog.hpp"
+#include "widgets/count_text.hpp"
 #include "work/cull_worker.hpp"
 #include "work/custom_shader_source.hpp"
 #include "work/progress_task.hpp"
@@ -91,10 +92,10 @@ bool MainWindow::openCaptureFrame(std::shared_ptr<const lc::CaptureFrame> frame)
     actions_.captureLists->setEnabled(true);
     for (const std::string& l : frame->echo) log(tr("read %1").arg(QString::fromStdString(l)));
     for (const std::string& w : frame->warnings) warn(QString::fromStdString(w));
-    log(tr("opened RenderDoc capture %1: %2 lights, lists %3; the lists are the capture's (edits to the lights are "
+    log(tr("opened RenderDoc capture %1: %2, lists %3; the lists are the capture's (edits to the lights are "
            "judged against them; Culling > Built-in algorithm culls on the capture's depth)")
             .arg(QString::fromStdString(frame->source))
-            .arg(frame->scene.lights.size())
+            .arg(countOf(frame->scene.lights.size(), "light", "lights"))
             .arg(QString::fromStdString(frame->layoutName)));
     if (runOnOpen && !isLive()) runCulling();
     return true;

@@ -1,12 +1,14 @@
 #include "window/run_status.hpp"
 
 #include "document/document.hpp"
+#include "widgets/count_text.hpp"
 #include "widgets/message_log.hpp"
 
 #include "culling/capture/capture_frame.hpp"
 #include "culling/custom/custom_cull.hpp"
 #include "culling/scene/gltf_io.hpp"
 
+#include <QFileInfo>
 #include <QLabel>
 #include <QStatusBar>
 #include <QStringList>
@@ -103,10 +105,10 @@ void RunStatus::finished(quint64 generation, const lc::RunOutput& out) {
                               : out.depthReused ? tr("reused (camera and meshes unchanged)")
                                                 : tr("%1 ms").arg(out.result.timings.depthMs, 0, 'f', 2);
     if (out.truthComputed) {
-        const QString line = tr("run %1: %2, %3 lights, depth %4%8, cull %5, false negatives %6, efficiency %7")
+        const QString line = tr("run %1: %2, %3, depth %4%8, cull %5, false negatives %6, efficiency %7")
                                  .arg(generation)
                                  .arg(listSourceName(out, false))
-                                 .arg(out.lights.size())
+                                 .arg(countOf(out.lights.size(), "light", "lights"))
                                  .arg(depthTime)
                                  .arg(cullTime(out))
                                  .arg(m.falseNegatives)
@@ -122,13 +124,13 @@ void RunStatus::finished(quint64 generation, const lc::RunOutput& out) {
 void RunStatus::logCustom(const lc::RunOutput& out) {
     const lc::CustomCullReport& c = *out.custom;
     log_->log(tr("%9 %1 (%2, %3): overflowed lists %4, invalid indices %5, duplicate indices %10, validation "
-                 "messages %6, %7 lists differ from built-in %8")
+                 "messages %6, %7 from built-in %8")
                   .arg(QString::fromStdString(c.source), QString::fromStdString(c.layout),
                        QString::fromStdString(c.lists))
                   .arg(c.overflowLists)
                   .arg(c.invalidIndices)
                   .arg(c.validationMessages.size())
-                  .arg(c.listsDifferingFromBuiltin)
+                  .arg(countOf(c.listsDifferingFromBuiltin, "list differs", "lists differ"))
                   .arg(QString::fromStdString(c.builtinAlgorithm), listSourceName(out, true))
                   .arg(c.duplicateIndices),
               c.overflowLists > 0 || c.invalidIndices > 0 || c.duplicateIndices > 0 || !c.validationMessages.empty());
@@ -143,13 +145,15 @@ void RunStatus::logLimits(quint64 generation, const lc::RunOutput& out) {
     QString keep;
     if (m.falseNegativesListFull) keep += tr("; a cap of %1 (the longest list) never overflows").arg(lim.longestUncapped);
     if (m.falseNegativesLightLimit)
-        keep += tr("; %1 lights past max-lights %2").arg(qulonglong(lim.lightsOverLimit)).arg(out.result.settings.maxLights);
-    log_->log(tr("run %1 limits: %2 over-full lists, %3 entries dropped; misses by cause: culling test %4, list "
+        keep += tr("; %1 past max-lights %2")
+                    .arg(countOf(lim.lightsOverLimit, "light", "lights"))
+                    .arg(out.result.settings.maxLights);
+    log_->log(tr("run %1 limits: %2 over-full, %3 dropped; misses by cause: culling test %4, list "
                  "full %5, light limit %6%7 (lightcull report --presets finds the smallest values that keep every "
                  "light)")
                   .arg(generation)
-                  .arg(qulonglong(lim.overflowLists.size()))
-                  .arg(qulonglong(lim.droppedLights.size()))
+                  .arg(countOf(lim.overflowLists.size(), "list", "lists"))
+                  .arg(countOf(lim.droppedLights.size(), "entry", "entries"))
                   .arg(qulonglong(m.falseNegativesCullingTest()))
                   .arg(qulonglong(m.falseNegativesListFull))
                   .arg(qulonglong(m.falseNegativesLightLimit))
@@ -163,15 +167,23 @@ void RunStatus::failed(quint64 generation, const QString& message) {
     update();
 }
 
+void RunStatus::setShaderRefused(const QString& file, const QString& why) {
+    refusedFile_ = why.isEmpty() ? QString() : file;
+    refusedWhy_ = why;
+    if (!why.isEmpty()) bar_->showMessage(tr("%1 refused: %2").arg(file, why), 10000);
+    update();
+}
+
 void RunStatus::updateCutoff() {
     // The cut-off that sized the lights without a range: a radius the file
     // did not give, so the user should see where it came from.
     const std::size_t cut = lc::gltfCutoffLights(doc_->scene()).size();
     cutoff_->setVisible(cut > 0);
-    cutoff_->setText(tr("cut-off %1 lux (%2 lights)").arg(doc_->scene().origin.gltfMinIntensity).arg(cut));
-    cutoff_->setToolTip(tr("%1 lights have no glTF range: their radius is sqrt(intensity x colour / I_min) "
+    cutoff_->setText(
+        tr("cut-off %1 lux (%2)").arg(doc_->scene().origin.gltfMinIntensity).arg(countOf(cut, "light", "lights")));
+    cutoff_->setToolTip(tr("%1 without a glTF range: their radius is sqrt(intensity x colour / I_min) "
                            "at I_min = %2 lux. File > glTF light cut-off... changes it.")
-                            .arg(cut)
+                            .arg(countOf(cut, "light", "lights"))
                             .arg(doc_->scene().origin.gltfMinIntensity));
 }
 
@@ -209,6 +221,16 @@ void RunStatus::update() {
                             .arg(what, times_->text()));
         times_->setToolTip(tr("The last run failed (the message log says why): the view, the tile inspector "
                               "and these figures are an earlier run's."));
+    } else if (!refusedWhy_.isEmpty()) {
+        times_->setStyleSheet(kStaleStyle);
+        times_->setText(tr("%1 refused, showing run %2 (%3): %4")
+                            .arg(QFileInfo(refusedFile_).fileName())
+                            .arg(doc_->runs().runGeneration())
+                            .arg(listSourceName(*run, true), times_->text()));
+        times_->setToolTip(tr("The shader was saved with settings that cannot be used (%1): nothing was culled "
+                              "with it; the view, the tile inspector and these figures are its earlier "
+                              "version's.")
+                               .arg(refusedWhy_));
     }
     updateFigures(*run);
 }

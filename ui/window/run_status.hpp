@@ -34,6 +34,9 @@ public:
     void failed(quint64 generation, const QString& message);
     // The worker opened a backend (before any run of it is shown).
     void backendReady(const QString& name, const QString& device);
+    // The custom shader's file, saved again, was refused (`why`; empty: it
+    // is in use again): the run shown is of its earlier version.
+    void setShaderRefused(const QString& file, const QString& why);
 
 private:
     void update();
@@ -55,6 +58,7 @@ private:
     // The newest run that failed (0: none): while it is newer than the run
     // shown, the status bar says the figures are an older run's.
     quint64 failedGeneration_ = 0;
+    QString refusedFile_, refusedWhy_;
 };
 
 } // namespace lcui

@@ -1,8 +1,9 @@
 #include "window/scene_files.hpp"
 
 #include "document/document.hpp"
-#include "work/progress_task.hpp"
+#include "widgets/count_text.hpp"
 #include "widgets/status_progress.hpp"
+#include "work/progress_task.hpp"
 
 #include "culling/core/errors.hpp"
 #include "culling/scene/scene_io.hpp"
@@ -76,10 +77,10 @@ bool SceneFiles::openSceneFile(const QString& path) {
         doc_->resetScene(std::move(s), path);
         for (const std::string& w : gltfReport.warnings) warn(QString::fromStdString(w));
         if (lc::isGltfPath(p))
-            log(tr("%1: %2 triangles, %3 lights, camera: %4; loaded in %5 ms")
+            log(tr("%1: %2, %3, camera: %4; loaded in %5 ms")
                     .arg(path)
-                    .arg(doc_->scene().triangleCount())
-                    .arg(doc_->scene().lights.size())
+                    .arg(countOf(doc_->scene().triangleCount(), "triangle", "triangles"))
+                    .arg(countOf(doc_->scene().lights.size(), "light", "lights"))
                     .arg(QString::fromStdString(gltfReport.camera))
                     .arg(loadTimer.elapsed()));
     } catch (const lc::Cancelled&) {

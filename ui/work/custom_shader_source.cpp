@@ -40,6 +40,7 @@ void CustomShaderSource::set(const QString& path) {
     if (!watcher_->directories().isEmpty()) watcher_->removePaths(watcher_->directories());
     options_ = o;
     gone_ = false;
+    emit refusalChanged({});
     if (!o) return;
     // The file, and its folder: an editor or `git checkout` that deletes the
     // file and writes it anew ends the file's watch, the folder's stays.
@@ -69,8 +70,10 @@ void CustomShaderSource::reload() {
         options_ = std::make_shared<const lc::CustomShaderOptions>(lc::shaderOptionsFromFile(p.toStdString()));
     } catch (const std::exception& e) {
         emit logged(tr("cannot use %1: %2").arg(p, QString::fromStdString(e.what())), true);
+        emit refusalChanged(QString::fromStdString(e.what()));
         return;
     }
+    emit refusalChanged({});
     emit changed();
 }
 

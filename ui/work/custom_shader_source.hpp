@@ -34,6 +34,10 @@ signals:
     // The watched file changed and its options were read again: run.
     void changed();
     void logged(const QString& message, bool error);
+    // The file changed and its settings line is refused (`why`): culling
+    // keeps the settings it had, and the run shown is the file's earlier
+    // version's. Empty `why`: the file (or another, or none) is in use again.
+    void refusalChanged(const QString& why);
 
 private:
     void reload();

@@ -1,0 +1,14 @@
+#pragma once
+// "1 light", "3 lights" in the studio's messages: lc::countOf as a QString
+// (the studio is not translated; tr() strings take the result as an %n).
+#include "culling/core/text.hpp"
+
+#include <QString>
+
+namespace lcui {
+
+inline QString countOf(std::uint64_t n, const char* one, const char* many) {
+    return QString::fromStdString(lc::countOf(n, one, many));
+}
+
+} // namespace lcui
