@@ -22,6 +22,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <numeric>
 #include <regex>
 #include <sstream>
@@ -808,6 +809,24 @@ TEST_F(GpuTest, ReportNamesShadersOfOneFileNameByTheirPaths) {
     EXPECT_EQ(labels[1].rfind("custom:" + paths[1] + " ", 0), 0u) << labels[1];
     // A file name no other shader has stays short.
     EXPECT_EQ(labels[2].rfind("custom:tiled_fixed.comp ", 0), 0u) << labels[2];
+
+    // With --tile the shader runs at each size given (TILE_SIZE), its rows
+    // named by the size.
+    o.shaders = {optionsFor(kExamples + "tiled_fixed.comp")};
+    o.fixed["tile"] = "8,16";
+    const Report tiles = runReport(atrium(96, 64, 20), o);
+    std::map<std::string, const ReportRow*> byLabel;
+    for (const ReportRow& r : tiles.rows)
+        if (!r.config.customLabel.empty()) byLabel[r.config.customLabel] = &r;
+    ASSERT_EQ(byLabel.size(), 2u);
+    const ReportRow* at8 = byLabel["custom:tiled_fixed.comp fixed:256 tile tile=8"];
+    const ReportRow* at16 = byLabel["custom:tiled_fixed.comp fixed:256 tile tile=16"];
+    ASSERT_TRUE(at8 && at16);
+    EXPECT_EQ(at8->config.tileSize, 8u);
+    EXPECT_EQ(at16->config.tileSize, 16u);
+    EXPECT_EQ(at8->falseNegatives, 0u);
+    EXPECT_EQ(at16->falseNegatives, 0u);
+    EXPECT_GT(at16->meanList, at8->meanList); // larger tiles, longer lists
 }
 
 TEST_F(GpuTest, ReportPutsCustomShadersBesideTheBuiltinRows) {

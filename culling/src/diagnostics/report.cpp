@@ -454,7 +454,17 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
         work.push_back({std::move(owned), b, std::move(cfgs)});
     }
 
-    total += options.shaders.size();
+    // The custom shaders' tile sizes: each one `--tile` names (the shader
+    // gets TILE_SIZE), else the scene camera's.
+    std::vector<std::uint32_t> shaderTiles{sceneIn.camera.tileSize};
+    if (const auto it = options.fixed.find("tile"); it != options.fixed.end()) {
+        shaderTiles.clear();
+        for (const std::string& t : splitCommas(it->second))
+            if (const std::uint32_t v = std::uint32_t(std::stoul(t));
+                std::find(shaderTiles.begin(), shaderTiles.end(), v) == shaderTiles.end())
+                shaderTiles.push_back(v);
+    }
+    total += options.shaders.size() * shaderTiles.size();
     rep.queued = total;
     const ViewLights lights = makeViewLights(sceneIn);
     const Projection proj(sceneIn.camera);
@@ -512,11 +522,11 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
                 if (progress) progress(done, total, cfg.backend + " " + cfg.label());
             }
         }
-        for (const CustomShaderOptions& so : options.shaders) {
+        for (const CustomShaderOptions& so : options.shaders)
+        for (const std::uint32_t tile : shaderTiles) {
             if (cancelled(cancel)) throw Cancelled();
             if (!shaderFrame) throw Error("custom shaders need a backend for the depth pre-pass");
-            const TileGrid grid =
-                TileGrid::make(sceneIn.camera.width, sceneIn.camera.height, sceneIn.camera.tileSize);
+            const TileGrid grid = TileGrid::make(sceneIn.camera.width, sceneIn.camera.height, tile);
             ReportRow row;
             row.config.backend = "vulkan"; // it runs on a Vulkan device: judged beside the vulkan rows
             row.config.tileSize = grid.tileSize;
@@ -529,6 +539,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             row.config.params["algorithm"] = "custom:" + file;
             row.config.params["tile"] = std::to_string(grid.tileSize);
             row.config.customLabel = "custom:" + file + " " + toString(so.layout) + " " + toString(so.lists);
+            if (shaderTiles.size() > 1) row.config.customLabel += " tile=" + std::to_string(tile);
             std::vector<double> cullMs;
             CullResult result;
             CustomCullReport crep;
@@ -554,9 +565,10 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
                     note += " (the first: " + validationGist(crep.validationMessages.front()) + ")";
                 rep.notes.push_back(note);
             }
+            const std::string label = row.config.customLabel;
             rep.rows.push_back(std::move(row));
             ++done;
-            if (progress) progress(done, total, "custom " + file);
+            if (progress) progress(done, total, label);
         }
     } catch (const Cancelled&) {
         if (!options.partialOnCancel) throw;

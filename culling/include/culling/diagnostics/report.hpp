@@ -84,7 +84,8 @@ struct ReportOptions {
     int repeat = 3; // timed runs of cull and of shade per configuration
     int warmup = 1; // untimed runs before them (first-use pipeline compiles)
     // Custom culling shaders (docs/CUSTOM_CULLING.md), one row each at the
-    // scene camera's tile size, beside the vulkan rows: on the vulkan
+    // scene camera's tile size (at each of fixed["tile"] where given, the
+    // label then ending " tile=N"), beside the vulkan rows: on the vulkan
     // backend's depth when it ran, else the first backend's.
     std::vector<CustomShaderOptions> shaders;
     // Engine presets (core/presets.hpp) to run side by side instead of the
