@@ -70,8 +70,16 @@ inline void printCustomReport(const lc::RunOutput& run, const lc::Scene& scene, 
     const lc::CustomCullReport& c = *run.custom;
     std::cout << "custom: " << c.source << ", layout " << c.layout << ", lists " << c.lists;
     if (c.passMs >= 0) std::cout << ", pass " << c.passMs << " ms on " << c.device;
-    std::cout << "\n  overflowed lists " << c.overflowLists << " (" << c.overflowEntries << " entries lost), invalid indices "
-              << c.invalidIndices << ", duplicates " << c.duplicateIndices << ", validation messages "
+    // The first list of each kind, with its tile (summary.json lists them).
+    const auto first = [&](const std::vector<std::uint32_t>& lists) -> std::string {
+        if (lists.empty()) return "";
+        const std::uint32_t t = run.result.tileOfList(lists.front()), tx = std::max(run.result.grid.tilesX, 1u);
+        return " (first: list " + std::to_string(lists.front()) + ", tile " + std::to_string(t % tx) + "," +
+               std::to_string(t / tx) + ")";
+    };
+    std::cout << "\n  overflowed lists " << c.overflowLists << " (" << c.overflowEntries << " entries lost)"
+              << first(c.overflowedListIds) << ", invalid indices " << c.invalidIndices << first(c.invalidIndexListIds)
+              << ", duplicates " << c.duplicateIndices << first(c.duplicateIndexListIds) << ", validation messages "
               << c.validationMessages.size() << "\n";
     if (c.builtinAlgorithm.rfind("none", 0) == 0)
         std::cout << "  against built-in: " << c.builtinAlgorithm << "\n"; // "none (why)": nothing to count

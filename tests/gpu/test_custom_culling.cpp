@@ -297,12 +297,16 @@ TEST_F(GpuTest, InvalidAndDuplicateIndicesAreReportedNeverFollowed) {
     EXPECT_EQ(rep.duplicateIndices, tiles);
     for (std::uint32_t i : out.result.lightIndices) EXPECT_LT(i, s.lights.size());
     EXPECT_EQ(out.result.entries(), tiles); // light 0 once per tile
-    // summary.json says where: every list held an invalid index here.
+    // summary.json says where: every list held an invalid index here,
     const auto j = nlohmann::json::parse(summaryJson(s, out.result.settings, out));
     ASSERT_EQ(j["custom"]["invalid_index_lists"].size(), std::min<std::uint64_t>(tiles, 1000));
     EXPECT_EQ(j["custom"]["invalid_index_lists"][1]["list"], 1);
     EXPECT_EQ(j["custom"]["invalid_index_lists"][1]["tile_x"], 1);
     EXPECT_EQ(j["custom"]["overflowed_lists"].size(), 0u);
+    // And every list held light 0 twice.
+    ASSERT_EQ(j["custom"]["duplicate_index_lists"].size(), std::min<std::uint64_t>(tiles, 1000));
+    EXPECT_EQ(j["custom"]["duplicate_index_lists"][2]["list"], 2);
+    EXPECT_EQ(j["custom"]["duplicate_index_lists"][2]["tile_x"], 2);
 }
 
 TEST_F(GpuTest, AHangIsATimeoutAndTheNextRunWorks) {

@@ -167,6 +167,8 @@ TEST(HuntCustomProperties, ADuplicateIndexIsAFailureAndRunSaysSoToo) {
     EXPECT_EQ(lc_test::runReproScript(out, &reproLog), 3) << reproLog;
     // The shrunk repro's one duplicate, in the singular.
     EXPECT_NE(reproLog.find("1 duplicate index"), std::string::npos) << reproLog;
+    // And where it is.
+    EXPECT_NE(reproLog.find("duplicates 1 (first: list "), std::string::npos) << reproLog;
 }
 
 // --path on the flawed tile-edge shader: the atrium panned past at 650 x 370

@@ -74,6 +74,7 @@ void assignLists(std::vector<std::vector<std::uint32_t>>& lists, std::uint32_t l
         std::sort(v.begin(), v.end());
         const auto dup = std::unique(v.begin(), v.end());
         report.duplicateIndices += std::uint64_t(v.end() - dup);
+        if (dup != v.end()) report.duplicateIndexListIds.push_back(std::uint32_t(l));
         v.erase(dup, v.end());
         result.listOffset[l] = std::uint32_t(result.lightIndices.size());
         result.listCount[l] = std::uint32_t(v.size());

@@ -238,8 +238,8 @@ nlohmann::ordered_json customJson(const Scene& scene, const RunOutput& run) {
     cj["overflow_entries"] = c.overflowEntries;
     cj["invalid_indices"] = c.invalidIndices;
     cj["duplicate_indices"] = c.duplicateIndices;
-    // Where: the lists (and their tiles) that overflowed or held an index past
-    // the light count, the first 1,000 of each.
+    // Where: the lists (and their tiles) that overflowed, held an index past
+    // the light count or a light twice, the first 1,000 of each.
     const auto where = [&](const std::vector<std::uint32_t>& lists) {
         nlohmann::ordered_json a = nlohmann::ordered_json::array();
         for (std::size_t k = 0; k < lists.size() && k < 1000; ++k) {
@@ -251,6 +251,7 @@ nlohmann::ordered_json customJson(const Scene& scene, const RunOutput& run) {
     };
     cj["overflowed_lists"] = where(c.overflowedListIds);
     cj["invalid_index_lists"] = where(c.invalidIndexListIds);
+    cj["duplicate_index_lists"] = where(c.duplicateIndexListIds);
     cj["validation_messages"] = c.validationMessages;
     cj["warnings"] = c.warnings;
     cj["builtin_algorithm"] = c.builtinAlgorithm;

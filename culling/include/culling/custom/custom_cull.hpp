@@ -86,8 +86,9 @@ struct CustomCullReport {
     std::uint64_t invalidIndices = 0;    // indices >= the light count (reported, never followed)
     std::uint64_t duplicateIndices = 0;  // the same light twice in one list (kept once)
     // Which lists (CullResult numbering, ascending) overflowed, and which held
-    // an invalid index: a miss in such a list is labelled with that cause.
-    std::vector<std::uint32_t> overflowedListIds, invalidIndexListIds;
+    // an invalid index: a miss in such a list is labelled with that cause;
+    // and which held a light twice.
+    std::vector<std::uint32_t> overflowedListIds, invalidIndexListIds, duplicateIndexListIds;
     std::vector<std::string> validationMessages; // the validation layer's, during this shader's run
     double passMs = -1;                  // CPU wall time around submit and wait of the dispatch
     std::string device;
