@@ -89,6 +89,10 @@ inline void printCustomReport(const lc::RunOutput& run, const lc::Scene& scene, 
                   << run.result.entries() << (run.result.entries() == 1 ? " entry vs " : " entries vs ")
                   << c.builtinEntries << "\n";
     for (const std::string& w : c.warnings) std::cout << "  warning: " << w << "\n";
+    if (!c.headerLayout.empty() &&
+        (c.overflowLists || c.invalidIndices || c.duplicateIndices || run.truth.metrics.falseNegatives))
+        std::cout << "  note: the shader's settings line says --layout " << c.headerLayout << "; --layout " << c.layout
+                  << " overrides it: read in another layout, counts and indices come from the wrong words\n";
     for (std::size_t i = 0; i < c.validationMessages.size() && i < 5; ++i)
         std::cout << "  validation: " << lc::validationGist(c.validationMessages[i]).substr(0, 400) << "\n";
     // The culling test's misses first: a full list is a limit, and its many

@@ -889,6 +889,27 @@ TEST_F(GpuTest, ReportPutsCustomShadersBesideTheBuiltinRows) {
     EXPECT_NE(cpuMd.find("Best total per algorithm on vulkan: `custom:tiled_fixed.comp"), std::string::npos) << cpuMd;
 }
 
+// --layout over a shader's own settings line: when the lists then read
+// wrong, run says which layout the shader states.
+TEST_F(GpuTest, ALayoutFlagOverTheShadersOwnIsNamedWhenTheListsReadWrong) {
+    lc_test::ScratchDir d;
+    lc_test::CliResult r = lc_test::runCli({"run", "--builtin", "atrium", "--width", "96", "--height", "64", "--shader",
+                                            kExamples + "tiled_fixed.comp", "--layout", "compact", "--no-image-error",
+                                            "--out", (d.path / "wrong").string()},
+                                           d.path);
+    EXPECT_EQ(r.code, 3) << r.err;
+    EXPECT_NE(r.out.find("note: the shader's settings line says --layout fixed:256; --layout compact overrides it"),
+              std::string::npos)
+        << r.out;
+    // Its own layout given again: nothing to say.
+    r = lc_test::runCli({"run", "--builtin", "atrium", "--width", "96", "--height", "64", "--shader",
+                         kExamples + "tiled_fixed.comp", "--layout", "fixed:256", "--no-image-error", "--out",
+                         (d.path / "right").string()},
+                        d.path);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.out.find("note: the shader's settings line"), std::string::npos) << r.out;
+}
+
 TEST_F(GpuTest, CliRunShaderAndCheckWriteTheDiagnostics) {
     lc_test::ScratchDir d;
     const fs::path out = d.path / "mine";

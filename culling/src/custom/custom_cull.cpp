@@ -298,6 +298,7 @@ void applyShaderHeader(const std::string& text, const std::string& path, CustomS
             throw InputError(path, "", settingsLine, "lightcull settings: " + flag + " needs a value");
         try {
             if (flag == "--layout") {
+                o.headerLayout = toString(parseLayout(value));
                 if (!layoutGiven) o.layout = parseLayout(value);
             } else if (flag == "--lists") {
                 if (!listsGiven) o.lists = parseListSpec(value);

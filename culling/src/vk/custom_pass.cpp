@@ -502,6 +502,7 @@ CullResult runCustomShader(const CustomShaderOptions& o, const DepthImage& depth
                            const TileGrid& grid, const ViewLights& lights, CustomCullReport& report) {
     report.source = o.path;
     report.layout = toString(o.layout);
+    if (!o.headerLayout.empty() && o.headerLayout != report.layout) report.headerLayout = o.headerLayout;
     report.lists = toString(o.lists);
     const auto lightCount = std::uint32_t(lights.size());
 

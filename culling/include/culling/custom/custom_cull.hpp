@@ -56,6 +56,7 @@ struct CustomShaderOptions {
     bool validation = true;        // the Khronos validation layer: user code, on by default
     double timeoutMs = 10000;      // a dispatch still running then is a hang
     std::string device;            // Vulkan device, as for the built-in backend
+    std::string headerLayout;      // the layout its settings line states ("": none), a flag overriding it or not
 };
 
 // The settings a shader states in a comment of its leading block (comments,
@@ -81,6 +82,7 @@ std::string validationGist(const std::string& message);
 struct CustomCullReport {
     std::string source;                  // the shader or dump file
     std::string layout, lists;           // as given
+    std::string headerLayout;            // a shader's settings line's layout, where --layout overrode another
     std::uint64_t overflowLists = 0;     // lists whose count exceeded the layout's capacity
     std::uint64_t overflowEntries = 0;   // entries that did not fit (fixed: count - N summed; compact: past N)
     std::uint64_t invalidIndices = 0;    // indices >= the light count (reported, never followed)
