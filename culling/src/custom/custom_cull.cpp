@@ -13,13 +13,17 @@
 #include <png.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <limits>
 #include <map>
 #include <regex>
 #include <sstream>
+#include <thread>
 
 namespace lc {
 
@@ -411,31 +415,69 @@ std::vector<MissedLight> locateFalseNegatives(const RunOutput& run, const Projec
     const CullResult& r = run.result;
     if (!run.truthComputed || run.truth.metrics.falseNegatives == 0) return out;
     const std::uint32_t per = r.algorithm == Algorithm::All ? 0 : std::max(r.listsPerTile, 1u);
-    for (std::uint32_t t = 0; t < r.grid.tileCount(); ++t) {
-        bool any = false;
-        if (per == 0) any = true;
-        for (std::uint32_t k = 0; per && k < per && !any; ++k) any = run.truth.listFalseNegatives[t * per + k] > 0;
-        if (!any) continue;
-        std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> missed; // (list, light) -> pixels
-        const TileGrid::Rect rect = r.grid.tileRect(t % r.grid.tilesX, t / r.grid.tilesX);
-        for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
-            for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
-                if (!run.depth.hasGeometry(x, y)) continue;
-                const glm::dvec3 p = proj.viewPositionFromDepth(x, y, run.depth.at(x, y));
-                const std::uint32_t list = r.listOfPixel(x, y, -p.z);
-                const auto first = r.lightIndices.begin() + r.listOffset[list];
-                const auto last = first + r.listCount[list];
-                for (std::uint32_t i = 0; i < run.lights.size(); ++i)
-                    if (detail::lightNeeds(run.lights, i, p) && !std::binary_search(first, last, i)) ++missed[{list, i}];
+    // Tile by tile, on every core (a run missing thousands of lights has
+    // misses in most tiles); concatenated in tile order.
+    const std::uint32_t tileCount = r.grid.tileCount();
+    std::vector<std::vector<MissedLight>> perTile(tileCount);
+    std::atomic<std::uint32_t> nextTile{0};
+    auto work = [&] {
+        for (std::uint32_t t; (t = nextTile++) < tileCount;) {
+            bool any = false;
+            if (per == 0) any = true;
+            for (std::uint32_t k = 0; per && k < per && !any; ++k)
+                any = run.truth.listFalseNegatives[t * per + k] > 0;
+            if (!any) continue;
+            // (list, light) -> pixels
+            std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> missed;
+            const TileGrid::Rect rect = r.grid.tileRect(t % r.grid.tilesX, t / r.grid.tilesX);
+            // The tile's points and their box: only a light whose sphere reaches
+            // the box can be needed here (the point of the box nearest its centre
+            // is no farther than any point in it, in floating point too).
+            std::vector<std::pair<glm::dvec3, std::uint32_t>> points; // (point, its list)
+            const double inf = std::numeric_limits<double>::infinity();
+            glm::dvec3 lo(inf), hi(-inf);
+            for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
+                for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
+                    if (!run.depth.hasGeometry(x, y)) continue;
+                    const glm::dvec3 p = proj.viewPositionFromDepth(x, y, run.depth.at(x, y));
+                    points.emplace_back(p, r.listOfPixel(x, y, -p.z));
+                    lo = glm::min(lo, p), hi = glm::max(hi, p);
+                }
+            std::vector<std::uint32_t> candidates;
+            for (std::uint32_t i = 0; i < run.lights.size() && !points.empty(); ++i)
+                if (detail::lightContains(run.lights.centers[i], run.lights.radii[i],
+                                          glm::clamp(run.lights.centers[i], lo, hi)))
+                    candidates.push_back(i);
+            // Per list of the tile, the candidates it lacks: only those are
+            // tested at its points (a list holds most of what its pixels need).
+            std::map<std::uint32_t, std::vector<std::uint32_t>> lacks; // list -> candidates not in it
+            for (const auto& [p, list] : points) {
+                auto [at, fresh] = lacks.try_emplace(list);
+                if (fresh) {
+                    const auto first = r.lightIndices.begin() + r.listOffset[list];
+                    std::set_difference(candidates.begin(), candidates.end(), first,
+                                        first + r.listCount[list], std::back_inserter(at->second));
+                }
+                for (const std::uint32_t i : at->second)
+                    if (detail::lightNeeds(run.lights, i, p)) ++missed[{list, i}];
             }
-        for (const auto& [key, pixels] : missed) out.push_back({t, key.first, key.second, pixels, causeOf(key.first, key.second)});
-    }
+            for (const auto& [key, pixels] : missed)
+                perTile[t].push_back({t, key.first, key.second, pixels, causeOf(key.first, key.second)});
+        }
+    };
+    std::vector<std::thread> helpers(std::min(std::max(std::thread::hardware_concurrency(), 1u), 8u) - 1);
+    for (std::thread& h : helpers)
+        h = std::thread(work);
+    work();
+    for (std::thread& h : helpers)
+        h.join();
+    for (const auto& v : perTile)
+        out.insert(out.end(), v.begin(), v.end());
     std::stable_sort(out.begin(), out.end(), [](const MissedLight& a, const MissedLight& b) {
         return a.cause != b.cause ? a.cause < b.cause : a.pixels > b.pixels;
     });
     return out;
 }
-
 
 CullResult ShaderLists::makeLists(const Scene&, const DepthImage& depth, const Projection& proj, const TileGrid& grid,
                                   const ViewLights& lights) {
