@@ -279,7 +279,7 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
                                  std::to_string(settings.proxyConeAngle) + " degrees)"
                            : std::string());
         if (cones)
-            std::cout << "; " << cones << " spot cones of " << settings.proxySegments << " sides, overfit "
+            std::cout << "; " << lc::countOf(cones, "spot cone", "spot cones") << " of " << settings.proxySegments << " sides, overfit "
                       << fmt("%.4f", autoOverfit ? lc::coneEnclosingOverfit(settings.proxySegments) : settings.proxyOverfit);
         std::cout << (autoOverfit ? " (auto: each encloses its light)" : " (as set)") << "\n"
                   << "depth: "

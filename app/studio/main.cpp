@@ -234,6 +234,11 @@ int main(int argc, char** argv) {
         }
     }
 
+    if (parser.isSet(presetOpt) && parser.isSet(shaderOpt)) {
+        // As the CLI: the shader makes the lists, the preset's culling would not run.
+        std::fprintf(stderr, "lightcull-studio: --preset: has no effect with --shader\n");
+        return 2;
+    }
     if (parser.isSet(presetOpt)) {
         try {
             lc::enginePreset(parser.value(presetOpt).toStdString());

@@ -723,6 +723,34 @@ TEST(CustomSpecs, LayoutsListsAndFirstLineSettings) {
     EXPECT_THROW(applyShaderHeader("// lightcull: --layout bitmask\n// lightcull: --lists halfz\n", "x.comp", mention,
                                    false, false, false),
                  InputError);
+
+    // Written as the CLI takes it: --layout=VALUE.
+    CustomShaderOptions joined;
+    applyShaderHeader("// lightcull: --layout=bitmask --lists=halfz\n", "x.comp", joined, false, false, false);
+    EXPECT_EQ(toString(joined.layout), "bitmask");
+    EXPECT_EQ(toString(joined.lists), "halfz");
+    // Mistyped settings lines were skipped and the shader ran with the
+    // defaults: each is refused, with its line and how to write it.
+    auto refusal = [](const std::string& text) -> std::string {
+        try {
+            CustomShaderOptions x;
+            applyShaderHeader(text, "x.comp", x, false, false, false);
+        } catch (const InputError& e) {
+            return std::to_string(e.line()) + ": " + e.what();
+        }
+        return "accepted";
+    };
+    for (const char* near : {"// LightCull: --layout fixed:256\n", "// lightcull --layout fixed:256\n",
+                             "// lightcull : --layout fixed:256\n", "/*\n * LIGHTCULL --lists halfz\n */\n"}) {
+        const std::string why = refusal(std::string("// Tiled culling\n") + near + "void main() {}\n");
+        EXPECT_NE(why.find("write this line as '// lightcull: --layout"), std::string::npos) << near << why;
+        EXPECT_NE(why.find(near[1] == '*' ? "3: " : "2: "), std::string::npos) << why;
+    }
+    // Ordinary comments naming the tool stay comments.
+    EXPECT_EQ(refusal("// LightCull Studio example: run it with --shader\nvoid main() {}\n"), "accepted");
+    EXPECT_NE(refusal("// lightcull: layout=fixed:256\n").find("unknown flag 'layout=fixed:256'"), std::string::npos);
+    EXPECT_NE(refusal("// lightcull: --layout fixed:256 --layout bitmask\n").find("--layout given twice"),
+              std::string::npos);
 }
 
 TEST(CustomSpecs, ValidationMessagesAreCutToWhatIsWrong) {

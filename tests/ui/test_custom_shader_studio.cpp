@@ -22,6 +22,7 @@
 #include <QElapsedTimer>
 #include <QFile>
 #include <QPlainTextEdit>
+#include <QProcess>
 #include <QTableView>
 #include <QUndoStack>
 
@@ -266,6 +267,17 @@ private slots:
                  qPrintable(fn));
         QVERIFY(w_->messageLog()->toPlainText().contains(
             QString("duplicate indices %1").arg(run->custom->duplicateIndices)));
+    }
+
+    // As the CLI: a preset beside --shader would not cull (the shader does),
+    // so the studio refuses the pair instead of showing the preset's grid.
+    void startingWithAShaderAndAPresetIsRefused() {
+        QProcess studio;
+        studio.start(LC_STUDIO_PATH, {"--shader", kExamples + "tiled_fixed.comp", "--preset", "godot-4", "--quit"});
+        QVERIFY(studio.waitForFinished(lctest::kRunTimeoutMs));
+        const QString err = QString::fromUtf8(studio.readAllStandardError());
+        QCOMPARE(studio.exitCode(), 2);
+        QVERIFY2(err.contains("--preset: has no effect with --shader"), qPrintable(err));
     }
 
     void badFirstLineIsRefusedAndShown() {

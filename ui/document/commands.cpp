@@ -1,6 +1,7 @@
 #include "document/commands.hpp"
 
 #include "document/document.hpp"
+#include "widgets/count_text.hpp"
 
 namespace lcui {
 
@@ -57,7 +58,7 @@ void InsertLightsCommand::redo() { doc_->applyInsertLights(indices_, lights_, se
 RemoveLightsCommand::RemoveLightsCommand(Document* doc, std::vector<int> indices,
                                          std::vector<lc::PointLight> lights)
     : doc_(doc), indices_(std::move(indices)), lights_(std::move(lights)) {
-    setText(QObject::tr("Delete %n light(s)", nullptr, int(indices_.size())));
+    setText(QObject::tr("Delete %1").arg(countOf(indices_.size(), "light", "lights")));
 }
 void RemoveLightsCommand::undo() { doc_->applyInsertLights(indices_, lights_, true); }
 void RemoveLightsCommand::redo() { doc_->applyRemoveLights(indices_); }

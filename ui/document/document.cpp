@@ -1,6 +1,7 @@
 #include "document/document.hpp"
 
 #include "document/commands.hpp"
+#include "widgets/count_text.hpp"
 
 #include "culling/core/file_io.hpp"
 #include "culling/scene/gltf_io.hpp"
@@ -85,7 +86,7 @@ void Document::duplicateLights(const std::vector<int>& indices) {
         l.name += " copy";
         copies.push_back(std::move(l));
     }
-    addLights(copies, tr("Duplicate %n light(s)", nullptr, int(copies.size())));
+    addLights(copies, tr("Duplicate %1").arg(countOf(copies.size(), "light", "lights")));
 }
 
 void Document::deleteLights(std::vector<int> indices) {

@@ -22,6 +22,7 @@
 #include <limits>
 #include <map>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -254,6 +255,26 @@ std::size_t settingsTagEnd(const std::string& line) {
     return line.compare(i, tag.size(), tag) == 0 ? i + tag.size() : std::string::npos;
 }
 
+// A comment that means to be the settings line but is not written as one:
+// "LightCull: --layout ...", "lightcull --layout ...", "lightcull : --lists
+// ..." (silently skipped, the shader would run with the defaults).
+bool looksLikeSettings(const std::string& line) {
+    std::size_t i = line.find_first_not_of(" \t");
+    if (i == std::string::npos) return false;
+    if (line.compare(i, 2, "//") == 0 || line.compare(i, 2, "/*") == 0) i += 2;
+    else if (line[i] == '*') i += 1;
+    else return false;
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '*' || line[i] == '/')) ++i;
+    std::string word = line.substr(i, 9);
+    for (char& c : word) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (word != "lightcull") return false;
+    i += 9;
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == ':')) ++i;
+    for (const char* flag : {"--layout", "--lists", "--entry"})
+        if (line.compare(i, std::strlen(flag), flag) == 0) return true;
+    return false;
+}
+
 } // namespace
 
 void applyShaderHeader(const std::string& text, const std::string& path, CustomShaderOptions& o, bool layoutGiven,
@@ -284,6 +305,10 @@ void applyShaderHeader(const std::string& text, const std::string& path, CustomS
             settings = line.substr(tagEnd);
             if (const auto close = settings.find("*/"); close != std::string::npos) settings.resize(close);
             settingsLine = number;
+        } else if (!firstCode && looksLikeSettings(line)) {
+            throw InputError(path, "", number,
+                             "lightcull settings: write this line as '// lightcull: --layout ... --lists ...' "
+                             "(lower case, the colon right after lightcull), or it is not read");
         } else if (code && !firstCode) {
             firstCode = number;
         }
@@ -297,20 +322,26 @@ void applyShaderHeader(const std::string& text, const std::string& path, CustomS
     if (!settingsLine) return;
     std::istringstream words(settings);
     std::string flag, value;
+    std::set<std::string> seen;
     while (words >> flag) {
-        if (!(words >> value))
+        const std::size_t eq = flag.find('=');
+        const bool joined = flag.rfind("--", 0) == 0 && eq != std::string::npos; // --layout=fixed:64, as the CLI takes
+        if (joined) value = flag.substr(eq + 1), flag.resize(eq);
+        if (flag != "--layout" && flag != "--lists" && flag != "--entry")
+            throw InputError(path, "", settingsLine,
+                             "lightcull settings: unknown flag '" + flag + "' (--layout, --lists, --entry)");
+        if (!joined && !(words >> value))
             throw InputError(path, "", settingsLine, "lightcull settings: " + flag + " needs a value");
+        if (!seen.insert(flag).second)
+            throw InputError(path, "", settingsLine, "lightcull settings: " + flag + " given twice: keep one");
         try {
             if (flag == "--layout") {
                 o.headerLayout = toString(parseLayout(value));
                 if (!layoutGiven) o.layout = parseLayout(value);
             } else if (flag == "--lists") {
                 if (!listsGiven) o.lists = parseListSpec(value);
-            } else if (flag == "--entry") {
+            } else { // --entry
                 if (!entryGiven) o.entry = value;
-            } else {
-                throw InputError(path, "", settingsLine,
-                                 "lightcull settings: unknown flag '" + flag + "' (--layout, --lists, --entry)");
             }
         } catch (const SettingsError& e) {
             throw InputError(path, "", settingsLine, std::string("lightcull settings: ") + e.what());
