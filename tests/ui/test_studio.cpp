@@ -908,7 +908,10 @@ private slots:
         const std::string before = sceneText(doc());
         // While the import runs the window takes no input but Cancel (a
         // click on the toolbar's Add light is dropped: the scene compares
-        // equal below); Cancel is pressed as soon as the status bar shows it.
+        // equal below); Cancel is pressed as soon as the status bar shows it,
+        // and again at each poll while it shows (on a loaded machine the
+        // first click can come before the status bar has laid the button
+        // out, and land beside it).
         auto* fileBar = w_->findChild<QToolBar*>("fileToolbar");
         QWidget* addLight = fileBar ? fileBar->widgetForAction(w_->action("actionAddLight")) : nullptr;
         QVERIFY(addLight && addLight->isVisible());
@@ -916,10 +919,12 @@ private slots:
         QTimer poll;
         connect(&poll, &QTimer::timeout, [&] {
             auto* cancel = w_->findChild<QToolButton*>("statusCancel_load");
-            if (!cancel || !cancel->isVisible() || clicked) return;
+            if (!cancel || !cancel->isVisible()) return;
             // Through the window, as the window system delivers real clicks.
             QWindow* window = w_->windowHandle();
-            QTest::mouseClick(window, Qt::LeftButton, Qt::NoModifier, addLight->mapTo(w_.get(), addLight->rect().center()));
+            if (!blockedClickSent)
+                QTest::mouseClick(window, Qt::LeftButton, Qt::NoModifier,
+                                  addLight->mapTo(w_.get(), addLight->rect().center()));
             blockedClickSent = true;
             QTest::mouseClick(window, Qt::LeftButton, Qt::NoModifier, cancel->mapTo(w_.get(), cancel->rect().center()));
             clicked = true;
