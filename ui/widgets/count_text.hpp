@@ -1,6 +1,7 @@
 #pragma once
 // "1 light", "3 lights" in the studio's messages: lc::countOf as a QString
-// (the studio is not translated; tr() strings take the result as an %n).
+// (the studio is not translated; a tr() string takes the result as an
+// argument).
 #include "culling/core/text.hpp"
 
 #include <QString>

@@ -211,26 +211,25 @@ void RunStatus::update() {
     times_->setToolTip(stale ? tr("The scene changed since this run: F5 runs it again.") : QString());
     if (stale) times_->setText(tr("stale: %1").arg(times_->text()));
     // A failed run (a custom shader that does not compile, settings the
-    // device refuses) leaves the last good run on screen: say whose it is.
+    // device refuses), or a shader saved with settings it cannot use, leaves
+    // the last good run on screen: say whose it is.
+    QString instead, why;
     if (failedGeneration_ > doc_->runs().runGeneration()) {
-        const QString what = listSourceName(*run, true);
-        times_->setStyleSheet(kStaleStyle);
-        times_->setText(tr("run %1 failed, showing run %2 (%3): %4")
-                            .arg(failedGeneration_)
-                            .arg(doc_->runs().runGeneration())
-                            .arg(what, times_->text()));
-        times_->setToolTip(tr("The last run failed (the message log says why): the view, the tile inspector "
-                              "and these figures are an earlier run's."));
+        instead = tr("run %1 failed").arg(failedGeneration_);
+        why = tr("The last run failed (the message log says why): the view, the tile inspector and these figures "
+                 "are an earlier run's.");
     } else if (!refusedWhy_.isEmpty()) {
+        instead = tr("%1 refused").arg(QFileInfo(refusedFile_).fileName());
+        why = tr("The shader was saved with settings that cannot be used (%1): nothing was culled with it; the "
+                 "view, the tile inspector and these figures are its earlier version's.")
+                  .arg(refusedWhy_);
+    }
+    if (!instead.isEmpty()) {
         times_->setStyleSheet(kStaleStyle);
-        times_->setText(tr("%1 refused, showing run %2 (%3): %4")
-                            .arg(QFileInfo(refusedFile_).fileName())
-                            .arg(doc_->runs().runGeneration())
-                            .arg(listSourceName(*run, true), times_->text()));
-        times_->setToolTip(tr("The shader was saved with settings that cannot be used (%1): nothing was culled "
-                              "with it; the view, the tile inspector and these figures are its earlier "
-                              "version's.")
-                               .arg(refusedWhy_));
+        times_->setText(tr("%1, showing run %2 (%3): %4")
+                            .arg(instead, QString::number(doc_->runs().runGeneration()),
+                                 listSourceName(*run, true), times_->text()));
+        times_->setToolTip(why);
     }
     updateFigures(*run);
 }

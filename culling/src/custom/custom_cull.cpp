@@ -13,6 +13,7 @@
 #include <png.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cctype>
 #include <cstring>
@@ -244,34 +245,39 @@ namespace {
 // Where a line holds the settings tag as a comment ("// lightcull: ...", or
 // " * lightcull: ..." inside a block comment): the text after the tag, else
 // npos.
-std::size_t settingsTagEnd(const std::string& line) {
-    const std::string tag = "lightcull:";
+// Where a comment line's text starts (past "//", "/*" or a block's "*" and
+// the spaces and stars after them); npos for a line that is not a comment.
+std::size_t commentTextStart(const std::string& line) {
     std::size_t i = line.find_first_not_of(" \t");
     if (i == std::string::npos) return std::string::npos;
     if (line.compare(i, 2, "//") == 0 || line.compare(i, 2, "/*") == 0) i += 2;
     else if (line[i] == '*') i += 1;
     else return std::string::npos;
     while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '*' || line[i] == '/')) ++i;
-    return line.compare(i, tag.size(), tag) == 0 ? i + tag.size() : std::string::npos;
+    return i;
+}
+
+const std::array<std::string, 3> kSettingsFlags = {"--layout", "--lists", "--entry"};
+
+std::size_t settingsTagEnd(const std::string& line) {
+    const std::string tag = "lightcull:";
+    const std::size_t i = commentTextStart(line);
+    return i != std::string::npos && line.compare(i, tag.size(), tag) == 0 ? i + tag.size() : std::string::npos;
 }
 
 // A comment that means to be the settings line but is not written as one:
 // "LightCull: --layout ...", "lightcull --layout ...", "lightcull : --lists
 // ..." (silently skipped, the shader would run with the defaults).
 bool looksLikeSettings(const std::string& line) {
-    std::size_t i = line.find_first_not_of(" \t");
+    std::size_t i = commentTextStart(line);
     if (i == std::string::npos) return false;
-    if (line.compare(i, 2, "//") == 0 || line.compare(i, 2, "/*") == 0) i += 2;
-    else if (line[i] == '*') i += 1;
-    else return false;
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '*' || line[i] == '/')) ++i;
     std::string word = line.substr(i, 9);
     for (char& c : word) c = char(std::tolower(static_cast<unsigned char>(c)));
     if (word != "lightcull") return false;
     i += 9;
     while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == ':')) ++i;
-    for (const char* flag : {"--layout", "--lists", "--entry"})
-        if (line.compare(i, std::strlen(flag), flag) == 0) return true;
+    for (const std::string& flag : kSettingsFlags)
+        if (line.compare(i, flag.size(), flag) == 0) return true;
     return false;
 }
 
@@ -327,7 +333,7 @@ void applyShaderHeader(const std::string& text, const std::string& path, CustomS
         const std::size_t eq = flag.find('=');
         const bool joined = flag.rfind("--", 0) == 0 && eq != std::string::npos; // --layout=fixed:64, as the CLI takes
         if (joined) value = flag.substr(eq + 1), flag.resize(eq);
-        if (flag != "--layout" && flag != "--lists" && flag != "--entry")
+        if (std::find(kSettingsFlags.begin(), kSettingsFlags.end(), flag) == kSettingsFlags.end())
             throw InputError(path, "", settingsLine,
                              "lightcull settings: unknown flag '" + flag + "' (--layout, --lists, --entry)");
         if (!joined && !(words >> value))
@@ -336,8 +342,9 @@ void applyShaderHeader(const std::string& text, const std::string& path, CustomS
             throw InputError(path, "", settingsLine, "lightcull settings: " + flag + " given twice: keep one");
         try {
             if (flag == "--layout") {
-                o.headerLayout = toString(parseLayout(value));
-                if (!layoutGiven) o.layout = parseLayout(value);
+                const LayoutSpec layout = parseLayout(value);
+                o.headerLayout = toString(layout);
+                if (!layoutGiven) o.layout = layout;
             } else if (flag == "--lists") {
                 if (!listsGiven) o.lists = parseListSpec(value);
             } else { // --entry

@@ -124,7 +124,9 @@ bool explainRaster(const RunOutput& run, const Projection& proj, Explanation& e)
             lo = std::min(lo, a), hi = std::max(hi, b);
         }
         if (covering.empty()) return false;
-        const std::uint32_t all = p.sliceMask(s, r.clusterNear, r.clusterFar, lo, hi, ~0u);
+        const std::uint32_t all = p.sliceMask(
+            SliceLocator(s.slicing, r.clusterNear, r.clusterFar, std::min<std::uint32_t>(s.cells, 32)), s.skipEmpty, lo,
+            hi, ~0u);
         const std::uint32_t k = std::uint32_t(std::max(e.sub, 0));
         const bool inRange = (all >> k) & 1u;
         std::string rule;

@@ -157,25 +157,12 @@ LightProxy makeLightProxy(const ViewLights& lights, std::size_t l, const CullSet
 
 double LightProxy::slack() const { return sphereTestSlack(origin, radius * overfit); }
 
-std::pair<double, double> LightProxy::sliceRange(double clusterNear, double clusterFar, double lo, double hi) const {
-    const double e = slack();
-    double a = lo - e, b = hi + e;
-    if (depthMin - e <= clusterNear) a = std::min(a, clusterNear);
-    if (depthMax + e >= clusterFar) b = std::max(b, clusterFar);
-    return {a, b};
-}
-
-std::uint32_t LightProxy::sliceMask(const CullSettings& settings, double clusterNear, double clusterFar, double lo,
-                                    double hi, std::uint32_t occupied) const {
-    const auto [a, b] = sliceRange(clusterNear, clusterFar, lo, hi);
-    std::uint32_t m = sliceRangeMask(settings.slicing, clusterNear, clusterFar, settings.cells, a, b);
-    if (settings.skipEmpty) m &= occupied;
-    return m;
-}
-
 std::uint32_t LightProxy::sliceMask(const SliceLocator& slices, bool skipEmpty, double lo, double hi,
                                     std::uint32_t occupied) const {
-    const auto [a, b] = sliceRange(slices.lo(), slices.hi(), lo, hi);
+    const double e = slack();
+    double a = lo - e, b = hi + e;
+    if (depthMin - e <= slices.lo()) a = std::min(a, slices.lo());
+    if (depthMax + e >= slices.hi()) b = std::max(b, slices.hi());
     std::uint32_t m = slices.rangeMask(a, b);
     if (skipEmpty) m &= occupied;
     return m;

@@ -20,14 +20,6 @@ constexpr std::uint32_t kPushBytes = 8;
 constexpr VkShaderStageFlags kStages =
     VK_SHADER_STAGE_COMPUTE_BIT | VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
 constexpr std::uint32_t kSetupGroup = 64; // proxy_setup.comp's local_size_x
-
-void barrier(VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags srcAccess, VkPipelineStageFlags dst,
-             VkAccessFlags dstAccess) {
-    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    b.srcAccessMask = srcAccess;
-    b.dstAccessMask = dstAccess;
-    vkCmdPipelineBarrier(cmd, src, dst, 0, 1, &b, 0, nullptr, 0, nullptr);
-}
 } // namespace
 
 RasterPass::RasterPass(Context& ctx) : ctx_(ctx) {
@@ -169,14 +161,15 @@ void RasterPass::record(VkCommandBuffer cmd, Coverage c, VkDescriptorSet set, st
         const std::uint32_t push[2] = {std::uint32_t(first),
                                        std::uint32_t(std::min<std::uint64_t>(batch, triangles - first))};
         if (first) // the previous batch's draw has read the records this one overwrites
-            barrier(cmd, VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0,
-                    VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0);
+            memoryBarrier(cmd, VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0,
+                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, setupPipeline_);
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layouts_.pipeline, 0, 1, &set, 0, nullptr);
         vkCmdPushConstants(cmd, layouts_.pipeline, kStages, 0, kPushBytes, push);
         vkCmdDispatch(cmd, (push[1] + kSetupGroup - 1) / kSetupGroup, 1, 1);
-        barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+                      VK_ACCESS_SHADER_READ_BIT);
         vkCmdBeginRenderPass(cmd, &rbi, VK_SUBPASS_CONTENTS_INLINE);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layouts_.pipeline, 0, 1, &set, 0, nullptr);

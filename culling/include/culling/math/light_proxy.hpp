@@ -13,7 +13,6 @@
 #include <array>
 #include <cstdint>
 #include <functional>
-#include <utility>
 #include <vector>
 
 namespace lc {
@@ -63,22 +62,17 @@ struct LightProxy {
     bool depthReaches(double tileMin, double tileMax) const {
         return depthMin - slack() <= tileMax && depthMax + slack() >= tileMin;
     }
-    // proxy-depth slices: the slices of `settings` (cells of slicing over
-    // [clusterNear, clusterFar]) a tile lists the light in, from the depths
-    // [lo, hi] its covering triangles span there (proxyTriangleTileDepth),
-    // widened by the slack; from the first slice when the proxy reaches the
-    // near plane (its part in front is clipped away, and the camera may be
-    // inside), to the last when it reaches the far one (Godot's "touches
-    // near / far"); with skip-empty only the `occupied` slices.
-    std::uint32_t sliceMask(const CullSettings& settings, double clusterNear, double clusterFar, double lo, double hi,
-                            std::uint32_t occupied) const;
-    // The same over the slices a locator holds (its boundaries worked out
-    // once for every light and tile), skipping empty slices when `skipEmpty`.
+    // proxy-depth slices: the slices (`slices`: the settings' cells of
+    // slicing over [clusterNear, clusterFar], their boundaries worked out
+    // once for every light and tile) a tile lists the light in, from the
+    // depths [lo, hi] its covering triangles span there
+    // (proxyTriangleTileDepth), widened by the slack; from the first slice
+    // when the proxy reaches the near plane (its part in front is clipped
+    // away, and the camera may be inside), to the last when it reaches the
+    // far one (Godot's "touches near / far"); with skip-empty only the
+    // `occupied` slices.
     std::uint32_t sliceMask(const SliceLocator& slices, bool skipEmpty, double lo, double hi,
                             std::uint32_t occupied) const;
-    // [lo, hi] as both widen it: by the slack, and to the near / far end
-    // the proxy reaches.
-    std::pair<double, double> sliceRange(double clusterNear, double clusterFar, double lo, double hi) const;
 };
 // `spotAngle` 0 for a point light; `axis` unit (ignored for a point light).
 LightProxy makeLightProxy(const glm::dvec3& center, double radius, const glm::dvec3& axis, double spotAngle,
