@@ -17,6 +17,7 @@
 #include "window/main_window.hpp"
 #include "document/miss_navigator.hpp"
 #include "shading_probe.hpp"
+#include "widgets/count_text.hpp"
 
 #include "culling/core/backend.hpp"
 #include "culling/core/params.hpp"
@@ -269,8 +270,8 @@ int main(int argc, char** argv) {
             return 2;
         }
         window.document()->resetScene(std::move(scene), window.document()->filePath());
-        window.log(QString("the scene's lights replaced by %1 generated ones (--lights, seed %2)")
-                       .arg(lightCount)
+        window.log(QString("the scene's lights replaced by %1 (--lights, seed %2)")
+                       .arg(lcui::countOf(std::uint64_t(lightCount), "generated light", "generated lights"))
                        .arg(seed));
     }
     if (ok && parser.isSet(presetOpt)) {
