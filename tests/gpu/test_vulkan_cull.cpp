@@ -942,28 +942,34 @@ TEST_F(GpuTest, ZBinBinsHoldTheReferenceBins) {
     }
 }
 
-// A backend keeps the culling pipelines it used last, at most 256 (a report
-// sweep made over a thousand, megabytes each on lavapipe): settings culled again
+// A backend keeps the culling pipelines it used last, at most 128 (megabytes
+// each on lavapipe; a report sweep makes hundreds): settings culled again
 // soon make none, settings whose pipelines went make them again and cull
 // the same lists, and a backend's pipelines go with it.
-TEST_F(GpuTest, CullPipelinesHeldAreTheLastUsedAndAtMost256) {
+TEST_F(GpuTest, CullPipelinesHeldAreTheLastUsedAndAtMost128) {
     const VulkanPipelineCount before = vulkanCullPipelines(); // other backends' (held, unchanged here)
     auto cpu = makeCpuBackend();
     Scene scene = sized("atrium", 64, 36, 16);
-    scene.lights = generateLights(defaultLightGen(scene, 12, 5));
+    LightGenSettings gen = defaultLightGen(scene, 12, 5);
+    gen.spotFraction = 0.5; // the spot tests are constants of the count pass
+    scene.lights = generateLights(gen);
     const gputest::Frame f(scene, cpu.get());
+    // (Pipelines are keyed by the constants their shader reads: about one
+    // new count pass a setting, the bounds pass one per cells and slicing.)
     std::vector<CullSettings> all;
     for (Algorithm algo : {Algorithm::TwoPointFiveD, Algorithm::Clustered})
         for (std::uint32_t cells : {2u, 4u, 8u, 16u, 32u})
             for (Slicing slicing : {Slicing::Log, Slicing::Linear})
-                for (SphereTest test : kTests) {
-                    CullSettings s;
-                    s.algorithm = algo;
-                    s.cells = cells;
-                    s.slicing = slicing;
-                    s.test = test;
-                    all.push_back(s);
-                }
+                for (SphereTest test : kTests)
+                    for (SpotTest spot : {SpotTest::ApexSphere, SpotTest::ConeSphere, SpotTest::ConePlanes}) {
+                        CullSettings s;
+                        s.algorithm = algo;
+                        s.cells = cells;
+                        s.slicing = slicing;
+                        s.test = test;
+                        s.spotTest = spot;
+                        all.push_back(s);
+                    }
     {
         std::unique_ptr<CullBackend> gpu = makeVulkanBackend("");
         const auto made = [] { return vulkanCullPipelines().made; };
@@ -971,11 +977,11 @@ TEST_F(GpuTest, CullPipelinesHeldAreTheLastUsedAndAtMost256) {
         std::vector<CullResult> first;
         for (const CullSettings& s : all) {
             first.push_back(gpu->cull(f.depth, f.proj, f.grid, f.lights, s));
-            ASSERT_LE(held(), 256u);
+            ASSERT_LE(held(), 128u);
         }
         const std::uint64_t afterSweep = made();
-        ASSERT_GT(afterSweep - before.made, 256u) << "the sweep must make more pipelines than are kept";
-        EXPECT_EQ(held(), 256u);
+        ASSERT_GT(afterSweep - before.made, 128u) << "the sweep must make more pipelines than are kept";
+        EXPECT_EQ(held(), 128u);
         // The last settings: their pipelines are still there.
         EXPECT_EQ(gpu->cull(f.depth, f.proj, f.grid, f.lights, all.back()).lightIndices, first.back().lightIndices);
         EXPECT_EQ(made(), afterSweep);
@@ -984,7 +990,51 @@ TEST_F(GpuTest, CullPipelinesHeldAreTheLastUsedAndAtMost256) {
         EXPECT_GT(made(), afterSweep);
         EXPECT_EQ(again.lightIndices, first.front().lightIndices);
         EXPECT_EQ(again.listCount, first.front().listCount);
-        EXPECT_LE(held(), 256u);
+        EXPECT_LE(held(), 128u);
     }
     EXPECT_EQ(vulkanCullPipelines().held, before.held);
+}
+
+// A cull makes only the pipelines it runs, keyed by the constants each
+// shader reads: another sphere test compiles the list passes again but not
+// the bounds and bins passes, and raster (which runs the bounds pass and
+// draws) makes that one pipeline alone. On lavapipe a list pass's pipeline
+// is 25 to 40 ms of compiling: a report sweep paid it for every pass of
+// every configuration, and raster for four passes it never ran.
+TEST_F(GpuTest, CullsMakeOnlyThePipelinesTheyRun) {
+    auto cpu = makeCpuBackend();
+    Scene scene = sized("atrium", 64, 36, 16);
+    scene.lights = generateLights(defaultLightGen(scene, 12, 5));
+    const gputest::Frame f(scene, cpu.get());
+    std::unique_ptr<CullBackend> gpu = makeVulkanBackend("");
+    const auto made = [] { return vulkanCullPipelines().made; };
+    CullSettings s;
+    s.algorithm = Algorithm::Clustered;
+    s.cells = 7; // no other test's constants
+    std::uint64_t at = made();
+    const CullResult planes = gpu->cull(f.depth, f.proj, f.grid, f.lights, s);
+    const std::uint64_t first = made() - at;
+    s.test = SphereTest::Exact;
+    at = made();
+    const CullResult exact = gpu->cull(f.depth, f.proj, f.grid, f.lights, s);
+    const std::uint64_t second = made() - at;
+    EXPECT_GE(first, second + 2) << "the bounds and bins passes are the same pipelines for either test (first "
+                                 << first << ", then " << second << ")";
+    EXPECT_GE(second, 1u) << "the list pass reads the test";
+    EXPECT_EQ(cpu->cull(f.depth, f.proj, f.grid, f.lights, s).lightIndices, exact.lightIndices);
+
+    CullSettings r;
+    r.algorithm = Algorithm::Raster;
+    r.cells = 7;
+    at = made();
+    const CullResult raster = gpu->cull(f.depth, f.proj, f.grid, f.lights, r);
+    EXPECT_LE(made() - at, 1u) << "raster runs one culling pipeline, the bounds pass";
+    r.proxyLevel = 2;
+    at = made();
+    gpu->cull(f.depth, f.proj, f.grid, f.lights, r);
+    EXPECT_EQ(made() - at, 0u) << "the proxy's detail is no constant of the bounds pass";
+    GroundTruthOptions o;
+    o.imageError = false;
+    EXPECT_EQ(computeGroundTruth(f.depth, f.proj, f.lights, raster, o).metrics.falseNegatives, 0u);
+    EXPECT_EQ(computeGroundTruth(f.depth, f.proj, f.lights, planes, o).metrics.falseNegatives, 0u);
 }

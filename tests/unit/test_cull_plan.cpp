@@ -3,6 +3,9 @@
 // then read from, and which inputs the device's limits refuse.
 #include "culling/core/errors.hpp"
 #include "vk/cull_plan.hpp"
+#include "embedded_spirv.hpp"
+
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -12,6 +15,7 @@ namespace {
 using vk::CullHistory;
 using vk::CullPlan;
 using vk::CullPlanInputs;
+using vk::CullSpec;
 using vk::CullStrategy;
 using vk::DeviceProfile;
 using vk::ListsFrom;
@@ -190,6 +194,38 @@ TEST(CullPlan, SpecialisationFollowsTheInputs) {
     // Wide depth loads on a CPU device: 8 pixels a load where the width and tile allow.
     EXPECT_TRUE(vk::planCull(lavapipe(), CullHistory{}, inputs(Algorithm::MinMax)).wideBounds);
     EXPECT_EQ(vk::planCull(lavapipe(), CullHistory{}, inputs(Algorithm::MinMax)).depthLoad, 8u);
+}
+
+// A pipeline is keyed by the constants its module declares (glslang -Os
+// declares only those a shader reads): tile_bounds the same whatever the
+// sphere test, prefix_sum whatever the algorithm.
+TEST(CullPlan, PipelinesAreKeyedByTheConstantsTheirShaderDeclares) {
+    const auto ids = [](spirv::Code c) { return vk::specConstantIds(c.words, c.wordCount); };
+    const auto has = [](std::uint32_t mask, std::uint32_t id) { return (mask >> id & 1u) != 0; };
+    const std::uint32_t bounds = ids(spirv::tileBounds()), cull = ids(spirv::cullLists()), scan = ids(spirv::prefixSum());
+    EXPECT_TRUE(has(bounds, 1) && has(bounds, 2) && has(bounds, 4)) << "tile size, cells, algorithm";
+    EXPECT_FALSE(has(bounds, 5)) << "tile_bounds does not read the sphere test";
+    EXPECT_TRUE(has(cull, 5) && has(cull, 6) && has(cull, 11)) << "sphere test, pass, spot test";
+    EXPECT_EQ(scan, (1u << 0) | (1u << 7)) << "prefix_sum: local size and lanes";
+    EXPECT_EQ(ids(spirv::tileBoundsWide()), bounds);
+
+    const CullPlan planes = vk::planCull(lavapipe(), CullHistory{}, inputs(Algorithm::Clustered));
+    CullPlanInputs in = inputs(Algorithm::Clustered);
+    in.settings.test = SphereTest::Exact;
+    const CullPlan exact = vk::planCull(lavapipe(), CullHistory{}, in);
+    EXPECT_EQ(planes.bounds.only(bounds).key(), exact.bounds.only(bounds).key());
+    EXPECT_NE(planes.count.only(cull).key(), exact.count.only(cull).key());
+    EXPECT_EQ(planes.bounds.only(~0u).key(), planes.bounds.key());
+    EXPECT_EQ(planes.bounds.only(0).key(), CullSpec{}.only(0).key());
+
+    // Words that are not SPIR-V, or a truncated instruction, are refused.
+    std::vector<std::uint32_t> words(spirv::prefixSum().words, spirv::prefixSum().words + spirv::prefixSum().wordCount);
+    EXPECT_THROW(vk::specConstantIds(words.data(), 4), Error);
+    words[0] = 0;
+    EXPECT_THROW(vk::specConstantIds(words.data(), words.size()), Error);
+    words[0] = 0x07230203;
+    words[5] = 0xffff0000u | (words[5] & 0xffffu); // the first instruction claims 65,535 words
+    EXPECT_THROW(vk::specConstantIds(words.data(), words.size()), Error);
 }
 
 } // namespace

@@ -53,6 +53,32 @@ std::string CullSpec::key() const {
     return k;
 }
 
+CullSpec CullSpec::only(std::uint32_t ids) const {
+    CullSpec out = *this;
+    auto* v = reinterpret_cast<std::uint32_t*>(&out);
+    for (std::uint32_t i = 0; i < kCount; ++i)
+        if (!(ids >> i & 1u)) v[i] = 0;
+    return out;
+}
+
+std::uint32_t specConstantIds(const std::uint32_t* words, std::size_t wordCount) {
+    constexpr std::uint32_t kMagic = 0x07230203, kOpDecorate = 71, kSpecId = 1;
+    if (wordCount < 5 || words[0] != kMagic) throw Error("specConstantIds: not a SPIR-V module");
+    std::uint32_t ids = 0;
+    for (std::size_t i = 5; i < wordCount;) {
+        const std::uint32_t op = words[i] & 0xffffu, n = words[i] >> 16;
+        if (n == 0 || n > wordCount - i) throw Error("specConstantIds: a truncated instruction at word " + std::to_string(i));
+        // OpDecorate %target SpecId N
+        if (op == kOpDecorate && n >= 4 && words[i + 2] == kSpecId) {
+            if (words[i + 3] >= CullSpec::kCount)
+                throw Error("specConstantIds: constant_id " + std::to_string(words[i + 3]) + " is not a CullSpec field");
+            ids |= 1u << words[i + 3];
+        }
+        i += n;
+    }
+    return ids;
+}
+
 const char* strategyName(CullStrategy s) {
     switch (s) {
     case CullStrategy::CountScan:

@@ -62,7 +62,8 @@ struct CullHistory {
 };
 
 // The specialisation constants of the culling shaders, in constant_id order
-// (cull_common.glsl); every pipeline is cached per value of the whole struct.
+// (cull_common.glsl); a pipeline is cached per value of the constants its
+// module declares (specConstantIds: `only`).
 struct CullSpec {
     std::uint32_t local = 64;     // 0: local size
     std::uint32_t tileSize = 16;  // 1
@@ -83,7 +84,17 @@ struct CullSpec {
     std::uint32_t testsWrap = 1;  // 16
     static constexpr std::uint32_t kCount = 17;
     std::string key() const;
+    // This spec with every constant outside `ids` (bit i: constant_id i) zero.
+    CullSpec only(std::uint32_t ids) const;
 };
+
+// The constant_ids a SPIR-V module declares (bit i: constant_id i). glslang
+// declares only the constants a shader reads, so the code of a pipeline made
+// from the module depends on those alone: tile_bounds is the same pipeline
+// whatever the sphere test, prefix_sum whatever the algorithm. A report
+// sweep on lavapipe compiled each pass once per configuration (15 to 25 ms a
+// pipeline) before it was keyed so. Throws Error on words that are not SPIR-V.
+std::uint32_t specConstantIds(const std::uint32_t* words, std::size_t wordCount);
 static_assert(sizeof(CullSpec) == CullSpec::kCount * 4, "CullSpec: one uint per constant_id");
 
 // Workgroup counts (x, y) of a dispatch.

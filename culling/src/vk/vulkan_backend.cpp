@@ -44,6 +44,7 @@
 
 #include "scene/closed_solids.hpp"
 
+#include "culling/core/content_hash.hpp"
 #include "culling/core/errors.hpp"
 #include "culling/vk/gpu_shared.h"
 #include "embedded_spirv.hpp"
@@ -205,37 +206,8 @@ glm::vec4 depthBinSlicing(const Projection& proj, double camNear, double lightNe
 
 
 // A 64-bit digest of a mesh's positions and indices (not its transform):
-// the key of its closed solids, which depend on nothing else. Four lanes of
-// 8-byte words, so that the multiplies do not wait on each other (0.06 ms
-// for forest's 0.5 MB, against 0.12 with one lane).
-std::uint64_t meshContentKey(const Mesh& m) {
-    std::uint64_t lane[4] = {0x243F6A8885A308D3ull ^ m.positions.size(), 0x13198A2E03707344ull ^ m.indices.size(),
-                             0xA4093822299F31D0ull, 0x082EFA98EC4E6C89ull};
-    auto word = [&lane](int k, std::uint64_t w) {
-        lane[k] = (lane[k] ^ (w * 0xC2B2AE3D27D4EB4Full)) * 0x9E3779B97F4A7C15ull;
-        lane[k] ^= lane[k] >> 31;
-    };
-    auto mix = [&word](const void* data, std::size_t bytes) {
-        const auto* p = static_cast<const unsigned char*>(data);
-        std::size_t i = 0;
-        for (; i + 32 <= bytes; i += 32)
-            for (int k = 0; k < 4; ++k) {
-                std::uint64_t w;
-                std::memcpy(&w, p + i + 8 * k, 8);
-                word(k, w);
-            }
-        for (int k = 0; i < bytes; i += 8, ++k) {
-            std::uint64_t w = 0;
-            std::memcpy(&w, p + i, std::min<std::size_t>(8, bytes - i));
-            word(k, w);
-        }
-    };
-    mix(m.positions.data(), m.positions.size() * sizeof(float));
-    mix(m.indices.data(), m.indices.size() * sizeof(std::uint32_t));
-    std::uint64_t h = lane[0];
-    for (int k = 1; k < 4; ++k) h = ((h ^ lane[k]) * 0x9E3779B97F4A7C15ull) ^ (h >> 29);
-    return h;
-}
+// the key of its closed solids, which depend on nothing else.
+std::uint64_t meshContentKey(const Mesh& m) { return ContentHash().add(m.positions).add(m.indices).value(); }
 
 struct Counted;
 struct CullInputs;
@@ -286,7 +258,10 @@ private:
                    zbin = VK_NULL_HANDLE, atomicWrite = VK_NULL_HANDLE, fused = VK_NULL_HANDLE,
                    pruneWide = VK_NULL_HANDLE;
     };
-    CullPipelines cullPipelines(const CullPlan& plan);
+    // The first submission's (`listPasses` false: the bounds pass alone, for
+    // raster), and the second submission's added to them.
+    CullPipelines cullPipelines(const CullPlan& plan, bool listPasses = true);
+    void addWritePipelines(const CullPlan& plan, CullPipelines& pipes);
     // One cull's buffers (the cache's, each role acquired once), the bytes
     // each was asked for, its descriptors, staging and clocks.
     struct CullRun {
@@ -350,15 +325,17 @@ private:
     // The culling pipelines, by shader and specialisation, each with the
     // cullPipelines call that last used it. At most kHeldPipelines are kept,
     // the least recently used going first (never one the current call uses):
-    // lavapipe's compiled code is megabytes a pipeline, and a report sweep
-    // of 352 configurations held 2.2 GB of it (1,257 pipelines; kept to 64
-    // it made 510 again, kept to 256 only 15).
+    // lavapipe's compiled code is megabytes a pipeline. The report sweep of
+    // forest's 352 configurations makes 359 (each cull makes only the passes
+    // it runs, keyed by the constants each reads); kept to 128 it makes one
+    // of them again and peaks at 596 MB resident, kept to 256 at 874 MB.
     struct HeldPipeline {
         PipelineHandle pipeline;
         std::uint64_t lastUse = 0;
     };
-    static constexpr std::size_t kHeldPipelines = 256;
+    static constexpr std::size_t kHeldPipelines = 128;
     std::map<std::string, HeldPipeline> computePipelines_;
+    std::map<VkShaderModule, std::uint32_t> specIds_; // specConstantIds of each culling shader
     std::uint64_t pipelineUse_ = 0; // cullPipelines calls
     PipelineLayoutHandle depthLayout_;
     RenderPassHandle renderPass_[2];
@@ -404,7 +381,11 @@ void VulkanBackend::createComputeObjects() {
     setLayout_ = std::move(layouts.set);
     computeLayout_ = std::move(layouts.pipeline);
 
-    auto mk = [&](spirv::Code c, const char* n) { return ctx_.createShader(c.words, c.wordCount, n); };
+    auto mk = [&](spirv::Code c, const char* n) {
+        ShaderModuleHandle m = ctx_.createShader(c.words, c.wordCount, n);
+        specIds_[m] = specConstantIds(c.words, c.wordCount);
+        return m;
+    };
     boundsShader_ = mk(spirv::tileBounds(), "shader.tile_bounds");
     if (ctx_.int64Supported()) boundsWideShader_ = mk(spirv::tileBoundsWide(), "shader.tile_bounds_wide");
     binsShader_ = mk(spirv::lightBins(), "shader.light_bins");
@@ -420,7 +401,8 @@ void VulkanBackend::createComputeObjects() {
 // A culling pipeline, cached per shader and specialisation (CullSpec).
 VkPipeline VulkanBackend::computePipeline(const char* what, VkShaderModule module, const CullSpec& spec,
                                           bool oneSubgroup) {
-    const std::string key = what + spec.key();
+    const CullSpec used = spec.only(specIds_.at(module));
+    const std::string key = what + used.key();
     auto it = computePipelines_.find(key);
     if (it != computePipelines_.end()) {
         it->second.lastUse = pipelineUse_;
@@ -441,8 +423,8 @@ VkPipeline VulkanBackend::computePipeline(const char* what, VkShaderModule modul
     VkSpecializationInfo si{};
     si.mapEntryCount = CullSpec::kCount;
     si.pMapEntries = entries.data();
-    si.dataSize = sizeof(spec);
-    si.pData = &spec;
+    si.dataSize = sizeof(used);
+    si.pData = &used;
     VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
     ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -1071,36 +1053,51 @@ DeviceProfile VulkanBackend::profileOf(const Context& ctx) {
     return d;
 }
 
-VulkanBackend::CullPipelines VulkanBackend::cullPipelines(const CullPlan& plan) {
+VulkanBackend::CullPipelines VulkanBackend::cullPipelines(const CullPlan& plan, bool listPasses) {
     // `oneSubgroup`: the pass relies on its workgroup being whole subgroups.
     const bool subgroupLanes = plan.lanes > 1;
     ++pipelineUse_;
     CullPipelines p;
     p.bounds = plan.wideBounds ? computePipeline("tile_bounds.wide", boundsWideShader_, plan.bounds, false)
                                : computePipeline("tile_bounds", boundsShader_, plan.bounds, subgroupLanes);
-    p.bins = plan.binLanes > 1 ? computePipeline("light_bins.shuffle", binsShuffleShader_, plan.bins, true)
-                               : computePipeline("light_bins", binsShader_, plan.bins, false);
-    p.count = computePipeline("cull_lists.count", cullShader_, plan.count, subgroupLanes);
-    p.write = computePipeline("cull_lists.write", cullShader_, plan.write, subgroupLanes);
-    p.scan = computePipeline("prefix_sum", scanShader_, plan.scan, true);
+    if (!listPasses) return p;
+    if (!plan.all && plan.lights > 0)
+        p.bins = plan.binLanes > 1 ? computePipeline("light_bins.shuffle", binsShuffleShader_, plan.bins, true)
+                                   : computePipeline("light_bins", binsShader_, plan.bins, false);
+    if (plan.zbin) {
+        p.zbinInit = computePipeline("zbin.init", zbinShader_, plan.zbinInit, false);
+        p.zbin = computePipeline("zbin", zbinShader_, plan.zbinBins, false);
+    }
+    // Only what the first submission's strategy dispatches: the second's
+    // come in addWritePipelines when it runs (a lavapipe pipeline of
+    // cull_lists is 25 to 40 ms of compiling).
+    const CullStrategy st = plan.strategy;
+    if (st == CullStrategy::Fused)
+        p.fused = plan.index16 ? computePipeline("cull_lists.fused.index16", cullShader16_, plan.fusedSpec, true)
+                               : computePipeline("cull_lists.fused", cullShader_, plan.fusedSpec, true);
+    else
+        p.count = computePipeline("cull_lists.count", cullShader_, plan.count, subgroupLanes);
+    if (st == CullStrategy::WalkAtomicWrite)
+        p.atomicWrite = computePipeline("cull_lists.write.atomic", cullShader_, plan.atomicWriteSpec, false);
+    if (st == CullStrategy::CountScan || st == CullStrategy::CountScanWrite)
+        p.scan = computePipeline("prefix_sum", scanShader_, plan.scan, true);
+    if (st == CullStrategy::CountScanWrite)
+        p.write = computePipeline("cull_lists.write", cullShader_, plan.write, subgroupLanes);
+    return p;
+}
+
+void VulkanBackend::addWritePipelines(const CullPlan& plan, CullPipelines& p) {
+    const bool subgroupLanes = plan.lanes > 1;
+    if (!p.write) p.write = computePipeline("cull_lists.write", cullShader_, plan.write, subgroupLanes);
+    if (!p.scan && plan.hostOffsets()) p.scan = computePipeline("prefix_sum", scanShader_, plan.scan, true);
     if (plan.fptl) {
         p.prune = computePipeline("fine_prune", pruneShader_, plan.prune, false);
         if (plan.pruneWide.lanes > 1) p.pruneWide = computePipeline("fine_prune.wide", pruneShader_, plan.pruneWide, true);
         p.pack = computePipeline("fine_prune.pack", pruneShader_, plan.pack, false);
     }
-    if (plan.zbin) {
-        p.zbinInit = computePipeline("zbin.init", zbinShader_, plan.zbinInit, false);
-        p.zbin = computePipeline("zbin", zbinShader_, plan.zbinBins, false);
-    }
-    if (plan.atomicWrite)
-        p.atomicWrite = computePipeline("cull_lists.write.atomic", cullShader_, plan.atomicWriteSpec, false);
-    if (plan.fused)
-        p.fused = plan.index16 ? computePipeline("cull_lists.fused.index16", cullShader16_, plan.fusedSpec, true)
-                               : computePipeline("cull_lists.fused", cullShader_, plan.fusedSpec, true);
-    return p;
 }
 
-// The first submission, in the plan's strategy: bins, bounds (zbin's bins),
+// The first submission: uploads, the bins and bounds passes (zbin's bins),
 // then count and, as the strategy says, scan and write.
 void VulkanBackend::recordFirstSubmission(VkCommandBuffer cmd, const CullPlan& plan, const CullPipelines& pipes,
                                           const CullRun& run) {
@@ -1173,8 +1170,10 @@ void VulkanBackend::recordFirstSubmission(VkCommandBuffer cmd, const CullPlan& p
 // ListsFrom::SecondSubmission: the write pass again into an index array
 // sized exactly (after the scan where the first submission ran none), then
 // fptl's prune and pack, whose packed ranges the host lays out in order.
-void VulkanBackend::writeListsAgain(const CullPlan& plan, const CullPipelines& pipes, CullRun& run,
+void VulkanBackend::writeListsAgain(const CullPlan& plan, const CullPipelines& first, CullRun& run,
                                     const Counted& c, CullResult& res) {
+    CullPipelines pipes = first;
+    addWritePipelines(plan, pipes);
     const std::uint32_t listTotal = plan.listTotal, total = c.total;
     // The coarse counts and offsets, before fptl's pack rewrites the counts
     // (in place when the buffer is mapped).
@@ -1627,7 +1626,7 @@ CullResult VulkanBackend::cullRaster(const CullFrame& frame, const DepthImage& d
     CullRun run;
     Staging staging(cache_);
     const CullReadback out = setUpBuffers(plan, in, depth, staging, run);
-    const CullPipelines pipes = cullPipelines(plan);
+    const CullPipelines pipes = cullPipelines(plan, false);
     auto storage = [&](const char* role, std::size_t bytes, VkBufferUsageFlags extra = 0) -> const Buffer& {
         const Buffer& b = cache_.get(role, std::max<std::size_t>(bytes, 16),
                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | extra, BufferCache::Kind::Device);
