@@ -201,6 +201,46 @@ TEST(Report, RunsOnATinySceneWithProgressAndParetoFlags) {
     EXPECT_EQ(allRep.rows[0].efficiency, allRep.rows[0].efficiency); // not NaN
 }
 
+// Rows whose lists and pixels' lists equal an earlier row's (minmax's are
+// 2.5d's with one cell) take that row's ground truth, shading time and image
+// error instead of working them out again; every row's figures are still its
+// own configuration's, zbin's and the clusters' included.
+TEST(Report, RowsWithTheSameListsShareOneJudgement) {
+    ReportOptions o;
+    o.backends = {"cpu"};
+    o.fixed["algorithm"] = "minmax,2.5d,clustered,zbin";
+    o.fixed["test"] = "planes";
+    o.fixed["skip-empty"] = "false";
+    o.tileSizes = {8, 16};
+    o.cellCounts = {1, 2, 8};
+    o.repeat = 1;
+    o.warmup = 0;
+    const Scene scene = tinyScene();
+    const Report rep = runReport(scene, o);
+    std::set<double> shadeTimes;
+    for (const ReportRow& r : rep.rows) {
+        expectRowIsTheRunsOwn(scene, r);
+        shadeTimes.insert(r.shadeMs);
+    }
+    for (const std::uint32_t tile : {8u, 16u}) {
+        const auto find = [&](Algorithm a, std::uint32_t cells) {
+            return std::find_if(rep.rows.begin(), rep.rows.end(), [&](const ReportRow& r) {
+                return r.config.settings.algorithm == a && r.config.tileSize == tile &&
+                       (a == Algorithm::MinMax || r.config.settings.cells == cells);
+            });
+        };
+        const auto minmax = find(Algorithm::MinMax, 1), oneCell = find(Algorithm::TwoPointFiveD, 1),
+                   clusters = find(Algorithm::Clustered, 8);
+        ASSERT_NE(minmax, rep.rows.end());
+        ASSERT_NE(oneCell, rep.rows.end());
+        ASSERT_NE(clusters, rep.rows.end());
+        // A shading time measured again would differ in its last bits.
+        EXPECT_EQ(oneCell->shadeMs, minmax->shadeMs) << "tile " << tile << ": one judgement for the same lists";
+        EXPECT_NE(clusters->shadeMs, minmax->shadeMs) << "tile " << tile << ": other lists, another judgement";
+    }
+    EXPECT_LT(shadeTimes.size(), rep.rows.size());
+}
+
 TEST(Report, CancelStopsTheSweep) {
     ReportOptions o;
     o.backends = {"cpu"};

@@ -4,6 +4,7 @@
 #include "culling/diagnostics/report.hpp"
 
 #include "culling/core/backend.hpp"
+#include "culling/core/content_hash.hpp"
 #include "culling/core/depth.hpp"
 #include "culling/core/presets.hpp"
 #include "culling/core/errors.hpp"
@@ -249,31 +250,68 @@ std::shared_ptr<SweepFrame> sweepFrame(DepthImage depth, const Projection& proj,
     return f;
 }
 
+// What judging a row finds: its ground truth's metrics, its shading time and
+// image error.
+struct Judged {
+    Metrics metrics;
+    double shadeMs = -1;
+    ImageError error;
+};
+
+// Rows judged on one backend, by what judging reads: the lists, zbin's bins
+// and order, and the list each pixel shades (ShadeInputs::list, and zbin's
+// per-pixel lists). A row whose lists equal an earlier row's takes its
+// judgement (minmax's lists are 2.5d's with one or two cells, for one).
+using JudgedKey = std::array<std::uint64_t, 2>;
+JudgedKey judgedKey(const CullResult& r, const ShadeInputs& in) {
+    ContentHash h;
+    h.addValue(std::uint64_t(r.algorithm == Algorithm::ZBin)).addValue(r.bytes());
+    h.add(r.listOffset).add(r.listCount).add(r.lightIndices).add(r.pixelList);
+    h.add(r.zbinOrder).add(r.zbinRank).add(r.zbinLo).add(r.zbinHi);
+    h.add(&r.zbinNear, sizeof r.zbinNear).add(&r.zbinFar, sizeof r.zbinFar);
+    h.add(in.list);
+    if (const CullResult* p = in.perPixelLists.get()) h.add(p->listOffset).add(p->listCount).add(p->lightIndices);
+    return h.value128();
+}
+
 // A row after its timed culls: ground truth, `repeat` timed shades of the
-// culled lists on `shader`, and the image error against the all-lights image.
+// culled lists on `shader`, and the image error against the all-lights image;
+// or, where `judged` holds a row of the same lists, that row's.
 // `fullLists`: a custom shader's lists over its layout's capacity.
 void judgeRow(ReportRow& row, const std::vector<double>& cullMs, const CullResult& result, const Projection& proj,
               const ViewLights& lights, CullBackend& shader, SweepFrame& frame, const ReportOptions& options,
-              const CancelToken* cancel, const std::vector<std::uint32_t>* fullLists = nullptr) {
+              const CancelToken* cancel, std::map<JudgedKey, Judged>* judged,
+              const std::vector<std::uint32_t>* fullLists = nullptr) {
     const DepthImage& depth = *frame.depth;
-    GroundTruthOptions gto;
-    gto.imageError = false;
-    gto.needs = frame.needs.get();
-    gto.fullLists = fullLists;
-    const GroundTruth truth = computeGroundTruth(depth, proj, lights, result, gto, cancel);
     setShadeLists(frame.shadeIn, depth, proj, &result);
-    const ShadeInputs& in = frame.shadeIn;
-    std::vector<float> image;
-    std::vector<double> shadeMs;
-    for (int r = 0; r < options.warmup + options.repeat; ++r) {
-        image = shader.shade(in, lights, &result);
-        if (r >= options.warmup) shadeMs.push_back(shader.lastShadeMs());
+    // The limits' misses are told apart by what the cull dropped, which the
+    // key does not hold: those rows are judged each.
+    const bool shareable = judged && !fullLists && !result.settings.hasLimits();
+    const JudgedKey key = shareable ? judgedKey(result, frame.shadeIn) : JudgedKey{};
+    const auto known = shareable ? judged->find(key) : std::map<JudgedKey, Judged>::iterator();
+    Judged j;
+    if (shareable && known != judged->end()) {
+        j = known->second;
+    } else {
+        GroundTruthOptions gto;
+        gto.imageError = false;
+        gto.needs = frame.needs.get();
+        gto.fullLists = fullLists;
+        j.metrics = computeGroundTruth(depth, proj, lights, result, gto, cancel).metrics;
+        std::vector<float> image;
+        std::vector<double> shadeMs;
+        for (int r = 0; r < options.warmup + options.repeat; ++r) {
+            image = shader.shade(frame.shadeIn, lights, &result);
+            if (r >= options.warmup) shadeMs.push_back(shader.lastShadeMs());
+        }
+        j.shadeMs = median(shadeMs);
+        j.error = compareShadedImages(depth, image, frame.allImage);
+        if (shareable) judged->emplace(key, j);
     }
-    const ImageError err = compareShadedImages(depth, image, frame.allImage);
     row.cullMs = median(cullMs);
-    row.shadeMs = median(shadeMs);
+    row.shadeMs = j.shadeMs;
     row.totalMs = row.cullMs + row.shadeMs;
-    const Metrics& m = truth.metrics;
+    const Metrics& m = j.metrics;
     row.efficiency = m.efficiency;
     row.optimalWork = m.optimalWork;
     row.efficiencyVsOptimal = m.efficiencyVsOptimal;
@@ -285,8 +323,8 @@ void judgeRow(ReportRow& row, const std::vector<double>& cullMs, const CullResul
     row.meanList = m.meanList;
     row.maxList = m.maxList;
     row.resultBytes = m.resultBytes;
-    row.imageRmse = err.rmse;
-    row.imageMaxError = err.maxAbs;
+    row.imageRmse = j.error.rmse;
+    row.imageMaxError = j.error.maxAbs;
 }
 
 } // namespace
@@ -494,6 +532,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
             const std::shared_ptr<SweepFrame> frame =
                 sweepFrame(backend->renderDepth(sceneIn, proj), proj, lights, *backend, cancel);
             const DepthImage& depth = *frame->depth;
+            std::map<JudgedKey, Judged> judged; // this backend's rows, by their lists
             if (!shaderFrame || backend->name() == "vulkan") {
                 shaderFrame = frame;
                 shaderShade = backend;
@@ -514,7 +553,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
                 if (const std::string bad = result.validate(lights.size()); !bad.empty())
                     throw Error("backend '" + backend->name() + "' produced an inconsistent result for " +
                                 cfg.label() + ": " + bad);
-                judgeRow(row, cullMs, result, proj, lights, *backend, *frame, options, cancel);
+                judgeRow(row, cullMs, result, proj, lights, *backend, *frame, options, cancel, &judged);
                 if (!cfg.preset.empty())
                     row.fix = findFix(row, enginePreset(cfg.preset), sceneIn, *backend, *frame, proj, lights, cancel);
                 rep.rows.push_back(std::move(row));
@@ -549,7 +588,7 @@ Report runReport(const Scene& sceneIn, const ReportOptions& options, const Repor
                 if (r >= options.warmup) cullMs.push_back(crep.passMs);
             }
             row.device = crep.device;
-            judgeRow(row, cullMs, result, proj, lights, *shaderShade, *shaderFrame, options, cancel,
+            judgeRow(row, cullMs, result, proj, lights, *shaderShade, *shaderFrame, options, cancel, nullptr,
                      &crep.overflowedListIds);
             row.overflowLists = crep.overflowLists;
             // What `run` fails a shader for beside its misses, and the
