@@ -11,6 +11,7 @@
 #include "culling/diagnostics/export.hpp"
 #include "culling/diagnostics/overlays.hpp"
 #include "culling/diagnostics/report.hpp"
+#include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -232,6 +233,57 @@ TEST(Limits, FalseNegativesAreSplitByCauseExactlyOnEveryAlgorithm) {
         const std::vector<MissedLight> located = locateFalseNegatives(run, proj);
         for (const MissedLight& ml : located)
             EXPECT_EQ(ml.cause, ml.light == 4 ? MissCause::LightLimit : MissCause::ListFull) << a << " " << ml.light;
+    }
+}
+
+// An engine with a light limit keeps max-lights of the view's lights before
+// it culls: the cull tests those alone (its time is what the engine pays),
+// and zbin sorts and bins those alone. The result is the cull of a scene
+// holding only the kept lights, its indices naming the scene's lights.
+TEST(Limits, ALightLimitCullsOnlyTheLightsItKeeps) {
+    Scene scene = makeBuiltinScene("atrium");
+    scene.camera.width = 96;
+    scene.camera.height = 64;
+    LightGenSettings gen = defaultLightGen(scene, 40, 3);
+    gen.spotFraction = 0.3;
+    scene.lights = generateLights(gen);
+    auto cpu = makeCpuBackend();
+    const Projection proj(scene.camera);
+    const DepthImage depth = cpu->renderDepth(scene, proj);
+    const TileGrid grid = TileGrid::make(scene.camera.width, scene.camera.height, 16);
+    const ViewLights all = makeViewLights(scene);
+    const std::vector<std::uint8_t> over = lightsOverLimit(all, 15, LimitKeep::Nearest);
+    ASSERT_EQ(over.size(), 40u);
+    std::vector<std::uint32_t> keep;
+    Scene kept = scene;
+    kept.lights.clear();
+    for (std::uint32_t i = 0; i < 40; ++i)
+        if (!over[i]) keep.push_back(i), kept.lights.push_back(scene.lights[i]);
+    ASSERT_EQ(keep.size(), 15u);
+    ASSERT_NE(keep.back(), 14u) << "the nearest 15 are not the first 15";
+    const ViewLights keptLights = makeViewLights(kept);
+    for (const Algorithm a : {Algorithm::All, Algorithm::MinMax, Algorithm::Clustered, Algorithm::ZBin, Algorithm::Raster}) {
+        CullSettings s;
+        s.algorithm = a;
+        s.maxLights = 15;
+        s.limitKeep = LimitKeep::Nearest;
+        const CullResult r = cpu->cull(depth, proj, grid, all, s);
+        s.maxLights = 0;
+        const CullResult alone = cpu->cull(depth, proj, grid, keptLights, s);
+        const std::string what = toString(a);
+        EXPECT_EQ(r.volumeTests, alone.volumeTests) << what << ": the lights past the limit are never tested";
+        std::vector<std::uint32_t> named;
+        for (const std::uint32_t i : alone.lightIndices) named.push_back(keep[i]);
+        EXPECT_EQ(r.lightIndices, named) << what;
+        EXPECT_EQ(r.listCount, alone.listCount) << what;
+        EXPECT_EQ(r.limits.lightsOverLimit, 25u) << what;
+        EXPECT_TRUE(r.validate(all.size()).empty()) << what << ": " << r.validate(all.size());
+        if (a == Algorithm::ZBin) {
+            EXPECT_EQ(r.zbinLo, alone.zbinLo) << "the bins hold the kept lights' sorted positions";
+            EXPECT_EQ(r.zbinHi, alone.zbinHi);
+            for (std::uint32_t k = 0; k < alone.zbinOrder.size(); ++k)
+                EXPECT_EQ(r.zbinOrder[k], keep[alone.zbinOrder[k]]) << k;
+        }
     }
 }
 

@@ -32,10 +32,12 @@ struct ListLimits {
     // droppedLights[droppedOffset[k] .. droppedOffset[k+1]), ascending (none
     // under the all-lights fallback, which lists every light instead).
     std::vector<std::uint32_t> overflowLists, droppedOffset, droppedLights;
-    // The longest list the test made, before any cap: the smallest cap that
+    // The longest list the test made (of the lights the light limit keeps:
+    // the others are never tested), before any cap: the smallest cap that
     // never overflows.
     std::uint32_t longestUncapped = 0;
-    // Entries before the limits; the lists' entries after them are entries().
+    // Entries before the cap and record buffer; the lists' entries after
+    // them are entries().
     std::uint64_t entriesUncapped = 0;
 
     bool empty() const { return overLightLimit.empty() && overflowLists.empty(); }
