@@ -571,7 +571,13 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
 
     nlohmann::json configs = nlohmann::json::array();
     std::vector<std::size_t> index(sweeps.size(), 0);
+    // Configurations the device refuses (past one of its limits: raster's
+    // slices over the binding range, too many tiles for a dispatch) are
+    // rows of their own: the sweep goes on and keeps what it measured.
+    std::size_t refused = 0, total = 0;
+    std::string firstRefusal;
     for (;;) {
+        ++total;
         lc::Scene scene = baseWithParams;
         lc::CullSettings settings = baseSettings;
         nlohmann::json params = nlohmann::json::object();
@@ -598,31 +604,44 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
             return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         };
         lc::DepthPass pass;
-        for (int i = 0; i < opt.warmup + opt.repeat; ++i) {
-            const Clock::time_point d0 = Clock::now();
-            pass = backend->depthPass(scene, proj);
-            const double dc = msSince(d0);
-            const lc::DepthImage& depth = pass.image;
-            const double d = pass.ms, dw = pass.wallMs;
-            // Peak device memory of the culling pass alone: what it allocates
-            // beyond what is alive before it (its buffers, the staging copies
-            // included; the depth image is the input, on the device already
-            // when the backend rendered it).
-            backend->resetPeakDeviceBytes();
-            const std::size_t alive = backend->peakDeviceBytes();
-            last = lc::CullResult();
-            const Clock::time_point c0 = Clock::now();
-            last = backend->cull(depth, proj, grid, lights, settings);
-            const double cc = msSince(c0);
-            peakDeviceBytes = std::max(peakDeviceBytes, backend->peakDeviceBytes() - alive);
-            if (i >= opt.warmup) {
-                depthMs.push_back(d);
-                depthWallMs.push_back(dw);
-                depthCallMs.push_back(dc);
-                cullMs.push_back(last.timings.cullMs);
-                cullWallMs.push_back(backend->lastCullWallMs());
-                cullCallMs.push_back(cc);
+        try {
+            for (int i = 0; i < opt.warmup + opt.repeat; ++i) {
+                const Clock::time_point d0 = Clock::now();
+                pass = backend->depthPass(scene, proj);
+                const double dc = msSince(d0);
+                const lc::DepthImage& depth = pass.image;
+                const double d = pass.ms, dw = pass.wallMs;
+                // Peak device memory of the culling pass alone: what it allocates
+                // beyond what is alive before it (its buffers, the staging copies
+                // included; the depth image is the input, on the device already
+                // when the backend rendered it).
+                backend->resetPeakDeviceBytes();
+                const std::size_t alive = backend->peakDeviceBytes();
+                last = lc::CullResult();
+                const Clock::time_point c0 = Clock::now();
+                last = backend->cull(depth, proj, grid, lights, settings);
+                const double cc = msSince(c0);
+                peakDeviceBytes = std::max(peakDeviceBytes, backend->peakDeviceBytes() - alive);
+                if (i >= opt.warmup) {
+                    depthMs.push_back(d);
+                    depthWallMs.push_back(dw);
+                    depthCallMs.push_back(dc);
+                    cullMs.push_back(last.timings.cullMs);
+                    cullWallMs.push_back(backend->lastCullWallMs());
+                    cullCallMs.push_back(cc);
+                }
             }
+        } catch (const lc::SettingsError& e) {
+            // Every value was checked before the first run: this is the
+            // device's refusal. Without a sweep it is the command's error.
+            if (sweeps.empty()) throw;
+            std::cout << label << ": refused: " << e.what() << "\n";
+            configs.push_back({{"params", params}, {"refused", e.what()}});
+            if (!refused++) firstRefusal = label + ": " + e.what();
+            std::size_t k = 0;
+            while (k < sweeps.size() && ++index[k] == sweeps[k].values.size()) index[k++] = 0;
+            if (k == sweeps.size()) break;
+            continue;
         }
         const Stats ds = stats(depthMs), dws = stats(depthWallMs), dcs = stats(depthCallMs),
                     cs = stats(cullMs), ws = stats(cullWallMs), ccs = stats(cullCallMs);
@@ -677,6 +696,9 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
         lc::writeFileAtomic(opt.jsonFile, doc.dump(2) + "\n");
         std::cout << "wrote " << opt.jsonFile << "\n";
     }
+    if (refused)
+        return fail(1, std::to_string(refused) + " of " + std::to_string(total) +
+                           " configurations refused by the device (the first: " + firstRefusal + ")");
     return 0;
 }
 

@@ -4,12 +4,14 @@
 // with centre sampling they are the reference's up to a rounding at an
 // edge; the misses of an inscribed proxy show on both.
 #include "gpu_test_env.hpp"
+#include "../unit/cli_support.hpp"
 
 #include "culling/core/pipeline.hpp"
 #include "culling/scene/scene_io.hpp"
 #include "culling/truth/ground_truth.hpp"
 
 #include <algorithm>
+#include <nlohmann/json.hpp>
 #include <iterator>
 
 using namespace lc;
@@ -233,4 +235,43 @@ TEST_F(VulkanRaster, NearCutAndEdgeOnTrianglesCoverWhatTheCpuReferenceCovers) {
             EXPECT_EQ(c.gpuFalseNegatives, c.cpuFalseNegatives) << (slices ? "slices" : "tile");
         }
     }
+}
+
+// Settings past a device's limit (raster's slices at one-pixel tiles: 7.5 GB
+// of depth ranges, more than any device binds) are refused by the cull, not
+// the command line. A bench sweep keeps going: the refused configuration is
+// a row saying why, the others are measured and written, and the command
+// fails (exit 1) naming the first refusal; alone, it is exit 2 as before.
+TEST_F(GpuTest, ABenchSweepKeepsItsRowsPastADeviceRefusal) {
+    lc_test::ScratchDir d;
+    const std::string json = (d.path / "bench.json").string();
+    const std::vector<std::string> common = {"bench", "--builtin", "wall", "--backend", "vulkan", "--width", "1280",
+                                             "--height", "720", "--lights", "1024", "--algorithm", "raster",
+                                             "--proxy-depth", "slices", "--repeat", "1", "--warmup", "0"};
+    std::vector<std::string> sweep = common;
+    for (const char* a : {"--sweep", "tile=32,1,64", "--json"}) sweep.push_back(a);
+    sweep.push_back(json);
+    const lc_test::CliResult r = lc_test::runCli(sweep, d.path);
+    EXPECT_EQ(r.code, 1) << r.out << r.err;
+    EXPECT_EQ(lc_test::lineCount(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("1 of 3 configurations refused by the device (the first: tile=1: proxy-depth:"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.out.find("tile=1: refused: proxy-depth:"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("tile=32: depth "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("tile=64: depth "), std::string::npos) << r.out;
+    const nlohmann::json doc = nlohmann::json::parse(lc_test::slurp(json));
+    ASSERT_EQ(doc["configs"].size(), 3u);
+    EXPECT_GT(doc["configs"][0]["list_entries"].get<std::uint64_t>(), 0u);
+    EXPECT_NE(doc["configs"][1]["refused"].get<std::string>().find("binds at once"), std::string::npos);
+    EXPECT_EQ(doc["configs"][1]["params"]["tile"], "1");
+    EXPECT_FALSE(doc["configs"][1].contains("cull_ms"));
+    EXPECT_GT(doc["configs"][2]["list_entries"].get<std::uint64_t>(), 0u);
+
+    std::vector<std::string> alone = common;
+    for (const char* a : {"--tile", "1"}) alone.push_back(a);
+    const lc_test::CliResult one = lc_test::runCli(alone, d.path);
+    EXPECT_EQ(one.code, 2) << one.out << one.err;
+    EXPECT_NE(one.err.find("--proxy-depth: raster's slices need two depths per tile and light"), std::string::npos)
+        << one.err;
 }
