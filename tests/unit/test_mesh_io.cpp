@@ -2,6 +2,7 @@
 // contents are derived by hand, and broken files that must give InputError
 // naming the file.
 #include "culling/core/errors.hpp"
+#include "culling/scene/gltf_io.hpp"
 #include "culling/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
@@ -107,6 +108,26 @@ TEST(MeshIo, SmallObjTriangulatesAndDropsDegenerates) {
     const std::vector<std::uint32_t> expected = {0, 1, 2, 0, 2, 3, 0, 1, 2, 1, 2, 4};
     EXPECT_EQ(m.indices, expected);
     EXPECT_FALSE(rep.warning.empty());
+}
+
+// A scene JSON naming that OBJ: the dropped faces are one warning of the
+// scene's load (what `run`, `convert` and the studio print), not lost inside it.
+TEST(MeshIo, ASceneNamingAMeshWithDegenerateFacesWarnsOfThem) {
+    const std::filesystem::path dir = tempPath("scene_dir");
+    std::filesystem::create_directories(dir);
+    std::filesystem::copy_file(kData + "/small.obj", dir / "small.obj",
+                               std::filesystem::copy_options::overwrite_existing);
+    const std::string scene = (dir / "scene.json").string();
+    std::ofstream(scene) << R"({"format": "lightcull-scene", "version": 1, "meshes": [{"path": "small.obj"}]})";
+    GltfReadReport rep;
+    const Scene s = loadSceneAny(scene, GltfReadOptions{}, &rep);
+    EXPECT_EQ(s.triangleCount(), 4u);
+    ASSERT_EQ(rep.warnings.size(), 1u);
+    EXPECT_NE(rep.warnings[0].find("small.obj: dropped 2 degenerate face(s)"), std::string::npos) << rep.warnings[0];
+    std::vector<std::string> direct;
+    loadSceneFile(scene, nullptr, {}, &direct);
+    EXPECT_EQ(direct, rep.warnings);
+    std::filesystem::remove_all(dir);
 }
 
 TEST(MeshIo, OffAndStlAndBinaryPly) {

@@ -1160,7 +1160,7 @@ Scene loadSceneAny(const std::string& path, const GltfReadOptions& options, Gltf
                              "import the mesh into it (the studio's File > Import mesh..., or the scene JSON's "
                              "\"meshes\")");
     Scene s = isGltfPath(path) ? loadGltfScene(path, options, &rep, cancel, progress)
-                               : loadSceneFile(path, cancel, progress);
+                               : loadSceneFile(path, cancel, progress, &rep.warnings);
     s.origin = {};
     s.origin.file = std::filesystem::absolute(path).lexically_normal().string();
     s.origin.contentHash = fileHashFnv1a64(path);

@@ -319,7 +319,7 @@ PointLight readLight(const SceneReader& r, const json& v, std::size_t i) {
 }
 
 Mesh readMesh(const SceneReader& r, const json& v, std::size_t i, const fs::path& baseDir,
-              const CancelToken* cancel) {
+              const CancelToken* cancel, std::vector<std::string>* warnings) {
     const std::string p = SceneReader::at("meshes", i);
     r.requireObject(v, p);
     r.checkKeys(v, p, {"name", "path", "positions", "indices", "transform"});
@@ -337,6 +337,11 @@ Mesh readMesh(const SceneReader& r, const json& v, std::size_t i, const fs::path
             m = loadMesh(full.string(), &report, cancel);
         } catch (const InputError& e) {
             r.fail(SceneReader::at(p, "path"), std::string("cannot load mesh: ") + e.what());
+        }
+        if (warnings && !report.warning.empty()) {
+            std::istringstream lines(report.warning);
+            for (std::string line; std::getline(lines, line);)
+                if (!line.empty()) warnings->push_back(line);
         }
         m.sourcePath = rel;
         m.name = fs::path(rel).stem().string();
@@ -371,7 +376,7 @@ Mesh readMesh(const SceneReader& r, const json& v, std::size_t i, const fs::path
 }
 
 Scene parseSceneImpl(const std::string& text, const std::string& file, const CancelToken* cancel,
-                     const Progress& progress) {
+                     const Progress& progress, std::vector<std::string>* warnings) {
     json root;
     LineMap lines;
     parseWithLines(text, file, root, lines);
@@ -399,7 +404,7 @@ Scene parseSceneImpl(const std::string& text, const std::string& file, const Can
         const fs::path base = fs::path(file).parent_path();
         for (std::size_t i = 0; i < x->size(); ++i) {
             if (cancel) cancel->throwIfCancelled();
-            s.meshes.push_back(readMesh(r, (*x)[i], i, base, cancel));
+            s.meshes.push_back(readMesh(r, (*x)[i], i, base, cancel, warnings));
             if (progress) progress(0.1 + 0.9 * double(i + 1) / double(x->size()));
         }
     }
@@ -418,10 +423,11 @@ Scene parseSceneImpl(const std::string& text, const std::string& file, const Can
 } // namespace scene_json
 
 Scene parseScene(const std::string& text, const std::string& path) {
-    return scene_json::parseSceneImpl(text, path, nullptr, {});
+    return scene_json::parseSceneImpl(text, path, nullptr, {}, nullptr);
 }
 
-Scene loadSceneFile(const std::string& path, const CancelToken* cancel, const Progress& progress) {
+Scene loadSceneFile(const std::string& path, const CancelToken* cancel, const Progress& progress,
+                    std::vector<std::string>* warnings) {
     std::error_code ec;
     if (!fs::exists(path, ec)) throw InputError(path, "", 0, "file not found");
     if (fs::is_directory(path, ec)) throw InputError(path, "", 0, "is a folder, not a scene file");
@@ -432,7 +438,7 @@ Scene loadSceneFile(const std::string& path, const CancelToken* cancel, const Pr
     if (in.bad()) throw InputError(path, "", 0, "read error");
     const std::string text = ss.str();
     if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw InputError(path, "", 0, "empty file");
-    return scene_json::parseSceneImpl(text, path, cancel, progress);
+    return scene_json::parseSceneImpl(text, path, cancel, progress, warnings);
 }
 
 namespace {

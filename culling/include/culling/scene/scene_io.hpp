@@ -30,9 +30,11 @@ Mesh loadMesh(const std::string& path, MeshLoadReport* report = nullptr,
 constexpr int kSceneFormatVersion = 1;
 
 // Reads a scene JSON file; meshes are loaded relative to the file's folder.
-// Errors are InputError naming the file, the field path and its line.
+// Errors are InputError naming the file, the field path and its line. What
+// loading a mesh file warns about (degenerate faces dropped) goes into
+// `warnings`, one line each, where given.
 Scene loadSceneFile(const std::string& path, const CancelToken* cancel = nullptr,
-                    const Progress& progress = {});
+                    const Progress& progress = {}, std::vector<std::string>* warnings = nullptr);
 // Parses scene JSON text; `path` is used for messages and relative mesh paths.
 Scene parseScene(const std::string& json, const std::string& path);
 // Serialises a scene. Lossless: parseScene(serializeScene(s)) == s in every
