@@ -5,7 +5,9 @@
 // shared index array. One workgroup per tile walks the tile's depth slices
 // (log slices of lc.planes.z..w, the froxel range the tool gives), gathers
 // the slice's lights in shared memory, then reserves a block of the index
-// array with one atomic and writes it.
+// array with one atomic and writes it. A froxel with more lights than the
+// shared array holds is not cut short: its lights are tested again and
+// written straight into the block (a cap would lose lights without a word).
 //   lightcull run --builtin forest --shader clustered_compact.comp --out out/mine
 #version 450
 #extension GL_GOOGLE_include_directive : require
@@ -16,12 +18,27 @@ layout(local_size_x = 64) in;
 const uint kMaxPerFroxel = 512u;
 shared uint sCount;
 shared uint sBase;
+shared uint sCursor;
 shared uint sList[kMaxPerFroxel];
 
 float sliceBoundary(uint i) {
     const float lo = lc.planes.z, hi = lc.planes.w;
     const float t = float(i) / float(LC_LISTS_PER_TILE);
     return lc.mode.w == LC_SLICING_LOG && lo > 0.0 ? lo * pow(hi / lo, t) : lo + (hi - lo) * t;
+}
+
+// The tile's four side planes (view space, inward normals).
+vec4 planes[4];
+
+// Whether light i's sphere reaches the froxel between view depths z0 and z1
+// behind the tile's side planes.
+bool inFroxel(uint i, float z0, float z1) {
+    const vec4 l = lcLights[i].positionRadius;
+    // Widened a little so float rounding never drops a light the exact test keeps.
+    const float r = l.w + 1e-5 * (abs(l.x) + abs(l.y) + abs(l.z) + l.w);
+    bool inside = -l.z + r >= z0 * (1.0 - 1e-5) && -l.z - r <= z1 * (1.0 + 1e-5);
+    for (int k = 0; k < 4 && inside; ++k) inside = dot(planes[k].xyz, l.xyz) + planes[k].w >= -r;
+    return inside;
 }
 
 void main() {
@@ -31,7 +48,6 @@ void main() {
     const uvec2 p1 = min(p0 + uint(TILE_SIZE), lc.size.xy);
     const float u0 = 2.0 * float(p0.x) / float(lc.size.x) - 1.0, u1 = 2.0 * float(p1.x) / float(lc.size.x) - 1.0;
     const float v0 = 2.0 * float(p0.y) / float(lc.size.y) - 1.0, v1 = 2.0 * float(p1.y) / float(lc.size.y) - 1.0;
-    vec4 planes[4];
     if (lc.lens.z > 0.5) {
         planes[0] = vec4(1, 0, 0, -u0 * lc.lens.x);
         planes[1] = vec4(-1, 0, 0, u1 * lc.lens.x);
@@ -48,25 +64,30 @@ void main() {
         // outside the froxel range use them (the tool's rule).
         const float z0 = s == 0u ? 0.0 : sliceBoundary(s);
         const float z1 = s + 1u == uint(LC_LISTS_PER_TILE) ? 3.0e38 : sliceBoundary(s + 1u);
-        if (gl_LocalInvocationIndex == 0u) sCount = 0u;
+        if (gl_LocalInvocationIndex == 0u) {
+            sCount = 0u;
+            sCursor = 0u;
+        }
         barrier();
-        for (uint i = gl_LocalInvocationIndex; i < lc.counts.x; i += 64u) {
-            const vec4 l = lcLights[i].positionRadius;
-            // Widened a little so float rounding never drops a light the exact test keeps.
-            const float r = l.w + 1e-5 * (abs(l.x) + abs(l.y) + abs(l.z) + l.w);
-            bool inside = -l.z + r >= z0 * (1.0 - 1e-5) && -l.z - r <= z1 * (1.0 + 1e-5);
-            for (int k = 0; k < 4 && inside; ++k) inside = dot(planes[k].xyz, l.xyz) + planes[k].w >= -r;
-            if (inside) {
+        for (uint i = gl_LocalInvocationIndex; i < lc.counts.x; i += 64u)
+            if (inFroxel(i, z0, z1)) {
                 const uint k = atomicAdd(sCount, 1u);
                 if (k < kMaxPerFroxel) sList[k] = i;
             }
+        barrier();
+        if (gl_LocalInvocationIndex == 0u) sBase = lcCompactReserve(lcListIndex(tileIndex, s), sCount);
+        barrier();
+        if (sBase != ~0u) {
+            if (sCount <= kMaxPerFroxel) {
+                for (uint k = gl_LocalInvocationIndex; k < sCount; k += 64u) lcOut[sBase + k] = sList[k];
+            } else {
+                // More than the shared array holds: the same test on the same
+                // light by the same invocation again, each light written
+                // straight into the block.
+                for (uint i = gl_LocalInvocationIndex; i < lc.counts.x; i += 64u)
+                    if (inFroxel(i, z0, z1)) lcOut[sBase + atomicAdd(sCursor, 1u)] = i;
+            }
         }
-        barrier();
-        const uint n = min(sCount, kMaxPerFroxel);
-        if (gl_LocalInvocationIndex == 0u) sBase = lcCompactReserve(lcListIndex(tileIndex, s), n);
-        barrier();
-        if (sBase != ~0u)
-            for (uint k = gl_LocalInvocationIndex; k < n; k += 64u) lcOut[sBase + k] = sList[k];
         barrier();
     }
 }

@@ -180,6 +180,23 @@ TEST_F(GpuTest, ClusteredCompactExampleMatchesClustered) {
     const RunOutput outLin = runShader(s, optionsFor(kExamples + "clustered_compact.comp", "", "froxel:8:linear"), lin);
     expectCorrect(outLin, lin, cpuReference(s, outLin.depth, Algorithm::Clustered, 8, Slicing::Linear),
                   "clustered_compact.comp froxel:8:linear");
+    // A crowd: 700 lights in the same froxels. The example once gathered a
+    // froxel's lights in a shared array of 512 and dropped the rest unsaid.
+    Scene crowd = atrium(96, 64, 0);
+    for (int i = 0; i < 700; ++i) {
+        PointLight l;
+        l.name = "crowd" + std::to_string(i);
+        l.position = crowd.camera.target + glm::dvec3(0.001 * i, 0.0, 0.0);
+        l.explicitRadius = 0.4;
+        crowd.lights.push_back(l);
+    }
+    CustomCullReport many;
+    const RunOutput outMany = runShader(crowd, optionsFor(kExamples + "clustered_compact.comp"), many);
+    expectCorrect(outMany, many, cpuReference(crowd, outMany.depth, Algorithm::Clustered, 16, Slicing::Log),
+                  "clustered_compact.comp, 700 lights in a froxel");
+    std::uint32_t longest = 0;
+    for (const std::uint32_t c : outMany.result.listCount) longest = std::max(longest, c);
+    EXPECT_EQ(longest, 700u);
 }
 
 TEST_F(GpuTest, CellListsOverTheTileDepthRange) {
