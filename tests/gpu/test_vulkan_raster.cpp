@@ -7,6 +7,7 @@
 #include "../unit/cli_support.hpp"
 
 #include "culling/core/pipeline.hpp"
+#include "culling/diagnostics/explain.hpp"
 #include "culling/scene/scene_io.hpp"
 #include "culling/truth/ground_truth.hpp"
 
@@ -274,4 +275,40 @@ TEST_F(GpuTest, ABenchSweepKeepsItsRowsPastADeviceRefusal) {
     EXPECT_EQ(one.code, 2) << one.out << one.err;
     EXPECT_NE(one.err.find("--proxy-depth: raster's slices need two depths per tile and light"), std::string::npos)
         << one.err;
+}
+
+// The GPU's rasteriser covers tiles the exact reference does not (edges
+// pushed out by half a tile's diagonal): Explain of such an entry says the
+// reference's tests reject the light and the list holds it, and now why,
+// instead of leaving the two side by side.
+TEST_F(GpuTest, ExplainSaysWhyTheGpuListedALightItsTestsReject) {
+    Scene scene = atrium();
+    scene.lights = generateLights(defaultLightGen(scene, 96, 7));
+    CullSettings s;
+    s.algorithm = Algorithm::Raster;
+    RunOptions o;
+    o.truthOptions.imageError = false;
+    const RunOutput run = runPipeline(scene, s, gputest::vulkan(), o);
+    const RunOutput ref = runPipeline(scene, s, *makeCpuBackend(), o);
+    const Projection proj(scene.camera);
+    const CullResult& g = run.result;
+    std::size_t explained = 0;
+    for (std::uint32_t l = 0; l < g.listCount.size() && explained < 3; ++l) {
+        const auto cb = ref.result.lightIndices.begin() + ref.result.listOffset[l];
+        const auto ce = cb + ref.result.listCount[l];
+        for (std::uint32_t k = 0; k < g.listCount[l] && explained < 3; ++k) {
+            const std::uint32_t light = g.lightIndices[g.listOffset[l] + k];
+            if (std::binary_search(cb, ce, light)) continue; // the reference lists it too
+            const Explanation e = explainLight(run, proj, l, light);
+            if (e.testsPass) continue; // the depth pre-passes differ here, not the coverage
+            ++explained;
+            const std::string text = e.text();
+            EXPECT_NE(text.find("tests: reject it; the list holds it\n  why listed: the rasteriser's coverage"),
+                      std::string::npos)
+                << text;
+            // On the CPU's own lists the reference agrees: nothing to explain away.
+            EXPECT_TRUE(explainLight(ref, proj, l, light).listedAnyway.empty());
+        }
+    }
+    EXPECT_GT(explained, 0u) << "no entry the GPU alone listed";
 }

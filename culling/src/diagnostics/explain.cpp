@@ -459,6 +459,20 @@ Explanation explainLight(const RunOutput& run, const Projection& proj, std::uint
     e.testsPass = r.algorithm == Algorithm::All || explainTests(run, proj, sphere, e);
     explainPixels(run, proj, e);
     verdictOf(run, e);
+    if (e.listed && !e.testsPass) {
+        if (run.custom)
+            e.listedAnyway = "the shader's own test kept it; the tests above are the built-in ones of its lists";
+        else if (r.algorithm == Algorithm::Raster && r.backend == "vulkan")
+            e.listedAnyway = "the rasteriser's coverage of its proxy reached the tile (" +
+                             (r.coverage.empty() ? std::string("conservative") : r.coverage) +
+                             "), wider than the exact overlap the tests above work out";
+        else if (r.backend == "vulkan")
+            e.listedAnyway = "the Vulkan passes widen every float comparison (by about 2e-5 relative, docs/VULKAN.md) "
+                             "so that rounding never drops a light; the tests above, in double precision, reject it "
+                             "by less than that";
+        else
+            e.listedAnyway = "the backend's own test kept it though the reference's rejects it: report it as a defect";
+    }
     return e;
 }
 
@@ -477,6 +491,7 @@ std::string Explanation::text(const std::string& lightName) const {
                chunkPlaneName(decisivePlane) + " (signed distance + r = " + num(decisiveMargin) + ")\n";
     out += "  tests: " + std::string(testsPass ? "keep it" : "reject it") + "; the list " +
            (listed ? "holds it" : "does not hold it") + "\n";
+    if (!listedAnyway.empty()) out += "  why listed: " + listedAnyway + "\n";
     out += "  verdict: " + verdict + "\n";
     return out;
 }

@@ -54,6 +54,10 @@ struct Explanation {
     bool hasNeededPixel = false;
     glm::dvec3 neededPosition{0.0};
     std::string verdict;       // one line: needed / false positive (why) / MISSING / not listed, rightly
+    // Listed though the reference's tests reject it: why the run's culling
+    // kept it (a GPU's widened comparisons, a rasteriser's coverage, a
+    // custom shader's own test). Empty otherwise.
+    std::string listedAnyway;
     // The whole explanation, one step a line, as the CLI prints it.
     std::string text(const std::string& lightName = {}) const;
 };
