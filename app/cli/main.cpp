@@ -266,12 +266,16 @@ void printSummary(const lc::Scene& scene, const lc::CullSettings& settings, cons
     }
     if (settings.algorithm == lc::Algorithm::Raster && !r.coverage.empty()) {
         const bool autoOverfit = settings.proxyOverfit <= 0;
-        // How many lights each proxy shape stands for.
-        std::size_t cones = 0, wide = 0;
-        for (std::size_t l = 0; l < run.lights.size(); ++l)
+        // How many lights each proxy shape stands for (those the light
+        // limit keeps: the others are never drawn).
+        std::size_t cones = 0, wide = 0, drawn = 0;
+        for (std::uint32_t l = 0; l < run.lights.size(); ++l) {
+            if (r.limits.isOverLimit(l)) continue;
+            ++drawn;
             if (run.lights.isSpot(l))
                 (run.lights.spotAngles[l] <= settings.proxyConeAngle * M_PI / 180.0 ? cones : wide)++;
-        const std::size_t spheres = run.lights.size() - cones;
+        }
+        const std::size_t spheres = drawn - cones;
         std::cout << "proxies: " << spheres << (spheres == 1 ? " icosphere" : " icospheres") << " of level " << settings.proxyLevel << " ("
                   << lc::unitIcosphere(settings.proxyLevel).triangles.size() << " triangles), overfit "
                   << fmt("%.4f", autoOverfit ? lc::icosphereEnclosingOverfit(settings.proxyLevel) : settings.proxyOverfit)
@@ -565,9 +569,16 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
     }
     std::unique_ptr<lc::CullBackend> backend = flags.openBackend();
 
-    std::cout << "bench " << base.name << ": backend " << backend->name() << ", device " << backend->deviceName()
-              << ", timing " << backend->timingMethod() << ", " << opt.warmup << " warm-up + " << opt.repeat
-              << " timed runs per configuration (ms: median [min..max])\n";
+    // The header comes with the first row: a command that fails at its one
+    // configuration prints nothing on stdout (docs/CLI.md, errors).
+    bool headerShown = false;
+    const auto header = [&] {
+        if (headerShown) return;
+        headerShown = true;
+        std::cout << "bench " << base.name << ": backend " << backend->name() << ", device " << backend->deviceName()
+                  << ", timing " << backend->timingMethod() << ", " << opt.warmup << " warm-up + " << opt.repeat
+                  << " timed runs per configuration (ms: median [min..max])\n";
+    };
 
     nlohmann::json configs = nlohmann::json::array();
     std::vector<std::size_t> index(sweeps.size(), 0);
@@ -635,6 +646,7 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
             // Every value was checked before the first run: this is the
             // device's refusal. Without a sweep it is the command's error.
             if (sweeps.empty()) throw;
+            header();
             std::cout << label << ": refused: " << e.what() << "\n";
             configs.push_back({{"params", params}, {"refused", e.what()}});
             if (!refused++) firstRefusal = label + ": " + e.what();
@@ -645,6 +657,7 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
         }
         const Stats ds = stats(depthMs), dws = stats(depthWallMs), dcs = stats(depthCallMs),
                     cs = stats(cullMs), ws = stats(cullWallMs), ccs = stats(cullCallMs);
+        header();
         std::cout << label << ": depth " << fmt("%.3f", ds.median) << " [" << fmt("%.3f", ds.min) << ".."
                   << fmt("%.3f", ds.max) << "] (wall " << fmt("%.3f", dws.median) << ", call "
                   << fmt("%.3f", dcs.median) << ", " << pass.trianglesDrawn << " of "

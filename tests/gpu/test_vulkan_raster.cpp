@@ -273,6 +273,7 @@ TEST_F(GpuTest, ABenchSweepKeepsItsRowsPastADeviceRefusal) {
     for (const char* a : {"--tile", "1"}) alone.push_back(a);
     const lc_test::CliResult one = lc_test::runCli(alone, d.path);
     EXPECT_EQ(one.code, 2) << one.out << one.err;
+    EXPECT_TRUE(one.out.empty()) << "an error prints nothing on stdout: " << one.out;
     EXPECT_NE(one.err.find("--proxy-depth: raster's slices need two depths per tile and light"), std::string::npos)
         << one.err;
 }

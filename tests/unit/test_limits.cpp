@@ -303,6 +303,16 @@ TEST(Limits, ExplainSaysWhichLimitDroppedALight) {
     EXPECT_NE(limit.find("past the light limit, max-lights 4"), std::string::npos) << limit;
     const std::string kept = explainLight(run, proj, 0, 1).verdict;
     EXPECT_EQ(kept.find("dropped"), std::string::npos) << kept;
+    // zbin sorts and bins the kept lights alone: one past the limit has no
+    // sorted position, and the Z-bin step says why instead of giving one.
+    CullSettings z = s;
+    z.algorithm = Algorithm::ZBin;
+    const RunOutput zrun = runPipeline(scene, z, *makeCpuBackend(), o);
+    const std::string past = explainLight(zrun, proj, 0, 4).text();
+    EXPECT_NE(past.find("not binned: past the light limit (max-lights 4), only the 4 lights kept"), std::string::npos)
+        << past;
+    const std::string in = explainLight(zrun, proj, 0, 1).text();
+    EXPECT_NE(in.find(" of 4; bins "), std::string::npos) << "positions among the kept lights: " << in;
 }
 
 TEST(Limits, ExportsCountOverfullListsAndCauses) {
@@ -321,6 +331,16 @@ TEST(Limits, ExportsCountOverfullListsAndCauses) {
     EXPECT_EQ(j["limits"]["longest_list_uncapped"], 5);
     EXPECT_EQ(j["metrics"]["false_negatives_by_cause"]["list_full"], j["metrics"]["false_negatives"]);
     EXPECT_EQ(j["metrics"]["false_negatives_by_cause"]["culling_test"], 0);
+    // The located pairs by cause hold every pair, a light limit's too.
+    CullSettings limited = s;
+    limited.maxLights = 4;
+    const RunOutput lrun = runPipeline(scene, limited, *makeCpuBackend(), o);
+    const nlohmann::json lj = nlohmann::json::parse(summaryJson(scene, limited, lrun));
+    std::uint64_t pairs = 0;
+    for (const auto& [cause, n] : lj["missed_pairs_by_cause"].items()) pairs += n.get<std::uint64_t>();
+    EXPECT_EQ(pairs, lj["missed_pairs"].get<std::uint64_t>()) << lj["missed_pairs_by_cause"].dump();
+    EXPECT_EQ(lj["missed_pairs_by_cause"]["light_limit"], lists) << "light 4 in every tile";
+    EXPECT_GT(lj["missed_pairs_by_cause"]["list_full"].get<std::uint64_t>(), 0u);
     // tiles.csv: every list over-full, 2 dropped, its misses all list full.
     std::istringstream csv(tilesCsv(run));
     std::string line;

@@ -269,7 +269,14 @@ bool explainTests(const RunOutput& run, const Projection& proj, const BoundingSp
             ok = step(std::string("spot cone (") + toString(s.spotTest) + ")",
                       pass ? "the cone meets the chunk" : "the cone misses the chunk", pass) && ok;
         }
-        if (r.algorithm == Algorithm::ZBin && light < r.zbinRank.size()) {
+        if (r.algorithm == Algorithm::ZBin && r.limits.isOverLimit(light)) {
+            // The kept lights alone were sorted and binned: this one has no
+            // place among them (reported, as below, not a test of the list).
+            step("Z-bins (per pixel, after the mask)",
+                 "not binned: past the light limit (max-lights " + std::to_string(s.maxLights) + "), only the " +
+                     std::to_string(lights.size() - r.limits.lightsOverLimit) + " lights kept are sorted into the bins",
+                 false);
+        } else if (r.algorithm == Algorithm::ZBin && light < r.zbinRank.size()) {
             // After the mask, each pixel's bin: the light is looped over
             // where its rank lies in the bin's range. Reported, not a test
             // of the list (the mask is the list).
@@ -283,7 +290,8 @@ bool explainTests(const RunOutput& run, const Projection& proj, const BoundingSp
                     inRange += r.zbinLo[b] <= k && k <= r.zbinHi[b];
                 }
             step("Z-bins (per pixel, after the mask)",
-                 "sorted position " + std::to_string(k) + " of " + std::to_string(lights.size()) + "; bins " +
+                 "sorted position " + std::to_string(k) + " of " +
+                     std::to_string(lights.size() - r.limits.lightsOverLimit) + "; bins " +
                      std::to_string(r.zbinOf(cd - sphere.radius)) + ".." + std::to_string(r.zbinOf(cd + sphere.radius)) +
                      " of " + std::to_string(r.zbinLo.size()) + "; the pixels of " + std::to_string(inRange) + " of the tile's " +
                      std::to_string(pixels) + " geometry pixels loop over it",

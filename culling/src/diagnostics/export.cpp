@@ -196,7 +196,8 @@ nlohmann::ordered_json limitsJson(const CullSettings& settings, const RunOutput&
 
 // docs/CUSTOM_CULLING.md: what a user's culling did beside its lists.
 // Every false negative located: tile, list, light and the pixels that
-// needed it (the 1,000 with most pixels; the total is in metrics), as
+// needed it (the first 1,000, cause by cause and most pixels first within
+// a cause; the total is in metrics), as
 // "missed", "missed_pairs" and "missed_pairs_by_cause" of `j`.
 void addMissed(nlohmann::ordered_json& j, const Scene& scene, const RunOutput& run) {
     const TileGrid& grid = run.result.grid;
@@ -204,7 +205,7 @@ void addMissed(nlohmann::ordered_json& j, const Scene& scene, const RunOutput& r
     nlohmann::ordered_json missed = nlohmann::ordered_json::array();
     const std::vector<MissedLight> located = locateFalseNegatives(run, proj);
     nlohmann::ordered_json byCause;
-    for (MissCause c : {MissCause::CullingTest, MissCause::ListFull, MissCause::InvalidIndex})
+    for (MissCause c : {MissCause::CullingTest, MissCause::ListFull, MissCause::LightLimit, MissCause::InvalidIndex})
         byCause[jsonName(c)] = std::count_if(located.begin(), located.end(),
                                              [&](const MissedLight& m) { return m.cause == c; });
     for (std::size_t i = 0; i < located.size() && i < 1000; ++i) {
