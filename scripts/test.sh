@@ -88,6 +88,12 @@ if [[ " $stages " == *" 4 "* ]]; then
   test -s "$prefix/studio.png"
   test -f "$prefix/share/applications/lightcull-studio.desktop"
   test -f "$prefix/share/icons/hicolor/scalable/apps/lightcull-studio.svg"
+  # Every page an installed page links to is installed beside it.
+  for page in $(grep -ho '](\([A-Za-z_]*\.md\)' "$prefix/share/doc/lightcull/"*.md | sed 's/^](//' | sort -u); do
+    test -f "$prefix/share/doc/lightcull/$page" ||
+      { echo "test.sh: the installed docs link to $page, which is not installed" >&2; exit 1; }
+  done
+  test -f "$prefix/share/doc/lightcull/ENGINES.md"
   (cd build && cpack -G DEB >/dev/null)
   deb="$(ls build/lightcull_*_*.deb | head -n1)"
   dpkg-deb -f "$deb" Depends | tee "$prefix/depends.txt"
