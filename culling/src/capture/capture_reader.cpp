@@ -86,6 +86,16 @@ std::string pythonPath() {
 // Runs the replay helper with `args`; returns its JSON reply. Errors the
 // helper reports about the file become InputError naming it.
 json runReplay(const std::string& capture, const std::vector<std::string>& args, const TempDir& tmp) {
+    // A capture starts with "RDOC". RenderDoc's own check of a file that is
+    // no capture at all (a text file) now and then crashed the replay
+    // (signal 11, RenderDoc 1.24, in the gpu tests), which read as a device
+    // failure: such a file is refused here, before any replay.
+    if (std::ifstream in(capture, std::ios::binary); in) {
+        char magic[4] = {};
+        in.read(magic, 4);
+        if (in.gcount() < 4 || std::memcmp(magic, "RDOC", 4) != 0)
+            throw InputError(capture, "", 0, "not a RenderDoc capture (a capture starts with \"RDOC\")");
+    }
     const fs::path script = tmp.path / "replay.py";
     {
         std::ofstream out(script);
