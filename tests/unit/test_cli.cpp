@@ -207,6 +207,19 @@ TEST(Cli, RunHeaderNamesOnlyTheSettingsTheAlgorithmReads) {
     }
 }
 
+// raster's proxy line counts the proxies drawn: under a light limit, the
+// lights it keeps (it counted every light of the scene).
+TEST(Cli, RasterProxiesAreTheLightsTheLimitKeeps) {
+    ScratchDir s;
+    const CliResult r = runCli({"run", "--builtin", "wall", "--width", "64", "--height", "48", "--backend", "cpu",
+                                "--lights", "20", "--algorithm", "raster", "--max-lights", "8", "--no-image-error",
+                                "--out", (s.path / "o").string()},
+                               s.path);
+    ASSERT_TRUE(r.code == 0 || r.code == 3) << r.err; // the limit may miss lights
+    EXPECT_NE(r.out.find("12 lights past the limit"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("proxies: 8 icospheres of level"), std::string::npos) << r.out;
+}
+
 // The parser's own complaints, worded as the rest: the flag, what it takes,
 // what it got (they read "Value abc not in range 1 to 1000" and "Could not
 // convert: --lights = x").
