@@ -587,6 +587,13 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
     // rows of their own: the sweep goes on and keeps what it measured.
     std::size_t refused = 0, total = 0;
     std::string firstRefusal;
+    // The next configuration of the cross product (the first sweep varies
+    // fastest); false after the last.
+    const auto next = [&] {
+        std::size_t k = 0;
+        while (k < sweeps.size() && ++index[k] == sweeps[k].values.size()) index[k++] = 0;
+        return k < sweeps.size();
+    };
     for (;;) {
         ++total;
         lc::Scene scene = baseWithParams;
@@ -650,9 +657,7 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
             std::cout << label << ": refused: " << e.what() << "\n";
             configs.push_back({{"params", params}, {"refused", e.what()}});
             if (!refused++) firstRefusal = label + ": " + e.what();
-            std::size_t k = 0;
-            while (k < sweeps.size() && ++index[k] == sweeps[k].values.size()) index[k++] = 0;
-            if (k == sweeps.size()) break;
+            if (!next()) break;
             continue;
         }
         const Stats ds = stats(depthMs), dws = stats(depthWallMs), dcs = stats(depthCallMs),
@@ -692,10 +697,7 @@ int runBench(const SceneFlags& flags, const BenchOptions& opt) {
                            {"depth_triangles", pass.triangles},
                            {"depth_triangles_drawn", pass.trianglesDrawn},
                            {"peak_device_bytes", peakDeviceBytes}});
-
-        std::size_t k = 0;
-        while (k < sweeps.size() && ++index[k] == sweeps[k].values.size()) index[k++] = 0;
-        if (k == sweeps.size()) break;
+        if (!next()) break;
     }
 
     if (!opt.jsonFile.empty()) {

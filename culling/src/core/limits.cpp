@@ -46,12 +46,18 @@ std::vector<std::uint8_t> lightsOverLimit(const ViewLights& lights, std::uint32_
 }
 
 void applyListLimits(CullResult& r, const ViewLights& lights, const CullSettings& s) {
+    applyListLimits(r, lights, s, s.hasLimits() ? lightsOverLimit(lights, s.maxLights, s.limitKeep)
+                                                : std::vector<std::uint8_t>());
+}
+
+void applyListLimits(CullResult& r, const ViewLights& lights, const CullSettings& s,
+                     std::vector<std::uint8_t> overLimit) {
     r.limits = ListLimits{};
     if (!s.hasLimits()) return;
     ListLimits& lim = r.limits;
     lim.entriesUncapped = r.entries();
     for (std::uint32_t c : r.listCount) lim.longestUncapped = std::max(lim.longestUncapped, c);
-    lim.overLightLimit = lightsOverLimit(lights, s.maxLights, s.limitKeep);
+    lim.overLightLimit = std::move(overLimit);
     // The lights the view keeps, for the all-lights fallback.
     std::vector<std::uint32_t> kept;
     for (std::uint32_t i = 0; i < lights.size(); ++i)

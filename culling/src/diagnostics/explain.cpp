@@ -269,12 +269,13 @@ bool explainTests(const RunOutput& run, const Projection& proj, const BoundingSp
             ok = step(std::string("spot cone (") + toString(s.spotTest) + ")",
                       pass ? "the cone meets the chunk" : "the cone misses the chunk", pass) && ok;
         }
+        const std::size_t binned = lights.size() - r.limits.lightsOverLimit; // zbin sorts the kept lights
         if (r.algorithm == Algorithm::ZBin && r.limits.isOverLimit(light)) {
             // The kept lights alone were sorted and binned: this one has no
             // place among them (reported, as below, not a test of the list).
             step("Z-bins (per pixel, after the mask)",
                  "not binned: past the light limit (max-lights " + std::to_string(s.maxLights) + "), only the " +
-                     std::to_string(lights.size() - r.limits.lightsOverLimit) + " lights kept are sorted into the bins",
+                     std::to_string(binned) + " lights kept are sorted into the bins",
                  false);
         } else if (r.algorithm == Algorithm::ZBin && light < r.zbinRank.size()) {
             // After the mask, each pixel's bin: the light is looped over
@@ -290,8 +291,7 @@ bool explainTests(const RunOutput& run, const Projection& proj, const BoundingSp
                     inRange += r.zbinLo[b] <= k && k <= r.zbinHi[b];
                 }
             step("Z-bins (per pixel, after the mask)",
-                 "sorted position " + std::to_string(k) + " of " +
-                     std::to_string(lights.size() - r.limits.lightsOverLimit) + "; bins " +
+                 "sorted position " + std::to_string(k) + " of " + std::to_string(binned) + "; bins " +
                      std::to_string(r.zbinOf(cd - sphere.radius)) + ".." + std::to_string(r.zbinOf(cd + sphere.radius)) +
                      " of " + std::to_string(r.zbinLo.size()) + "; the pixels of " + std::to_string(inRange) + " of the tile's " +
                      std::to_string(pixels) + " geometry pixels loop over it",

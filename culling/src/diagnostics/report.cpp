@@ -288,10 +288,12 @@ void judgeRow(ReportRow& row, const std::vector<double>& cullMs, const CullResul
     // key does not hold: those rows are judged each.
     const bool shareable = judged && !fullLists && !result.settings.hasLimits();
     const JudgedKey key = shareable ? judgedKey(result, frame.shadeIn) : JudgedKey{};
-    const auto known = shareable ? judged->find(key) : std::map<JudgedKey, Judged>::iterator();
+    const Judged* known = nullptr;
+    if (shareable)
+        if (const auto it = judged->find(key); it != judged->end()) known = &it->second;
     Judged j;
-    if (shareable && known != judged->end()) {
-        j = known->second;
+    if (known) {
+        j = *known;
     } else {
         GroundTruthOptions gto;
         gto.imageError = false;

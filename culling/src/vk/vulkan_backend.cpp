@@ -262,6 +262,11 @@ private:
     // raster), and the second submission's added to them.
     CullPipelines cullPipelines(const CullPlan& plan, bool listPasses = true);
     void addWritePipelines(const CullPlan& plan, CullPipelines& pipes);
+    // The write and scan passes, which either submission may run.
+    VkPipeline writePipeline(const CullPlan& plan) {
+        return computePipeline("cull_lists.write", cullShader_, plan.write, plan.lanes > 1);
+    }
+    VkPipeline scanPipeline(const CullPlan& plan) { return computePipeline("prefix_sum", scanShader_, plan.scan, true); }
     // One cull's buffers (the cache's, each role acquired once), the bytes
     // each was asked for, its descriptors, staging and clocks.
     struct CullRun {
@@ -1079,17 +1084,14 @@ VulkanBackend::CullPipelines VulkanBackend::cullPipelines(const CullPlan& plan, 
         p.count = computePipeline("cull_lists.count", cullShader_, plan.count, subgroupLanes);
     if (st == CullStrategy::WalkAtomicWrite)
         p.atomicWrite = computePipeline("cull_lists.write.atomic", cullShader_, plan.atomicWriteSpec, false);
-    if (st == CullStrategy::CountScan || st == CullStrategy::CountScanWrite)
-        p.scan = computePipeline("prefix_sum", scanShader_, plan.scan, true);
-    if (st == CullStrategy::CountScanWrite)
-        p.write = computePipeline("cull_lists.write", cullShader_, plan.write, subgroupLanes);
+    if (st == CullStrategy::CountScan || st == CullStrategy::CountScanWrite) p.scan = scanPipeline(plan);
+    if (st == CullStrategy::CountScanWrite) p.write = writePipeline(plan);
     return p;
 }
 
 void VulkanBackend::addWritePipelines(const CullPlan& plan, CullPipelines& p) {
-    const bool subgroupLanes = plan.lanes > 1;
-    if (!p.write) p.write = computePipeline("cull_lists.write", cullShader_, plan.write, subgroupLanes);
-    if (!p.scan && plan.hostOffsets()) p.scan = computePipeline("prefix_sum", scanShader_, plan.scan, true);
+    if (!p.write) p.write = writePipeline(plan);
+    if (!p.scan && plan.hostOffsets()) p.scan = scanPipeline(plan);
     if (plan.fptl) {
         p.prune = computePipeline("fine_prune", pruneShader_, plan.prune, false);
         if (plan.pruneWide.lanes > 1) p.pruneWide = computePipeline("fine_prune.wide", pruneShader_, plan.pruneWide, true);

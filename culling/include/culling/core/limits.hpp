@@ -27,7 +27,12 @@ std::vector<std::uint8_t> lightsOverLimit(const ViewLights& lights, std::uint32_
 
 // Applies settings.cap, maxLights and maxEntries to `result`'s lists (in
 // place) and records what they dropped in result.limits. Does nothing when
-// no limit is set. The lists stay ascending and compact.
+// no limit is set. The lists stay ascending and compact. `overLimit` is
+// lightsOverLimit(lights, settings.maxLights, settings.limitKeep), given
+// where the caller has it (CullBackend::cull, which culls the kept lights
+// alone); the overload without it works it out.
+void applyListLimits(CullResult& result, const ViewLights& lights, const CullSettings& settings,
+                     std::vector<std::uint8_t> overLimit);
 void applyListLimits(CullResult& result, const ViewLights& lights, const CullSettings& settings);
 
 } // namespace lc
